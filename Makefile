@@ -1,0 +1,42 @@
+# hybriddiff development build. `make test` builds and runs every test; `make help` lists targets.
+CC      ?= cc
+CFLAGS  ?= -O3 -march=x86-64-v2 -g
+WARN    := -std=c99 -Wall -Wextra -Werror -Wpedantic
+CPPFLAGS := -I. -D_POSIX_C_SOURCE=200809L
+LDLIBS  := -lm -lpthread -lz
+B       := build
+
+.PHONY: all test clean help data
+all: $(B)/hdtest $(B)/hdrender $(B)/hdbench
+
+help:
+	@echo "make test      build and run the unit and analytic tests (CPU backend)"
+	@echo "make all       tests, examples/hdrender, bench/hdbench"
+	@echo "make data      fetch the head CT into data/ (Debian package invesalius-examples)"
+
+LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
+
+$(B)/%.o: tests/%.c $(LIB_SRC) tests/hd_test.h | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+
+TEST_OBJ := $(patsubst tests/%.c,$(B)/%.o,$(wildcard tests/*.c))
+$(B)/hdtest: $(TEST_OBJ)
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
+
+$(B)/hdrender: examples/hdrender.c examples/*.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+$(B)/hdbench: bench/hdbench.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+$(B):
+	mkdir -p $(B)
+
+test: $(B)/hdtest
+	$(B)/hdtest
+
+data:
+	scripts/fetch-data
+
+clean:
+	rm -rf $(B)

@@ -1,0 +1,306 @@
+/* hd_cpu.h - the plain-C reference backend: the shared kernels run on a small pthread pool.
+   Work is split into rows (x-rows of the grid, image rows); every row is computed by the same
+   code whatever thread takes it and no result depends on another row of the same pass, so the
+   output is bit-identical for any thread count. This backend is the golden model the GPU
+   backends are checked against. */
+#include <pthread.h>
+#include <unistd.h>
+
+typedef void (*hd__cpu_job)(hd__backend *be, int item);
+
+struct hd__backend {
+    hd__ctx *ctx;
+    int nthreads;
+    int nworkers;            /* threads started besides the caller's */
+    pthread_t *workers;
+    pthread_mutex_t mu;
+    pthread_cond_t cv_work, cv_done;
+    int sync_ready;
+    /* the pass being run */
+    hd__cpu_job job;
+    int items, next, chunk, busy, quit;
+    unsigned generation;
+    /* buffers */
+    float *sig, *E, *phi, *phi2, *img;
+    size_t illum_floats;
+    hd__kctx k;
+    int parity, jacobi;      /* the diffusion pass being run */
+};
+
+static const char *hd__be_name(void) { return "cpu"; }
+
+/* Takes chunks of the current pass until none is left. */
+static void hd__cpu_work(hd__backend *be)
+{
+    for (;;) {
+        int i, end;
+        pthread_mutex_lock(&be->mu);
+        i = be->next;
+        be->next += be->chunk;
+        pthread_mutex_unlock(&be->mu);
+        if (i >= be->items) break;
+        end = i + be->chunk < be->items ? i + be->chunk : be->items;
+        for (; i < end; ++i) be->job(be, i);
+    }
+}
+
+static void *hd__cpu_worker(void *arg)
+{
+    hd__backend *be = (hd__backend *)arg;
+    unsigned seen = 0;
+    for (;;) {
+        pthread_mutex_lock(&be->mu);
+        while (!be->quit && be->generation == seen) pthread_cond_wait(&be->cv_work, &be->mu);
+        if (be->quit) { pthread_mutex_unlock(&be->mu); break; }
+        seen = be->generation;
+        pthread_mutex_unlock(&be->mu);
+        hd__cpu_work(be);
+        pthread_mutex_lock(&be->mu);
+        if (--be->busy == 0) pthread_cond_signal(&be->cv_done);
+        pthread_mutex_unlock(&be->mu);
+    }
+    return NULL;
+}
+
+/* Runs job(item) for every item in [0, items) on all threads and returns when all are done. */
+static void hd__cpu_parallel(hd__backend *be, hd__cpu_job job, int items)
+{
+    int chunk = items / (be->nthreads * 16);
+    be->job = job;
+    be->items = items;
+    be->next = 0;
+    be->chunk = chunk > 0 ? chunk : 1;
+    if (be->nworkers == 0) { hd__cpu_work(be); return; }
+    pthread_mutex_lock(&be->mu);
+    be->busy = be->nworkers;
+    ++be->generation;
+    pthread_cond_broadcast(&be->cv_work);
+    pthread_mutex_unlock(&be->mu);
+    hd__cpu_work(be);
+    pthread_mutex_lock(&be->mu);
+    while (be->busy > 0) pthread_cond_wait(&be->cv_done, &be->mu);
+    pthread_mutex_unlock(&be->mu);
+}
+
+static void hd__be_destroy(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int i;
+    if (!be) return;
+    if (be->sync_ready) {
+        pthread_mutex_lock(&be->mu);
+        be->quit = 1;
+        pthread_cond_broadcast(&be->cv_work);
+        pthread_mutex_unlock(&be->mu);
+        for (i = 0; i < be->nworkers; ++i) pthread_join(be->workers[i], NULL);
+        pthread_cond_destroy(&be->cv_done);
+        pthread_cond_destroy(&be->cv_work);
+        pthread_mutex_destroy(&be->mu);
+    }
+    hd__free(ctx, be->workers);
+    hd__free(ctx, be->sig);
+    hd__free(ctx, be->E);
+    hd__free(ctx, be->phi);
+    hd__free(ctx, be->phi2);
+    hd__free(ctx, be->img);
+    hd__free(ctx, be);
+    ctx->be = NULL;
+}
+
+static hd_result hd__be_create(hd__ctx *ctx)
+{
+    hd__backend *be;
+    int n = ctx->desc.threads, i;
+    if (n <= 0) {
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        n = cores > 0 ? (int)cores : 1;
+    }
+    if (n > 256) n = 256;
+    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
+    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the backend");
+    ctx->be = be;
+    be->ctx = ctx;
+    be->nthreads = n;
+    be->k.p = &ctx->kp;
+    be->k.vol = ctx->vol;
+    if (n > 1) {
+        be->workers = (pthread_t *)hd__calloc(ctx, (size_t)(n - 1), sizeof(pthread_t));
+        if (!be->workers) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d threads", n);
+        if (pthread_mutex_init(&be->mu, NULL) != 0) return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_mutex_init failed");
+        if (pthread_cond_init(&be->cv_work, NULL) != 0) {
+            pthread_mutex_destroy(&be->mu);
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
+        }
+        if (pthread_cond_init(&be->cv_done, NULL) != 0) {
+            pthread_cond_destroy(&be->cv_work);
+            pthread_mutex_destroy(&be->mu);
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
+        }
+        be->sync_ready = 1;
+        for (i = 0; i < n - 1; ++i) {
+            if (pthread_create(&be->workers[i], NULL, hd__cpu_worker, be) != 0) {
+                HD__INFO(&ctx->log, "cpu: started %d of %d worker threads", i, n - 1);
+                break;
+            }
+            be->nworkers = i + 1;
+        }
+        be->nthreads = be->nworkers + 1;
+    }
+    HD__INFO(&ctx->log, "cpu: %d threads", be->nthreads);
+    return HD_SUCCESS;
+}
+
+/* The volume lives in ctx->vol, the TF and majorants in ctx: the kernels read them in place. */
+static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+{
+    ctx->be->k.tf = ctx->tf;
+    ctx->be->k.maj = ctx->majorant;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
+{
+    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
+             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
+    return HD_SUCCESS;
+}
+
+/* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid and channels. */
+static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+{
+    hd__backend *be = ctx->be;
+    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    hd__free(ctx, be->sig); hd__free(ctx, be->E); hd__free(ctx, be->phi); hd__free(ctx, be->phi2);
+    be->sig = be->E = be->phi = be->phi2 = NULL;
+    be->k.sig = be->k.E = be->k.phi = be->k.phi2 = NULL;
+    be->illum_floats = 0;
+    be->sig = (float *)hd__calloc(ctx, gvox, sizeof(float));
+    be->E = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
+    be->phi = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
+    if (!be->sig || !be->E || !be->phi)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", illum_floats);
+    be->illum_floats = illum_floats;
+    be->k.sig = be->sig; be->k.E = be->E; be->k.phi = be->phi;
+    return HD_SUCCESS;
+}
+
+/* Jacobi's second phi buffer, allocated only while the Jacobi solver is selected. */
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
+{
+    hd__backend *be = ctx->be;
+    hd__free(ctx, be->phi2);
+    be->phi2 = be->k.phi2 = NULL;
+    if (!enable) return HD_SUCCESS;
+    be->phi2 = (float *)hd__calloc(ctx, be->illum_floats, sizeof(float));
+    if (!be->phi2) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
+    be->k.phi2 = be->phi2;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+{
+    hd__backend *be = ctx->be;
+    hd__free(ctx, be->img);
+    be->img = be->k.img = (float *)hd__calloc(ctx, (size_t)width * height * 4, sizeof(float));
+    if (!be->img) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image", width, height);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+{
+    hd__backend *be = ctx->be;
+    if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, be->illum_floats * sizeof(float));
+    if ((what & HD__DIRTY_PHI) && be->phi) memset(be->phi, 0, be->illum_floats * sizeof(float));
+    if ((what & HD__DIRTY_PHI) && be->phi2) memset(be->phi2, 0, be->illum_floats * sizeof(float));
+    if ((what & HD__DIRTY_IMAGE) && be->img)
+        memset(be->img, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
+    return HD_SUCCESS;
+}
+
+static void hd__cpu_classify_row(hd__backend *be, int r)
+{
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    for (x = 0; x < gx; ++x) hd_classify_voxel(&be->k, x, r % gy, r / gy);
+}
+static void hd__cpu_direct_row(hd__backend *be, int r)
+{
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    for (x = 0; x < gx; ++x) hd_direct_voxel(&be->k, x, r % gy, r / gy);
+}
+static void hd__cpu_diffuse_row(hd__backend *be, int r)
+{
+    int gy = be->ctx->gdims[1], gz = be->ctx->gdims[2];
+    hd_diffuse_row(&be->k, r % gy, (r / gy) % gz, r / (gy * gz), be->parity, be->jacobi);
+}
+static void hd__cpu_project_row(hd__backend *be, int py)
+{
+    int px, w = be->ctx->kp.image.x;
+    for (px = 0; px < w; ++px) hd_project_pixel(&be->k, px, py);
+}
+
+static hd_result hd__be_classify(hd__ctx *ctx)
+{
+    hd__cpu_parallel(ctx->be, hd__cpu_classify_row, ctx->gdims[1] * ctx->gdims[2]);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_direct(hd__ctx *ctx)
+{
+    hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
+    return HD_SUCCESS;
+}
+/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
+static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+{
+    hd__backend *be = ctx->be;
+    int rows = ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
+    be->jacobi = jacobi;
+    if (jacobi) {
+        float *t;
+        be->parity = 0;
+        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
+        t = be->phi; be->phi = be->phi2; be->phi2 = t;
+        be->k.phi = be->phi; be->k.phi2 = be->phi2;
+    } else {
+        be->parity = 0;
+        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
+        be->parity = 1;
+        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
+    }
+    return HD_SUCCESS;
+}
+static hd_result hd__be_project(hd__ctx *ctx)
+{
+    hd__cpu_parallel(ctx->be, hd__cpu_project_row, ctx->kp.image.y);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+{
+    memcpy(dst, ctx->be->img, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
+    return HD_SUCCESS;
+}
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    const float *src = which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi;
+    memcpy(dst, src, ctx->be->illum_floats * sizeof(float));
+    return HD_SUCCESS;
+}
+
+/* Relative residual |r| / |sigma_s E| of the diffusion equation for the current E and phi: the
+   solver's convergence measure, for tests and benchmarks. Summed row by row in a fixed order. */
+HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], gz = ctx->gdims[2], x, y, z, c;
+    double r2 = 0.0, b2 = 0.0;
+    for (c = 0; c < ctx->channels; ++c)
+        for (z = 0; z < gz; ++z)
+            for (y = 0; y < gy; ++y)
+                for (x = 0; x < gx; ++x) {
+                    float rhs;
+                    float r = hd_diffuse_residual(&be->k, x, y, z, c, &rhs);
+                    r2 += (double)r * r;
+                    b2 += (double)rhs * rhs;
+                }
+    return b2 > 0.0 ? sqrt(r2 / b2) : sqrt(r2);
+}

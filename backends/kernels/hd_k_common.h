@@ -1,0 +1,230 @@
+/* hd_k_common.h - shared kernel math: random numbers, the medium, tracking (shared source).
+   Written in the subset C99, OpenCL C 1.2 and GLSL 4.30 all accept (see hd_prelude_c.h):
+   no pointers (HD_INOUT instead), no recursion, no names that are keywords in one of them
+   (sample, filter, local, global, half, ...), float literals with an f suffix. */
+
+#define HD_FLAG_GLOBAL_MAJORANT 1
+#define HD_FLAG_NO_DIFFUSION 2
+#define HD_TRACK_RATIO 1
+#define HD_TRACK_DELTA 2
+/* Decorrelates the random streams of the stages that share a pixel or voxel index. */
+#define HD_STREAM_DIRECT 0x68bc21ebu
+#define HD_STREAM_PROJECT 0x02e5be93u
+#define HD_STREAM_PATH 0x967a889bu
+#define HD_INV_4PI 0.0795774715f
+/* Ratio tracking stops by Russian roulette below this transmittance (unbiased). */
+#define HD_RR_THRESHOLD 0.1f
+
+/* ---- random numbers: a stateless hash of 32-bit integers, bit-identical everywhere -------- */
+/* lowbias32 (C. Wellons): full avalanche with two multiplies. */
+HD_FN hd_u32 hd_hash(hd_u32 v)
+{
+    v ^= v >> 16;
+    v *= 0x7feb352du;
+    v ^= v >> 15;
+    v *= 0x846ca68bu;
+    v ^= v >> 16;
+    return v;
+}
+
+/* The key of one voxel or pixel in one iteration of one stream. */
+HD_FN hd_u32 hd_rng_key(hd_u32 index, hd_u32 iteration, hd_u32 seed, hd_u32 stream)
+{
+    return hd_hash(index ^ hd_hash(iteration ^ hd_hash(seed ^ stream)));
+}
+
+/* The dim-th uniform number in [0, 1) of a key: 24 bits, so the float is exact. */
+HD_FN float hd_rand(hd_u32 key, hd_u32 dim)
+{
+    return HD_F(hd_hash(key ^ (dim * 0x9e3779b9u)) >> 8u) * (1.0f / 16777216.0f);
+}
+
+/* ---- the medium ---------------------------------------------------------------------------- */
+/* Texture coordinate in [0,1]^3 of a world position (the box is centred at the origin). */
+HD_FN hd_v3 hd_world_to_tex(HD_KARGS hd_v3 p)
+{
+    return HD_V3(p.x / HD_PRM(box).x + 0.5f, p.y / HD_PRM(box).y + 0.5f, p.z / HD_PRM(box).z + 0.5f);
+}
+
+/* Linear-filter footprint along one axis, clamp to edge (as a GPU sampler does): the lower texel
+   is returned, the weight of the upper one goes to HD_INOUT w. */
+HD_FN int hd_lerp_axis(float u, int n, HD_INOUT(float) w)
+{
+    float f = hd_clampf(u * HD_F(n) - 0.5f, 0.0f, HD_F(n - 1));
+    int i0 = hd_mini(HD_I(f), hd_maxi(n - 2, 0));
+    HD_DEREF(w) = f - HD_F(i0);
+    return i0;
+}
+
+#ifndef HD_PRELUDE_SAMPLES_VOLUME
+/* Trilinear interpolation of the normalised volume at texture coordinate u. */
+HD_FN float hd_sample_value(HD_KARGS hd_v3 u)
+{
+    int nx = HD_PRM(dims).x, ny = HD_PRM(dims).y, nz = HD_PRM(dims).z;
+    float wx, wy, wz;
+    int x0 = hd_lerp_axis(u.x, nx, HD_REF(wx));
+    int y0 = hd_lerp_axis(u.y, ny, HD_REF(wy));
+    int z0 = hd_lerp_axis(u.z, nz, HD_REF(wz));
+    int x1 = hd_mini(x0 + 1, nx - 1), y1 = hd_mini(y0 + 1, ny - 1), z1 = hd_mini(z0 + 1, nz - 1);
+    int r00 = (z0 * ny + y0) * nx, r10 = (z0 * ny + y1) * nx;
+    int r01 = (z1 * ny + y0) * nx, r11 = (z1 * ny + y1) * nx;
+    float c00 = HD_GET(vol, r00 + x0, x0, y0, z0) + wx * (HD_GET(vol, r00 + x1, x1, y0, z0) - HD_GET(vol, r00 + x0, x0, y0, z0));
+    float c10 = HD_GET(vol, r10 + x0, x0, y1, z0) + wx * (HD_GET(vol, r10 + x1, x1, y1, z0) - HD_GET(vol, r10 + x0, x0, y1, z0));
+    float c01 = HD_GET(vol, r01 + x0, x0, y0, z1) + wx * (HD_GET(vol, r01 + x1, x1, y0, z1) - HD_GET(vol, r01 + x0, x0, y0, z1));
+    float c11 = HD_GET(vol, r11 + x0, x0, y1, z1) + wx * (HD_GET(vol, r11 + x1, x1, y1, z1) - HD_GET(vol, r11 + x0, x0, y1, z1));
+    float c0 = c00 + wy * (c10 - c00);
+    float c1 = c01 + wy * (c11 - c01);
+    return c0 + wz * (c1 - c0);
+}
+#endif
+
+/* The transfer function: entries at i/(count-1), linearly interpolated; rgba. */
+HD_FN hd_v4 hd_tf(HD_KARGS float v)
+{
+    int n = HD_PRM(dims).w;
+    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
+    int i = hd_mini(HD_I(t), n - 2);
+    float f = t - HD_F(i);
+    int a = i * 4, b = a + 4;
+    return HD_V4(HD_GET1(tf, a) + f * (HD_GET1(tf, b) - HD_GET1(tf, a)),
+                 HD_GET1(tf, a + 1) + f * (HD_GET1(tf, b + 1) - HD_GET1(tf, a + 1)),
+                 HD_GET1(tf, a + 2) + f * (HD_GET1(tf, b + 2) - HD_GET1(tf, a + 2)),
+                 HD_GET1(tf, a + 3) + f * (HD_GET1(tf, b + 3) - HD_GET1(tf, a + 3)));
+}
+
+/* Extinction at a texture coordinate. */
+HD_FN float hd_sigma_t(HD_KARGS hd_v3 u)
+{
+    return hd_tf(HD_KPASS hd_sample_value(HD_KPASS u)).w * HD_PRM(medium).x;
+}
+
+/* Distance from p (inside the box) along unit d to where it leaves the box. */
+HD_FN float hd_box_exit(HD_KARGS hd_v3 p, hd_v3 d)
+{
+    float hx = 0.5f * HD_PRM(box).x, hy = 0.5f * HD_PRM(box).y, hz = 0.5f * HD_PRM(box).z;
+    float t = 3.0e38f;
+    if (d.x > 0.0f) t = hd_minf(t, (hx - p.x) / d.x);
+    if (d.x < 0.0f) t = hd_minf(t, (-hx - p.x) / d.x);
+    if (d.y > 0.0f) t = hd_minf(t, (hy - p.y) / d.y);
+    if (d.y < 0.0f) t = hd_minf(t, (-hy - p.y) / d.y);
+    if (d.z > 0.0f) t = hd_minf(t, (hz - p.z) / d.z);
+    if (d.z < 0.0f) t = hd_minf(t, (-hz - p.z) / d.z);
+    return hd_maxf(t, 0.0f);
+}
+
+/* Entry and exit distances of the ray o + t d through the box (entry > exit: a miss). */
+HD_FN float hd_box_entry(HD_KARGS hd_v3 o, hd_v3 d, HD_INOUT(float) t_exit)
+{
+    float t0 = 0.0f, t1 = 3.0e38f;
+    float hx = 0.5f * HD_PRM(box).x, hy = 0.5f * HD_PRM(box).y, hz = 0.5f * HD_PRM(box).z;
+    float ia, ta, tb;
+    ia = 1.0f / d.x; ta = (-hx - o.x) * ia; tb = (hx - o.x) * ia;
+    t0 = hd_maxf(t0, hd_minf(ta, tb)); t1 = hd_minf(t1, hd_maxf(ta, tb));
+    ia = 1.0f / d.y; ta = (-hy - o.y) * ia; tb = (hy - o.y) * ia;
+    t0 = hd_maxf(t0, hd_minf(ta, tb)); t1 = hd_minf(t1, hd_maxf(ta, tb));
+    ia = 1.0f / d.z; ta = (-hz - o.z) * ia; tb = (hz - o.z) * ia;
+    t0 = hd_maxf(t0, hd_minf(ta, tb)); t1 = hd_minf(t1, hd_maxf(ta, tb));
+    HD_DEREF(t_exit) = t1;
+    return t0;
+}
+
+/* ---- transmittance tracking --------------------------------------------------------------- */
+/* One unbiased estimate of the transmittance along p + t d, t in [0, tmax] (p inside the box,
+   d unit). Null-collision tracking with a local majorant per cell of the majorant grid, walked
+   cell by cell (a 3D DDA), so empty cells cost no collision at all; the exponential free path is
+   memoryless, so restarting it at each cell boundary is exact. mode: HD_TRACK_RATIO (ratio
+   tracking, Russian roulette below HD_RR_THRESHOLD) or HD_TRACK_DELTA (0 or 1).
+   Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim. */
+HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
+                             int mode, HD_INOUT(hd_u32) next_dim)
+{
+    float T = 1.0f;
+    hd_u32 dim = dim0;
+    float t = 0.0f;
+    int done = 0;
+    /* The ray in majorant-cell coordinates (cells of mdims.w voxels): g(t) = g0 + t * gd. */
+    hd_v3 u0 = hd_world_to_tex(HD_KPASS p);
+    float cell = HD_F(HD_PRM(mdims).w);
+    float csx = HD_F(HD_PRM(dims).x) / cell, csy = HD_F(HD_PRM(dims).y) / cell;
+    float csz = HD_F(HD_PRM(dims).z) / cell;
+    hd_v3 g0 = HD_V3(u0.x * csx, u0.y * csy, u0.z * csz);
+    hd_v3 gd = HD_V3(d.x / HD_PRM(box).x * csx, d.y / HD_PRM(box).y * csy, d.z / HD_PRM(box).z * csz);
+    int cx = hd_clampi(HD_I(hd_floor(g0.x)), 0, HD_PRM(mdims).x - 1);
+    int cy = hd_clampi(HD_I(hd_floor(g0.y)), 0, HD_PRM(mdims).y - 1);
+    int cz = hd_clampi(HD_I(hd_floor(g0.z)), 0, HD_PRM(mdims).z - 1);
+    int sx = gd.x > 0.0f ? 1 : -1, sy = gd.y > 0.0f ? 1 : -1, sz = gd.z > 0.0f ? 1 : -1;
+    float inf = 3.0e38f;
+    float nx = gd.x != 0.0f ? (HD_F(cx + (sx > 0 ? 1 : 0)) - g0.x) / gd.x : inf;
+    float ny = gd.y != 0.0f ? (HD_F(cy + (sy > 0 ? 1 : 0)) - g0.y) / gd.y : inf;
+    float nz = gd.z != 0.0f ? (HD_F(cz + (sz > 0 ? 1 : 0)) - g0.z) / gd.z : inf;
+    float dx = gd.x != 0.0f ? hd_absf(1.0f / gd.x) : inf;
+    float dy = gd.y != 0.0f ? hd_absf(1.0f / gd.y) : inf;
+    float dz = gd.z != 0.0f ? hd_absf(1.0f / gd.z) : inf;
+    int global_majorant = (HD_PRM(counts).z & HD_FLAG_GLOBAL_MAJORANT) != 0 ? 1 : 0;
+    while (done == 0 && t < tmax) {
+        float t_end = global_majorant != 0 ? tmax : hd_minf(hd_minf(nx, ny), hd_minf(nz, tmax));
+        float mu = global_majorant != 0 ? HD_PRM(medium).w
+                 : HD_GET1(maj, (cz * HD_PRM(mdims).y + cy) * HD_PRM(mdims).x + cx);
+        if (mu > 0.0f) {
+            float inv_mu = 1.0f / mu;
+            for (;;) {
+                float xi = hd_rand(key, dim);
+                float sig, ratio;
+                dim += 1u;
+                t -= hd_log(1.0f - xi) * inv_mu;
+                if (t >= t_end) break;
+                sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
+                ratio = hd_minf(sig * inv_mu, 1.0f);
+                if (mode == HD_TRACK_DELTA) {
+                    if (hd_rand(key, dim) < ratio) { T = 0.0f; done = 1; }
+                    dim += 1u;
+                } else {
+                    T *= 1.0f - ratio;
+                    if (T < HD_RR_THRESHOLD) {
+                        /* survive with probability T / threshold, then weigh by its inverse */
+                        if (hd_rand(key, dim) * HD_RR_THRESHOLD >= T) { T = 0.0f; done = 1; }
+                        else T = HD_RR_THRESHOLD;
+                        dim += 1u;
+                    }
+                }
+                if (done != 0) break;
+            }
+        }
+        t = t_end;
+        if (global_majorant != 0) break;
+        /* step into the next cell along the axis whose boundary comes first */
+        if (nx <= ny && nx <= nz) { cx += sx; nx += dx; if (cx < 0 || cx >= HD_PRM(mdims).x) break; }
+        else if (ny <= nz) { cy += sy; ny += dy; if (cy < 0 || cy >= HD_PRM(mdims).y) break; }
+        else { cz += sz; nz += dz; if (cz < 0 || cz >= HD_PRM(mdims).z) break; }
+    }
+    HD_DEREF(next_dim) = dim;
+    return T;
+}
+
+/* Direction toward light l from p, the distance to stop tracking at (light or box exit) and the
+   light's falloff factor (1, or 1/r^2 for a point light that asks for it). */
+HD_FN hd_v3 hd_light_dir(HD_KARGS int l, hd_v3 p, HD_INOUT(float) tmax, HD_INOUT(float) falloff)
+{
+    hd_v4 la = HD_PRM(light_a)[l];
+    hd_v3 d;
+    HD_DEREF(falloff) = 1.0f;
+    if (la.w < 0.5f) { /* directional: travels along la.xyz, so look back against it */
+        d = HD_V3(-la.x, -la.y, -la.z);
+        HD_DEREF(tmax) = hd_box_exit(HD_KPASS p, d);
+    } else {
+        hd_v3 v = hd_sub(HD_XYZ(la), p);
+        float r2 = hd_maxf(hd_dot(v, v), 1.0e-12f);
+        float r = hd_sqrt(r2);
+        d = hd_scale(v, 1.0f / r);
+        HD_DEREF(tmax) = hd_minf(r, hd_box_exit(HD_KPASS p, d));
+        if (HD_PRM(light_b)[l].w > 0.5f) HD_DEREF(falloff) = 1.0f / r2;
+    }
+    return d;
+}
+
+/* Light l's radiance in channel c (1 channel: the scalar weight; the colour comes at projection). */
+HD_FN float hd_light_channel(HD_KARGS int l, int c)
+{
+    hd_v4 lb = HD_PRM(light_b)[l];
+    return c == 0 ? lb.x : (c == 1 ? lb.y : lb.z);
+}

@@ -1,0 +1,72 @@
+/* hd_k_diffuse.h - stage 2 of HD and CD: one relaxation sweep of the diffusion equation
+   -div(D grad phi) + sigma_a phi = sigma_s E  (shared source)
+   on the illumination grid, D = 1 / (3 sigma_t'), sigma_t' = sigma_a + sigma_s (1 - g)
+   = sigma_t (1 - albedo g). Face coefficients are the harmonic mean of the two voxels' D,
+   2 / (3 (sigma'_i + sigma'_j)), floored so empty space stays finite; outside the box phi = 0
+   (vacuum) with the voxel's own D. Each update is the paper's weighted sum of the 6 neighbours:
+   phi_i = (sigma_s E_i + sum_j w_j phi_j) / (sigma_a + sum_j w_j),  w_j = D_ij / h^2. */
+
+/* The numerator of voxel (x,y,z)'s update in channel c; its denominator goes to *den. */
+HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) den)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
+    int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
+    int ic = i + c * nvox, zc = z + c * gz;
+    float a = HD_PRM(medium).y;
+    float ag = 1.0f - a * HD_PRM(medium).z;
+    float fl = HD_PRM(grid).w;
+    float st = HD_GET(sig, i, x, y, z);
+    float sp = st * ag;
+    float own = 0.6666667f / hd_maxf(sp + sp, fl);
+    float num = a * st * HD_GET(E, ic, x, y, zc);
+    float dn = (1.0f - a) * st;
+    float w;
+    w = HD_PRM(grid).x * (x > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - 1, x - 1, y, z), fl) : own);
+    if (x > 0) num += w * HD_GET(phi, ic - 1, x - 1, y, zc);
+    dn += w;
+    w = HD_PRM(grid).x * (x < gx - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + 1, x + 1, y, z), fl) : own);
+    if (x < gx - 1) num += w * HD_GET(phi, ic + 1, x + 1, y, zc);
+    dn += w;
+    w = HD_PRM(grid).y * (y > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - gx, x, y - 1, z), fl) : own);
+    if (y > 0) num += w * HD_GET(phi, ic - gx, x, y - 1, zc);
+    dn += w;
+    w = HD_PRM(grid).y * (y < gy - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + gx, x, y + 1, z), fl) : own);
+    if (y < gy - 1) num += w * HD_GET(phi, ic + gx, x, y + 1, zc);
+    dn += w;
+    w = HD_PRM(grid).z * (z > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - gx * gy, x, y, z - 1), fl) : own);
+    if (z > 0) num += w * HD_GET(phi, ic - gx * gy, x, y, zc - 1);
+    dn += w;
+    w = HD_PRM(grid).z * (z < gz - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + gx * gy, x, y, z + 1), fl) : own);
+    if (z < gz - 1) num += w * HD_GET(phi, ic + gx * gy, x, y, zc + 1);
+    dn += w;
+    HD_DEREF(den) = dn;
+    return num;
+}
+
+/* Relaxes the voxels x0, x0 + xstep, ... of row (y, z), channel c. Red-black Gauss-Seidel:
+   xstep 2 and x0 chosen by the parity, in place. Jacobi: xstep 1, reads phi, writes phi2. */
+HD_FN void hd_diffuse_row(HD_KARGS int y, int z, int c, int parity, int jacobi)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
+    int base = (c * gz + z) * gy * gx + y * gx;
+    int x = jacobi != 0 ? 0 : ((y + z + parity) & 1);
+    int xstep = jacobi != 0 ? 1 : 2;
+    for (; x < gx; x += xstep) {
+        float den;
+        float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
+        if (jacobi != 0) HD_SET(phi2, base + x, x, y, z + c * gz, num / den);
+        else HD_SET(phi, base + x, x, y, z + c * gz, num / den);
+    }
+}
+
+/* Residual of the discrete equation at one voxel, and its right-hand side in *rhs: the solver's
+   convergence measure (relative residual = |r| / |rhs| over the grid). */
+HD_FN float hd_diffuse_residual(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) rhs)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
+    int i = (z * gy + y) * gx + x, ic = i + c * gx * gy * gz;
+    float den;
+    float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
+    HD_DEREF(rhs) = HD_PRM(medium).y * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
+    return num - den * HD_GET(phi, ic, x, y, z + c * gz);
+}

@@ -1,0 +1,23 @@
+/* hd_k_params.h - the parameter block every kernel reads (shared source; no #include here).
+   Only 16-byte vectors, so C, OpenCL and std140 GLSL agree on the layout. The host fills it in
+   src/hd_context.h (hd__fill_kparams). */
+HD_PARAMS_BEGIN
+HD_PARAM_I4(dims)       /* volume dims x, y, z; w = TF entry count */
+HD_PARAM_I4(gdims)      /* illumination grid dims x, y, z; w = channels (1 or 3) */
+HD_PARAM_I4(mdims)      /* majorant grid dims x, y, z; w = voxels per cell edge */
+HD_PARAM_I4(counts)     /* x = lights, y = tracking (1 ratio, 2 delta), z = flags, w = bounces */
+HD_PARAM_I4(frame)      /* x = iteration (1-based), y = frame (1-based), z = seed, w = half-sweep parity */
+HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = unused */
+HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / (4 pi) */
+HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
+HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */
+HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = unused */
+HD_PARAM_F4(cam_pos)    /* eye */
+HD_PARAM_F4(cam_u)      /* image right, scaled by tan(fov/2) * aspect */
+HD_PARAM_F4(cam_v)      /* image up, scaled by tan(fov/2) */
+HD_PARAM_F4(cam_w)      /* forward, unit */
+HD_PARAM_F4(background) /* rgb radiance behind the volume */
+HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */
+HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position, w = type */
+HD_PARAM_F4_ARRAY(light_b, HD_MAX_LIGHTS) /* rgb = colour * intensity (x only with 1 channel), w = 1/r^2 */
+HD_PARAMS_END

@@ -1,0 +1,428 @@
+/* hybriddiff.h - global illumination for volumes by the hybrid diffusion method.
+   MIT or public domain, see the end of the file.
+
+   Do this:
+      #define HYBRIDDIFF_IMPLEMENTATION
+      #define HYBRIDDIFF_BACKEND_CPU        (or _OPENCL, _VULKAN, _GL)
+   before you include this file in *one* C or C++ file to create the implementation.
+   Every other file includes it with no macros and sees only the declarations.
+
+   What it does
+      Lights a scalar volume (CT, MRI, simulation) seen through a 1D RGBA transfer function with
+      physically based global illumination, progressively:
+        1. direct light E, per voxel, by Monte Carlo tracking of transmittance toward one randomly
+           chosen light per iteration (progressive mean; memory independent of the light count);
+        2. multiple scattering phi, by a diffusion solve on the grid, warm-started each iteration;
+        3. an emission-absorption ray-marched projection of sigma_s * c * (E + phi) / (4 pi).
+      Only stage 3 depends on the camera: moving the camera keeps the converged illumination.
+
+   Quick start
+      hd_desc desc = {0};
+      desc.volume.type = HD_VOXEL_U8;
+      desc.volume.dims[0] = 128; desc.volume.dims[1] = 128; desc.volume.dims[2] = 84;
+      desc.volume.data = voxels;                 // copied; may be freed after hd_create
+      hd_context ctx;
+      if (hd_create(&desc, &ctx) != HD_SUCCESS) { ... }
+      hd_iterate(ctx, 64);                       // progressive: call again to refine
+      hd_read_image_rgba8(ctx, pixels, w * h * 4);
+      hd_destroy(ctx);
+
+   Configuration macros (define before including the implementation)
+      HYBRIDDIFF_BACKEND_CPU     plain C99 reference backend, multi-threaded with pthreads
+      HYBRIDDIFF_BACKEND_OPENCL  OpenCL 1.2+ (link -lOpenCL)
+      HYBRIDDIFF_BACKEND_VULKAN  Vulkan 1.1+  (link -lvulkan)
+      HYBRIDDIFF_BACKEND_GL      OpenGL 4.3+ compute (link -lEGL -lOpenGL)
+      HYBRIDDIFF_STATIC          make every function static (private to one translation unit)
+      HYBRIDDIFF_NO_ZLIB         build the file loaders without zlib (gzip-encoded files are then
+                                 rejected with HD_ERROR_UNSUPPORTED_ENCODING); otherwise link -lz
+      HD_MAX_CONTEXTS            live contexts per process (default 64)
+
+   Conventions (see docs/ and METHOD.md of the project)
+      - The volume fills a box centred on the origin whose largest side has length 1; the other
+        sides follow dims * spacing. Voxel centres sit at (i + 0.5) / n in texture space.
+      - sigma_t(x) = TF_alpha(v(x)) * extinction, sigma_s = albedo * sigma_t; v(x) is the trilinear
+        interpolation of the normalised voxel values, the TF is sampled after interpolation.
+      - One HD iteration = one direct-light sample per voxel + the diffusion sweeps + one frame.
+      - Random numbers are a counter-based hash of (voxel or pixel, iteration, dimension, seed),
+        so every backend draws the same samples.
+
+   Threading: calls on one context must not overlap; different contexts may be used from
+   different threads at the same time.
+
+   Changelog
+      0.1  first release: CPU backend, hybrid diffusion method.
+*/
+#ifndef HYBRIDDIFF_H
+#define HYBRIDDIFF_H
+
+/* The implementation uses clock_gettime and pthreads, which are POSIX: a strict -std=c99 build
+   needs this before any system header, so include hybriddiff.h first in the implementation file
+   (or build with -D_POSIX_C_SOURCE=200809L, or -std=gnu99). */
+#if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_POSIX_C_SOURCE) && !defined(_WIN32)
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef HYBRIDDIFF_STATIC
+#define HDDEF static
+#else
+#define HDDEF extern
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- results ------------------------------------------------------------------------------ */
+/* Every error has its own code; hd_result_string() names it, the logger says what was wrong. */
+#define HD__RESULT_LIST(X) \
+    X(HD_SUCCESS, "success") \
+    X(HD_ERROR_NULL_POINTER, "a required pointer is NULL") \
+    X(HD_ERROR_INVALID_HANDLE, "the context handle is invalid, stale or already destroyed") \
+    X(HD_ERROR_INVALID_ENUM, "an enum value is out of range") \
+    X(HD_ERROR_INVALID_DIMENSIONS, "volume or image dimensions are zero, negative or too large") \
+    X(HD_ERROR_SIZE_OVERFLOW, "a size computed from the dimensions overflows") \
+    X(HD_ERROR_INVALID_SPACING, "voxel spacing is negative, zero, NaN or infinite") \
+    X(HD_ERROR_INVALID_PARAMETER, "a parameter is NaN, infinite or out of range") \
+    X(HD_ERROR_INVALID_TRANSFER_FUNCTION, "the transfer function has too few or invalid entries") \
+    X(HD_ERROR_INVALID_CAMERA, "the camera is degenerate") \
+    X(HD_ERROR_NO_LIGHTS, "no lights were given") \
+    X(HD_ERROR_INVALID_LIGHT, "a light is degenerate or has invalid values") \
+    X(HD_ERROR_TOO_MANY_LIGHTS, "more lights than HD_MAX_LIGHTS") \
+    X(HD_ERROR_BUFFER_TOO_SMALL, "the destination buffer is too small") \
+    X(HD_ERROR_TOO_MANY_CONTEXTS, "HD_MAX_CONTEXTS contexts are alive already") \
+    X(HD_ERROR_UNSUPPORTED, "the method or feature is not available on this backend") \
+    X(HD_ERROR_OUT_OF_MEMORY, "host memory allocation failed") \
+    X(HD_ERROR_OUT_OF_DEVICE_MEMORY, "device memory allocation failed") \
+    X(HD_ERROR_DEVICE_LOST, "the compute device was lost") \
+    X(HD_ERROR_BACKEND, "the compute API reported an error (see the log)") \
+    X(HD_ERROR_FILE_IO, "the file cannot be opened or read") \
+    X(HD_ERROR_FILE_FORMAT, "the file header is malformed") \
+    X(HD_ERROR_FILE_TRUNCATED, "the file is shorter than its header claims") \
+    X(HD_ERROR_UNSUPPORTED_ENCODING, "the file's encoding or voxel type is not supported") \
+    X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated")
+
+typedef enum hd_result {
+#define HD__X(name, text) name,
+    HD__RESULT_LIST(HD__X)
+#undef HD__X
+    HD_RESULT_COUNT
+} hd_result;
+
+/* ---- enums: zero always means "default" -------------------------------------------------- */
+typedef enum hd_method {
+    HD_METHOD_DEFAULT = 0, /* = HD_METHOD_HD */
+    HD_METHOD_HD,          /* hybrid diffusion: tracked direct light + diffusion + projection */
+    HD_METHOD_CD,          /* convection-diffusion baseline (one light volume per light) */
+    HD_METHOD_PT_SS,       /* camera path tracing, single scattering */
+    HD_METHOD_PT_MS,       /* camera path tracing, multiple scattering */
+    HD_METHOD_COUNT
+} hd_method;
+
+typedef enum hd_voxel_type {
+    HD_VOXEL_INVALID = 0, /* the type must be given */
+    HD_VOXEL_U8,
+    HD_VOXEL_U16,
+    HD_VOXEL_F32,
+    HD_VOXEL_COUNT
+} hd_voxel_type;
+
+typedef enum hd_light_type {
+    HD_LIGHT_DIRECTIONAL = 0,
+    HD_LIGHT_POINT,
+    HD_LIGHT_TYPE_COUNT
+} hd_light_type;
+
+typedef enum hd_tracking {
+    HD_TRACKING_DEFAULT = 0, /* = RATIO */
+    HD_TRACKING_RATIO,       /* ratio tracking with Russian roulette: lower variance */
+    HD_TRACKING_DELTA,       /* delta (Woodcock) tracking: a 0/1 estimate per sample */
+    HD_TRACKING_COUNT
+} hd_tracking;
+
+typedef enum hd_solver {
+    HD_SOLVER_DEFAULT = 0,   /* = RED_BLACK */
+    HD_SOLVER_RED_BLACK,     /* red-black Gauss-Seidel, in place: two half-sweeps per sweep */
+    HD_SOLVER_JACOBI,        /* Jacobi with a ping-pong buffer (+4 bytes per voxel) */
+    HD_SOLVER_COUNT
+} hd_solver;
+
+typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_log_level;
+
+typedef enum hd_illumination {
+    HD_ILLUMINATION_DIRECT = 0, /* E: direct light, progressive mean */
+    HD_ILLUMINATION_SCATTERED,  /* phi: fluence of scattered light from the diffusion solve */
+    HD_ILLUMINATION_COUNT
+} hd_illumination;
+
+/* ---- callbacks ------------------------------------------------------------------------------ */
+/* Silent unless a logger is given. hd_log_stderr is a ready one. */
+typedef void (*hd_log_fn)(void *user_data, hd_log_level level, hd_result code, const char *message,
+                          const char *file, int line);
+typedef struct hd_logger {
+    hd_log_fn func;
+    void *user_data;
+} hd_logger;
+
+/* All or none: giving one of alloc/free without the other is HD_ERROR_NULL_POINTER. */
+typedef struct hd_allocator {
+    void *(*alloc)(size_t size, void *user_data);
+    void (*free)(void *ptr, void *user_data);
+    void *user_data;
+} hd_allocator;
+
+/* ---- inputs ---------------------------------------------------------------------------------- */
+#define HD_MAX_LIGHTS 64
+#define HD_MAX_DIM 8192           /* per axis */
+#define HD_MAX_IMAGE_DIM 16384
+
+typedef struct hd_volume_desc {
+    hd_voxel_type type;   /* required */
+    int dims[3];          /* x, y, z; x varies fastest in data. Each in 1..HD_MAX_DIM */
+    float spacing[3];     /* physical voxel size; {0,0,0} -> {1,1,1}; must be finite and > 0 */
+    const void *data;     /* dims[0]*dims[1]*dims[2] voxels; copied by hd_create */
+    float value_range[2]; /* raw value mapped to TF coordinate 0 and 1; {0,0} -> {0,255} for U8,
+                             {0,65535} for U16, {0,1} for F32. Values outside are clamped. */
+} hd_volume_desc;
+
+/* RGBA entries placed at TF coordinates i/(count-1), linearly interpolated.
+   rgb is the scattering colour (0..1), alpha scales the extinction (0..1). */
+typedef struct hd_transfer_function {
+    const float *rgba; /* count * 4 floats; copied */
+    int count;         /* >= 2; a desc with rgba == NULL and count == 0 gets a linear grey ramp */
+} hd_transfer_function;
+
+typedef struct hd_light {
+    hd_light_type type;
+    float direction[3]; /* DIRECTIONAL: the direction the light travels in (need not be unit) */
+    float position[3];  /* POINT: position in world space (the volume box is centred at 0) */
+    float color[3];     /* linear RGB, >= 0; {0,0,0} -> {1,1,1} */
+    float intensity;    /* >= 0; 0 -> 1 */
+    int inverse_square; /* POINT: 1 = intensity / r^2 falloff (r in world units), 0 = none */
+} hd_light;
+
+typedef struct hd_camera {
+    float eye[3];    /* {0,0,0} together with target {0,0,0} -> eye {0,0,2.5} */
+    float target[3]; /* looked-at point */
+    float up[3];     /* {0,0,0} -> {0,1,0}; must not be parallel to target - eye */
+    float fov_y;     /* vertical field of view in degrees, 0 -> 40; must be in (0, 180) */
+    int width;       /* image size, 0 -> 512 */
+    int height;      /* 0 -> 512 */
+} hd_camera;
+
+typedef struct hd_params {
+    hd_method method;
+    float extinction;       /* sigma_t = TF alpha * extinction, per world unit; 0 -> 100 */
+    float albedo;           /* sigma_s / sigma_t in (0, 1]; 0 -> 0.9 */
+    float anisotropy;       /* Henyey-Greenstein g in (-1, 1): reduces the diffusion's sigma_s
+                               to sigma_s (1 - g); used by PT_MS as its phase; default 0 */
+    float majorant;         /* 0 -> a coarse grid of local majorants (empty space is skipped);
+                               > 0 -> this global majorant (must be >= max sigma_t) */
+    int diffusion_sweeps;   /* solver sweeps per iteration, 0 -> 4 */
+    int disable_diffusion;  /* 1: phi stays 0 (direct light only, the PT_SS equivalent) */
+    hd_solver solver;
+    hd_tracking tracking;
+    uint32_t seed;
+    float background[3];    /* linear RGB radiance behind the volume, default black */
+    float step;             /* ray-march step of the projection in voxels, 0 -> 0.5 */
+    int frame_window;       /* the image is a running mean of at most this many frames, so it
+                               follows the converging illumination; 0 -> 8 */
+    float exposure;         /* scale applied before the sRGB encoding of RGBA8 output; 0 -> 1 */
+    int max_bounces;        /* PT_MS bounce cap, 0 -> 64 */
+} hd_params;
+
+typedef struct hd_desc {
+    hd_volume_desc volume;
+    hd_transfer_function transfer_function;
+    const hd_light *lights; /* NULL with light_count 0 -> one white directional light along -z */
+    int light_count;
+    hd_camera camera;
+    hd_params params;
+    int threads;            /* CPU backend worker threads, 0 -> all cores; results do not
+                               depend on it */
+    hd_logger logger;
+    hd_allocator allocator;
+    /* Backend-specific, ignored by the others; void* so this header needs no API header. */
+    struct {
+        void *context, *device, *queue; /* cl_context, cl_device_id, cl_command_queue or NULL */
+        const char *device_name;        /* substring of the device to pick (or env HD_CL_DEVICE) */
+    } opencl;
+    struct {
+        void *instance, *physical_device, *device, *queue; /* VkInstance... or NULL */
+        uint32_t queue_family;
+        void *get_instance_proc_addr; /* PFN_vkGetInstanceProcAddr, or NULL for the loader's */
+        const char *device_name;      /* substring (or env HD_VK_DEVICE) */
+        int enable_validation;
+    } vulkan;
+    struct {
+        int use_current_context; /* 1: use the caller's current GL context */
+        void *(*get_proc_address)(const char *name); /* NULL -> eglGetProcAddress */
+    } gl;
+} hd_desc;
+
+/* ---- outputs --------------------------------------------------------------------------------- */
+typedef struct hd_stats {
+    hd_method method;
+    uint64_t iterations;      /* iterations of the current method since its state was reset */
+    uint64_t frames;          /* frames accumulated into the current image */
+    size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
+                                 (illumination grids and helpers; volume and image excluded) */
+    size_t image_bytes;       /* bytes of the image accumulation */
+    size_t volume_bytes;      /* bytes of the volume, the TF and the majorant grid on the device */
+    int illumination_dims[3]; /* grid of the illumination volumes */
+    int illumination_channels;/* 1 (grey) or 3 (lights of different colours) */
+    double seconds_direct;    /* accumulated wall time per stage since creation */
+    double seconds_diffusion;
+    double seconds_projection;
+} hd_stats;
+
+typedef struct hd_context {
+    uint32_t id; /* 0 is never valid */
+} hd_context;
+
+/* ---- API --------------------------------------------------------------------------------------- */
+HDDEF const char *hd_result_string(hd_result result);
+HDDEF const char *hd_method_name(hd_method method);
+HDDEF const char *hd_backend_name(void);
+HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, const char *message,
+                         const char *file, int line);
+
+HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx);
+HDDEF hd_result hd_destroy(hd_context ctx);
+/* The desc with every default filled in (lights and TF pointers refer to the context's copies,
+   valid until the next call on this context). */
+HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
+
+/* Setters invalidate only what depends on them:
+     transfer function, extinction, majorant   -> majorant grid, E, phi, image
+     lights, seed                              -> E, phi, image
+     albedo, anisotropy, disable_diffusion     -> phi, image
+     camera, step, background, frame_window    -> image only (E and phi are kept)
+     method                                    -> the new method starts from scratch
+     solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
+HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
+HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);
+HDDEF hd_result hd_set_camera(hd_context ctx, const hd_camera *camera);
+HDDEF hd_result hd_set_params(hd_context ctx, const hd_params *params);
+
+/* Runs n >= 1 iterations of the current method. */
+HDDEF hd_result hd_iterate(hd_context ctx, int n);
+
+/* The image, top row first. RGBA8: sRGB-encoded radiance * exposure, alpha = opacity.
+   Float: linear RGB radiance and opacity. Sizes are in bytes / in floats. */
+HDDEF hd_result hd_read_image_rgba8(hd_context ctx, uint8_t *dst, size_t dst_bytes);
+HDDEF hd_result hd_read_image_f32(hd_context ctx, float *dst, size_t dst_floats);
+/* An illumination volume, channel-planar: channel c of voxel (x,y,z) at
+   ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. */
+HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, float *dst,
+                                     size_t dst_floats);
+HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
+
+/* ---- file loaders ----------------------------------------------------------------------------- */
+/* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
+   types are converted to F32. */
+typedef struct hd_volume_file {
+    hd_volume_desc desc; /* ready to be copied into hd_desc.volume */
+    void *data;          /* what desc.data points to */
+    float value_min, value_max; /* range of the values in the file */
+} hd_volume_file;
+
+typedef enum hd_endian { HD_ENDIAN_LITTLE = 0, HD_ENDIAN_BIG } hd_endian;
+
+typedef enum hd_raw_type {
+    HD_RAW_U8 = 0, HD_RAW_I8, HD_RAW_U16, HD_RAW_I16, HD_RAW_U32, HD_RAW_I32, HD_RAW_F32,
+    HD_RAW_F64, HD_RAW_TYPE_COUNT
+} hd_raw_type;
+
+/* NRRD (.nrrd, attached header; raw or gzip encoding). */
+HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out, const hd_logger *log);
+/* Headerless raw: dims, type, endianness and byte offset given by the caller. */
+HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_type type,
+                                   hd_endian endian, size_t offset, hd_volume_file *out,
+                                   const hd_logger *log);
+/* The same parsers on a memory buffer (what the fuzzers drive). */
+HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_file *out,
+                                     const hd_logger *log);
+HDDEF void hd_volume_free(hd_volume_file *vol);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* HYBRIDDIFF_H */
+
+/* ================================================================================================
+   Implementation
+   ================================================================================================ */
+#ifdef HYBRIDDIFF_IMPLEMENTATION
+#ifndef HYBRIDDIFF_IMPLEMENTATION_DONE
+#define HYBRIDDIFF_IMPLEMENTATION_DONE
+
+#if (defined(HYBRIDDIFF_BACKEND_CPU) + defined(HYBRIDDIFF_BACKEND_OPENCL) + \
+     defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL)) == 0
+#error "hybriddiff: define exactly one backend: HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN or HYBRIDDIFF_BACKEND_GL"
+#elif (defined(HYBRIDDIFF_BACKEND_CPU) + defined(HYBRIDDIFF_BACKEND_OPENCL) + \
+       defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL)) > 1
+#error "hybriddiff: more than one backend defined; define exactly one of HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN, HYBRIDDIFF_BACKEND_GL"
+#endif
+
+#include "backends/hd_prelude_c.h"
+#include "src/hd_internal.h"
+#include "backends/kernels/hd_kernels.h"
+#if defined(HYBRIDDIFF_BACKEND_CPU)
+#include "backends/hd_cpu.h"
+#elif defined(HYBRIDDIFF_BACKEND_OPENCL)
+#include "backends/hd_opencl.h"
+#elif defined(HYBRIDDIFF_BACKEND_VULKAN)
+#include "backends/hd_vulkan.h"
+#elif defined(HYBRIDDIFF_BACKEND_GL)
+#include "backends/hd_gl.h"
+#endif
+#include "src/hd_validate.h"
+#include "src/hd_context.h"
+#include "src/hd_io.h"
+
+#endif /* HYBRIDDIFF_IMPLEMENTATION_DONE */
+#endif /* HYBRIDDIFF_IMPLEMENTATION */
+
+/*
+------------------------------------------------------------------------------
+This software is available under 2 licenses -- choose whichever you prefer.
+------------------------------------------------------------------------------
+ALTERNATIVE A - MIT License
+Copyright (c) 2026 The hybriddiff authors
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+of the Software, and to permit persons to whom the Software is furnished to do
+so, subject to the following conditions:
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+------------------------------------------------------------------------------
+ALTERNATIVE B - Public Domain (www.unlicense.org)
+This is free and unencumbered software released into the public domain.
+Anyone is free to copy, modify, publish, use, compile, sell, or distribute this
+software, either in source code form or as a compiled binary, for any purpose,
+commercial or non-commercial, and by any means.
+In jurisdictions that recognize copyright laws, the author or authors of this
+software dedicate any and all copyright interest in the software to the public
+domain. We make this dedication in perpetuity for the benefit of the software
+to the public and to the detriment of all attempts to gain control of the
+software under copyright law.
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER LIABILITY, WHETHER IN AN
+ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM, OUT OF OR IN CONNECTION
+WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE SOFTWARE.
+------------------------------------------------------------------------------
+*/

@@ -1,0 +1,623 @@
+/* hd_context.h - the public API: handles, context life cycle, what a change invalidates, and
+   the schedule of each method's stages on the selected backend (hd__be_* functions). */
+#include <pthread.h>
+
+/* ---- names ----------------------------------------------------------------------------------- */
+HDDEF const char *hd_result_string(hd_result result)
+{
+    switch (result) {
+#define HD__X(name, text) case name: return #name ": " text;
+        HD__RESULT_LIST(HD__X)
+#undef HD__X
+    default: return "HD_ERROR_UNKNOWN: not a hd_result value";
+    }
+}
+
+HDDEF const char *hd_method_name(hd_method method)
+{
+    switch (method) {
+    case HD_METHOD_DEFAULT: return "default";
+    case HD_METHOD_HD: return "HD";
+    case HD_METHOD_CD: return "CD";
+    case HD_METHOD_PT_SS: return "PT_SS";
+    case HD_METHOD_PT_MS: return "PT_MS";
+    default: return "unknown";
+    }
+}
+
+HDDEF const char *hd_backend_name(void) { return hd__be_name(); }
+
+HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, const char *message,
+                         const char *file, int line)
+{
+    static const char *names[] = {"error", "warning", "info"};
+    (void)user_data; (void)file; (void)line;
+    fprintf(stderr, "hybriddiff %s: %s%s%s\n", names[level <= HD_LOG_INFO ? level : 0], message,
+            code != HD_SUCCESS ? " -- " : "", code != HD_SUCCESS ? hd_result_string(code) : "");
+}
+
+/* ---- handles: a slot index and a generation, so a stale handle is caught, not dereferenced ---- */
+typedef struct hd__slot {
+    hd__ctx *ctx;
+    uint32_t generation;
+    hd_logger last_logger; /* stays after destroy, so use of a stale handle can still be logged */
+} hd__slot;
+static hd__slot hd__slots[HD_MAX_CONTEXTS];
+static pthread_mutex_t hd__slots_mu = PTHREAD_MUTEX_INITIALIZER;
+
+static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out)
+{
+    uint32_t slot = (h.id & 0xffu), gen = h.id >> 8;
+    hd__ctx *ctx = NULL;
+    if (log_out) memset(log_out, 0, sizeof *log_out);
+    if (slot == 0 || slot > HD_MAX_CONTEXTS) return NULL;
+    pthread_mutex_lock(&hd__slots_mu);
+    if (hd__slots[slot - 1].generation == gen) ctx = hd__slots[slot - 1].ctx;
+    if (log_out) *log_out = hd__slots[slot - 1].last_logger;
+    pthread_mutex_unlock(&hd__slots_mu);
+    return ctx;
+}
+
+/* Resolves a handle or returns HD_ERROR_INVALID_HANDLE from the calling function. */
+#define HD__GET_CTX(var, handle) \
+    hd__ctx *var; \
+    do { \
+        hd_logger hd__stale_log; \
+        var = hd__lookup((handle), &hd__stale_log); \
+        if (!var) return HD__ERR(&hd__stale_log, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)(handle).id); \
+    } while (0)
+
+/* ---- volume preparation ------------------------------------------------------------------------ */
+static float hd__raw_value(const hd_volume_desc *v, size_t i)
+{
+    switch (v->type) {
+    case HD_VOXEL_U8: return (float)((const uint8_t *)v->data)[i];
+    case HD_VOXEL_U16: return (float)((const uint16_t *)v->data)[i];
+    default: return ((const float *)v->data)[i];
+    }
+}
+
+/* Normalises the voxels to TF coordinates and records, per majorant cell, the value range a
+   trilinear sample inside the cell can take (its voxels and a one-voxel halo). */
+static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
+{
+    float lo = v->value_range[0], hi = v->value_range[1], scale;
+    size_t i, ncell;
+    int d, x, y, z, maxdim = 0;
+    float extent[3], emax = 0.0f;
+    for (d = 0; d < 3; ++d) {
+        ctx->dims[d] = v->dims[d];
+        extent[d] = (float)v->dims[d] * v->spacing[d];
+        if (extent[d] > emax) emax = extent[d];
+        if (v->dims[d] > maxdim) maxdim = v->dims[d];
+        ctx->mdims[d] = (v->dims[d] + HD__MAJORANT_CELL - 1) / HD__MAJORANT_CELL;
+    }
+    for (d = 0; d < 3; ++d) ctx->box[d] = extent[d] / emax;
+    ctx->nvox = (size_t)ctx->dims[0] * ctx->dims[1] * ctx->dims[2];
+    ctx->vol = (float *)hd__alloc(ctx, ctx->nvox * sizeof(float));
+    ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    ctx->cell_range = (float *)hd__alloc(ctx, ncell * 2 * sizeof(float));
+    ctx->majorant = (float *)hd__calloc(ctx, ncell, sizeof(float));
+    if (!ctx->vol || !ctx->cell_range || !ctx->majorant)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cannot allocate the volume (%zu voxels)", ctx->nvox);
+    scale = 1.0f / (hi - lo);
+    for (i = 0; i < ctx->nvox; ++i) {
+        float t = (hd__raw_value(v, i) - lo) * scale;
+        ctx->vol[i] = t != t ? 0.0f : (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t));
+    }
+    for (i = 0; i < ncell; ++i) { ctx->cell_range[2 * i] = 1.0f; ctx->cell_range[2 * i + 1] = 0.0f; }
+    /* each voxel widens the range of every cell whose halo-extended footprint holds it */
+    for (z = 0; z < ctx->dims[2]; ++z)
+        for (y = 0; y < ctx->dims[1]; ++y)
+            for (x = 0; x < ctx->dims[0]; ++x) {
+                float val = ctx->vol[((size_t)z * ctx->dims[1] + y) * ctx->dims[0] + x];
+                int c0[3], c1[3], p[3], cx, cy, cz;
+                p[0] = x; p[1] = y; p[2] = z;
+                for (d = 0; d < 3; ++d) {
+                    c0[d] = (p[d] - 1 + HD__MAJORANT_CELL) / HD__MAJORANT_CELL - 1; /* cell whose last halo voxel is p */
+                    c1[d] = (p[d] + 1) / HD__MAJORANT_CELL;                         /* cell whose first halo voxel is p */
+                    if (c0[d] < 0) c0[d] = 0;
+                    if (c1[d] > ctx->mdims[d] - 1) c1[d] = ctx->mdims[d] - 1;
+                }
+                for (cz = c0[2]; cz <= c1[2]; ++cz)
+                    for (cy = c0[1]; cy <= c1[1]; ++cy)
+                        for (cx = c0[0]; cx <= c1[0]; ++cx) {
+                            float *r = &ctx->cell_range[2 * (((size_t)cz * ctx->mdims[1] + cy) * ctx->mdims[0] + cx)];
+                            if (val < r[0]) r[0] = val;
+                            if (val > r[1]) r[1] = val;
+                        }
+            }
+    (void)maxdim;
+    return HD_SUCCESS;
+}
+
+/* TF alpha at coordinate t, exactly as the kernels interpolate it. */
+static float hd__tf_alpha(const hd__ctx *ctx, float t)
+{
+    float f = (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t)) * (float)(ctx->tf_count - 1);
+    int i = (int)f < ctx->tf_count - 2 ? (int)f : ctx->tf_count - 2;
+    float w = f - (float)i;
+    return ctx->tf[4 * i + 3] + w * (ctx->tf[4 * i + 7] - ctx->tf[4 * i + 3]);
+}
+
+/* Max sigma_t over a value range: the TF is piecewise linear, so its maximum over [lo, hi] is at
+   an end or at an entry inside. Padded so float rounding in the kernels never exceeds it. */
+static float hd__range_majorant(const hd__ctx *ctx, float lo, float hi)
+{
+    float m, n1 = (float)(ctx->tf_count - 1);
+    int i, i0, i1;
+    if (hi < lo) return 0.0f;
+    m = hd__tf_alpha(ctx, lo);
+    if (hd__tf_alpha(ctx, hi) > m) m = hd__tf_alpha(ctx, hi);
+    i0 = (int)ceilf(lo * n1);
+    i1 = (int)floorf(hi * n1);
+    for (i = i0 < 0 ? 0 : i0; i <= i1 && i < ctx->tf_count; ++i)
+        if (ctx->tf[4 * i + 3] > m) m = ctx->tf[4 * i + 3];
+    return m > 0.0f ? m * ctx->params.extinction * (1.0f + 1e-5f) + 1e-30f : 0.0f;
+}
+
+static void hd__build_majorants(hd__ctx *ctx)
+{
+    size_t i, ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    ctx->max_sigma = 0.0f;
+    for (i = 0; i < ncell; ++i) {
+        ctx->majorant[i] = hd__range_majorant(ctx, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]);
+        if (ctx->majorant[i] > ctx->max_sigma) ctx->max_sigma = ctx->majorant[i];
+    }
+}
+
+/* ---- inputs --------------------------------------------------------------------------------- */
+static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
+{
+    static const float ramp[8] = {1.0f, 1.0f, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+    const float *src = tf->rgba ? tf->rgba : ramp;
+    int count = tf->rgba ? tf->count : 2;
+    float *copy = (float *)hd__alloc(ctx, (size_t)count * 4 * sizeof(float));
+    if (!copy) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cannot copy a %d-entry transfer function", count);
+    memcpy(copy, src, (size_t)count * 4 * sizeof(float));
+    hd__free(ctx, ctx->tf);
+    ctx->tf = copy;
+    ctx->tf_count = count;
+    ctx->desc.transfer_function.rgba = ctx->tf;
+    ctx->desc.transfer_function.count = count;
+    return HD_SUCCESS;
+}
+
+/* Lights of one colour need one illumination channel; mixed colours need three. */
+static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
+{
+    int i, same = 1;
+    for (i = 0; i < count; ++i) {
+        hd_light l = lights[i];
+        if (l.color[0] == 0.0f && l.color[1] == 0.0f && l.color[2] == 0.0f) l.color[0] = l.color[1] = l.color[2] = 1.0f;
+        if (l.intensity == 0.0f) l.intensity = 1.0f;
+        ctx->lights[i] = l;
+        if (i > 0 && memcmp(l.color, ctx->lights[0].color, sizeof l.color) != 0) same = 0;
+    }
+    ctx->light_count = count;
+    ctx->channels = same ? 1 : 3;
+    for (i = 0; i < 3; ++i) ctx->chan_color[i] = same ? ctx->lights[0].color[i] : 1.0f;
+    ctx->desc.lights = ctx->lights;
+    ctx->desc.light_count = count;
+}
+
+static hd_result hd__check_majorant(hd__ctx *ctx, const hd_params *p)
+{
+    if (p->majorant > 0.0f && p->majorant < ctx->max_sigma / (1.0f + 1e-5f) * (p->extinction / ctx->params.extinction))
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
+                       "params.majorant = %g is below the largest extinction %g: tracking would be biased",
+                       (double)p->majorant, (double)(ctx->max_sigma * p->extinction / ctx->params.extinction));
+    return HD_SUCCESS;
+}
+
+/* ---- the kernels' parameter block ------------------------------------------------------------ */
+static void hd__fill_kparams(hd__ctx *ctx)
+{
+    hd__kparams *k = &ctx->kp;
+    const hd_camera *c = &ctx->camera;
+    float w[3], u[3], v[3], len, th, aspect;
+    int i;
+    memset(k, 0, sizeof *k);
+    k->dims.x = ctx->dims[0]; k->dims.y = ctx->dims[1]; k->dims.z = ctx->dims[2]; k->dims.w = ctx->tf_count;
+    k->gdims.x = ctx->gdims[0]; k->gdims.y = ctx->gdims[1]; k->gdims.z = ctx->gdims[2]; k->gdims.w = ctx->channels;
+    k->mdims.x = ctx->mdims[0]; k->mdims.y = ctx->mdims[1]; k->mdims.z = ctx->mdims[2]; k->mdims.w = HD__MAJORANT_CELL;
+    k->counts.x = ctx->light_count;
+    k->counts.y = ctx->params.tracking == HD_TRACKING_DELTA ? HD_TRACK_DELTA : HD_TRACK_RATIO;
+    k->counts.z = (ctx->params.majorant > 0.0f ? HD_FLAG_GLOBAL_MAJORANT : 0) |
+                  (ctx->params.disable_diffusion ? HD_FLAG_NO_DIFFUSION : 0);
+    k->counts.w = ctx->params.max_bounces;
+    k->frame.x = (int32_t)ctx->iterations;
+    k->frame.y = (int32_t)ctx->frames;
+    k->frame.z = (int32_t)ctx->params.seed;
+    k->image.x = c->width; k->image.y = c->height; k->image.z = (int32_t)ctx->params.method;
+    k->box.x = ctx->box[0]; k->box.y = ctx->box[1]; k->box.z = ctx->box[2]; k->box.w = 0.0795774715f;
+    k->medium.x = ctx->params.extinction; k->medium.y = ctx->params.albedo;
+    k->medium.z = ctx->params.anisotropy; k->medium.w = ctx->params.majorant;
+    for (i = 0; i < 3; ++i) {
+        float h = ctx->box[i] / (float)ctx->gdims[i];
+        (&k->grid.x)[i] = 1.0f / (h * h);
+    }
+    k->grid.w = 1e-3f; /* sigma' floor: keeps D finite in empty space */
+    {
+        float vs = ctx->box[0] / (float)ctx->dims[0];
+        if (ctx->box[1] / (float)ctx->dims[1] < vs) vs = ctx->box[1] / (float)ctx->dims[1];
+        if (ctx->box[2] / (float)ctx->dims[2] < vs) vs = ctx->box[2] / (float)ctx->dims[2];
+        k->march.x = ctx->params.step * vs;
+    }
+    {
+        uint64_t f = ctx->frames < 1 ? 1 : ctx->frames;
+        uint64_t win = (uint64_t)ctx->params.frame_window;
+        k->march.y = 1.0f / (float)(f < win ? f : win);
+    }
+    k->march.z = 1e-4f; /* stop marching below this transmittance */
+    /* camera basis */
+    for (i = 0; i < 3; ++i) w[i] = c->target[i] - c->eye[i];
+    len = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    for (i = 0; i < 3; ++i) w[i] /= len;
+    u[0] = w[1] * c->up[2] - w[2] * c->up[1];
+    u[1] = w[2] * c->up[0] - w[0] * c->up[2];
+    u[2] = w[0] * c->up[1] - w[1] * c->up[0];
+    len = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (i = 0; i < 3; ++i) u[i] /= len;
+    v[0] = u[1] * w[2] - u[2] * w[1];
+    v[1] = u[2] * w[0] - u[0] * w[2];
+    v[2] = u[0] * w[1] - u[1] * w[0];
+    th = tanf(0.5f * c->fov_y * 3.14159265f / 180.0f);
+    aspect = (float)c->width / (float)c->height;
+    k->cam_pos.x = c->eye[0]; k->cam_pos.y = c->eye[1]; k->cam_pos.z = c->eye[2];
+    k->cam_u.x = u[0] * th * aspect; k->cam_u.y = u[1] * th * aspect; k->cam_u.z = u[2] * th * aspect;
+    k->cam_v.x = v[0] * th; k->cam_v.y = v[1] * th; k->cam_v.z = v[2] * th;
+    k->cam_w.x = w[0]; k->cam_w.y = w[1]; k->cam_w.z = w[2];
+    k->background.x = ctx->params.background[0];
+    k->background.y = ctx->params.background[1];
+    k->background.z = ctx->params.background[2];
+    k->chan_color.x = ctx->chan_color[0]; k->chan_color.y = ctx->chan_color[1]; k->chan_color.z = ctx->chan_color[2];
+    for (i = 0; i < ctx->light_count; ++i) {
+        const hd_light *l = &ctx->lights[i];
+        hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];
+        if (l->type == HD_LIGHT_DIRECTIONAL) {
+            float n = sqrtf(l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] + l->direction[2] * l->direction[2]);
+            a->x = l->direction[0] / n; a->y = l->direction[1] / n; a->z = l->direction[2] / n; a->w = 0.0f;
+        } else {
+            a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
+        }
+        if (ctx->channels == 1) {
+            b->x = b->y = b->z = l->intensity;
+        } else {
+            b->x = l->color[0] * l->intensity; b->y = l->color[1] * l->intensity; b->z = l->color[2] * l->intensity;
+        }
+        b->w = l->type == HD_LIGHT_POINT && l->inverse_square ? 1.0f : 0.0f;
+    }
+}
+
+/* ---- life cycle ---------------------------------------------------------------------------- */
+static void hd__ctx_free(hd__ctx *ctx)
+{
+    if (ctx->be) hd__be_destroy(ctx);
+    hd__free(ctx, ctx->vol);
+    hd__free(ctx, ctx->cell_range);
+    hd__free(ctx, ctx->majorant);
+    hd__free(ctx, ctx->tf);
+    hd__free(ctx, ctx);
+}
+
+HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
+{
+    hd_desc d;
+    const hd_logger *log;
+    hd__ctx *ctx;
+    hd_result r;
+    hd_light default_light;
+    uint32_t slot;
+    if (!desc) return HD_ERROR_NULL_POINTER; /* no logger to tell */
+    log = &desc->logger;
+    if (!out_ctx) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_create: out_ctx is NULL");
+    out_ctx->id = 0;
+    d = *desc;
+    if ((d.allocator.alloc == NULL) != (d.allocator.free == NULL))
+        return HD__ERR(log, HD_ERROR_NULL_POINTER, "allocator: give both alloc and free, or neither");
+    /* validate everything first: nothing is allocated for a bad desc */
+    if ((r = hd__check_volume(&d.volume, log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_tf(&d.transfer_function, log)) != HD_SUCCESS) return r;
+    memset(&default_light, 0, sizeof default_light);
+    default_light.direction[2] = -1.0f;
+    if (!d.lights && d.light_count == 0) { d.lights = &default_light; d.light_count = 1; }
+    if ((r = hd__check_lights(d.lights, d.light_count, log)) != HD_SUCCESS) return r;
+    hd__camera_defaults(&d.camera);
+    if ((r = hd__check_camera(&d.camera, log)) != HD_SUCCESS) return r;
+    hd__params_defaults(&d.params);
+    if ((r = hd__check_params(&d.params, log)) != HD_SUCCESS) return r;
+    if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
+    if (d.volume.spacing[0] == 0.0f && d.volume.spacing[1] == 0.0f && d.volume.spacing[2] == 0.0f)
+        d.volume.spacing[0] = d.volume.spacing[1] = d.volume.spacing[2] = 1.0f;
+    if (d.volume.value_range[0] == 0.0f && d.volume.value_range[1] == 0.0f)
+        d.volume.value_range[1] = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f : 1.0f;
+    if (!d.allocator.alloc) { d.allocator.alloc = hd__malloc_default; d.allocator.free = hd__free_default; }
+
+    ctx = (hd__ctx *)d.allocator.alloc(sizeof *ctx, d.allocator.user_data);
+    if (!ctx) return HD__ERR(log, HD_ERROR_OUT_OF_MEMORY, "cannot allocate the context");
+    memset(ctx, 0, sizeof *ctx);
+    ctx->desc = d;
+    ctx->alloc = d.allocator;
+    ctx->log = d.logger;
+    ctx->camera = d.camera;
+    ctx->params = d.params;
+    ctx->desc.volume.data = NULL; /* the caller's buffer is not kept */
+    hd__set_lights(ctx, d.lights, d.light_count);
+    if ((r = hd__set_tf(ctx, &d.transfer_function)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    if ((r = hd__prepare_volume(ctx, &d.volume)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    hd__build_majorants(ctx);
+    if ((r = hd__check_majorant(ctx, &ctx->params)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    memcpy(ctx->gdims, ctx->dims, sizeof ctx->gdims);
+    ctx->dirty = HD__DIRTY_ALL;
+    if ((r = hd__be_create(ctx)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+
+    pthread_mutex_lock(&hd__slots_mu);
+    for (slot = 0; slot < HD_MAX_CONTEXTS && hd__slots[slot].ctx; ++slot) {}
+    if (slot < HD_MAX_CONTEXTS) {
+        hd__slots[slot].ctx = ctx;
+        hd__slots[slot].generation = (hd__slots[slot].generation + 1) & 0xffffffu;
+        if (hd__slots[slot].generation == 0) hd__slots[slot].generation = 1;
+        hd__slots[slot].last_logger = ctx->log;
+        out_ctx->id = (hd__slots[slot].generation << 8) | (slot + 1);
+    }
+    pthread_mutex_unlock(&hd__slots_mu);
+    if (slot == HD_MAX_CONTEXTS) {
+        hd__ctx_free(ctx);
+        return HD__ERR(log, HD_ERROR_TOO_MANY_CONTEXTS, "%d contexts are alive already", HD_MAX_CONTEXTS);
+    }
+    HD__INFO(&ctx->log, "created: %s backend, volume %dx%dx%d, %d lights", hd__be_name(),
+             ctx->dims[0], ctx->dims[1], ctx->dims[2], ctx->light_count);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_destroy(hd_context h)
+{
+    uint32_t slot = h.id & 0xffu;
+    HD__GET_CTX(ctx, h);
+    pthread_mutex_lock(&hd__slots_mu);
+    hd__slots[slot - 1].ctx = NULL;
+    pthread_mutex_unlock(&hd__slots_mu);
+    hd__ctx_free(ctx);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_query_desc(hd_context h, hd_desc *out)
+{
+    HD__GET_CTX(ctx, h);
+    if (!out) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_query_desc: out_desc is NULL");
+    *out = ctx->desc;
+    out->camera = ctx->camera;
+    out->params = ctx->params;
+    return HD_SUCCESS;
+}
+
+/* ---- setters ----------------------------------------------------------------------------------- */
+HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_function *tf)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!tf) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_set_transfer_function: tf is NULL");
+    if ((r = hd__check_tf(tf, &ctx->log)) != HD_SUCCESS) return r;
+    if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
+    hd__build_majorants(ctx);
+    if (ctx->params.majorant > 0.0f && ctx->params.majorant < ctx->max_sigma / (1.0f + 1e-5f)) {
+        HD__INFO(&ctx->log, "params.majorant %g is below the new TF's largest extinction %g: using the majorant grid",
+                 (double)ctx->params.majorant, (double)ctx->max_sigma);
+        ctx->params.majorant = 0.0f;
+    }
+    ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
+{
+    hd_result r;
+    int channels_before;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__check_lights(lights, count, &ctx->log)) != HD_SUCCESS) return r;
+    channels_before = ctx->channels;
+    hd__set_lights(ctx, lights, count);
+    ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    if (ctx->channels != channels_before) ctx->dirty |= HD__DIRTY_ALLOC;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
+{
+    hd_camera c;
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!camera) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_set_camera: camera is NULL");
+    c = *camera;
+    hd__camera_defaults(&c);
+    if ((r = hd__check_camera(&c, &ctx->log)) != HD_SUCCESS) return r;
+    if (c.width != ctx->camera.width || c.height != ctx->camera.height) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
+    ctx->camera = c;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
+{
+    hd_params p;
+    hd_result r;
+    const hd_params *o;
+    HD__GET_CTX(ctx, h);
+    if (!params) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_set_params: params is NULL");
+    p = *params;
+    hd__params_defaults(&p);
+    if ((r = hd__check_params(&p, &ctx->log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
+    o = &ctx->params;
+    if (p.method != o->method) ctx->dirty |= HD__DIRTY_ALL;
+    if (p.extinction != o->extinction || p.majorant != o->majorant)
+        ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    if (p.seed != o->seed) ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    if (p.albedo != o->albedo || p.anisotropy != o->anisotropy || p.disable_diffusion != o->disable_diffusion)
+        ctx->dirty |= HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    if (p.step != o->step || p.frame_window != o->frame_window ||
+        memcmp(p.background, o->background, sizeof p.background) != 0)
+        ctx->dirty |= HD__DIRTY_IMAGE;
+    if ((p.solver == HD_SOLVER_JACOBI) != (o->solver == HD_SOLVER_JACOBI)) ctx->dirty |= HD__DIRTY_JACOBI;
+    ctx->params = p;
+    if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
+    return HD_SUCCESS;
+}
+
+/* ---- the schedule ---------------------------------------------------------------------------- */
+static size_t hd__illum_floats(const hd__ctx *ctx)
+{
+    return (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2] * (size_t)ctx->channels;
+}
+
+/* Brings the device state up to date with what the setters changed, in dependency order. */
+static hd_result hd__prepare(hd__ctx *ctx)
+{
+    hd_result r;
+    unsigned dirty = ctx->dirty;
+    if (dirty & HD__DIRTY_ALLOC) {
+        if ((r = hd__be_alloc_illumination(ctx, hd__illum_floats(ctx))) != HD_SUCCESS) return r;
+        dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE | HD__DIRTY_JACOBI;
+    }
+    if (dirty & HD__DIRTY_JACOBI) {
+        if ((r = hd__be_alloc_jacobi(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    }
+    if (dirty & HD__DIRTY_IMAGE_ALLOC) {
+        if ((r = hd__be_alloc_image(ctx, ctx->camera.width, ctx->camera.height)) != HD_SUCCESS) return r;
+        dirty |= HD__DIRTY_IMAGE;
+    }
+    ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
+    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
+    if (dirty & HD__DIRTY_IMAGE) ctx->frames = 0;
+    hd__fill_kparams(ctx);
+    if (dirty & HD__DIRTY_SIGMA) {
+        if ((r = hd__be_upload_inputs(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
+    }
+    if ((r = hd__be_clear(ctx, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
+    ctx->dirty = 0;
+    return HD_SUCCESS;
+}
+
+/* One HD iteration: a direct-light sample per voxel, the diffusion sweeps, one frame. */
+static hd_result hd__iterate_hd(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now(), t1, t2;
+    int s;
+    ctx->iterations++;
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
+    t1 = hd__now();
+    if (!ctx->params.disable_diffusion)
+        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
+            if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    t2 = hd__now();
+    if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
+    ctx->seconds[0] += t1 - t0;
+    ctx->seconds[1] += t2 - t1;
+    ctx->seconds[2] += hd__now() - t2;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_iterate(hd_context h, int n)
+{
+    hd_result r;
+    int i;
+    HD__GET_CTX(ctx, h);
+    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: n = %d, must be >= 1", n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: more than 2^31 iterations; reset with a new seed");
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    for (i = 0; i < n; ++i) {
+        if ((r = hd__iterate_hd(ctx)) != HD_SUCCESS) return r;
+    }
+    return HD_SUCCESS;
+}
+
+/* ---- read-back --------------------------------------------------------------------------------- */
+HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
+{
+    hd_result r;
+    size_t need;
+    HD__GET_CTX(ctx, h);
+    if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_image_f32: dst is NULL");
+    need = (size_t)ctx->camera.width * ctx->camera.height * 4;
+    if (dst_floats < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_f32: %zu floats given, %zu needed", dst_floats, need);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    return hd__be_read_image(ctx, dst);
+}
+
+static uint8_t hd__srgb8(float v)
+{
+    float s;
+    if (!(v > 0.0f)) return 0;
+    if (v >= 1.0f) return 255;
+    s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)(s * 255.0f + 0.5f);
+}
+
+HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes)
+{
+    hd_result r;
+    size_t need, i, n;
+    float *tmp;
+    HD__GET_CTX(ctx, h);
+    if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_image_rgba8: dst is NULL");
+    n = (size_t)ctx->camera.width * ctx->camera.height;
+    need = n * 4;
+    if (dst_bytes < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_rgba8: %zu bytes given, %zu needed", dst_bytes, need);
+    tmp = (float *)hd__alloc(ctx, need * sizeof(float));
+    if (!tmp) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "hd_read_image_rgba8: no memory for the conversion");
+    if ((r = hd__prepare(ctx)) == HD_SUCCESS && (r = hd__be_read_image(ctx, tmp)) == HD_SUCCESS) {
+        float e = ctx->params.exposure;
+        for (i = 0; i < n; ++i) {
+            float a = tmp[4 * i + 3];
+            dst[4 * i] = hd__srgb8(tmp[4 * i] * e);
+            dst[4 * i + 1] = hd__srgb8(tmp[4 * i + 1] * e);
+            dst[4 * i + 2] = hd__srgb8(tmp[4 * i + 2] * e);
+            dst[4 * i + 3] = (uint8_t)(a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)(a * 255.0f + 0.5f));
+        }
+    }
+    hd__free(ctx, tmp);
+    return r;
+}
+
+HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float *dst, size_t dst_floats)
+{
+    hd_result r;
+    size_t need;
+    HD__GET_CTX(ctx, h);
+    if ((int)which < 0 || which >= HD_ILLUMINATION_COUNT)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_ENUM, "hd_read_illumination: which = %d is not a hd_illumination", (int)which);
+    if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_illumination: dst is NULL");
+    need = hd__illum_floats(ctx);
+    if (dst_floats < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    return hd__be_read_illumination(ctx, which, dst);
+}
+
+HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
+{
+    size_t gvox;
+    HD__GET_CTX(ctx, h);
+    if (!out) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_get_stats: out_stats is NULL");
+    memset(out, 0, sizeof *out);
+    gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    out->method = ctx->params.method;
+    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations;
+    out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
+    /* sigma_t grid + E + phi (+ Jacobi's buffer): what the method needs, independent of lights */
+    out->method_bytes = gvox * sizeof(float) +
+                        hd__illum_floats(ctx) * sizeof(float) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+    out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
+    hd__be_volume_bytes(ctx, &out->volume_bytes);
+    memcpy(out->illumination_dims, ctx->gdims, sizeof ctx->gdims);
+    out->illumination_channels = ctx->channels;
+    out->seconds_direct = ctx->seconds[0];
+    out->seconds_diffusion = ctx->seconds[1];
+    out->seconds_projection = ctx->seconds[2];
+    return HD_SUCCESS;
+}

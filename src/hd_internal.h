@@ -1,0 +1,118 @@
+/* hd_internal.h - the context's private state, logging and allocation, shared by the core
+   (hd_context.h) and the backends. Private names are hd__ / HD__. */
+#ifndef HD_INTERNAL_H
+#define HD_INTERNAL_H
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <math.h>
+
+#ifndef HD_MAX_CONTEXTS
+#define HD_MAX_CONTEXTS 64
+#endif
+/* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
+#define HD__MAX_VOXELS (1u << 30)
+#define HD__MAJORANT_CELL 8 /* voxels per majorant-grid cell edge */
+
+/* What a setter invalidates (see the table above hd_set_transfer_function). */
+enum {
+    HD__DIRTY_SIGMA = 1,   /* sigma_t grid and majorant grid */
+    HD__DIRTY_DIRECT = 2,  /* E and its iteration count */
+    HD__DIRTY_PHI = 4,     /* phi */
+    HD__DIRTY_IMAGE = 8,   /* image accumulation */
+    HD__DIRTY_ALLOC = 16,  /* illumination grids must be (re)allocated (size or channels) */
+    HD__DIRTY_IMAGE_ALLOC = 32, /* the image must be (re)allocated (its size changed) */
+    HD__DIRTY_JACOBI = 64, /* Jacobi's second buffer must be allocated or freed */
+    HD__DIRTY_ALL = 127
+};
+
+#if defined(__GNUC__) || defined(__clang__)
+#define HD__MAYBE_UNUSED __attribute__((unused))
+#else
+#define HD__MAYBE_UNUSED
+#endif
+
+typedef struct hd__backend hd__backend; /* defined by the selected backend */
+
+typedef struct hd__ctx {
+    hd_desc desc;            /* with defaults filled in; pointers refer to the copies below */
+    hd_allocator alloc;
+    hd_logger log;
+    /* volume */
+    int dims[3];
+    size_t nvox;
+    float box[3];            /* world size of the volume box */
+    float *vol;              /* normalised voxel values in [0, 1] */
+    float *cell_range;       /* per majorant cell: min and max value incl. the filter halo */
+    int mdims[3];
+    float *majorant;         /* per cell: max sigma_t */
+    float max_sigma;         /* max over the whole grid */
+    /* inputs */
+    float *tf;               /* RGBA * tf_count */
+    int tf_count;
+    hd_light lights[HD_MAX_LIGHTS];
+    int light_count;
+    hd_camera camera;
+    hd_params params;
+    /* method state */
+    int gdims[3];            /* illumination grid */
+    int channels;            /* 1 or 3 */
+    float chan_color[3];
+    unsigned dirty;
+    uint64_t iterations;
+    uint64_t frames;
+    hd__kparams kp;
+    double seconds[3];       /* direct (or convection / paths), diffusion, projection */
+    hd__backend *be;
+} hd__ctx;
+
+/* ---- logging ---------------------------------------------------------------------------- */
+static void hd__logf(const hd_logger *log, hd_log_level level, hd_result code, const char *file,
+                     int line, const char *fmt, ...)
+{
+    char msg[1024];
+    va_list ap;
+    if (!log || !log->func) return;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    log->func(log->user_data, level, code, msg, file, line);
+}
+/* Logs an error and evaluates to its code: `return HD__ERR(log, HD_ERROR_X, "...", ...);` */
+#define HD__ERR(log, code, ...) (hd__logf((log), HD_LOG_ERROR, (code), __FILE__, __LINE__, __VA_ARGS__), (code))
+#define HD__INFO(log, ...) hd__logf((log), HD_LOG_INFO, HD_SUCCESS, __FILE__, __LINE__, __VA_ARGS__)
+
+/* ---- allocation through the caller's allocator ------------------------------------------ */
+static void *hd__malloc_default(size_t size, void *user) { (void)user; return malloc(size); }
+static void hd__free_default(void *ptr, void *user) { (void)user; free(ptr); }
+
+static void *hd__alloc(hd__ctx *ctx, size_t size)
+{
+    return ctx->alloc.alloc(size ? size : 1, ctx->alloc.user_data);
+}
+static void *hd__calloc(hd__ctx *ctx, size_t count, size_t size)
+{
+    void *p;
+    if (size && count > (size_t)-1 / size) return NULL;
+    p = hd__alloc(ctx, count * size);
+    if (p) memset(p, 0, count * size);
+    return p;
+}
+static void hd__free(hd__ctx *ctx, void *ptr)
+{
+    if (ptr) ctx->alloc.free(ptr, ctx->alloc.user_data);
+}
+
+/* Wall clock for the per-stage timers. */
+#include <time.h>
+static double hd__now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int hd__finite(float v) { return v == v && v - v == 0.0f; }
+
+#endif /* HD_INTERNAL_H */

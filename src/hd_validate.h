@@ -1,0 +1,153 @@
+/* hd_validate.h - checks every input and fills the documented defaults, before anything is
+   allocated or dispatched. Each check returns its own hd_result and logs what was wrong. */
+
+static int hd__finite3(const float v[3]) { return hd__finite(v[0]) && hd__finite(v[1]) && hd__finite(v[2]); }
+
+static hd_result hd__check_volume(const hd_volume_desc *v, const hd_logger *log)
+{
+    size_t nvox = 1;
+    int i;
+    if (v->type <= HD_VOXEL_INVALID || v->type >= HD_VOXEL_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "volume.type %d is not a hd_voxel_type", (int)v->type);
+    for (i = 0; i < 3; ++i) {
+        if (v->dims[i] < 1 || v->dims[i] > HD_MAX_DIM)
+            return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "volume.dims[%d] = %d is outside 1..%d", i, v->dims[i], HD_MAX_DIM);
+    }
+    for (i = 0; i < 3; ++i) nvox *= (size_t)v->dims[i];
+    /* 3 channels of illumination are indexed by 32-bit ints in the kernels */
+    if (nvox > HD__MAX_VOXELS / 3)
+        return HD__ERR(log, HD_ERROR_SIZE_OVERFLOW, "volume of %dx%dx%d voxels exceeds the %u-voxel limit",
+                       v->dims[0], v->dims[1], v->dims[2], HD__MAX_VOXELS / 3);
+    if (!v->data) return HD__ERR(log, HD_ERROR_NULL_POINTER, "volume.data is NULL");
+    for (i = 0; i < 3; ++i) {
+        if (v->spacing[0] == 0.0f && v->spacing[1] == 0.0f && v->spacing[2] == 0.0f) break;
+        if (!hd__finite(v->spacing[i]) || !(v->spacing[i] > 0.0f))
+            return HD__ERR(log, HD_ERROR_INVALID_SPACING, "volume.spacing[%d] = %g must be finite and > 0", i, (double)v->spacing[i]);
+    }
+    if (!hd__finite(v->value_range[0]) || !hd__finite(v->value_range[1]) ||
+        (v->value_range[0] == v->value_range[1] && v->value_range[0] != 0.0f))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "volume.value_range {%g, %g} must be finite and not empty",
+                       (double)v->value_range[0], (double)v->value_range[1]);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__check_tf(const hd_transfer_function *tf, const hd_logger *log)
+{
+    int i;
+    if (!tf->rgba && tf->count == 0) return HD_SUCCESS; /* the default ramp */
+    if (tf->count < 2) return HD__ERR(log, HD_ERROR_INVALID_TRANSFER_FUNCTION, "transfer function has %d entries, needs >= 2", tf->count);
+    if (tf->count > (1 << 20)) return HD__ERR(log, HD_ERROR_INVALID_TRANSFER_FUNCTION, "transfer function has %d entries, at most %d", tf->count, 1 << 20);
+    if (!tf->rgba) return HD__ERR(log, HD_ERROR_NULL_POINTER, "transfer_function.rgba is NULL with count %d", tf->count);
+    for (i = 0; i < tf->count * 4; ++i) {
+        float v = tf->rgba[i];
+        if (!hd__finite(v) || v < 0.0f || v > 1.0f)
+            return HD__ERR(log, HD_ERROR_INVALID_TRANSFER_FUNCTION, "transfer function entry %d component %d = %g is not in [0, 1]",
+                           i / 4, i % 4, (double)v);
+    }
+    return HD_SUCCESS;
+}
+
+static hd_result hd__check_lights(const hd_light *lights, int count, const hd_logger *log)
+{
+    int i;
+    if (count == 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "no lights: give at least one");
+    if (count < 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "light count %d is negative", count);
+    if (count > HD_MAX_LIGHTS) return HD__ERR(log, HD_ERROR_TOO_MANY_LIGHTS, "%d lights, at most %d", count, HD_MAX_LIGHTS);
+    if (!lights) return HD__ERR(log, HD_ERROR_NULL_POINTER, "lights is NULL with count %d", count);
+    for (i = 0; i < count; ++i) {
+        const hd_light *l = &lights[i];
+        if ((int)l->type < 0 || l->type >= HD_LIGHT_TYPE_COUNT)
+            return HD__ERR(log, HD_ERROR_INVALID_ENUM, "light %d: type %d is not a hd_light_type", i, (int)l->type);
+        if (!hd__finite3(l->direction) || !hd__finite3(l->position) || !hd__finite3(l->color) || !hd__finite(l->intensity))
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d has a NaN or infinite value", i);
+        if (l->color[0] < 0.0f || l->color[1] < 0.0f || l->color[2] < 0.0f || l->intensity < 0.0f)
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d has a negative colour or intensity", i);
+        if (l->type == HD_LIGHT_DIRECTIONAL &&
+            l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] + l->direction[2] * l->direction[2] < 1e-20f)
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: directional light with a zero direction", i);
+    }
+    return HD_SUCCESS;
+}
+
+static void hd__camera_defaults(hd_camera *c)
+{
+    int i, zero = 1;
+    for (i = 0; i < 3; ++i) zero &= c->eye[i] == 0.0f && c->target[i] == 0.0f;
+    if (zero) c->eye[2] = 2.5f;
+    if (c->up[0] == 0.0f && c->up[1] == 0.0f && c->up[2] == 0.0f) c->up[1] = 1.0f;
+    if (c->fov_y == 0.0f) c->fov_y = 40.0f;
+    if (c->width == 0) c->width = 512;
+    if (c->height == 0) c->height = 512;
+}
+
+/* Checks a camera whose defaults are filled in. */
+static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
+{
+    float f[3], cr[3], lf, lu, lc;
+    if (!hd__finite3(c->eye) || !hd__finite3(c->target) || !hd__finite3(c->up) || !hd__finite(c->fov_y))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera has a NaN or infinite value");
+    if (!(c->fov_y > 0.0f && c->fov_y < 180.0f))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera fov_y = %g degrees is outside (0, 180)", (double)c->fov_y);
+    if (c->width < 1 || c->height < 1 || c->width > HD_MAX_IMAGE_DIM || c->height > HD_MAX_IMAGE_DIM)
+        return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "image size %dx%d is outside 1..%d", c->width, c->height, HD_MAX_IMAGE_DIM);
+    f[0] = c->target[0] - c->eye[0]; f[1] = c->target[1] - c->eye[1]; f[2] = c->target[2] - c->eye[2];
+    cr[0] = f[1] * c->up[2] - f[2] * c->up[1];
+    cr[1] = f[2] * c->up[0] - f[0] * c->up[2];
+    cr[2] = f[0] * c->up[1] - f[1] * c->up[0];
+    lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+    lu = sqrtf(c->up[0] * c->up[0] + c->up[1] * c->up[1] + c->up[2] * c->up[2]);
+    lc = sqrtf(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    if (!(lf > 1e-6f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye and target coincide");
+    if (!(lc > 1e-4f * lf * lu)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is parallel to the view direction (or zero)");
+    return HD_SUCCESS;
+}
+
+static void hd__params_defaults(hd_params *p)
+{
+    if (p->method == HD_METHOD_DEFAULT) p->method = HD_METHOD_HD;
+    if (p->extinction == 0.0f) p->extinction = 100.0f;
+    if (p->albedo == 0.0f) p->albedo = 0.9f;
+    if (p->diffusion_sweeps == 0) p->diffusion_sweeps = 4;
+    if (p->solver == HD_SOLVER_DEFAULT) p->solver = HD_SOLVER_RED_BLACK;
+    if (p->tracking == HD_TRACKING_DEFAULT) p->tracking = HD_TRACKING_RATIO;
+    if (p->step == 0.0f) p->step = 0.5f;
+    if (p->frame_window == 0) p->frame_window = 8;
+    if (p->exposure == 0.0f) p->exposure = 1.0f;
+    if (p->max_bounces == 0) p->max_bounces = 64;
+}
+
+/* Checks parameters whose defaults are filled in. */
+static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
+{
+    if ((int)p->method < 0 || p->method >= HD_METHOD_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.method %d is not a hd_method", (int)p->method);
+    if ((int)p->solver < 0 || p->solver >= HD_SOLVER_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.solver %d is not a hd_solver", (int)p->solver);
+    if ((int)p->tracking < 0 || p->tracking >= HD_TRACKING_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.tracking %d is not a hd_tracking", (int)p->tracking);
+    if (!hd__finite(p->extinction) || p->extinction < 0.0f || p->extinction > 1e6f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.extinction = %g is outside (0, 1e6]", (double)p->extinction);
+    if (!hd__finite(p->albedo) || p->albedo < 0.0f || p->albedo > 1.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.albedo = %g is outside (0, 1]", (double)p->albedo);
+    if (!hd__finite(p->anisotropy) || !(p->anisotropy > -1.0f && p->anisotropy < 1.0f))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.anisotropy = %g is outside (-1, 1)", (double)p->anisotropy);
+    if (!hd__finite(p->majorant) || p->majorant < 0.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.majorant = %g must be >= 0 and finite", (double)p->majorant);
+    if (p->diffusion_sweeps < 0 || p->diffusion_sweeps > 100000)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_sweeps = %d is outside 1..100000", p->diffusion_sweeps);
+    if (!hd__finite3(p->background) || p->background[0] < 0.0f || p->background[1] < 0.0f || p->background[2] < 0.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.background must be finite and >= 0");
+    if (!hd__finite(p->step) || !(p->step >= 0.01f && p->step <= 16.0f))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.step = %g voxels is outside [0.01, 16]", (double)p->step);
+    if (p->frame_window < 0)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.frame_window = %d is negative", p->frame_window);
+    if (!hd__finite(p->exposure) || p->exposure < 0.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.exposure = %g must be >= 0 and finite", (double)p->exposure);
+    if (p->max_bounces < 0 || p->max_bounces > 100000)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.max_bounces = %d is outside 1..100000", p->max_bounces);
+    if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
+    if (p->method != HD_METHOD_HD)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method %s is not implemented yet", hd_method_name(p->method));
+    return HD_SUCCESS;
+}

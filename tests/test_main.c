@@ -1,0 +1,33 @@
+/* test_main.c - runs every suite. Usage: hdtest [name-filter] */
+#include "hd_test.h"
+#include <stdlib.h>
+
+int hd_test_failures;
+
+#define HD_SUITES(X) X(core) X(kernels) X(io)
+#define HD__DECL(s) extern const hd_test_case hd_tests_##s[]; extern const int hd_tests_##s##_count;
+HD_SUITES(HD__DECL)
+
+int hd_test_run(const hd_test_case *cases, int count, const char *filter, int *passed, int *failed)
+{
+    int i, bad = 0;
+    for (i = 0; i < count; ++i) {
+        if (filter && !strstr(cases[i].name, filter)) continue;
+        hd_test_failures = 0;
+        fprintf(stderr, "[ RUN  ] %s\n", cases[i].name);
+        cases[i].fn();
+        if (hd_test_failures) { ++*failed; ++bad; fprintf(stderr, "[ FAIL ] %s\n", cases[i].name); }
+        else { ++*passed; fprintf(stderr, "[  OK  ] %s\n", cases[i].name); }
+    }
+    return bad;
+}
+
+int main(int argc, char **argv)
+{
+    int passed = 0, failed = 0;
+    const char *filter = argc > 1 ? argv[1] : NULL;
+#define HD__RUN(s) hd_test_run(hd_tests_##s, hd_tests_##s##_count, filter, &passed, &failed);
+    HD_SUITES(HD__RUN)
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
