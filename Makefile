@@ -16,8 +16,13 @@ help:
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
 
-$(B)/%.o: tests/%.c $(LIB_SRC) tests/hd_test.h | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/%.o: tests/%.c $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(B)
+	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(CFLAGS) -c $< -o $@
+
+# Every tests/*.c that defines `const hd_test_case hd_tests_NAME[]` is a suite of build/hdtest.
+$(B)/hd_suites.h: $(wildcard tests/*.c) | $(B)
+	sed -n 's/^const hd_test_case hd_tests_\([a-z0-9_]*\)\[\].*/X(\1)/p' tests/*.c > $@.tmp
+	cmp -s $@.tmp $@ || mv $@.tmp $@; rm -f $@.tmp
 
 TEST_OBJ := $(patsubst tests/%.c,$(B)/%.o,$(wildcard tests/*.c))
 $(B)/hdtest: $(TEST_OBJ)
@@ -40,3 +45,6 @@ data:
 
 clean:
 	rm -rf $(B)
+
+# Backends, tools and test programs that bring their own rules (one fragment each).
+-include $(wildcard mk/*.mk)

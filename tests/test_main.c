@@ -1,12 +1,14 @@
-/* test_main.c - runs every suite. Usage: hdtest [name-filter] */
+/* test_main.c - runs every suite. Usage: hdtest [name-filter]
+   hd_suites.h (made by the Makefile) lists X(name) for each tests/*.c that defines
+   `const hd_test_case hd_tests_name[]`, so a new suite needs no edit here. */
 #include "hd_test.h"
 #include <stdlib.h>
 
 int hd_test_failures;
 
-#define HD_SUITES(X) X(core) X(kernels) X(io)
-#define HD__DECL(s) extern const hd_test_case hd_tests_##s[]; extern const int hd_tests_##s##_count;
-HD_SUITES(HD__DECL)
+#define X(s) extern const hd_test_case hd_tests_##s[]; extern const int hd_tests_##s##_count;
+#include "hd_suites.h"
+#undef X
 
 int hd_test_run(const hd_test_case *cases, int count, const char *filter, int *passed, int *failed)
 {
@@ -26,8 +28,9 @@ int main(int argc, char **argv)
 {
     int passed = 0, failed = 0;
     const char *filter = argc > 1 ? argv[1] : NULL;
-#define HD__RUN(s) hd_test_run(hd_tests_##s, hd_tests_##s##_count, filter, &passed, &failed);
-    HD_SUITES(HD__RUN)
+#define X(s) hd_test_run(hd_tests_##s, hd_tests_##s##_count, filter, &passed, &failed);
+#include "hd_suites.h"
+#undef X
     printf("%d passed, %d failed\n", passed, failed);
     return failed ? 1 : 0;
 }
