@@ -6,13 +6,15 @@ CPPFLAGS := -I. -D_POSIX_C_SOURCE=200809L
 LDLIBS  := -lm -lpthread -lz
 B       := build
 
-.PHONY: all test clean help data
+.PHONY: all test clean help data render bench
 all: $(B)/hdtest $(B)/hdrender $(B)/hdbench
 
 help:
 	@echo "make test      build and run the unit and analytic tests (CPU backend)"
 	@echo "make all       tests, examples/hdrender, bench/hdbench"
 	@echo "make data      fetch the head CT into data/ (Debian package invesalius-examples)"
+	@echo "make render    fetch the data, build hdrender and render the head to out/head.png"
+	@echo "make bench     print the benchmark figures (bench/hdbench)"
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
 
@@ -42,6 +44,12 @@ test: $(B)/hdtest
 
 data:
 	scripts/fetch-data
+
+render: $(B)/hdrender data
+	$(B)/hdrender data/head.nrrd -o out/head.png
+
+bench: $(B)/hdbench data
+	$(B)/hdbench
 
 clean:
 	rm -rf $(B)

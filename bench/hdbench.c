@@ -1,0 +1,196 @@
+/* hdbench - prints the figures the core's targets are measured by, in one run:
+     - memory bandwidth (STREAM triad a = b + s c, all threads), the roofline for the stencil;
+     - the diffusion sweep's time and bytes/s as a share of the triad;
+     - HD iterations/s and per-stage times on the head CT at 512^2 and 1024^2, 1 and 3 lights;
+     - bytes per voxel of HD's state for 1, 3 and 16 lights.
+   Usage: hdbench [data/head.nrrd] [--quick]   (make data fetches the head CT)
+   Figures, not a test: nothing here passes or fails. */
+#define HYBRIDDIFF_IMPLEMENTATION
+#ifndef HYBRIDDIFF_BACKEND_OPENCL
+#define HYBRIDDIFF_BACKEND_CPU
+#endif
+#include "hybriddiff.h"
+
+#define BENCH_TRIAD_N (32u << 20) /* 3 arrays of 128 MiB: far beyond the caches */
+
+typedef struct triad_job { float *a, *b, *c; size_t lo, hi; int reps; } triad_job;
+
+static void *triad_worker(void *arg)
+{
+    triad_job *j = (triad_job *)arg;
+    int r;
+    size_t i;
+    for (r = 0; r < j->reps; ++r)
+        for (i = j->lo; i < j->hi; ++i) j->a[i] = j->b[i] + 3.0f * j->c[i];
+    return NULL;
+}
+
+/* Best-of-5 triad bandwidth in bytes/s over nthreads threads (24 bytes per element, the STREAM
+   convention: write-allocate traffic not counted). */
+static double triad_bandwidth(int nthreads)
+{
+    float *a = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
+    float *b = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
+    float *c = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
+    pthread_t th[64];
+    triad_job jobs[64];
+    double best = 0.0;
+    int rep, t;
+    size_t i;
+    for (i = 0; i < BENCH_TRIAD_N; ++i) { a[i] = 0.0f; b[i] = 1.0f; c[i] = 2.0f; }
+    for (rep = 0; rep < 5; ++rep) {
+        double t0 = hd__now(), dt;
+        for (t = 0; t < nthreads; ++t) {
+            jobs[t].a = a; jobs[t].b = b; jobs[t].c = c; jobs[t].reps = 1;
+            jobs[t].lo = BENCH_TRIAD_N / nthreads * t;
+            jobs[t].hi = t == nthreads - 1 ? BENCH_TRIAD_N : BENCH_TRIAD_N / nthreads * (t + 1);
+            pthread_create(&th[t], NULL, triad_worker, &jobs[t]);
+        }
+        for (t = 0; t < nthreads; ++t) pthread_join(th[t], NULL);
+        dt = hd__now() - t0;
+        if (24.0 * BENCH_TRIAD_N / dt > best) best = 24.0 * BENCH_TRIAD_N / dt;
+    }
+    free(a); free(b); free(c);
+    return best;
+}
+
+static hd_light bench_lights[3];
+
+static void setup_lights(void)
+{
+    memset(bench_lights, 0, sizeof bench_lights);
+    bench_lights[0].direction[0] = -0.5f; bench_lights[0].direction[1] = -1.0f; bench_lights[0].direction[2] = -0.6f;
+    bench_lights[1].direction[0] = 1.0f; bench_lights[1].direction[1] = -0.3f; bench_lights[1].direction[2] = 0.2f;
+    bench_lights[2].direction[0] = 0.2f; bench_lights[2].direction[1] = 0.8f; bench_lights[2].direction[2] = -1.0f;
+}
+
+/* A CT transfer function over HU -1024..3071: skin faint, bone dense. */
+static const float bench_tf[] = {
+    0.0f, 0.0f, 0.0f, 0.0f,        /* -1024 air */
+    0.0f, 0.0f, 0.0f, 0.0f,        /* -512 */
+    0.93f, 0.73f, 0.62f, 0.02f,    /* 0 soft tissue */
+    0.93f, 0.73f, 0.62f, 0.05f,    /* 512 */
+    1.0f, 0.98f, 0.9f, 0.5f,       /* 1024 bone */
+    1.0f, 1.0f, 1.0f, 1.0f,        /* 1536 */
+    1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+
+static void fill_desc(hd_desc *d, const hd_volume_file *vf, int size, int lights)
+{
+    memset(d, 0, sizeof *d);
+    d->volume = vf->desc;
+    d->volume.value_range[0] = -1024.0f;
+    d->volume.value_range[1] = 3071.0f;
+    d->transfer_function.rgba = bench_tf;
+    d->transfer_function.count = (int)(sizeof bench_tf / sizeof bench_tf[0] / 4);
+    d->lights = bench_lights;
+    d->light_count = lights;
+    d->camera.eye[1] = 2.3f; d->camera.eye[2] = 0.3f; d->camera.up[2] = 1.0f;
+    d->camera.fov_y = 30.0f;
+    d->camera.width = d->camera.height = size;
+    d->logger.func = hd_log_stderr;
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = "data/head.nrrd";
+    int quick = 0, i, sizes[2] = {512, 1024}, si, li, nthreads;
+    hd_volume_file vf;
+    hd_result r;
+    double triad, hd_rate[2][2] = {{0, 0}, {0, 0}};
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--quick") == 0) quick = 1;
+        else path = argv[i];
+    }
+    r = hd_volume_load_nrrd(path, &vf, NULL);
+    if (r != HD_SUCCESS) {
+        fprintf(stderr, "hdbench: cannot load %s: %s (run `make data` first)\n", path, hd_result_string(r));
+        return 2;
+    }
+    setup_lights();
+    nthreads = (int)sysconf(_SC_NPROCESSORS_ONLN);
+    printf("hdbench: backend %s, %d threads, volume %s %dx%dx%d\n", hd_backend_name(), nthreads, path,
+           vf.desc.dims[0], vf.desc.dims[1], vf.desc.dims[2]);
+    triad = triad_bandwidth(nthreads);
+    printf("STREAM triad: %.2f GB/s\n", triad * 1e-9);
+
+    /* the diffusion sweep, timed through the per-stage clock over many sweeps */
+    {
+        hd_desc d;
+        hd_context ctx;
+        hd_stats s0, s1;
+        int solver, sweeps = quick ? 20 : 100;
+        for (solver = HD_SOLVER_RED_BLACK; solver <= HD_SOLVER_JACOBI; ++solver) {
+            double t, nvox, bytes;
+            fill_desc(&d, &vf, 64, 1);
+            d.params.solver = (hd_solver)solver;
+            d.params.diffusion_sweeps = sweeps;
+            if (hd_create(&d, &ctx) != HD_SUCCESS) return 1;
+            hd_iterate(ctx, 1); /* warm-up: first touch of the pages */
+            hd_get_stats(ctx, &s0);
+            hd_iterate(ctx, 1);
+            hd_get_stats(ctx, &s1);
+            t = (s1.seconds_diffusion - s0.seconds_diffusion) / sweeps;
+            nvox = (double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2];
+            /* red-black: each half-sweep streams sigma, E, phi in and phi out: 2 x 16 B/voxel;
+               Jacobi: sigma, E, phi in and phi2 out: 16 B/voxel */
+            bytes = nvox * (solver == HD_SOLVER_RED_BLACK ? 32.0 : 16.0);
+            printf("diffusion sweep (%s): %.2f ms = %.0f sweeps/s, %.2f GB/s = %.0f%% of the triad\n",
+                   solver == HD_SOLVER_RED_BLACK ? "red-black" : "Jacobi", t * 1e3, 1.0 / t, bytes / t * 1e-9,
+                   100.0 * bytes / t / triad);
+            hd_destroy(ctx);
+        }
+    }
+
+    /* HD iterations per second and per-stage times */
+    printf("\n| image | lights | HD it/s | direct ms | diffusion ms | projection ms | bytes/voxel |\n");
+    printf("|---|---|---|---|---|---|---|\n");
+    for (si = 0; si < 2; ++si) {
+        for (li = 0; li < 2; ++li) {
+            int lights = li == 0 ? 1 : 3, iters = quick ? 2 : 5;
+            hd_desc d;
+            hd_context ctx;
+            hd_stats s0, s1;
+            double t0, dt, n;
+            fill_desc(&d, &vf, sizes[si], lights);
+            if (hd_create(&d, &ctx) != HD_SUCCESS) return 1;
+            hd_iterate(ctx, 1);
+            hd_get_stats(ctx, &s0);
+            t0 = hd__now();
+            hd_iterate(ctx, iters);
+            dt = hd__now() - t0;
+            hd_get_stats(ctx, &s1);
+            n = (double)iters;
+            hd_rate[si][li] = n / dt;
+            printf("| %d^2 | %d | %.3f | %.1f | %.1f | %.1f | %.1f |\n", sizes[si], lights, n / dt,
+                   (s1.seconds_direct - s0.seconds_direct) / n * 1e3, (s1.seconds_diffusion - s0.seconds_diffusion) / n * 1e3,
+                   (s1.seconds_projection - s0.seconds_projection) / n * 1e3,
+                   (double)s1.method_bytes / ((double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2]));
+            hd_destroy(ctx);
+        }
+        printf("| %d^2 | 3 vs 1 | %.2fx | | | | |\n", sizes[si], hd_rate[si][1] / hd_rate[si][0]);
+    }
+
+    /* bytes per voxel against the light count */
+    {
+        hd_light many[16];
+        hd_desc d;
+        hd_context ctx;
+        hd_stats s;
+        int counts[3] = {1, 3, 16};
+        memset(many, 0, sizeof many);
+        for (i = 0; i < 16; ++i) { many[i].direction[0] = cosf((float)i); many[i].direction[1] = sinf((float)i); many[i].direction[2] = -1.0f; }
+        printf("\nHD state per voxel:");
+        for (i = 0; i < 3; ++i) {
+            fill_desc(&d, &vf, 64, counts[i]);
+            d.lights = many;
+            if (hd_create(&d, &ctx) != HD_SUCCESS) return 1;
+            hd_get_stats(ctx, &s);
+            printf(" %d lights %.1f B;", counts[i],
+                   (double)s.method_bytes / ((double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2]));
+            hd_destroy(ctx);
+        }
+        printf("\n");
+    }
+    hd_volume_free(&vf);
+    return 0;
+}
