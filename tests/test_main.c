@@ -1,5 +1,5 @@
 /* test_main.c - runs every suite. Usage: hdtest [name-filter]
-   hd_suites.h (made by the Makefile) lists X(name) for each tests/*.c that defines
+   hd_suites.h (made by the Makefile) lists X(name) for each test file that defines
    `const hd_test_case hd_tests_name[]`, so a new suite needs no edit here. */
 #include "hd_test.h"
 #include <stdlib.h>
