@@ -1,0 +1,467 @@
+/* hd_opencl.h - the OpenCL 1.2 backend: the shared kernels (backends/kernels/), compiled at run
+   time behind the OpenCL C prelude (hd_prelude_cl.h) from the strings scripts/embed-kernels
+   writes into hd_kernels_embedded.h, so there is no second copy of the math.
+   Defines the same hd__be_* functions, with the same contracts, as the CPU reference hd_cpu.h.
+
+   Whose device: the caller may pass its cl_command_queue (the context and device are taken from
+   it), or its cl_context (+ optionally a cl_device_id of it), in desc.opencl; the backend retains
+   them and releases them when the context is destroyed. Otherwise it picks a device itself: the
+   first whose name contains desc.opencl.device_name or $HD_CL_DEVICE (substring), else the first
+   GPU, else the first device of any type.
+   Memory: the volume, TF, majorant grid, sigma_t, E, phi (+ Jacobi's phi2) and the image are
+   plain buffers; volume reads use the shared software trilinear filter (docs/DESIGN-OPENCL.md
+   has the measurement against 3D images with a linear sampler).
+   Errors: every CL call is checked; the failing call and its CL error name are logged and the
+   code becomes an hd_result (allocation -> HD_ERROR_OUT_OF_DEVICE_MEMORY, lost device ->
+   HD_ERROR_DEVICE_LOST, which then sticks: later calls fail fast). */
+#ifndef CL_TARGET_OPENCL_VERSION
+#define CL_TARGET_OPENCL_VERSION 120
+#endif
+#if defined(__APPLE__)
+#include <OpenCL/cl.h>
+#else
+#include <CL/cl.h>
+#endif
+#include "hd_kernels_embedded.h"
+
+enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT, HD__CL_KERNEL_COUNT };
+static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
+    "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_project"};
+
+struct hd__backend {
+    hd__ctx *ctx;
+    cl_context context;
+    cl_device_id device;
+    cl_command_queue queue;
+    cl_program program;
+    cl_kernel kernels[HD__CL_KERNEL_COUNT];
+    /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
+    cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
+    size_t tf_bytes, illum_floats, img_floats;
+    cl_ulong max_alloc;
+    hd__kparams params_sent; /* what the params buffer holds */
+    int params_valid;
+    int lost;                /* a call reported a lost device: every later call fails fast */
+};
+
+static const char *hd__be_name(void) { return "opencl"; }
+
+/* ---- errors ------------------------------------------------------------------------------ */
+static const char *hd__cl_error_name(cl_int e)
+{
+    switch (e) {
+#define HD__CLE(name) case name: return #name;
+    HD__CLE(CL_SUCCESS) HD__CLE(CL_DEVICE_NOT_FOUND) HD__CLE(CL_DEVICE_NOT_AVAILABLE)
+    HD__CLE(CL_COMPILER_NOT_AVAILABLE) HD__CLE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    HD__CLE(CL_OUT_OF_RESOURCES) HD__CLE(CL_OUT_OF_HOST_MEMORY)
+    HD__CLE(CL_PROFILING_INFO_NOT_AVAILABLE) HD__CLE(CL_MEM_COPY_OVERLAP) HD__CLE(CL_IMAGE_FORMAT_MISMATCH)
+    HD__CLE(CL_IMAGE_FORMAT_NOT_SUPPORTED) HD__CLE(CL_BUILD_PROGRAM_FAILURE) HD__CLE(CL_MAP_FAILURE)
+    HD__CLE(CL_MISALIGNED_SUB_BUFFER_OFFSET) HD__CLE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    HD__CLE(CL_COMPILE_PROGRAM_FAILURE) HD__CLE(CL_LINKER_NOT_AVAILABLE) HD__CLE(CL_LINK_PROGRAM_FAILURE)
+    HD__CLE(CL_DEVICE_PARTITION_FAILED) HD__CLE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    HD__CLE(CL_INVALID_VALUE) HD__CLE(CL_INVALID_DEVICE_TYPE) HD__CLE(CL_INVALID_PLATFORM)
+    HD__CLE(CL_INVALID_DEVICE) HD__CLE(CL_INVALID_CONTEXT) HD__CLE(CL_INVALID_QUEUE_PROPERTIES)
+    HD__CLE(CL_INVALID_COMMAND_QUEUE) HD__CLE(CL_INVALID_HOST_PTR) HD__CLE(CL_INVALID_MEM_OBJECT)
+    HD__CLE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR) HD__CLE(CL_INVALID_IMAGE_SIZE) HD__CLE(CL_INVALID_SAMPLER)
+    HD__CLE(CL_INVALID_BINARY) HD__CLE(CL_INVALID_BUILD_OPTIONS) HD__CLE(CL_INVALID_PROGRAM)
+    HD__CLE(CL_INVALID_PROGRAM_EXECUTABLE) HD__CLE(CL_INVALID_KERNEL_NAME)
+    HD__CLE(CL_INVALID_KERNEL_DEFINITION) HD__CLE(CL_INVALID_KERNEL) HD__CLE(CL_INVALID_ARG_INDEX)
+    HD__CLE(CL_INVALID_ARG_VALUE) HD__CLE(CL_INVALID_ARG_SIZE) HD__CLE(CL_INVALID_KERNEL_ARGS)
+    HD__CLE(CL_INVALID_WORK_DIMENSION) HD__CLE(CL_INVALID_WORK_GROUP_SIZE)
+    HD__CLE(CL_INVALID_WORK_ITEM_SIZE) HD__CLE(CL_INVALID_GLOBAL_OFFSET)
+    HD__CLE(CL_INVALID_EVENT_WAIT_LIST) HD__CLE(CL_INVALID_EVENT) HD__CLE(CL_INVALID_OPERATION)
+    HD__CLE(CL_INVALID_GL_OBJECT) HD__CLE(CL_INVALID_BUFFER_SIZE) HD__CLE(CL_INVALID_MIP_LEVEL)
+    HD__CLE(CL_INVALID_GLOBAL_WORK_SIZE) HD__CLE(CL_INVALID_PROPERTY)
+#undef HD__CLE
+    case -1001: return "CL_PLATFORM_NOT_FOUND_KHR";
+    default: return "unknown CL error";
+    }
+}
+
+/* Logs the failing call with its CL error name and returns the hd_result it means. alloc: the
+   call allocates, so a lack of resources is a lack of device memory, not a lost device. */
+static hd_result hd__cl_fail(hd__ctx *ctx, cl_int e, const char *call, int alloc, int line)
+{
+    hd_result r = HD_ERROR_BACKEND;
+    if (e == CL_MEM_OBJECT_ALLOCATION_FAILURE || e == CL_INVALID_BUFFER_SIZE || (alloc && e == CL_OUT_OF_RESOURCES))
+        r = HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    else if (e == CL_OUT_OF_HOST_MEMORY)
+        r = HD_ERROR_OUT_OF_MEMORY;
+    else if (e == CL_DEVICE_NOT_AVAILABLE || e == CL_OUT_OF_RESOURCES || e == CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+        r = HD_ERROR_DEVICE_LOST;
+    if (r == HD_ERROR_DEVICE_LOST && ctx->be) ctx->be->lost = 1;
+    hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, line, "opencl: %s failed: %s (%d)", call,
+             hd__cl_error_name(e), (int)e);
+    return r;
+}
+/* Returns from the calling function when a CL call failed. */
+#define HD__CL_TRY(ctx, call_expr, name) \
+    do { cl_int hd__e = (call_expr); \
+         if (hd__e != CL_SUCCESS) return hd__cl_fail((ctx), hd__e, (name), 0, __LINE__); } while (0)
+
+#define HD__CL_LOST_CHECK(ctx) \
+    do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "opencl: the device was lost earlier"); } while (0)
+
+/* ---- device selection -------------------------------------------------------------------- */
+static int hd__cl_name_matches(cl_device_id dev, const char *want, char *name, size_t cap)
+{
+    name[0] = '\0';
+    if (clGetDeviceInfo(dev, CL_DEVICE_NAME, cap, name, NULL) != CL_SUCCESS) return 0;
+    name[cap - 1] = '\0';
+    return !want || !*want || strstr(name, want) != NULL;
+}
+
+/* Picks a device of the first platform that has one: by name, else a GPU, else any. */
+static hd_result hd__cl_pick_device(hd__ctx *ctx, cl_device_id *out)
+{
+    cl_platform_id plats[16];
+    cl_uint np = 0, p, pass;
+    cl_int e;
+    const char *want = ctx->desc.opencl.device_name;
+    char name[256];
+    if (!want || !*want) want = getenv("HD_CL_DEVICE");
+    e = clGetPlatformIDs(16, plats, &np);
+    if (e == -1001 || (e == CL_SUCCESS && np == 0))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no OpenCL platform is installed (clGetPlatformIDs: %s)",
+                       hd__cl_error_name(e == CL_SUCCESS ? -1001 : e));
+    if (e != CL_SUCCESS) return hd__cl_fail(ctx, e, "clGetPlatformIDs", 0, __LINE__);
+    if (np > 16) np = 16;
+    for (pass = 0; pass < 2; ++pass) {
+        for (p = 0; p < np; ++p) {
+            cl_device_id devs[16];
+            cl_uint nd = 0, d;
+            cl_device_type type = (pass == 0 && !(want && *want)) ? CL_DEVICE_TYPE_GPU : CL_DEVICE_TYPE_ALL;
+            if (clGetDeviceIDs(plats[p], type, 16, devs, &nd) != CL_SUCCESS) continue;
+            if (nd > 16) nd = 16;
+            for (d = 0; d < nd; ++d) {
+                cl_bool avail = CL_FALSE, compiler = CL_FALSE;
+                clGetDeviceInfo(devs[d], CL_DEVICE_AVAILABLE, sizeof avail, &avail, NULL);
+                clGetDeviceInfo(devs[d], CL_DEVICE_COMPILER_AVAILABLE, sizeof compiler, &compiler, NULL);
+                if (!avail || !compiler) continue;
+                if (!hd__cl_name_matches(devs[d], want, name, sizeof name)) continue;
+                *out = devs[d];
+                return HD_SUCCESS;
+            }
+        }
+    }
+    if (want && *want)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no available device's name contains \"%s\"", want);
+    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no available OpenCL device with a compiler");
+}
+
+/* The caller's queue, context and device, or ones the backend makes. Every object is retained
+   once here and released once in hd__be_destroy. */
+static hd_result hd__cl_open(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    cl_int e;
+    if (ctx->desc.opencl.queue) {
+        be->queue = (cl_command_queue)ctx->desc.opencl.queue;
+        HD__CL_TRY(ctx, clRetainCommandQueue(be->queue), "clRetainCommandQueue(desc.opencl.queue)");
+        HD__CL_TRY(ctx, clGetCommandQueueInfo(be->queue, CL_QUEUE_CONTEXT, sizeof be->context, &be->context, NULL), "clGetCommandQueueInfo(CL_QUEUE_CONTEXT)");
+        HD__CL_TRY(ctx, clRetainContext(be->context), "clRetainContext");
+        HD__CL_TRY(ctx, clGetCommandQueueInfo(be->queue, CL_QUEUE_DEVICE, sizeof be->device, &be->device, NULL), "clGetCommandQueueInfo(CL_QUEUE_DEVICE)");
+        return HD_SUCCESS;
+    }
+    if (ctx->desc.opencl.context) {
+        be->context = (cl_context)ctx->desc.opencl.context;
+        HD__CL_TRY(ctx, clRetainContext(be->context), "clRetainContext(desc.opencl.context)");
+        if (ctx->desc.opencl.device) {
+            be->device = (cl_device_id)ctx->desc.opencl.device;
+        } else {
+            HD__CL_TRY(ctx, clGetContextInfo(be->context, CL_CONTEXT_DEVICES, sizeof be->device, &be->device, NULL), "clGetContextInfo(CL_CONTEXT_DEVICES)");
+        }
+    } else {
+        hd_result r;
+        if (ctx->desc.opencl.device) be->device = (cl_device_id)ctx->desc.opencl.device;
+        else if ((r = hd__cl_pick_device(ctx, &be->device)) != HD_SUCCESS) return r;
+        be->context = clCreateContext(NULL, 1, &be->device, NULL, NULL, &e);
+        if (e != CL_SUCCESS) { be->context = NULL; return hd__cl_fail(ctx, e, "clCreateContext", 0, __LINE__); }
+    }
+    be->queue = clCreateCommandQueue(be->context, be->device, 0, &e);
+    if (e != CL_SUCCESS) { be->queue = NULL; return hd__cl_fail(ctx, e, "clCreateCommandQueue", 0, __LINE__); }
+    return HD_SUCCESS;
+}
+
+/* Builds the embedded source; a failure logs the build log (in pieces the logger can hold). */
+static hd_result hd__cl_build(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    cl_int e;
+    char opts[128];
+    int k;
+    be->program = clCreateProgramWithSource(be->context, (cl_uint)HD__CL_SOURCE_LINES, (const char **)hd__cl_source, NULL, &e);
+    if (e != CL_SUCCESS) { be->program = NULL; return hd__cl_fail(ctx, e, "clCreateProgramWithSource", 0, __LINE__); }
+    snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d", HD_MAX_LIGHTS);
+    e = clBuildProgram(be->program, 1, &be->device, opts, NULL, NULL);
+    if (e != CL_SUCCESS) {
+        size_t n = 0, i;
+        char *text;
+        hd_result r = hd__cl_fail(ctx, e, "clBuildProgram", 0, __LINE__);
+        clGetProgramBuildInfo(be->program, be->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
+        text = (char *)hd__alloc(ctx, n + 1);
+        if (text && clGetProgramBuildInfo(be->program, be->device, CL_PROGRAM_BUILD_LOG, n, text, NULL) == CL_SUCCESS) {
+            text[n] = '\0';
+            for (i = 0; i < n && text[i]; i += 900)
+                hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, __LINE__, "opencl: build log: %.900s", text + i);
+        }
+        hd__free(ctx, text);
+        return r;
+    }
+    for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
+        be->kernels[k] = clCreateKernel(be->program, hd__cl_kernel_names[k], &e);
+        if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(ctx, e, hd__cl_kernel_names[k], 0, __LINE__); }
+    }
+    return HD_SUCCESS;
+}
+
+/* ---- buffers ------------------------------------------------------------------------------ */
+static void hd__cl_release(cl_mem *m)
+{
+    if (*m) clReleaseMemObject(*m);
+    *m = NULL;
+}
+
+/* A device buffer of `bytes`, filled from host (copied) or with zeros. */
+static hd_result hd__cl_buffer(hd__ctx *ctx, cl_mem *out, size_t bytes, const void *host, const char *what)
+{
+    hd__backend *be = ctx->be;
+    cl_int e;
+    float zero = 0.0f;
+    *out = NULL;
+    if (bytes == 0) bytes = 16;
+    if ((cl_ulong)bytes > be->max_alloc)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_DEVICE_MEMORY, "opencl: %s needs %zu bytes, above the device's largest allocation (%llu)",
+                       what, bytes, (unsigned long long)be->max_alloc);
+    *out = clCreateBuffer(be->context, CL_MEM_READ_WRITE | (host ? CL_MEM_COPY_HOST_PTR : 0), bytes, (void *)host, &e);
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clCreateBuffer", 1, __LINE__); }
+    if (!host) {
+        e = clEnqueueFillBuffer(be->queue, *out, &zero, sizeof zero, 0, bytes & ~(size_t)3, 0, NULL, NULL);
+        if (e != CL_SUCCESS) return hd__cl_fail(ctx, e, "clEnqueueFillBuffer", 1, __LINE__);
+    }
+    return HD_SUCCESS;
+}
+
+static hd_result hd__cl_zero(hd__ctx *ctx, cl_mem m, size_t floats)
+{
+    float zero = 0.0f;
+    if (!m || floats == 0) return HD_SUCCESS;
+    HD__CL_TRY(ctx, clEnqueueFillBuffer(ctx->be->queue, m, &zero, sizeof zero, 0, floats * sizeof(float), 0, NULL, NULL), "clEnqueueFillBuffer");
+    return HD_SUCCESS;
+}
+
+/* ---- life cycle -------------------------------------------------------------------------- */
+static void hd__be_destroy(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int k;
+    if (!be) return;
+    if (be->queue) clFinish(be->queue);
+    hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf);
+    hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
+    hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
+    for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
+        if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
+    if (be->program) clReleaseProgram(be->program);
+    if (be->queue) clReleaseCommandQueue(be->queue);
+    if (be->context) clReleaseContext(be->context);
+    hd__free(ctx, be);
+    ctx->be = NULL;
+}
+
+static hd_result hd__be_create(hd__ctx *ctx)
+{
+    hd__backend *be;
+    hd_result r;
+    char name[256] = {0}, version[128] = {0};
+    cl_ulong const_size = 0;
+    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
+    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the backend");
+    ctx->be = be;
+    be->ctx = ctx;
+    if ((r = hd__cl_open(ctx)) != HD_SUCCESS) return r;
+    clGetDeviceInfo(be->device, CL_DEVICE_NAME, sizeof name - 1, name, NULL);
+    clGetDeviceInfo(be->device, CL_DEVICE_VERSION, sizeof version - 1, version, NULL);
+    HD__CL_TRY(ctx, clGetDeviceInfo(be->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof be->max_alloc, &be->max_alloc, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
+    HD__CL_TRY(ctx, clGetDeviceInfo(be->device, CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE, sizeof const_size, &const_size, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE)");
+    if (const_size < sizeof(hd__kparams))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: %s holds %llu bytes of __constant memory, the parameters need %zu",
+                       name, (unsigned long long)const_size, sizeof(hd__kparams));
+    HD__INFO(&ctx->log, "opencl: device %s (%s)", name, version);
+    if ((r = hd__cl_build(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->params, sizeof(hd__kparams), NULL, "the parameter block")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->vol, ctx->nvox * sizeof(float), ctx->vol, "the volume")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->maj, ncell * sizeof(float), NULL, "the majorant grid")) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
+    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    hd_result r;
+    HD__CL_LOST_CHECK(ctx);
+    if (tf_bytes != be->tf_bytes) {
+        hd__cl_release(&be->tf);
+        be->tf_bytes = 0;
+        if ((r = hd__cl_buffer(ctx, &be->tf, tf_bytes, NULL, "the transfer function")) != HD_SUCCESS) return r;
+        be->tf_bytes = tf_bytes;
+    }
+    /* blocking: ctx->tf and ctx->majorant may change as soon as this returns */
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->tf, CL_TRUE, 0, tf_bytes, ctx->tf, 0, NULL, NULL), "clEnqueueWriteBuffer(tf)");
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->maj, CL_TRUE, 0, ncell * sizeof(float), ctx->majorant, 0, NULL, NULL), "clEnqueueWriteBuffer(majorant)");
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
+{
+    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
+             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+{
+    hd__backend *be = ctx->be;
+    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    hd_result r;
+    HD__CL_LOST_CHECK(ctx);
+    hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
+    be->illum_floats = 0;
+    if ((r = hd__cl_buffer(ctx, &be->sig, gvox * sizeof(float), NULL, "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->E, illum_floats * sizeof(float), NULL, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->phi, illum_floats * sizeof(float), NULL, "phi")) != HD_SUCCESS) return r;
+    be->illum_floats = illum_floats;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
+{
+    hd__backend *be = ctx->be;
+    HD__CL_LOST_CHECK(ctx);
+    hd__cl_release(&be->phi2);
+    if (!enable) return HD_SUCCESS;
+    return hd__cl_buffer(ctx, &be->phi2, be->illum_floats * sizeof(float), NULL, "Jacobi's buffer");
+}
+
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    HD__CL_LOST_CHECK(ctx);
+    hd__cl_release(&be->img);
+    be->img_floats = 0;
+    if ((r = hd__cl_buffer(ctx, &be->img, (size_t)width * height * 4 * sizeof(float), NULL, "the image")) != HD_SUCCESS) return r;
+    be->img_floats = (size_t)width * height * 4;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+{
+    hd__backend *be = ctx->be;
+    hd_result r = HD_SUCCESS;
+    HD__CL_LOST_CHECK(ctx);
+    if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, be->illum_floats)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, be->illum_floats)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi2, be->illum_floats)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_IMAGE) && (r = hd__cl_zero(ctx, be->img, be->img_floats)) != HD_SUCCESS) return r;
+    return r;
+}
+
+/* ---- dispatch ------------------------------------------------------------------------------ */
+/* Sends ctx->kp when it changed since the last dispatch (blocking: the host copy changes every
+   iteration), and binds the buffers to kernel k's first nine arguments. */
+static hd_result hd__cl_bind(hd__ctx *ctx, int k)
+{
+    hd__backend *be = ctx->be;
+    cl_mem args[9];
+    cl_uint i;
+    HD__CL_LOST_CHECK(ctx);
+    if (!be->params_valid || memcmp(&be->params_sent, &ctx->kp, sizeof ctx->kp) != 0) {
+        HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof ctx->kp, &ctx->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
+        be->params_sent = ctx->kp;
+        be->params_valid = 1;
+    }
+    args[0] = be->params; args[1] = be->vol; args[2] = be->tf; args[3] = be->maj; args[4] = be->sig;
+    args[5] = be->E; args[6] = be->phi; args[7] = be->phi2; args[8] = be->img;
+    for (i = 0; i < 9; ++i)
+        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
+    return HD_SUCCESS;
+}
+
+static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+{
+    size_t global[3];
+    global[0] = gx; global[1] = gy; global[2] = gz;
+    if (gx == 0 || gy == 0 || gz == 0) return HD_SUCCESS;
+    HD__CL_TRY(ctx, clEnqueueNDRangeKernel(ctx->be->queue, ctx->be->kernels[k], dims, NULL, global, NULL, 0, NULL, NULL),
+               hd__cl_kernel_names[k]);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_classify(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__cl_bind(ctx, HD__CL_CLASSIFY)) != HD_SUCCESS) return r;
+    return hd__cl_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
+}
+
+static hd_result hd__be_direct(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__cl_bind(ctx, HD__CL_DIRECT)) != HD_SUCCESS) return r;
+    return hd__cl_run(ctx, HD__CL_DIRECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
+}
+
+/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
+static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+{
+    hd__backend *be = ctx->be;
+    cl_kernel kd = be->kernels[HD__CL_DIFFUSE];
+    cl_int parity, jac = jacobi ? 1 : 0;
+    hd_result r;
+    int pass;
+    if ((r = hd__cl_bind(ctx, HD__CL_DIFFUSE)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(kd, 10, sizeof jac, &jac), "clSetKernelArg(jacobi)");
+    for (pass = 0; pass < (jacobi ? 1 : 2); ++pass) {
+        parity = pass;
+        HD__CL_TRY(ctx, clSetKernelArg(kd, 9, sizeof parity, &parity), "clSetKernelArg(parity)");
+        if ((r = hd__cl_run(ctx, HD__CL_DIFFUSE, 3, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2], (size_t)ctx->channels)) != HD_SUCCESS)
+            return r;
+    }
+    if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_project(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__cl_bind(ctx, HD__CL_PROJECT)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_run(ctx, HD__CL_PROJECT, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
+    /* hd_iterate returns when its work is done, as on the CPU, so stage timers and the caller's
+       clock measure the device, not the enqueueing */
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* ---- read-back ------------------------------------------------------------------------------ */
+static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+{
+    hd__backend *be = ctx->be;
+    HD__CL_LOST_CHECK(ctx);
+    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
+               "clEnqueueReadBuffer(image)");
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    hd__backend *be = ctx->be;
+    HD__CL_LOST_CHECK(ctx);
+    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, 0,
+                                        be->illum_floats * sizeof(float), dst, 0, NULL, NULL),
+               "clEnqueueReadBuffer(illumination)");
+    return HD_SUCCESS;
+}

@@ -1,0 +1,85 @@
+/* hd_prelude_cl.h - OpenCL C 1.2 text, not C: makes the shared kernel sources (backends/kernels/)
+   valid OpenCL C, defining the same names as hd_prelude_c.h (read that file for what each means).
+   scripts/embed-kernels turns this file, the shared kernels and hd_entry_cl.h into string
+   literals in hd_kernels_embedded.h, which hd_opencl.h compiles at run time. The host passes
+   -DHD_MAX_LIGHTS=n, so the parameter block has one definition of its size. */
+#define HD_FN inline
+#define HD_LANG_CL 1
+/* C does not fuse a*b+c (x86-64-v2 has no FMA); OpenCL C would by default. Off, so the
+   deterministic stages round exactly as the CPU reference does. */
+#pragma OPENCL FP_CONTRACT OFF
+
+typedef uint hd_u32;
+typedef float3 hd_v3;
+typedef float4 hd_v4;
+typedef int4 hd_i4;
+typedef float4 hd_f4;
+
+#define HD_F(v) ((float)(v))
+#define HD_I(v) ((int)(v))
+#define HD_U(v) ((hd_u32)(v))
+
+#define HD_V3(x, y, z) ((float3)((x), (y), (z)))
+#define HD_V4(x, y, z, w) ((float4)((x), (y), (z), (w)))
+#define HD_XYZ(v4) ((v4).xyz)
+HD_FN hd_v3 hd_add(hd_v3 a, hd_v3 b) { return a + b; }
+HD_FN hd_v3 hd_sub(hd_v3 a, hd_v3 b) { return a - b; }
+HD_FN hd_v3 hd_scale(hd_v3 a, float s) { return a * s; }
+HD_FN hd_v3 hd_vmul(hd_v3 a, hd_v3 b) { return a * b; }
+HD_FN hd_v3 hd_vdiv(hd_v3 a, hd_v3 b) { return a / b; }
+HD_FN hd_v3 hd_madd(hd_v3 p, hd_v3 d, float t) { return p + d * t; }
+/* Spelled out, not dot(): the same order of operations as the C prelude. */
+HD_FN float hd_dot(hd_v3 a, hd_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+HD_FN float hd_len(hd_v3 a) { return sqrt(hd_dot(a, a)); }
+HD_FN hd_v3 hd_normalize(hd_v3 a) { return hd_scale(a, 1.0f / hd_len(a)); }
+
+#define hd_log(x) log(x)
+#define hd_exp(x) exp(x)
+#define hd_sqrt(x) sqrt(x)
+#define hd_floor(x) floor(x)
+#define hd_absf(x) fabs(x)
+#define hd_powf(x, y) pow((x), (y))
+HD_FN float hd_minf(float a, float b) { return a < b ? a : b; }
+HD_FN float hd_maxf(float a, float b) { return a > b ? a : b; }
+HD_FN int hd_mini(int a, int b) { return a < b ? a : b; }
+HD_FN int hd_maxi(int a, int b) { return a > b ? a : b; }
+HD_FN float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+HD_FN int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+#define HD_STRUCT(name) typedef struct name {
+#define HD_STRUCT_END(name) } name;
+
+/* Output parameters: pointers to private memory. */
+#define HD_INOUT(type) type *
+#define HD_DEREF(p) (*(p))
+#define HD_REF(v) (&(v))
+
+/* The parameter block lives in a __constant buffer; int4/float4 are 16-byte aligned like the
+   C prelude's structs of four 32-bit members, so the offsets agree. */
+#define HD_PARAM_I4(name) int4 name;
+#define HD_PARAM_F4(name) float4 name;
+#define HD_PARAM_F4_ARRAY(name, n) float4 name[n];
+#define HD_PARAMS_BEGIN typedef struct hd__kparams {
+#define HD_PARAMS_END } hd__kparams;
+
+/* What a kernel invocation reaches through K: a private struct of pointers, filled by the
+   __kernel entry points in hd_entry_cl.h. */
+typedef struct hd__kctx {
+    __constant struct hd__kparams *p;
+    __global const float *vol;
+    __global const float *tf;
+    __global const float *maj;
+    __global float *sig;
+    __global float *E;
+    __global float *phi;
+    __global float *phi2;
+    __global float *img;
+} hd__kctx;
+
+#define HD_KARGS const hd__kctx *K,
+#define HD_KPASS K,
+#define HD_PRM(name) (K->p->name)
+#define HD_GET(buf, i, x, y, z) (K->buf[(i)])
+#define HD_SET(buf, i, x, y, z, v) (K->buf[(i)] = (v))
+#define HD_GET1(buf, i) (K->buf[(i)])
+#define HD_SET1(buf, i, v) (K->buf[(i)] = (v))
