@@ -90,6 +90,8 @@ static const char *const hd__cl_source[] = {
 "    __global float *phi;\n",
 "    __global float *phi2;\n",
 "    __global float *img;\n",
+"    __global const float *lv;   /* CD: the light volume being read */\n",
+"    __global float *lv2;        /* CD: the light volume being written */\n",
 "} hd__kctx;\n",
 "\n",
 "#define HD_KARGS const hd__kctx *K,\n",

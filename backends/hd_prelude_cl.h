@@ -74,6 +74,8 @@ typedef struct hd__kctx {
     __global float *phi;
     __global float *phi2;
     __global float *img;
+    __global const float *lv;   /* CD: the light volume being read */
+    __global float *lv2;        /* CD: the light volume being written */
 } hd__kctx;
 
 #define HD_KARGS const hd__kctx *K,

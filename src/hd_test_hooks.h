@@ -1,0 +1,87 @@
+/* hd_test_hooks.h - PRIVATE hooks that run single stages of the schedule (not API: no hd_ names,
+   no stability promise). The conformance suite and the benchmarks include this file after the
+   library's implementation, in the same translation unit, to compare stages across backends:
+   one diffusion sweep, a solve, the projection of illumination they wrote themselves.
+   Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does. */
+
+/* The state a hook starts from: allocations, sigma_t, cleared accumulations. */
+static hd_result hd__test_prepare(hd_context h)
+{
+    HD__GET_CTX(ctx, h);
+    return hd__prepare(ctx);
+}
+
+/* n direct-light passes (HD stage 1 only), each one iteration of the progressive mean. */
+static hd_result hd__test_direct(hd_context h, int n)
+{
+    hd_result r;
+    int i;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    for (i = 0; i < n; ++i) {
+        ctx->iterations++;
+        hd__fill_kparams(ctx);
+        if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
+    }
+    return HD_SUCCESS;
+}
+
+/* n diffusion sweeps of the selected solver on the current E and phi. */
+static hd_result hd__test_diffuse(hd_context h, int n)
+{
+    hd_result r;
+    int i;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    hd__fill_kparams(ctx);
+    for (i = 0; i < n; ++i)
+        if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+/* n projection frames of the current E and phi into the image. */
+static hd_result hd__test_project(hd_context h, int n)
+{
+    hd_result r;
+    int i;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    for (i = 0; i < n; ++i) {
+        ctx->frames++;
+        hd__fill_kparams(ctx);
+        if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
+    }
+    return HD_SUCCESS;
+}
+
+/* Overwrites E or phi (channel-planar, hd_stats' dims and channels) with src: the only hook that
+   reaches into a backend's buffers, so it has one branch per backend. */
+static hd_result hd__test_write_illumination(hd_context h, hd_illumination which, const float *src)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+#if defined(HYBRIDDIFF_BACKEND_CPU)
+    memcpy(which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, src, ctx->be->illum_floats * sizeof(float));
+    return HD_SUCCESS;
+#elif defined(HYBRIDDIFF_BACKEND_OPENCL)
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, CL_TRUE, 0,
+                                         ctx->be->illum_floats * sizeof(float), src, 0, NULL, NULL),
+               "clEnqueueWriteBuffer(test illumination)");
+    return HD_SUCCESS;
+#else
+    (void)which; (void)src;
+    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
+#endif
+}
+
+/* Waits until the device has done everything queued (for timing). */
+static hd_result hd__test_finish(hd_context h)
+{
+    HD__GET_CTX(ctx, h);
+#if defined(HYBRIDDIFF_BACKEND_OPENCL)
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+#endif
+    (void)ctx;
+    return HD_SUCCESS;
+}

@@ -1,0 +1,456 @@
+/* conformance.c - the backend under test (hd_api_backend, chosen at build time by
+   -DHYBRIDDIFF_BACKEND_X in impl_backend.c) against the CPU reference (hd_api_cpu), both in this
+   process, on identical inputs.
+   Deterministic stages (one diffusion sweep, a full diffusion solve, the projection of fixed
+   illumination) must agree to a relative L2 <= 1e-5 and a relative Linf <= 1e-4; stochastic ones
+   (HD direct light, whole HD iterations) with identical seeds to a relative L2 <= 1e-3: the
+   counter-based RNG draws the same samples, only the rounding of log/exp may differ, which can
+   flip a rare tracking decision. Relative L2 = |b - a| / |a|, relative Linf = max|b - a| / max|a|,
+   a = reference. Every call is checked to leave the caller's buffers unchanged.
+   Output: one line per case with its errors, then "N passed, N failed". A backend whose runtime
+   or device is missing is reported SKIPPED with the reason (exit 0, or 1 when the environment
+   sets HD_CONFORMANCE_REQUIRE=1, as CI does). */
+#include "hd_api.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define TOL_DET_L2 1e-5
+#define TOL_DET_LINF 1e-4
+#define TOL_STOCH_L2 1e-3
+
+static int n_passed, n_failed;
+static char last_log[1024];
+
+static void capture_log(void *user, hd_log_level level, hd_result code, const char *msg, const char *file, int line)
+{
+    (void)user; (void)code; (void)file; (void)line;
+    if (level == HD_LOG_ERROR) {
+        strncpy(last_log, msg, sizeof last_log - 1);
+        last_log[sizeof last_log - 1] = '\0';
+        fprintf(stderr, "  log: %s\n", msg);
+    }
+}
+
+/* ---- scenes --------------------------------------------------------------------------------- */
+typedef struct scene {
+    hd_voxel_type type;
+    int dims[3];
+    void *data;
+    size_t data_bytes;
+    float tf[4 * 5];
+    int tf_count;
+    hd_light lights[16];
+    int light_count;
+    hd_camera camera;
+    hd_params params;
+} scene;
+
+/* A smooth blob with a shell and some noise, so the TF makes dense, thin and empty regions. */
+static float scene_value(int x, int y, int z, const int *d)
+{
+    float u = ((float)x + 0.5f) / (float)d[0] - 0.5f, v = ((float)y + 0.5f) / (float)d[1] - 0.5f;
+    float w = ((float)z + 0.5f) / (float)d[2] - 0.5f;
+    float r = sqrtf(u * u + v * v + w * w);
+    uint32_t h = (uint32_t)(x * 73856093u) ^ (uint32_t)(y * 19349663u) ^ (uint32_t)(z * 83492791u);
+    float noise = (float)((h * 2654435761u) >> 8) / 16777216.0f;
+    float val = 0.8f * expf(-12.0f * r * r) + (fabsf(r - 0.35f) < 0.04f ? 0.5f : 0.0f) + 0.1f * noise;
+    return val > 1.0f ? 1.0f : val;
+}
+
+static void scene_init(scene *s, hd_voxel_type type, int dx, int dy, int dz, int lights, int mixed_colors, int point)
+{
+    size_t n, i, bpv = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 ? 2 : 4;
+    int x, y, z, l;
+    static const float tf[] = {0.0f, 0.0f, 0.0f, 0.0f, 0.9f, 0.6f, 0.5f, 0.05f, 0.9f, 0.8f, 0.6f, 0.3f,
+                               1.0f, 1.0f, 0.9f, 0.6f, 1.0f, 1.0f, 1.0f, 1.0f};
+    memset(s, 0, sizeof *s);
+    s->type = type;
+    s->dims[0] = dx; s->dims[1] = dy; s->dims[2] = dz;
+    n = (size_t)dx * dy * dz;
+    s->data_bytes = n * bpv;
+    s->data = malloc(s->data_bytes);
+    for (z = 0, i = 0; z < dz; ++z)
+        for (y = 0; y < dy; ++y)
+            for (x = 0; x < dx; ++x, ++i) {
+                float v = scene_value(x, y, z, s->dims);
+                if (type == HD_VOXEL_U8) ((uint8_t *)s->data)[i] = (uint8_t)(v * 255.0f + 0.5f);
+                else if (type == HD_VOXEL_U16) ((uint16_t *)s->data)[i] = (uint16_t)(v * 65535.0f + 0.5f);
+                else ((float *)s->data)[i] = v;
+            }
+    memcpy(s->tf, tf, sizeof tf);
+    s->tf_count = 5;
+    s->light_count = lights;
+    for (l = 0; l < lights; ++l) {
+        hd_light *L = &s->lights[l];
+        float a = 0.7f * (float)l + 0.3f;
+        if (point && (l % 2 == 1 || lights == 1)) {
+            L->type = HD_LIGHT_POINT;
+            L->position[0] = 0.9f * cosf(a); L->position[1] = 0.6f; L->position[2] = 0.9f * sinf(a);
+            L->inverse_square = l % 4 == 1;
+        } else {
+            L->type = HD_LIGHT_DIRECTIONAL;
+            L->direction[0] = cosf(a); L->direction[1] = -1.0f; L->direction[2] = sinf(a) - 0.3f;
+        }
+        if (mixed_colors) { L->color[0] = 1.0f; L->color[1] = 0.5f + 0.1f * (float)(l % 5); L->color[2] = 0.3f; }
+        L->intensity = 1.0f + 0.25f * (float)(l % 3);
+    }
+    s->camera.eye[0] = 1.2f; s->camera.eye[1] = 0.8f; s->camera.eye[2] = 1.9f;
+    s->camera.width = 48; s->camera.height = 40;
+    s->params.seed = 1234u;
+    s->params.diffusion_sweeps = 4;
+}
+
+static void scene_free(scene *s) { free(s->data); }
+
+static hd_desc scene_desc(const scene *s)
+{
+    hd_desc d;
+    memset(&d, 0, sizeof d);
+    d.volume.type = s->type;
+    memcpy(d.volume.dims, s->dims, sizeof s->dims);
+    d.volume.spacing[0] = 1.0f; d.volume.spacing[1] = 1.0f; d.volume.spacing[2] = 1.3f;
+    d.volume.data = s->data;
+    d.transfer_function.rgba = s->tf;
+    d.transfer_function.count = s->tf_count;
+    d.lights = s->lights;
+    d.light_count = s->light_count;
+    d.camera = s->camera;
+    d.params = s->params;
+    d.logger.func = capture_log;
+    return d;
+}
+
+/* ---- the caller's buffers must not change --------------------------------------------------- */
+typedef struct guard {
+    const scene *s;
+    void *data;
+    scene copy;
+} guard;
+
+static void guard_take(guard *g, const scene *s)
+{
+    g->s = s;
+    g->copy = *s;
+    g->data = malloc(s->data_bytes);
+    memcpy(g->data, s->data, s->data_bytes);
+}
+static int guard_intact(const guard *g)
+{
+    scene a = *g->s, b = g->copy;
+    a.data = b.data = NULL;
+    return memcmp(g->data, g->s->data, g->s->data_bytes) == 0 && memcmp(&a, &b, sizeof a) == 0;
+}
+static void guard_free(guard *g) { free(g->data); }
+
+/* ---- comparison ------------------------------------------------------------------------------- */
+static void rel_errors(const float *ref, const float *got, size_t n, double *l2, double *linf)
+{
+    double d2 = 0.0, r2 = 0.0, dmax = 0.0, rmax = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        double d = (double)got[i] - (double)ref[i];
+        if (got[i] != got[i]) d = 1e30; /* NaN */
+        d2 += d * d;
+        r2 += (double)ref[i] * ref[i];
+        if (fabs(d) > dmax) dmax = fabs(d);
+        if (fabs((double)ref[i]) > rmax) rmax = fabs((double)ref[i]);
+    }
+    *l2 = r2 > 0.0 ? sqrt(d2 / r2) : sqrt(d2);
+    *linf = rmax > 0.0 ? dmax / rmax : dmax;
+}
+
+/* The pair of contexts a case runs on. */
+typedef struct pair {
+    hd_context ref, dut;
+    int ok;
+    char why[256];
+} pair;
+
+static void pair_fail(pair *p, const char *what, hd_result r)
+{
+    if (!p->ok) return;
+    p->ok = 0;
+    snprintf(p->why, sizeof p->why, "%s: %s", what, hd_api_backend.result_string(r));
+}
+
+/* Runs the same call on both; the reference must succeed, the backend must too. */
+#define BOTH(p, call, args_ref, args_dut) \
+    do { hd_result r_; \
+         if ((r_ = hd_api_cpu.call args_ref) != HD_SUCCESS) pair_fail((p), "reference " #call, r_); \
+         if ((r_ = hd_api_backend.call args_dut) != HD_SUCCESS) pair_fail((p), "backend " #call, r_); } while (0)
+
+static int pair_create(pair *p, const scene *s)
+{
+    hd_desc d = scene_desc(s);
+    hd_result r;
+    memset(p, 0, sizeof *p);
+    p->ok = 1;
+    if ((r = hd_api_cpu.create(&d, &p->ref)) != HD_SUCCESS) { pair_fail(p, "reference create", r); return 0; }
+    if ((r = hd_api_backend.create(&d, &p->dut)) != HD_SUCCESS) { pair_fail(p, "backend create", r); hd_api_cpu.destroy(p->ref); return 0; }
+    return 1;
+}
+static void pair_destroy(pair *p)
+{
+    if (p->ref.id) hd_api_cpu.destroy(p->ref);
+    if (p->dut.id) hd_api_backend.destroy(p->dut);
+}
+
+/* What a case compares. */
+enum { CMP_E = 1, CMP_PHI = 2, CMP_IMAGE = 4 };
+
+/* Reads the selected outputs of both and folds their errors into the worst ones seen. */
+static void pair_compare(pair *p, int what, double *l2, double *linf)
+{
+    hd_stats st;
+    size_t n;
+    float *a, *b;
+    int k;
+    if (!p->ok) return;
+    hd_api_cpu.get_stats(p->ref, &st);
+    n = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels;
+    {
+        hd_desc q;
+        size_t ni;
+        hd_api_cpu.query_desc(p->ref, &q);
+        ni = (size_t)q.camera.width * q.camera.height * 4;
+        if (ni > n) n = ni;
+    }
+    a = (float *)calloc(n, sizeof(float));
+    b = (float *)calloc(n, sizeof(float));
+    for (k = 0; k < 3; ++k) {
+        double e2, einf;
+        size_t cnt;
+        hd_result r1, r2;
+        if (!(what & (1 << k))) continue;
+        if (k < 2) {
+            cnt = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels;
+            r1 = hd_api_cpu.read_illumination(p->ref, k == 0 ? HD_ILLUMINATION_DIRECT : HD_ILLUMINATION_SCATTERED, a, n);
+            r2 = hd_api_backend.read_illumination(p->dut, k == 0 ? HD_ILLUMINATION_DIRECT : HD_ILLUMINATION_SCATTERED, b, n);
+        } else {
+            hd_desc q;
+            hd_api_cpu.query_desc(p->ref, &q);
+            cnt = (size_t)q.camera.width * q.camera.height * 4;
+            r1 = hd_api_cpu.read_image_f32(p->ref, a, n);
+            r2 = hd_api_backend.read_image_f32(p->dut, b, n);
+        }
+        if (r1 != HD_SUCCESS) { pair_fail(p, "reference read", r1); break; }
+        if (r2 != HD_SUCCESS) { pair_fail(p, "backend read", r2); break; }
+        rel_errors(a, b, cnt, &e2, &einf);
+        if (e2 > *l2) *l2 = e2;
+        if (einf > *linf) *linf = einf;
+    }
+    free(a);
+    free(b);
+}
+
+static void report(const char *name, const pair *p, const guard *g, double l2, double linf, int deterministic)
+{
+    int inputs_ok = guard_intact(g);
+    int pass = p->ok && inputs_ok && l2 <= (deterministic ? TOL_DET_L2 : TOL_STOCH_L2) &&
+               (!deterministic || linf <= TOL_DET_LINF);
+    printf("%s %-56s rel_L2 %.2e  rel_Linf %.2e  (%s: L2 <= %.0e%s)%s%s%s\n", pass ? "PASS" : "FAIL", name, l2, linf,
+           deterministic ? "deterministic" : "stochastic", deterministic ? TOL_DET_L2 : TOL_STOCH_L2,
+           deterministic ? ", Linf <= 1e-4" : "", inputs_ok ? "" : "  INPUTS CHANGED", p->ok ? "" : "  ERROR ", p->ok ? "" : p->why);
+    fflush(stdout);
+    if (pass) ++n_passed;
+    else ++n_failed;
+}
+
+/* Identical E and phi written into both contexts: a hash pattern, so every voxel differs. */
+static void write_pattern(pair *p, hd_illumination which, float scale)
+{
+    hd_stats st;
+    size_t n, i;
+    float *v;
+    hd_result r;
+    if (!p->ok) return;
+    BOTH(p, test_prepare, (p->ref), (p->dut));
+    hd_api_cpu.get_stats(p->ref, &st);
+    n = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels;
+    v = (float *)malloc(n * sizeof(float));
+    for (i = 0; i < n; ++i) {
+        uint32_t h = (uint32_t)i * 2654435761u + (uint32_t)which * 40503u;
+        h ^= h >> 15; h *= 0x2c1b3c6du; h ^= h >> 12;
+        v[i] = scale * (0.25f + (float)(h >> 8) / 16777216.0f);
+    }
+    if ((r = hd_api_cpu.test_write_illumination(p->ref, which, v)) != HD_SUCCESS) pair_fail(p, "reference write", r);
+    if ((r = hd_api_backend.test_write_illumination(p->dut, which, v)) != HD_SUCCESS) pair_fail(p, "backend write", r);
+    free(v);
+}
+
+/* ---- the cases -------------------------------------------------------------------------------- */
+static const char *type_name(hd_voxel_type t) { return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32"; }
+
+/* One sweep (red-black or Jacobi) or a solve of many, from identical E and phi. */
+static void case_diffusion(hd_voxel_type type, const int *d, hd_solver solver, int sweeps, int channels)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
+    s.params.solver = solver;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "diffuse %s %d sweep%s %s %dx%dx%d %dch", solver == HD_SOLVER_JACOBI ? "jacobi" : "red-black",
+             sweeps, sweeps > 1 ? "s" : "", type_name(type), d[0], d[1], d[2], channels);
+    if (pair_create(&p, &s)) {
+        write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
+        write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
+        BOTH(&p, test_diffuse, (p.ref, sweeps), (p.dut, sweeps));
+        pair_compare(&p, CMP_PHI, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, 1);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
+/* The projection of fixed E and phi, over several jittered frames. */
+static void case_project(hd_voxel_type type, const int *d, int channels, int frames)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "project %d frame%s %s %dx%dx%d %dch", frames, frames > 1 ? "s" : "", type_name(type), d[0], d[1], d[2], channels);
+    if (pair_create(&p, &s)) {
+        write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
+        write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
+        BOTH(&p, test_project, (p.ref, frames), (p.dut, frames));
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, 1);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
+/* HD direct light alone, n passes with identical seeds. */
+static void case_direct(hd_voxel_type type, const int *d, int lights, int mixed, int point, hd_tracking tracking,
+                        float majorant, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    scene_init(&s, type, d[0], d[1], d[2], lights, mixed, point);
+    s.params.tracking = tracking;
+    s.params.majorant = majorant;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "direct x%d %s %dx%dx%d %dL %s%s%s%s", n, type_name(type), d[0], d[1], d[2], lights,
+             point ? "dir+point" : "dir", mixed ? " rgb" : "", tracking == HD_TRACKING_DELTA ? " delta" : "",
+             majorant > 0.0f ? " global-maj" : "");
+    if (pair_create(&p, &s)) {
+        BOTH(&p, test_direct, (p.ref, n), (p.dut, n));
+        pair_compare(&p, CMP_E, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, 0);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
+/* Whole HD iterations through the public API; optionally a TF or camera change halfway. */
+enum { CHANGE_NONE, CHANGE_TF, CHANGE_CAMERA };
+static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed, int point, int change, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    static const float tf2[] = {0.0f, 0.0f, 0.0f, 0.0f, 0.2f, 0.5f, 0.9f, 0.2f, 1.0f, 0.9f, 0.8f, 0.8f};
+    hd_transfer_function tf;
+    hd_camera cam;
+    scene_init(&s, type, d[0], d[1], d[2], lights, mixed, point);
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "iterate x%d %s %dx%dx%d %dL %s%s%s", n, type_name(type), d[0], d[1], d[2], lights,
+             point ? "dir+point" : "dir", mixed ? " rgb" : "",
+             change == CHANGE_TF ? " TF change" : change == CHANGE_CAMERA ? " camera change" : "");
+    if (pair_create(&p, &s)) {
+        BOTH(&p, iterate, (p.ref, n / 2), (p.dut, n / 2));
+        if (change == CHANGE_TF) {
+            float tf2_copy[12];
+            memcpy(tf2_copy, tf2, sizeof tf2);
+            tf.rgba = tf2_copy;
+            tf.count = 3;
+            BOTH(&p, set_transfer_function, (p.ref, &tf), (p.dut, &tf));
+            if (memcmp(tf2_copy, tf2, sizeof tf2) != 0) pair_fail(&p, "set_transfer_function changed its input", HD_SUCCESS);
+        } else if (change == CHANGE_CAMERA) {
+            hd_camera before;
+            cam = s.camera;
+            cam.eye[0] = -1.5f; cam.eye[1] = 0.3f; cam.eye[2] = 1.4f; cam.width = 40; cam.height = 44;
+            before = cam;
+            BOTH(&p, set_camera, (p.ref, &cam), (p.dut, &cam));
+            if (memcmp(&before, &cam, sizeof cam) != 0) pair_fail(&p, "set_camera changed its input", HD_SUCCESS);
+        }
+        BOTH(&p, iterate, (p.ref, n - n / 2), (p.dut, n - n / 2));
+        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, 0);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
+/* ---- main ----------------------------------------------------------------------------------- */
+/* Creates one backend context: if the runtime or a device is missing, the backend is skipped. */
+static int backend_available(void)
+{
+    scene s;
+    hd_desc d;
+    hd_context c;
+    hd_result r;
+    scene_init(&s, HD_VOXEL_U8, 8, 8, 8, 1, 0, 0);
+    d = scene_desc(&s);
+    r = hd_api_backend.create(&d, &c);
+    scene_free(&s);
+    if (r == HD_SUCCESS) { hd_api_backend.destroy(c); return 1; }
+    printf("SKIPPED backend %s: %s%s%s\n", hd_api_backend.backend_name(), hd_api_backend.result_string(r),
+           last_log[0] ? " -- " : "", last_log);
+    return 0;
+}
+
+int main(void)
+{
+    static const int odd[3] = {37, 53, 29}, other[3] = {24, 17, 33};
+    static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
+    int t;
+    printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
+    if (!backend_available()) {
+        const char *req = getenv("HD_CONFORMANCE_REQUIRE");
+        printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed)\n", hd_api_backend.backend_name());
+        return req && req[0] == '1' ? 1 : 0;
+    }
+    /* deterministic stages */
+    for (t = 0; t < 3; ++t) {
+        case_diffusion(types[t], odd, HD_SOLVER_RED_BLACK, 1, 1);
+        case_project(types[t], odd, 1, 1);
+    }
+    case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_JACOBI, 1, 1);
+    case_diffusion(HD_VOXEL_U16, odd, HD_SOLVER_RED_BLACK, 200, 1);
+    case_diffusion(HD_VOXEL_F32, other, HD_SOLVER_JACOBI, 200, 1);
+    case_diffusion(HD_VOXEL_U8, other, HD_SOLVER_RED_BLACK, 50, 3);
+    case_project(HD_VOXEL_U8, other, 3, 4);
+    /* stochastic: direct light with identical seeds */
+    for (t = 0; t < 3; ++t) case_direct(types[t], odd, 1, 0, 0, HD_TRACKING_RATIO, 0.0f, 16);
+    case_direct(HD_VOXEL_U8, odd, 1, 0, 1, HD_TRACKING_RATIO, 0.0f, 16);
+    case_direct(HD_VOXEL_U16, odd, 3, 1, 1, HD_TRACKING_RATIO, 0.0f, 16);
+    case_direct(HD_VOXEL_F32, other, 16, 0, 1, HD_TRACKING_RATIO, 0.0f, 16);
+    case_direct(HD_VOXEL_U8, other, 16, 1, 1, HD_TRACKING_DELTA, 0.0f, 16);
+    case_direct(HD_VOXEL_U8, odd, 3, 0, 0, HD_TRACKING_RATIO, 150.0f, 16);
+    /* whole iterations through the public API, with changes in the middle of the run */
+    case_iterate(HD_VOXEL_U8, odd, 1, 0, 0, CHANGE_NONE, 8);
+    case_iterate(HD_VOXEL_U16, odd, 3, 1, 1, CHANGE_TF, 8);
+    case_iterate(HD_VOXEL_F32, odd, 16, 0, 1, CHANGE_CAMERA, 8);
+    case_iterate(HD_VOXEL_U8, other, 3, 0, 1, CHANGE_CAMERA, 8);
+    printf("%d passed, %d failed\n", n_passed, n_failed);
+    return n_failed == 0 ? 0 : 1;
+}
