@@ -1,0 +1,682 @@
+/* hdrender - renders a volume with hybriddiff to a PNG.
+
+     make build/hdrender && scripts/fetch-data && build/hdrender     -> out/head.png
+
+   `hdrender --help` lists the options. Exit status: 0 done, 2 a bad option, value or input file
+   (one line on stderr names it), 1 the library or the output failed while rendering.
+   The backend is the CPU one unless another HYBRIDDIFF_BACKEND_* is given with -D. */
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#endif
+
+#if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && \
+    !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
+#define HYBRIDDIFF_BACKEND_CPU
+#endif
+#define HYBRIDDIFF_IMPLEMENTATION
+#include "hybriddiff.h"
+#include "hd_tf.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#endif
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#include <stb/stb_image_write.h>
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+#define DEFAULT_INPUT "data/head.nrrd"
+#define DEFAULT_OUTPUT "out/head.png"
+#define DEFAULT_EXPOSURE 8.0f
+
+static const char *usage_text =
+    "usage: hdrender [options] [FILE.nrrd]          (default input: " DEFAULT_INPUT ")\n"
+    "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
+    "\n"
+    "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
+    "\n"
+    "input\n"
+    "  FILE.nrrd               NRRD volume (attached header; raw or gzip encoding)\n"
+    "  --raw FILE              headerless raw volume, x fastest; needs --dims and --type\n"
+    "  --dims X,Y,Z            raw: voxels per axis\n"
+    "  --type T                raw: u8 i8 u16 i16 u32 i32 f32 f64\n"
+    "  --endian little|big     raw: byte order (default little)\n"
+    "  --offset N              raw: bytes to skip at the start (default 0)\n"
+    "  --spacing X,Y,Z         voxel size, overrides the file's (default: file or 1,1,1)\n"
+    "\n"
+    "transfer function\n"
+    "  --tf PRESET|FILE        ct-skin, ct-bone, ct-tissue, ramp, or a TF file\n"
+    "                          (docs/TF_FORMAT.md). Default: ct-skin for CT data (values\n"
+    "                          below -500), else ramp. CT presets map -1024..3071 HU.\n"
+    "  --print-tf              print the chosen TF in the file format and exit\n"
+    "\n"
+    "lights (world space: the volume box is centred at 0, its largest side is 1)\n"
+    "  --light dir:X,Y,Z[:R,G,B][:INTENSITY]\n"
+    "                          directional light travelling along X,Y,Z (dir:0,0,-1 shines\n"
+    "                          down); repeatable, up to 64 lights\n"
+    "  --light point:X,Y,Z[:R,G,B][:INTENSITY][:falloff]\n"
+    "                          point light at X,Y,Z; falloff: intensity / r^2\n"
+    "  --lights N              N preset directional lights placed around the camera\n"
+    "                          (1: key light, 3: key, fill and rim; default 1)\n"
+    "\n"
+    "camera (default: in front of the face, for the head CT's axes: face +y, top +z)\n"
+    "  --eye X,Y,Z             camera position (default 0.6,1.65,0.3: face, three-quarter)\n"
+    "  --target X,Y,Z          looked-at point (default 0,0,0)\n"
+    "  --up X,Y,Z              up direction (default 0,0,1)\n"
+    "  --fov DEG               vertical field of view (default 40)\n"
+    "  --size WxH              image size (default 512x512)\n"
+    "\n"
+    "method\n"
+    "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
+    "  --iterations N          progressive iterations (default 24)\n"
+    "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"
+    "  --albedo F              sigma_s / sigma_t in (0,1] (default 0.9)\n"
+    "  --anisotropy G          Henyey-Greenstein g in (-1,1) (default 0)\n"
+    "  --majorant F            global majorant, 0 = grid of local majorants (default 0)\n"
+    "  --sweeps N              diffusion solver sweeps per iteration (default 4)\n"
+    "  --solver rb|jacobi      diffusion solver (default rb: red-black Gauss-Seidel)\n"
+    "  --tracking ratio|delta  transmittance estimator (default ratio)\n"
+    "  --no-diffusion          direct light only (single scattering)\n"
+    "  --seed N                random seed (default 0)\n"
+    "  --threads N             CPU threads, 0 = all cores (default 0)\n"
+    "  --step F                ray-march step in voxels (default 0.5)\n"
+    "  --frame-window N        the image is the mean of the last N frames (default 8)\n"
+    "\n"
+    "output\n"
+    "  -o, --out FILE.png      output image (default " DEFAULT_OUTPUT "; its directory is\n"
+    "                          created if needed)\n"
+    "  --exposure F            scale before the sRGB encoding (default 8)\n"
+    "  --background R,G,B      linear radiance behind the volume (default 0,0,0)\n"
+    "  --quiet                 no progress bar and no summary\n"
+    "  -v, --verbose           also print the library's information messages\n"
+    "  -h, --help              this text\n"
+    "\n"
+    "Options take their value as the next argument or after '=' (--size=256x256).\n";
+
+/* ---- messages -------------------------------------------------------------------------------- */
+static int g_quiet, g_verbose;
+
+#if defined(__GNUC__) || defined(__clang__)
+__attribute__((format(printf, 2, 3), noreturn))
+#endif
+static void fail(int status, const char *fmt, ...)
+{
+    va_list ap;
+    fputs("hdrender: error: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    exit(status);
+}
+
+/* The library's messages: errors are kept for the one line we print, the rest shown. */
+typedef struct log_state {
+    char last[1024];
+    hd_result code;
+} log_state;
+
+static void log_fn(void *user, hd_log_level level, hd_result code, const char *message,
+                   const char *file, int line)
+{
+    log_state *s = (log_state *)user;
+    (void)file;
+    (void)line;
+    if (level == HD_LOG_ERROR) {
+        snprintf(s->last, sizeof s->last, "%s", message);
+        s->code = code;
+    } else if (level == HD_LOG_WARNING) {
+        if (!g_quiet) fprintf(stderr, "hdrender: warning: %s\n", message);
+    } else if (g_verbose) {
+        fprintf(stderr, "hdrender: %s\n", message);
+    }
+}
+
+/* One line for a failed library call: its message and the result's name. */
+static void fail_lib(int status, const log_state *s, hd_result r, const char *what, const char *hint)
+{
+    fail(status, "%s%s%s (%s)%s", what ? what : "", what && s->last[0] ? ": " : "",
+         s->last[0] ? s->last : "", hd_result_string(r), hint ? hint : "");
+}
+
+/* ---- values ---------------------------------------------------------------------------------- */
+static float parse_float(const char *flag, const char *s, float lo, float hi, int lo_open,
+                         int hi_open)
+{
+    char *end;
+    double v;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end || errno == ERANGE || !isfinite(v))
+        fail(2, "%s: '%s' is not a number", flag, s);
+    if (v < lo || v > hi || (lo_open && v == lo) || (hi_open && v == hi))
+        fail(2, "%s: %s is outside %s%g, %g%s", flag, s, lo_open ? "(" : "[", (double)lo,
+             (double)hi, hi_open ? ")" : "]");
+    return (float)v;
+}
+
+static long parse_int(const char *flag, const char *s, long lo, long hi)
+{
+    char *end;
+    long v;
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (end == s || *end || errno == ERANGE) fail(2, "%s: '%s' is not an integer", flag, s);
+    if (v < lo || v > hi) fail(2, "%s: %s is outside %ld..%ld", flag, s, lo, hi);
+    return v;
+}
+
+/* "X,Y,Z" -> v; count numbers exactly. */
+static void parse_floats(const char *flag, const char *s, float *v, int count)
+{
+    const char *p = s;
+    int i;
+    for (i = 0; i < count; ++i) {
+        char *end;
+        double d;
+        errno = 0;
+        d = strtod(p, &end);
+        if (end == p || errno == ERANGE || !isfinite(d) ||
+            (i + 1 < count ? *end != ',' : *end != 0))
+            fail(2, "%s: '%s' is not %d comma-separated numbers", flag, s, count);
+        v[i] = (float)d;
+        p = end + 1;
+    }
+}
+
+static void parse_dims(const char *flag, const char *s, int dims[3])
+{
+    float v[3];
+    int i;
+    parse_floats(flag, s, v, 3);
+    for (i = 0; i < 3; ++i) {
+        if (v[i] != floorf(v[i]) || v[i] < 1 || v[i] > HD_MAX_DIM)
+            fail(2, "%s: '%s': each size must be an integer in 1..%d", flag, s, HD_MAX_DIM);
+        dims[i] = (int)v[i];
+    }
+}
+
+static void parse_size(const char *flag, const char *s, int *w, int *h)
+{
+    char *end;
+    long a, b;
+    errno = 0;
+    a = strtol(s, &end, 10);
+    if (end == s || (*end != 'x' && *end != 'X')) fail(2, "%s: '%s' is not WxH", flag, s);
+    s = end + 1;
+    b = strtol(s, &end, 10);
+    if (end == s || *end || errno == ERANGE) fail(2, "%s: '%s' is not WxH", flag, s);
+    if (a < 1 || b < 1 || a > HD_MAX_IMAGE_DIM || b > HD_MAX_IMAGE_DIM)
+        fail(2, "%s: %ldx%ld is outside 1..%d per side", flag, a, b, HD_MAX_IMAGE_DIM);
+    *w = (int)a;
+    *h = (int)b;
+}
+
+/* dir:X,Y,Z[:R,G,B][:INTENSITY]  or  point:X,Y,Z[:R,G,B][:INTENSITY][:falloff] */
+static hd_light parse_light(const char *s)
+{
+    hd_light l;
+    char buf[256], *parts[8];
+    int n = 0, i, have_color = 0, have_intensity = 0;
+    char *p;
+    memset(&l, 0, sizeof l);
+    if (strlen(s) >= sizeof buf) fail(2, "--light: '%s' is too long", s);
+    strcpy(buf, s);
+    for (p = buf; n < 8;) {
+        parts[n++] = p;
+        p = strchr(p, ':');
+        if (!p) break;
+        *p++ = 0;
+    }
+    if (p) fail(2, "--light: '%s' has too many ':' fields", s);
+    if (strcmp(parts[0], "dir") == 0 || strcmp(parts[0], "directional") == 0)
+        l.type = HD_LIGHT_DIRECTIONAL;
+    else if (strcmp(parts[0], "point") == 0)
+        l.type = HD_LIGHT_POINT;
+    else
+        fail(2, "--light: '%s' must start with dir: or point:", s);
+    if (n < 2) fail(2, "--light: '%s' needs a %s X,Y,Z", s,
+                    l.type == HD_LIGHT_POINT ? "position" : "direction");
+    parse_floats("--light", parts[1], l.type == HD_LIGHT_POINT ? l.position : l.direction, 3);
+    if (l.type == HD_LIGHT_DIRECTIONAL &&
+        l.direction[0] == 0.0f && l.direction[1] == 0.0f && l.direction[2] == 0.0f)
+        fail(2, "--light: '%s': the direction is zero", s);
+    for (i = 2; i < n; ++i) {
+        if (strcmp(parts[i], "falloff") == 0) {
+            if (l.type != HD_LIGHT_POINT)
+                fail(2, "--light: '%s': falloff is for point lights", s);
+            l.inverse_square = 1;
+        } else if (strchr(parts[i], ',')) {
+            if (have_color++) fail(2, "--light: '%s' has two colours", s);
+            parse_floats("--light colour", parts[i], l.color, 3);
+            if (l.color[0] < 0 || l.color[1] < 0 || l.color[2] < 0 ||
+                (l.color[0] == 0 && l.color[1] == 0 && l.color[2] == 0))
+                fail(2, "--light: '%s': the colour must be >= 0 and not black", s);
+        } else {
+            if (have_intensity++) fail(2, "--light: '%s' has two intensities", s);
+            l.intensity = parse_float("--light intensity", parts[i], 0.0f, 1e9f, 1, 0);
+        }
+    }
+    return l;
+}
+
+static void normalize3(float v[3])
+{
+    float n = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (n > 0.0f) { v[0] /= n; v[1] /= n; v[2] /= n; }
+}
+
+static void cross3(const float a[3], const float b[3], float out[3])
+{
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* n directional lights placed in the camera's frame, so they light what the camera sees:
+   a key light from the upper left, a fill from the right, a rim light from behind, then more
+   around the view axis. */
+static int preset_lights(int n, const hd_camera *cam, hd_light *out)
+{
+    /* from-directions in camera space (right, up, toward the camera) and intensities */
+    static const float base[3][4] = {
+        {-0.55f, 0.65f, 0.75f, 1.0f},  /* key */
+        {0.80f, 0.10f, 0.60f, 0.45f},  /* fill */
+        {0.30f, 0.60f, -0.75f, 0.70f}, /* rim */
+    };
+    float w[3], u[3], v[3];
+    int i, k;
+    for (k = 0; k < 3; ++k) w[k] = cam->target[k] - cam->eye[k];
+    normalize3(w);
+    cross3(w, cam->up, u);
+    normalize3(u);
+    cross3(u, w, v);
+    for (i = 0; i < n; ++i) {
+        float c[3], from[3], inten;
+        if (i < 3) {
+            c[0] = base[i][0]; c[1] = base[i][1]; c[2] = base[i][2];
+            inten = base[i][3];
+        } else { /* a ring around the view axis, slightly in front */
+            float a = 6.2831853f * (float)(i - 3) / (float)(n - 3) + 0.4f;
+            c[0] = cosf(a); c[1] = sinf(a); c[2] = 0.35f;
+            inten = 0.35f;
+        }
+        for (k = 0; k < 3; ++k) from[k] = c[0] * u[k] + c[1] * v[k] - c[2] * w[k];
+        normalize3(from);
+        memset(&out[i], 0, sizeof out[i]);
+        out[i].type = HD_LIGHT_DIRECTIONAL;
+        for (k = 0; k < 3; ++k) out[i].direction[k] = -from[k];
+        out[i].color[0] = out[i].color[1] = out[i].color[2] = 1.0f;
+        out[i].intensity = inten;
+    }
+    return n;
+}
+
+/* ---- files ----------------------------------------------------------------------------------- */
+/* Creates the directories above path (like mkdir -p of its dirname). */
+static void make_parent_dirs(const char *path)
+{
+    char buf[4096];
+    char *p;
+    if (strlen(path) >= sizeof buf) fail(2, "--out: path is too long");
+    strcpy(buf, path);
+    for (p = buf + 1; *p; ++p) {
+        if (*p != '/') continue;
+        *p = 0;
+        if (mkdir(buf, 0777) != 0 && errno != EEXIST)
+            fail(2, "--out: cannot create directory %s: %s", buf, strerror(errno));
+        *p = '/';
+    }
+}
+
+/* Fails now, not after the render, if path cannot be written. Leaves an existing file alone. */
+static void check_writable(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    int existed = f != NULL;
+    if (f) fclose(f);
+    f = fopen(path, "ab");
+    if (!f) fail(2, "--out: cannot write %s: %s", path, strerror(errno));
+    fclose(f);
+    if (!existed) remove(path);
+}
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void progress(int done, int total, double elapsed, int final)
+{
+    char bar[31];
+    int i, fill = total > 0 ? (int)(30.0 * done / total) : 30;
+    double rate = elapsed > 0.0 ? done / elapsed : 0.0;
+    double eta = rate > 0.0 ? (total - done) / rate : 0.0;
+    for (i = 0; i < 30; ++i) bar[i] = i < fill ? '#' : '.';
+    bar[30] = 0;
+    fprintf(stderr, "\r  [%s] %d/%d iterations  %.2f it/s  %s %d:%02d ", bar, done, total, rate,
+            final ? "took" : "ETA", (int)((final ? elapsed : eta) + 0.5) / 60,
+            (int)((final ? elapsed : eta) + 0.5) % 60);
+    if (final) fputc('\n', stderr);
+    fflush(stderr);
+}
+
+static const char *voxel_type_name(hd_voxel_type t)
+{
+    return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32";
+}
+
+/* ---- main ------------------------------------------------------------------------------------ */
+/* The value of option argv[*i] ("--x V" or "--x=V"). */
+static const char *opt_value(int argc, char **argv, int *i, const char *eq)
+{
+    if (eq) return eq + 1;
+    if (*i + 1 >= argc || (argv[*i + 1][0] == '-' && argv[*i + 1][1] == '-'))
+        fail(2, "%s needs a value (see --help)", argv[*i]);
+    return argv[++*i];
+}
+
+int main(int argc, char **argv)
+{
+    static hdx_tf tf;
+    const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
+    int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 24;
+    int print_tf = 0, i, k, have_spacing = 0, status;
+    hd_endian endian = HD_ENDIAN_LITTLE;
+    size_t offset = 0;
+    float spacing[3] = {0, 0, 0};
+    hd_light lights[HD_MAX_LIGHTS];
+    int light_count = 0;
+    hd_desc desc;
+    hd_volume_file vol;
+    hd_context ctx;
+    hd_result r;
+    log_state ls;
+    hd_logger logger;
+    hd_stats stats;
+    uint8_t *rgba, *rgb;
+    double t0, t_end;
+    int done = 0, chunk = 1;
+    size_t npix;
+    char err[512];
+
+    memset(&desc, 0, sizeof desc);
+    memset(&ls, 0, sizeof ls);
+    logger.func = log_fn;
+    logger.user_data = &ls;
+    desc.camera.eye[0] = 0.6f; desc.camera.eye[1] = 1.65f; desc.camera.eye[2] = 0.3f;
+    desc.camera.up[2] = 1.0f;
+    desc.camera.fov_y = 40.0f;
+    desc.camera.width = desc.camera.height = 512;
+    desc.params.exposure = DEFAULT_EXPOSURE;
+
+    for (i = 1; i < argc; ++i) {
+        char name[64];
+        const char *a = argv[i], *eq = NULL, *v;
+        if (a[0] == '-' && a[1] == '-' && (eq = strchr(a, '=')) != NULL) {
+            size_t n = (size_t)(eq - a);
+            if (n >= sizeof name) fail(2, "unknown option '%s' (see --help)", a);
+            memcpy(name, a, n);
+            name[n] = 0;
+            a = name;
+        }
+#define IS(s) (strcmp(a, s) == 0)
+#define VAL() (v = opt_value(argc, argv, &i, eq))
+#define FLAG() do { if (eq) fail(2, "%s takes no value", a); } while (0)
+        if (IS("-h") || IS("--help")) {
+            fputs(usage_text, stdout);
+            return 0;
+        } else if (IS("--raw")) {
+            raw = VAL();
+        } else if (IS("--dims")) {
+            parse_dims(a, VAL(), dims);
+            have_dims = 1;
+        } else if (IS("--type")) {
+            static const char *names[] = {"u8", "i8", "u16", "i16", "u32", "i32", "f32", "f64"};
+            VAL();
+            for (k = 0; k < 8 && strcmp(v, names[k]) != 0; ++k) {}
+            if (k == 8) fail(2, "--type: '%s' is not one of u8 i8 u16 i16 u32 i32 f32 f64", v);
+            raw_type = k;
+        } else if (IS("--endian")) {
+            VAL();
+            if (strcmp(v, "little") == 0) endian = HD_ENDIAN_LITTLE;
+            else if (strcmp(v, "big") == 0) endian = HD_ENDIAN_BIG;
+            else fail(2, "--endian: '%s' is not little or big", v);
+        } else if (IS("--offset")) {
+            char *end;
+            unsigned long long o;
+            VAL();
+            errno = 0;
+            o = strtoull(v, &end, 10);
+            if (end == v || *end || errno == ERANGE || v[0] == '-' || o > (size_t)-1)
+                fail(2, "--offset: '%s' is not a byte count", v);
+            offset = (size_t)o;
+        } else if (IS("--spacing")) {
+            parse_floats(a, VAL(), spacing, 3);
+            for (k = 0; k < 3; ++k)
+                if (!(spacing[k] > 0.0f)) fail(2, "--spacing: '%s': each must be > 0", v);
+            have_spacing = 1;
+        } else if (IS("--tf")) {
+            tf_arg = VAL();
+        } else if (IS("--print-tf")) {
+            FLAG();
+            print_tf = 1;
+        } else if (IS("--light")) {
+            VAL();
+            if (light_count == HD_MAX_LIGHTS) fail(2, "--light: more than %d lights", HD_MAX_LIGHTS);
+            lights[light_count++] = parse_light(v);
+        } else if (IS("--lights")) {
+            lights_n = (int)parse_int(a, VAL(), 1, HD_MAX_LIGHTS);
+        } else if (IS("--eye")) {
+            parse_floats(a, VAL(), desc.camera.eye, 3);
+        } else if (IS("--target")) {
+            parse_floats(a, VAL(), desc.camera.target, 3);
+        } else if (IS("--up")) {
+            parse_floats(a, VAL(), desc.camera.up, 3);
+        } else if (IS("--fov")) {
+            desc.camera.fov_y = parse_float(a, VAL(), 0.0f, 180.0f, 1, 1);
+        } else if (IS("--size")) {
+            parse_size(a, VAL(), &desc.camera.width, &desc.camera.height);
+        } else if (IS("--method")) {
+            VAL();
+            if (strcmp(v, "hd") == 0) desc.params.method = HD_METHOD_HD;
+            else if (strcmp(v, "cd") == 0) desc.params.method = HD_METHOD_CD;
+            else if (strcmp(v, "pt_ss") == 0) desc.params.method = HD_METHOD_PT_SS;
+            else if (strcmp(v, "pt_ms") == 0) desc.params.method = HD_METHOD_PT_MS;
+            else fail(2, "--method: '%s' is not hd, cd, pt_ss or pt_ms", v);
+        } else if (IS("--iterations")) {
+            iterations = (int)parse_int(a, VAL(), 1, 1000000);
+        } else if (IS("--extinction")) {
+            desc.params.extinction = parse_float(a, VAL(), 0.0f, 1e6f, 1, 0);
+        } else if (IS("--albedo")) {
+            desc.params.albedo = parse_float(a, VAL(), 0.0f, 1.0f, 1, 0);
+        } else if (IS("--anisotropy")) {
+            desc.params.anisotropy = parse_float(a, VAL(), -1.0f, 1.0f, 1, 1);
+        } else if (IS("--majorant")) {
+            desc.params.majorant = parse_float(a, VAL(), 0.0f, 1e30f, 0, 0);
+        } else if (IS("--sweeps")) {
+            desc.params.diffusion_sweeps = (int)parse_int(a, VAL(), 1, 100000);
+        } else if (IS("--solver")) {
+            VAL();
+            if (strcmp(v, "rb") == 0) desc.params.solver = HD_SOLVER_RED_BLACK;
+            else if (strcmp(v, "jacobi") == 0) desc.params.solver = HD_SOLVER_JACOBI;
+            else fail(2, "--solver: '%s' is not rb or jacobi", v);
+        } else if (IS("--tracking")) {
+            VAL();
+            if (strcmp(v, "ratio") == 0) desc.params.tracking = HD_TRACKING_RATIO;
+            else if (strcmp(v, "delta") == 0) desc.params.tracking = HD_TRACKING_DELTA;
+            else fail(2, "--tracking: '%s' is not ratio or delta", v);
+        } else if (IS("--no-diffusion")) {
+            FLAG();
+            desc.params.disable_diffusion = 1;
+        } else if (IS("--seed")) {
+            desc.params.seed = (uint32_t)parse_int(a, VAL(), 0, 2147483647L);
+        } else if (IS("--threads")) {
+            desc.threads = (int)parse_int(a, VAL(), 0, 4096);
+        } else if (IS("--step")) {
+            desc.params.step = parse_float(a, VAL(), 0.01f, 16.0f, 0, 0);
+        } else if (IS("--exposure")) {
+            desc.params.exposure = parse_float(a, VAL(), 0.0f, 1e9f, 1, 0);
+        } else if (IS("--background")) {
+            parse_floats(a, VAL(), desc.params.background, 3);
+            for (k = 0; k < 3; ++k)
+                if (desc.params.background[k] < 0.0f) fail(2, "--background: '%s' is negative", v);
+        } else if (IS("--frame-window")) {
+            desc.params.frame_window = (int)parse_int(a, VAL(), 1, 1000000);
+        } else if (IS("-o") || IS("--out")) {
+            out_path = VAL();
+            if (!*out_path) fail(2, "%s: empty file name", a);
+        } else if (IS("--quiet") || IS("-q")) {
+            FLAG();
+            g_quiet = 1;
+        } else if (IS("--verbose") || IS("-v")) {
+            FLAG();
+            g_verbose = 1;
+        } else if (a[0] == '-' && a[1] != 0) {
+            fail(2, "unknown option '%s' (see --help)", a);
+        } else {
+            if (input) fail(2, "two input files: '%s' and '%s'", input, a);
+            input = a;
+        }
+#undef IS
+#undef VAL
+#undef FLAG
+    }
+
+    /* ---- check the combination ---- */
+    if (raw && input) fail(2, "give either FILE.nrrd or --raw FILE, not both");
+    if (!raw && (have_dims || raw_type >= 0 || offset))
+        fail(2, "--dims, --type and --offset are for --raw input");
+    if (raw && (!have_dims || raw_type < 0)) fail(2, "--raw needs --dims X,Y,Z and --type T");
+    if (light_count && lights_n) fail(2, "give either --light (one or more) or --lights N");
+
+    /* ---- transfer function ---- */
+    if (tf_arg) {
+        if (!hdx_tf_preset(tf_arg, &tf)) {
+            FILE *f = fopen(tf_arg, "rb");
+            if (!f) fail(2, "--tf: '%s' is neither a preset (ct-skin, ct-bone, ct-tissue, ramp) "
+                            "nor a readable file", tf_arg);
+            fclose(f);
+            if (!hdx_tf_load(tf_arg, &tf, err, sizeof err)) fail(2, "--tf: %s", err);
+        }
+        if (print_tf) {
+            hdx_tf_write(stdout, &tf);
+            return 0;
+        }
+    } else if (print_tf) {
+        fail(2, "--print-tf needs --tf PRESET|FILE");
+    }
+
+    /* ---- volume ---- */
+    if (raw) {
+        r = hd_volume_load_raw(raw, dims, (hd_raw_type)raw_type, endian, offset, &vol, &logger);
+        if (r != HD_SUCCESS) fail_lib(2, &ls, r, NULL, NULL);
+    } else {
+        if (!input) input = DEFAULT_INPUT;
+        r = hd_volume_load_nrrd(input, &vol, &logger);
+        if (r != HD_SUCCESS)
+            fail_lib(2, &ls, r, NULL,
+                     r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0
+                         ? "; run scripts/fetch-data (make data) to fetch the head CT" : NULL);
+    }
+    desc.volume = vol.desc;
+    if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
+
+    if (!tf_arg) hdx_tf_preset(vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f
+                                   ? "ct-skin" : "ramp", &tf);
+    if (tf.data_domain) {
+        float lo = vol.value_min, hi = vol.value_max;
+        if (!(hi > lo)) hi = lo + 1.0f;
+        hdx_tf_set_domain(&tf, lo, hi);
+    }
+    desc.volume.value_range[0] = tf.domain[0];
+    desc.volume.value_range[1] = tf.domain[1];
+    desc.transfer_function = hdx_tf_desc(&tf);
+
+    /* ---- lights, the rest ---- */
+    if (!light_count) light_count = preset_lights(lights_n ? lights_n : 1, &desc.camera, lights);
+    desc.lights = lights;
+    desc.light_count = light_count;
+    desc.logger = logger;
+    make_parent_dirs(out_path);
+    check_writable(out_path);
+
+    ls.last[0] = 0;
+    r = hd_create(&desc, &ctx);
+    if (r != HD_SUCCESS) {
+        int usage_error = r == HD_ERROR_UNSUPPORTED || (r >= HD_ERROR_NULL_POINTER &&
+                                                        r <= HD_ERROR_TOO_MANY_LIGHTS);
+        fail_lib(usage_error ? 2 : 1, &ls, r, "cannot create the renderer", NULL);
+    }
+    if (!g_quiet)
+        fprintf(stderr, "hdrender: %s %dx%dx%d %s, values %g..%g, tf %s, %d light%s, %s on %s, "
+                "%dx%d, %d iteration%s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
+                vol.desc.dims[2], voxel_type_name(vol.desc.type), (double)vol.value_min,
+                (double)vol.value_max, tf.name, light_count, light_count == 1 ? "" : "s",
+                hd_method_name(desc.params.method == HD_METHOD_DEFAULT ? HD_METHOD_HD
+                                                                        : desc.params.method),
+                hd_backend_name(), desc.camera.width, desc.camera.height, iterations,
+                iterations == 1 ? "" : "s");
+    hd_volume_free(&vol);
+
+    /* ---- iterate, in chunks of about 0.2 s ---- */
+    t0 = now_seconds();
+    while (done < iterations) {
+        int n = chunk < iterations - done ? chunk : iterations - done;
+        double ts = now_seconds(), te, per;
+        ls.last[0] = 0;
+        r = hd_iterate(ctx, n);
+        if (r != HD_SUCCESS) {
+            if (!g_quiet && isatty(2)) fputc('\n', stderr);
+            fail_lib(1, &ls, r, "hd_iterate", NULL);
+        }
+        te = now_seconds();
+        done += n;
+        per = (te - ts) / n;
+        chunk = per > 0.0 ? (int)(0.2 / per) : 1000;
+        if (chunk < 1) chunk = 1;
+        if (chunk > 100000) chunk = 100000;
+        if (!g_quiet && isatty(2)) progress(done, iterations, te - t0, done == iterations);
+    }
+    t_end = now_seconds();
+
+    /* ---- image ---- */
+    npix = (size_t)desc.camera.width * desc.camera.height;
+    rgba = (uint8_t *)malloc(npix * 4);
+    rgb = (uint8_t *)malloc(npix * 3);
+    if (!rgba || !rgb) fail(1, "out of memory for a %dx%d image", desc.camera.width,
+                            desc.camera.height);
+    ls.last[0] = 0;
+    r = hd_read_image_rgba8(ctx, rgba, npix * 4);
+    if (r != HD_SUCCESS) fail_lib(1, &ls, r, "hd_read_image_rgba8", NULL);
+    for (i = 0; (size_t)i < npix; ++i) memcpy(rgb + 3 * (size_t)i, rgba + 4 * (size_t)i, 3);
+    status = stbi_write_png(out_path, desc.camera.width, desc.camera.height, 3, rgb,
+                            desc.camera.width * 3);
+    if (!status) fail(1, "cannot write %s", out_path);
+    if (!g_quiet && hd_get_stats(ctx, &stats) == HD_SUCCESS)
+        fprintf(stderr, "hdrender: %d iteration%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
+                "%.2f s, projection %.2f s) -> %s\n", iterations, iterations == 1 ? "" : "s", t_end - t0,
+                iterations / (t_end - t0), stats.seconds_direct, stats.seconds_diffusion,
+                stats.seconds_projection, out_path);
+    free(rgba);
+    free(rgb);
+    hd_destroy(ctx);
+    return 0;
+}
