@@ -25,6 +25,10 @@ struct hd__backend {
     size_t illum_floats;
     hd__kctx k;
     int parity, jacobi;      /* the diffusion pass being run */
+    /* CD: one light volume per light plus one spare, rotated through them as the ping-pong */
+    float **lv;
+    int nlv;                 /* lights with a volume (the buffers are nlv + 1) */
+    int light;               /* the light of the convection / sum pass being run */
 };
 
 static const char *hd__be_name(void) { return "cpu"; }
@@ -82,6 +86,20 @@ static void hd__cpu_parallel(hd__backend *be, hd__cpu_job job, int items)
     pthread_mutex_unlock(&be->mu);
 }
 
+/* Frees CD's light volumes. */
+static void hd__cpu_free_lights(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int l;
+    if (be->lv)
+        for (l = 0; l <= be->nlv; ++l) hd__free(ctx, be->lv[l]);
+    hd__free(ctx, be->lv);
+    be->lv = NULL;
+    be->nlv = 0;
+    be->k.lv = NULL;
+    be->k.lv2 = NULL;
+}
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -103,6 +121,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__free(ctx, be->phi);
     hd__free(ctx, be->phi2);
     hd__free(ctx, be->img);
+    hd__cpu_free_lights(ctx);
     hd__free(ctx, be);
     ctx->be = NULL;
 }
@@ -165,7 +184,8 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
     return HD_SUCCESS;
 }
 
-/* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid and channels. */
+/* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid and channels.
+   illum_floats == 0 frees them: the path tracers keep no illumination grid. */
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
@@ -174,6 +194,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     be->sig = be->E = be->phi = be->phi2 = NULL;
     be->k.sig = be->k.E = be->k.phi = be->k.phi2 = NULL;
     be->illum_floats = 0;
+    if (illum_floats == 0) return HD_SUCCESS;
     be->sig = (float *)hd__calloc(ctx, gvox, sizeof(float));
     be->E = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
     be->phi = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
@@ -190,7 +211,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     hd__backend *be = ctx->be;
     hd__free(ctx, be->phi2);
     be->phi2 = be->k.phi2 = NULL;
-    if (!enable) return HD_SUCCESS;
+    if (!enable || be->illum_floats == 0) return HD_SUCCESS;
     be->phi2 = (float *)hd__calloc(ctx, be->illum_floats, sizeof(float));
     if (!be->phi2) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
     be->k.phi2 = be->phi2;
@@ -303,4 +324,83 @@ HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
                     b2 += (double)rhs * rhs;
                 }
     return b2 > 0.0 ? sqrt(r2 / b2) : sqrt(r2);
+}
+
+/* ---- the other methods: CD's convection, PT_SS / PT_MS paths ---------------------------------- */
+#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
+#define HD__BE_HAS_PT 1 /* hd__be_path */
+
+/* CD's light volumes: frees the old ones and allocates count + 1 zeroed volumes of the
+   illumination grid (count lights and one spare that rotates through them as the ping-pong
+   buffer of hd__be_convect); count 0 frees them (every method but CD). Zeroed = dark: CD starts
+   with no light in the volume. Bytes held: 4 * (count + 1) per voxel. */
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
+{
+    hd__backend *be = ctx->be;
+    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    int l;
+    hd__cpu_free_lights(ctx);
+    if (count <= 0) return HD_SUCCESS;
+    be->lv = (float **)hd__calloc(ctx, (size_t)count + 1, sizeof(float *));
+    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes", count);
+    be->nlv = count;
+    for (l = 0; l <= count; ++l) {
+        be->lv[l] = (float *)hd__calloc(ctx, gvox, sizeof(float));
+        if (!be->lv[l]) {
+            hd__cpu_free_lights(ctx);
+            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes of %zu voxels", count, gvox);
+        }
+    }
+    return HD_SUCCESS;
+}
+
+static void hd__cpu_convect_row(hd__backend *be, int r)
+{
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    for (x = 0; x < gx; ++x) hd_convect_voxel(&be->k, x, r % gy, r / gy, be->light);
+}
+static void hd__cpu_sum_light_row(hd__backend *be, int r)
+{
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    for (x = 0; x < gx; ++x) hd_sum_light_voxel(&be->k, x, r % gy, r / gy, be->light, be->light == 0);
+}
+static void hd__cpu_path_row(hd__backend *be, int py)
+{
+    int px, w = be->ctx->kp.image.x;
+    for (px = 0; px < w; ++px) hd_path_pixel(&be->k, px, py);
+}
+
+/* One convection step of light `light` (hd_convect_voxel on every voxel of the illumination
+   grid): reads its volume, writes the spare, and the two swap roles. Needs sigma_t (classify). */
+static hd_result hd__be_convect(hd__ctx *ctx, int light)
+{
+    hd__backend *be = ctx->be;
+    float *t;
+    be->light = light;
+    be->k.lv = be->lv[light];
+    be->k.lv2 = be->lv[be->nlv];
+    hd__cpu_parallel(be, hd__cpu_convect_row, ctx->gdims[1] * ctx->gdims[2]);
+    t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
+    return HD_SUCCESS;
+}
+
+/* E = sum over the lights of colour * falloff * light volume (hd_sum_light_voxel, one pass per
+   light, the first overwriting E), so the diffusion and projection of HD run on it unchanged. */
+static hd_result hd__be_sum_lights(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int l;
+    for (l = 0; l < be->nlv; ++l) {
+        be->light = l;
+        be->k.lv = be->lv[l];
+        hd__cpu_parallel(be, hd__cpu_sum_light_row, ctx->gdims[1] * ctx->gdims[2]);
+    }
+    return HD_SUCCESS;
+}
+
+/* One path per pixel (hd_path_pixel), folded into the image with weight march.y. */
+static hd_result hd__be_path(hd__ctx *ctx)
+{
+    hd__cpu_parallel(ctx->be, hd__cpu_path_row, ctx->kp.image.y);
+    return HD_SUCCESS;
 }

@@ -90,6 +90,8 @@ typedef struct hd__kctx {
     float *phi;        /* scattered light (fluence), channel-planar */
     float *phi2;       /* Jacobi's second buffer */
     float *img;        /* RGBA float accumulation, width*height*4 */
+    const float *lv;   /* CD: the light volume being read (one light's rho) */
+    float *lv2;        /* CD: the light volume being written (ping-pong) */
 } hd__kctx;
 
 #define HD_KARGS const hd__kctx *K,

@@ -210,6 +210,9 @@ static hd_result hd__check_majorant(hd__ctx *ctx, const hd_params *p)
     return HD_SUCCESS;
 }
 
+/* The path tracers keep no illumination grid: the image is their whole state. */
+static int hd__method_is_pt(hd_method m) { return m == HD_METHOD_PT_SS || m == HD_METHOD_PT_MS; }
+
 /* ---- the kernels' parameter block ------------------------------------------------------------ */
 static void hd__fill_kparams(hd__ctx *ctx)
 {
@@ -225,14 +228,16 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->counts.y = ctx->params.tracking == HD_TRACKING_DELTA ? HD_TRACK_DELTA : HD_TRACK_RATIO;
     k->counts.z = (ctx->params.majorant > 0.0f ? HD_FLAG_GLOBAL_MAJORANT : 0) |
                   (ctx->params.disable_diffusion ? HD_FLAG_NO_DIFFUSION : 0);
-    k->counts.w = ctx->params.max_bounces;
+    /* PT_SS is the path kernel with one vertex and the isotropic phase (hd_k_path.h) */
+    k->counts.w = ctx->params.method == HD_METHOD_PT_SS ? 1 : ctx->params.max_bounces;
     k->frame.x = (int32_t)ctx->iterations;
     k->frame.y = (int32_t)ctx->frames;
     k->frame.z = (int32_t)ctx->params.seed;
     k->image.x = c->width; k->image.y = c->height; k->image.z = (int32_t)ctx->params.method;
     k->box.x = ctx->box[0]; k->box.y = ctx->box[1]; k->box.z = ctx->box[2]; k->box.w = 0.0795774715f;
     k->medium.x = ctx->params.extinction; k->medium.y = ctx->params.albedo;
-    k->medium.z = ctx->params.anisotropy; k->medium.w = ctx->params.majorant;
+    k->medium.z = ctx->params.method == HD_METHOD_PT_SS ? 0.0f : ctx->params.anisotropy;
+    k->medium.w = ctx->params.majorant;
     for (i = 0; i < 3; ++i) {
         float h = ctx->box[i] / (float)ctx->gdims[i];
         (&k->grid.x)[i] = 1.0f / (h * h);
@@ -245,9 +250,11 @@ static void hd__fill_kparams(hd__ctx *ctx)
         k->march.x = ctx->params.step * vs;
     }
     {
+        /* HD and CD: a windowed mean that follows the converging illumination; the path
+           tracers' frames are independent unbiased estimates: a plain 1/n mean */
         uint64_t f = ctx->frames < 1 ? 1 : ctx->frames;
-        uint64_t win = (uint64_t)ctx->params.frame_window;
-        k->march.y = 1.0f / (float)(f < win ? f : win);
+        uint64_t win = hd__method_is_pt(ctx->params.method) ? f : (uint64_t)ctx->params.frame_window;
+        k->march.y = (float)(1.0 / (double)(f < win ? f : win));
     }
     k->march.z = 1e-4f; /* stop marching below this transmittance */
     /* camera basis */
@@ -476,13 +483,24 @@ static hd_result hd__prepare(hd__ctx *ctx)
 {
     hd_result r;
     unsigned dirty = ctx->dirty;
+    int pt = hd__method_is_pt(ctx->params.method);
     if (dirty & HD__DIRTY_ALLOC) {
-        if ((r = hd__be_alloc_illumination(ctx, hd__illum_floats(ctx))) != HD_SUCCESS) return r;
+        if ((r = hd__be_alloc_illumination(ctx, pt ? 0 : hd__illum_floats(ctx))) != HD_SUCCESS) return r;
         dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE | HD__DIRTY_JACOBI;
     }
     if (dirty & HD__DIRTY_JACOBI) {
-        if ((r = hd__be_alloc_jacobi(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+        if ((r = hd__be_alloc_jacobi(ctx, !pt && ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
     }
+#ifdef HD__BE_HAS_CD
+    /* CD's light volumes follow the lights: reallocated (dark) when they change; freed for the
+       other methods (a method change sets every dirty bit) */
+    if (dirty & HD__DIRTY_DIRECT) {
+        if ((r = hd__be_alloc_lights(ctx, ctx->params.method == HD_METHOD_CD ? ctx->light_count : 0)) != HD_SUCCESS)
+            return r;
+    }
+#endif
+    /* the path tracers' state is their image: whatever resets it restarts them */
+    if (pt && (dirty & HD__DIRTY_IMAGE)) dirty |= HD__DIRTY_DIRECT;
     if (dirty & HD__DIRTY_IMAGE_ALLOC) {
         if ((r = hd__be_alloc_image(ctx, ctx->camera.width, ctx->camera.height)) != HD_SUCCESS) return r;
         dirty |= HD__DIRTY_IMAGE;
@@ -493,7 +511,7 @@ static hd_result hd__prepare(hd__ctx *ctx)
     hd__fill_kparams(ctx);
     if (dirty & HD__DIRTY_SIGMA) {
         if ((r = hd__be_upload_inputs(ctx)) != HD_SUCCESS) return r;
-        if ((r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
+        if (!pt && (r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
     }
     if ((r = hd__be_clear(ctx, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
     ctx->dirty = 0;
@@ -522,6 +540,76 @@ static hd_result hd__iterate_hd(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* The diffusion sweeps of HD and CD (none with disable_diffusion). */
+HD__MAYBE_UNUSED static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
+{
+    hd_result r;
+    int s;
+    if (!ctx->params.disable_diffusion)
+        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
+            if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+#ifdef HD__BE_HAS_CD
+/* One CD iteration: one convection step per light and their sum into E, the diffusion sweeps,
+   one frame. Time of the convection and the sum counts as the direct stage. */
+static hd_result hd__iterate_cd(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now(), t1, t2;
+    int l;
+    ctx->iterations++;
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    for (l = 0; l < ctx->light_count; ++l)
+        if ((r = hd__be_convect(ctx, l)) != HD_SUCCESS) return r;
+    if ((r = hd__be_sum_lights(ctx)) != HD_SUCCESS) return r;
+    t1 = hd__now();
+    if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
+    t2 = hd__now();
+    if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
+    ctx->seconds[0] += t1 - t0;
+    ctx->seconds[1] += t2 - t1;
+    ctx->seconds[2] += hd__now() - t2;
+    return HD_SUCCESS;
+}
+#endif
+
+#ifdef HD__BE_HAS_PT
+/* One PT_SS / PT_MS iteration: one full path per pixel into the image's plain running mean.
+   Its time counts as the direct stage (paths), none as diffusion or projection. */
+static hd_result hd__iterate_pt(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now();
+    ctx->iterations++;
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    if ((r = hd__be_path(ctx)) != HD_SUCCESS) return r;
+    ctx->seconds[0] += hd__now() - t0;
+    return HD_SUCCESS;
+}
+#endif
+
+/* One iteration of the current method (METHOD.md: what an iteration is, per method). */
+static hd_result hd__iterate_method(hd__ctx *ctx)
+{
+    switch (ctx->params.method) {
+#ifdef HD__BE_HAS_CD
+    case HD_METHOD_CD: return hd__iterate_cd(ctx);
+#endif
+#ifdef HD__BE_HAS_PT
+    case HD_METHOD_PT_SS:
+    case HD_METHOD_PT_MS: return hd__iterate_pt(ctx);
+#endif
+    case HD_METHOD_HD: return hd__iterate_hd(ctx);
+    default:
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
+                       hd_method_name(ctx->params.method), hd__be_name());
+    }
+}
+
 HDDEF hd_result hd_iterate(hd_context h, int n)
 {
     hd_result r;
@@ -532,7 +620,7 @@ HDDEF hd_result hd_iterate(hd_context h, int n)
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: more than 2^31 iterations; reset with a new seed");
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     for (i = 0; i < n; ++i) {
-        if ((r = hd__iterate_hd(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__iterate_method(ctx)) != HD_SUCCESS) return r;
     }
     return HD_SUCCESS;
 }
@@ -593,6 +681,9 @@ HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float 
     if ((int)which < 0 || which >= HD_ILLUMINATION_COUNT)
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_ENUM, "hd_read_illumination: which = %d is not a hd_illumination", (int)which);
     if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_illumination: dst is NULL");
+    if (hd__method_is_pt(ctx->params.method))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd_read_illumination: method %s keeps no illumination volume",
+                       hd_method_name(ctx->params.method));
     need = hd__illum_floats(ctx);
     if (dst_floats < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
@@ -608,10 +699,14 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
     out->method = ctx->params.method;
     out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations;
+    if (hd__method_is_pt(ctx->params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
-    /* sigma_t grid + E + phi (+ Jacobi's buffer): what the method needs, independent of lights */
+    /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
+       plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
     out->method_bytes = gvox * sizeof(float) +
                         hd__illum_floats(ctx) * sizeof(float) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+    if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
+    if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
     out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
     hd__be_volume_bytes(ctx, &out->volume_bytes);
     memcpy(out->illumination_dims, ctx->gdims, sizeof ctx->gdims);

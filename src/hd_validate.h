@@ -147,7 +147,14 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.max_bounces = %d is outside 1..100000", p->max_bounces);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
-    if (p->method != HD_METHOD_HD)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method %s is not implemented yet", hd_method_name(p->method));
+#ifndef HD__BE_HAS_CD
+    if (p->method == HD_METHOD_CD)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method CD is not available on the %s backend", hd__be_name());
+#endif
+#ifndef HD__BE_HAS_PT
+    if (p->method == HD_METHOD_PT_SS || p->method == HD_METHOD_PT_MS)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
+                       hd_method_name(p->method), hd__be_name());
+#endif
     return HD_SUCCESS;
 }

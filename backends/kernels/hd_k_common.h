@@ -134,11 +134,15 @@ HD_FN float hd_box_entry(HD_KARGS hd_v3 o, hd_v3 d, HD_INOUT(float) t_exit)
    cell by cell (a 3D DDA), so empty cells cost no collision at all; the exponential free path is
    memoryless, so restarting it at each cell boundary is exact. mode: HD_TRACK_RATIO (ratio
    tracking, Russian roulette below HD_RR_THRESHOLD) or HD_TRACK_DELTA (0 or 1).
-   Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim. */
-HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
-                             int mode, HD_INOUT(hd_u32) next_dim)
+   Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim.
+   hd_track is the shared walker: with HD_TRACK_DELTA it also reports in *t_hit the distance of
+   the real collision that ended the walk (tmax when the ray got through), which makes it the
+   free-flight sampler of the path tracers (hd_free_flight); hd_transmittance wraps it. */
+HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0, int mode,
+                     HD_INOUT(hd_u32) next_dim, HD_INOUT(float) t_hit)
 {
     float T = 1.0f;
+    float hit = tmax;
     hd_u32 dim = dim0;
     float t = 0.0f;
     int done = 0;
@@ -176,7 +180,7 @@ HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, 
                 sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
                 ratio = hd_minf(sig * inv_mu, 1.0f);
                 if (mode == HD_TRACK_DELTA) {
-                    if (hd_rand(key, dim) < ratio) { T = 0.0f; done = 1; }
+                    if (hd_rand(key, dim) < ratio) { T = 0.0f; done = 1; hit = t; }
                     dim += 1u;
                 } else {
                     T *= 1.0f - ratio;
@@ -198,7 +202,25 @@ HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, 
         else { cz += sz; nz += dz; if (cz < 0 || cz >= HD_PRM(mdims).z) break; }
     }
     HD_DEREF(next_dim) = dim;
+    HD_DEREF(t_hit) = hit;
     return T;
+}
+
+HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
+                             int mode, HD_INOUT(hd_u32) next_dim)
+{
+    float t_hit;
+    return hd_track(HD_KPASS p, d, tmax, key, dim0, mode, next_dim, HD_REF(t_hit));
+}
+
+/* Delta tracking to the first real collision along p + t d: its distance, or tmax when the ray
+   gets through. Same random dims as hd_transmittance in delta mode. */
+HD_FN float hd_free_flight(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
+                           HD_INOUT(hd_u32) next_dim)
+{
+    float t_hit;
+    hd_track(HD_KPASS p, d, tmax, key, dim0, HD_TRACK_DELTA, next_dim, HD_REF(t_hit));
+    return t_hit;
 }
 
 /* Direction toward light l from p, the distance to stop tracking at (light or box exit) and the

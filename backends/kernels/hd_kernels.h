@@ -5,3 +5,5 @@
 #include "hd_k_direct.h"
 #include "hd_k_diffuse.h"
 #include "hd_k_project.h"
+#include "hd_k_convect.h"
+#include "hd_k_path.h"
