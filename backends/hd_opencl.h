@@ -412,7 +412,11 @@ static hd_result hd__be_direct(hd__ctx *ctx)
 {
     hd_result r;
     if ((r = hd__cl_bind(ctx, HD__CL_DIRECT)) != HD_SUCCESS) return r;
-    return hd__cl_run(ctx, HD__CL_DIRECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
+    if ((r = hd__cl_run(ctx, HD__CL_DIRECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
+    /* each stage returns when its work is done, as on the CPU, so the core's per-stage clocks
+       measure the device rather than the enqueueing (cost: one clFinish per stage) */
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    return HD_SUCCESS;
 }
 
 /* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
@@ -432,6 +436,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
             return r;
     }
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
+    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
     return HD_SUCCESS;
 }
 
@@ -440,8 +445,6 @@ static hd_result hd__be_project(hd__ctx *ctx)
     hd_result r;
     if ((r = hd__cl_bind(ctx, HD__CL_PROJECT)) != HD_SUCCESS) return r;
     if ((r = hd__cl_run(ctx, HD__CL_PROJECT, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
-    /* hd_iterate returns when its work is done, as on the CPU, so stage timers and the caller's
-       clock measure the device, not the enqueueing */
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
     return HD_SUCCESS;
 }

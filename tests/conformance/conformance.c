@@ -9,7 +9,8 @@
    a = reference. Every call is checked to leave the caller's buffers unchanged.
    Output: one line per case with its errors, then "N passed, N failed". A backend whose runtime
    or device is missing is reported SKIPPED with the reason (exit 0, or 1 when the environment
-   sets HD_CONFORMANCE_REQUIRE=1, as CI does). */
+   sets HD_CONFORMANCE_REQUIRE=1, as CI does). `conformance-opencl --quick`: one case per stage
+   (what `make valgrind-opencl` runs). */
 #include "hd_api.h"
 #include <math.h>
 #include <stdio.h>
@@ -418,16 +419,23 @@ static int backend_available(void)
     return 0;
 }
 
-int main(void)
+int main(int argc, char **argv)
 {
     static const int odd[3] = {37, 53, 29}, other[3] = {24, 17, 33};
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
-    int t;
+    int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available()) {
         const char *req = getenv("HD_CONFORMANCE_REQUIRE");
         printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed)\n", hd_api_backend.backend_name());
         return req && req[0] == '1' ? 1 : 0;
+    }
+    if (quick) { /* one case per stage, for valgrind */
+        case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
+        case_project(HD_VOXEL_U16, odd, 1, 1);
+        case_iterate(HD_VOXEL_F32, other, 3, 1, 1, CHANGE_CAMERA, 2);
+        printf("%d passed, %d failed\n", n_passed, n_failed);
+        return n_failed == 0 ? 0 : 1;
     }
     /* deterministic stages */
     for (t = 0; t < 3; ++t) {
