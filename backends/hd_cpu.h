@@ -25,6 +25,7 @@ struct hd__backend {
     size_t illum_floats;
     hd__kctx k;
     int parity, jacobi;      /* the diffusion pass being run */
+    int row_group;           /* red-black: rows with (y + z) & 1 == row_group */
     /* CD: one light volume per light plus one spare, rotated through them as the ping-pong */
     float **lv;
     int nlv;                 /* lights with a volume (the buffers are nlv + 1) */
@@ -248,10 +249,56 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
     int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_direct_voxel(&be->k, x, r % gy, r / gy);
 }
+/* Rows inside the grid in y and z relax their interior voxels through a contiguous loop over a
+   row buffer: hd_diffuse_terms_at with literal in-grid flags has no branches, so the compiler
+   vectorises it (the strided red-black loop of hd_diffuse_row did not: 50 ms against 10 ms per
+   sweep on the head CT with AVX-512); red-black then copies back one colour, so half the row's
+   arithmetic is thrown away, still a 5x gain. Same function, same operations: the same bits as
+   hd_diffuse_row. Edge rows and the two end voxels take the general path. */
+#define HD__CPU_ROW_MAX 8192
+static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
+{
+    const hd__kctx *K = &be->k;
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], gz = be->ctx->gdims[2], x, x0;
+    float row[HD__CPU_ROW_MAX];
+    float *dst;
+    if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
+        hd_diffuse_row(K, y, z, c, be->parity, be->jacobi);
+        return;
+    }
+    /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them */
+    for (x = 1; x < gx - 1; ++x) {
+        float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, &den);
+        row[x] = num / den;
+    }
+    {
+        float den, num = hd_diffuse_terms(K, 0, y, z, c, &den);
+        row[0] = num / den;
+        num = hd_diffuse_terms(K, gx - 1, y, z, c, &den);
+        row[gx - 1] = num / den;
+    }
+    dst = (be->jacobi ? be->phi2 : be->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
+    x0 = be->jacobi ? 0 : ((y + z + be->parity) & 1);
+    if (be->jacobi) memcpy(dst, row, (size_t)gx * sizeof(float));
+    else for (x = x0; x < gx; x += 2) dst[x] = row[x];
+}
+
+/* Jacobi: any row, any order. */
 static void hd__cpu_diffuse_row(hd__backend *be, int r)
 {
     int gy = be->ctx->gdims[1], gz = be->ctx->gdims[2];
-    hd_diffuse_row(&be->k, r % gy, (r / gy) % gz, r / (gy * gz), be->parity, be->jacobi);
+    hd__cpu_diffuse_row_at(be, r % gy, (r / gy) % gz, r / (gy * gz));
+}
+
+/* Red-black: the rows of one group, (y + z) & 1 == be->row_group. A row reads its four
+   neighbour rows whole (the row buffer computes both colours), and those are all in the other
+   group, which no thread writes during this pass: no data race. */
+static void hd__cpu_diffuse_row_group(hd__backend *be, int r)
+{
+    int gy = be->ctx->gdims[1], gz = be->ctx->gdims[2], hy = (gy + 1) / 2;
+    int z = (r / hy) % gz, c = r / (hy * gz);
+    int y = 2 * (r % hy) + ((be->row_group + z) & 1);
+    if (y < gy) hd__cpu_diffuse_row_at(be, y, z, c);
 }
 static void hd__cpu_project_row(hd__backend *be, int py)
 {
@@ -282,10 +329,10 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
         be->k.phi = be->phi; be->k.phi2 = be->phi2;
     } else {
-        be->parity = 0;
-        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
-        be->parity = 1;
-        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
+        int half_rows = (ctx->gdims[1] + 1) / 2 * ctx->gdims[2] * ctx->channels;
+        for (be->parity = 0; be->parity < 2; ++be->parity)
+            for (be->row_group = 0; be->row_group < 2; ++be->row_group)
+                hd__cpu_parallel(be, hd__cpu_diffuse_row_group, half_rows);
     }
     return HD_SUCCESS;
 }

@@ -6,12 +6,15 @@
    (vacuum) with the voxel's own D. Each update is the paper's weighted sum of the 6 neighbours:
    phi_i = (sigma_s E_i + sum_j w_j phi_j) / (sigma_a + sum_j w_j),  w_j = D_ij / h^2. */
 
-/* The numerator of voxel (x,y,z)'s update in channel c; its denominator goes to *den. */
-HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) den)
+/* The numerator of voxel (x,y,z)'s update in channel c; its denominator goes to *den.
+   in_xm ... in_zp say whether the neighbour on each side lies inside the grid: the caller
+   passes literal 1s for interior voxels so the compiler drops the tests (see hd_cpu.h). */
+HD_FN float hd_diffuse_terms_at(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
+                                int in_ym, int in_yp, int in_zm, int in_zp, HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
-    int ic = i + c * nvox, zc = z + c * gz;
+    int ic = i + c * nvox, zc = z + c * gz, sxy = gx * gy;
     float a = HD_PRM(medium).y;
     float ag = 1.0f - a * HD_PRM(medium).z;
     float fl = HD_PRM(grid).w;
@@ -21,26 +24,33 @@ HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float
     float num = a * st * HD_GET(E, ic, x, y, zc);
     float dn = (1.0f - a) * st;
     float w;
-    w = HD_PRM(grid).x * (x > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - 1, x - 1, y, z), fl) : own);
-    if (x > 0) num += w * HD_GET(phi, ic - 1, x - 1, y, zc);
+    w = HD_PRM(grid).x * (in_xm != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - 1, x - 1, y, z), fl) : own);
+    if (in_xm != 0) num += w * HD_GET(phi, ic - 1, x - 1, y, zc);
     dn += w;
-    w = HD_PRM(grid).x * (x < gx - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + 1, x + 1, y, z), fl) : own);
-    if (x < gx - 1) num += w * HD_GET(phi, ic + 1, x + 1, y, zc);
+    w = HD_PRM(grid).x * (in_xp != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + 1, x + 1, y, z), fl) : own);
+    if (in_xp != 0) num += w * HD_GET(phi, ic + 1, x + 1, y, zc);
     dn += w;
-    w = HD_PRM(grid).y * (y > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - gx, x, y - 1, z), fl) : own);
-    if (y > 0) num += w * HD_GET(phi, ic - gx, x, y - 1, zc);
+    w = HD_PRM(grid).y * (in_ym != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - gx, x, y - 1, z), fl) : own);
+    if (in_ym != 0) num += w * HD_GET(phi, ic - gx, x, y - 1, zc);
     dn += w;
-    w = HD_PRM(grid).y * (y < gy - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + gx, x, y + 1, z), fl) : own);
-    if (y < gy - 1) num += w * HD_GET(phi, ic + gx, x, y + 1, zc);
+    w = HD_PRM(grid).y * (in_yp != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + gx, x, y + 1, z), fl) : own);
+    if (in_yp != 0) num += w * HD_GET(phi, ic + gx, x, y + 1, zc);
     dn += w;
-    w = HD_PRM(grid).z * (z > 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - gx * gy, x, y, z - 1), fl) : own);
-    if (z > 0) num += w * HD_GET(phi, ic - gx * gy, x, y, zc - 1);
+    w = HD_PRM(grid).z * (in_zm != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i - sxy, x, y, z - 1), fl) : own);
+    if (in_zm != 0) num += w * HD_GET(phi, ic - sxy, x, y, zc - 1);
     dn += w;
-    w = HD_PRM(grid).z * (z < gz - 1 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + gx * gy, x, y, z + 1), fl) : own);
-    if (z < gz - 1) num += w * HD_GET(phi, ic + gx * gy, x, y, zc + 1);
+    w = HD_PRM(grid).z * (in_zp != 0 ? 0.6666667f / hd_maxf(sp + ag * HD_GET(sig, i + sxy, x, y, z + 1), fl) : own);
+    if (in_zp != 0) num += w * HD_GET(phi, ic + sxy, x, y, zc + 1);
     dn += w;
     HD_DEREF(den) = dn;
     return num;
+}
+
+HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) den)
+{
+    return hd_diffuse_terms_at(HD_KPASS x, y, z, c, x > 0 ? 1 : 0, x < HD_PRM(gdims).x - 1 ? 1 : 0,
+                               y > 0 ? 1 : 0, y < HD_PRM(gdims).y - 1 ? 1 : 0,
+                               z > 0 ? 1 : 0, z < HD_PRM(gdims).z - 1 ? 1 : 0, den);
 }
 
 /* Relaxes the voxels x0, x0 + xstep, ... of row (y, z), channel c. Red-black Gauss-Seidel:
