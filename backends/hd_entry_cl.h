@@ -6,7 +6,7 @@
     __global float *phi, __global float *phi2, __global float *img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img
+    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0
 
 /* One work-item per voxel: global size = illumination grid (x, y, z). */
 __kernel void hd_k_classify(HD__CL_BUFFERS)
@@ -35,4 +35,29 @@ __kernel void hd_k_project(HD__CL_BUFFERS)
 {
     HD__CL_KCTX;
     hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
+}
+
+/* CD: one upwind convection step of light l, reading lv and writing lv2; one work-item per
+   voxel (global size = illumination grid). */
+__kernel void hd_k_convect(HD__CL_BUFFERS, __global const float *lv, __global float *lv2, int l)
+{
+    HD__CL_KCTX;
+    k.lv = lv;
+    k.lv2 = lv2;
+    hd_convect_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l);
+}
+
+/* CD: adds light l's volume into E (first != 0: overwrites); one work-item per voxel. */
+__kernel void hd_k_sum_light(HD__CL_BUFFERS, __global const float *lv, int l, int first)
+{
+    HD__CL_KCTX;
+    k.lv = lv;
+    hd_sum_light_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l, first);
+}
+
+/* PT_SS / PT_MS: one path per pixel (x, y). */
+__kernel void hd_k_path(HD__CL_BUFFERS)
+{
+    HD__CL_KCTX;
+    hd_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }

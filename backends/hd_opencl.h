@@ -24,9 +24,13 @@
 #endif
 #include "hd_kernels_embedded.h"
 
-enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT, HD__CL_KERNEL_COUNT };
+#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
+#define HD__BE_HAS_PT 1 /* hd__be_path */
+
+enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT, HD__CL_CONVECT, HD__CL_SUM_LIGHT,
+       HD__CL_PATH, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
-    "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_project"};
+    "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_project", "hd_k_convect", "hd_k_sum_light", "hd_k_path"};
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -37,6 +41,8 @@ struct hd__backend {
     cl_kernel kernels[HD__CL_KERNEL_COUNT];
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
+    cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
+    int nlv;
     size_t tf_bytes, illum_floats, img_floats;
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
@@ -250,6 +256,17 @@ static hd_result hd__cl_zero(hd__ctx *ctx, cl_mem m, size_t floats)
     return HD_SUCCESS;
 }
 
+static void hd__cl_free_lights(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int l;
+    if (!be->lv) return;
+    for (l = 0; l <= be->nlv; ++l) hd__cl_release(&be->lv[l]);
+    hd__free(ctx, be->lv);
+    be->lv = NULL;
+    be->nlv = 0;
+}
+
 /* ---- life cycle -------------------------------------------------------------------------- */
 static void hd__be_destroy(hd__ctx *ctx)
 {
@@ -257,6 +274,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     int k;
     if (!be) return;
     if (be->queue) clFinish(be->queue);
+    hd__cl_free_lights(ctx);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf);
     hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
     hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
@@ -466,5 +484,77 @@ static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, f
     HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, 0,
                                         be->illum_floats * sizeof(float), dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(illumination)");
+    return HD_SUCCESS;
+}
+
+/* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
+/* Frees the old light volumes and allocates count + 1 zeroed ones (count lights and a spare that
+   rotates through them as the ping-pong buffer); count 0 frees them. As hd_cpu.h. */
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
+{
+    hd__backend *be = ctx->be;
+    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    hd_result r;
+    int l;
+    HD__CL_LOST_CHECK(ctx);
+    hd__cl_free_lights(ctx);
+    if (count <= 0) return HD_SUCCESS;
+    be->lv = (cl_mem *)hd__calloc(ctx, (size_t)count + 1, sizeof(cl_mem));
+    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate %d light volume handles", count);
+    be->nlv = count;
+    for (l = 0; l <= count; ++l)
+        if ((r = hd__cl_buffer(ctx, &be->lv[l], gvox * sizeof(float), NULL, "a CD light volume")) != HD_SUCCESS) {
+            hd__cl_free_lights(ctx);
+            return r;
+        }
+    return HD_SUCCESS;
+}
+
+/* One convection step of light `light`: reads its volume, writes the spare, the two swap. */
+static hd_result hd__be_convect(hd__ctx *ctx, int light)
+{
+    hd__backend *be = ctx->be;
+    cl_kernel k = be->kernels[HD__CL_CONVECT];
+    cl_int l = light;
+    cl_mem t;
+    hd_result r;
+    if ((r = hd__cl_bind(ctx, HD__CL_CONVECT)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(k, 9, sizeof(cl_mem), &be->lv[light]), "clSetKernelArg(lv)");
+    HD__CL_TRY(ctx, clSetKernelArg(k, 10, sizeof(cl_mem), &be->lv[be->nlv]), "clSetKernelArg(lv2)");
+    HD__CL_TRY(ctx, clSetKernelArg(k, 11, sizeof l, &l), "clSetKernelArg(light)");
+    if ((r = hd__cl_run(ctx, HD__CL_CONVECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
+    t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
+    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
+static hd_result hd__be_sum_lights(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    cl_kernel k = be->kernels[HD__CL_SUM_LIGHT];
+    hd_result r;
+    int l;
+    if ((r = hd__cl_bind(ctx, HD__CL_SUM_LIGHT)) != HD_SUCCESS) return r;
+    for (l = 0; l < be->nlv; ++l) {
+        cl_int li = l, first = l == 0;
+        HD__CL_TRY(ctx, clSetKernelArg(k, 9, sizeof(cl_mem), &be->lv[l]), "clSetKernelArg(lv)");
+        HD__CL_TRY(ctx, clSetKernelArg(k, 10, sizeof li, &li), "clSetKernelArg(light)");
+        HD__CL_TRY(ctx, clSetKernelArg(k, 11, sizeof first, &first), "clSetKernelArg(first)");
+        if ((r = hd__cl_run(ctx, HD__CL_SUM_LIGHT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+            return r;
+    }
+    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* ---- PT_SS / PT_MS ------------------------------------------------------------------------ */
+/* One path per pixel, folded into the image with weight march.y. */
+static hd_result hd__be_path(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__cl_bind(ctx, HD__CL_PATH)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_run(ctx, HD__CL_PATH, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
     return HD_SUCCESS;
 }

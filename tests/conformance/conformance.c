@@ -401,6 +401,31 @@ static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed
     scene_free(&s);
 }
 
+/* CD (deterministic: upwind convection, diffusion, projection with the same jitter hash) or
+   PT_SS / PT_MS (stochastic paths with identical seeds), whole iterations through the API. */
+static void case_method(hd_method method, hd_voxel_type type, const int *d, int lights, int mixed, int point, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    int det = method == HD_METHOD_CD;
+    scene_init(&s, type, d[0], d[1], d[2], lights, mixed, point);
+    s.params.method = method;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s x%d %s %dx%dx%d %dL %s%s", hd_api_cpu.method_name(method), n, type_name(type), d[0], d[1], d[2],
+             lights, point ? "dir+point" : "dir", mixed ? " rgb" : "");
+    if (pair_create(&p, &s)) {
+        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
+        pair_compare(&p, det ? CMP_E | CMP_PHI | CMP_IMAGE : CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, det);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
 /* ---- main ----------------------------------------------------------------------------------- */
 /* Creates one backend context: if the runtime or a device is missing, the backend is skipped. */
 static int backend_available(void)
@@ -459,6 +484,14 @@ int main(int argc, char **argv)
     case_iterate(HD_VOXEL_U16, odd, 3, 1, 1, CHANGE_TF, 8);
     case_iterate(HD_VOXEL_F32, odd, 16, 0, 1, CHANGE_CAMERA, 8);
     case_iterate(HD_VOXEL_U8, other, 3, 0, 1, CHANGE_CAMERA, 8);
+    /* the baselines */
+    case_method(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 0, 0, 8);
+    case_method(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 1, 1, 8);
+    case_method(HD_METHOD_CD, HD_VOXEL_F32, other, 16, 0, 1, 4);
+    case_method(HD_METHOD_PT_SS, HD_VOXEL_U8, odd, 1, 0, 0, 8);
+    case_method(HD_METHOD_PT_SS, HD_VOXEL_F32, other, 3, 1, 1, 8);
+    case_method(HD_METHOD_PT_MS, HD_VOXEL_U16, odd, 3, 0, 1, 8);
+    case_method(HD_METHOD_PT_MS, HD_VOXEL_U8, other, 16, 1, 1, 8);
     printf("%d passed, %d failed\n", n_passed, n_failed);
     return n_failed == 0 ? 0 : 1;
 }
