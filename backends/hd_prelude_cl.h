@@ -5,8 +5,8 @@
    -DHD_MAX_LIGHTS=n, so the parameter block has one definition of its size. */
 #define HD_FN inline
 #define HD_LANG_CL 1
-/* C does not fuse a*b+c (x86-64-v2 has no FMA); OpenCL C would by default. Off, so the
-   deterministic stages round exactly as the CPU reference does. */
+/* The C reference does not fuse a*b+c (ISO C modes, -std=c99, default to -ffp-contract=off);
+   OpenCL C would by default. Off, so the deterministic stages round exactly as the CPU does. */
 #pragma OPENCL FP_CONTRACT OFF
 
 typedef uint hd_u32;
