@@ -1,0 +1,81 @@
+/* hd_prelude_glsl.h - GLSL 4.30 text, not C: makes the shared kernel sources (backends/kernels/)
+   valid GLSL compute shaders, defining the same names as hd_prelude_c.h (read that file for what
+   each means). Buffers are globals here (GLSL has no pointers), so HD_KARGS/HD_KPASS are empty
+   and HD_GET(buf, ...) names the buffer's array. This version binds every buffer as a storage
+   buffer; a backend that prefers images (lavapipe/llvmpipe run storage buffers about 6x slower
+   than image3D) defines HD_GLSL_CUSTOM_BUFFERS and its own HD_GET/HD_SET before the kernels.
+   The backend prepends `#version`, `#define HD_MAX_LIGHTS n` and its local size. */
+#define HD_FN
+#define HD_LANG_GLSL 1
+#define hd_u32 uint
+#define hd_v3 vec3
+#define hd_v4 vec4
+#define hd_i4 ivec4
+#define hd_f4 vec4
+
+#define HD_F(v) float(v)
+#define HD_I(v) int(v)
+#define HD_U(v) uint(v)
+
+#define HD_V3(x, y, z) vec3((x), (y), (z))
+#define HD_V4(x, y, z, w) vec4((x), (y), (z), (w))
+#define HD_XYZ(v4) ((v4).xyz)
+vec3 hd_add(vec3 a, vec3 b) { return a + b; }
+vec3 hd_sub(vec3 a, vec3 b) { return a - b; }
+vec3 hd_scale(vec3 a, float s) { return a * s; }
+vec3 hd_vmul(vec3 a, vec3 b) { return a * b; }
+vec3 hd_vdiv(vec3 a, vec3 b) { return a / b; }
+vec3 hd_madd(vec3 p, vec3 d, float t) { return p + d * t; }
+/* Spelled out, not dot(): the same order of operations as the C prelude. */
+float hd_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+float hd_len(vec3 a) { return sqrt(hd_dot(a, a)); }
+vec3 hd_normalize(vec3 a) { return hd_scale(a, 1.0f / hd_len(a)); }
+
+#define hd_log(x) log(x)
+#define hd_exp(x) exp(x)
+#define hd_sqrt(x) sqrt(x)
+#define hd_floor(x) floor(x)
+#define hd_absf(x) abs(x)
+#define hd_powf(x, y) pow((x), (y))
+float hd_minf(float a, float b) { return a < b ? a : b; }
+float hd_maxf(float a, float b) { return a > b ? a : b; }
+int hd_mini(int a, int b) { return a < b ? a : b; }
+int hd_maxi(int a, int b) { return a > b ? a : b; }
+float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+
+#define HD_STRUCT(name) struct name {
+#define HD_STRUCT_END(name) };
+
+/* Output parameters: GLSL's inout. */
+#define HD_INOUT(type) inout type
+#define HD_DEREF(p) p
+#define HD_REF(v) v
+
+/* The parameter block: a std140 uniform block; only 16-byte vectors, as in C. */
+#define HD_PARAM_I4(name) ivec4 name;
+#define HD_PARAM_F4(name) vec4 name;
+#define HD_PARAM_F4_ARRAY(name, n) vec4 name[n];
+#define HD_PARAMS_BEGIN layout(std140, binding = 0) uniform hd_kparams_block {
+#define HD_PARAMS_END } hd_kp;
+
+#define HD_KARGS
+#define HD_KPASS
+#define HD_PRM(name) (hd_kp.name)
+
+#ifndef HD_GLSL_CUSTOM_BUFFERS
+layout(std430, binding = 1) readonly buffer hd_b_vol { float vol[]; };
+layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
+layout(std430, binding = 3) readonly buffer hd_b_maj { float maj[]; };
+layout(std430, binding = 4) buffer hd_b_sig { float sig[]; };
+layout(std430, binding = 5) buffer hd_b_E { float E[]; };
+layout(std430, binding = 6) buffer hd_b_phi { float phi[]; };
+layout(std430, binding = 7) buffer hd_b_phi2 { float phi2[]; };
+layout(std430, binding = 8) buffer hd_b_img { float img[]; };
+layout(std430, binding = 9) readonly buffer hd_b_lv { float lv[]; };
+layout(std430, binding = 10) buffer hd_b_lv2 { float lv2[]; };
+#define HD_GET(buf, i, x, y, z) buf[(i)]
+#define HD_SET(buf, i, x, y, z, v) buf[(i)] = (v)
+#define HD_GET1(buf, i) buf[(i)]
+#define HD_SET1(buf, i, v) buf[(i)] = (v)
+#endif
