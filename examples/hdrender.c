@@ -83,7 +83,8 @@ static const char *usage_text =
     "\n"
     "method\n"
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
-    "  --iterations N          progressive iterations (default 24)\n"
+    "  --iterations N          progressive iterations (default 24; 256 for pt_ss, pt_ms,\n"
+    "                          whose iteration is one path per pixel)\n"
     "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"
     "  --albedo F              sigma_s / sigma_t in (0,1] (default 0.9)\n"
     "  --anisotropy G          Henyey-Greenstein g in (-1,1) (default 0)\n"
@@ -397,7 +398,7 @@ int main(int argc, char **argv)
 {
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
-    int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 24;
+    int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
     int print_tf = 0, i, k, have_spacing = 0, status;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -566,6 +567,10 @@ int main(int argc, char **argv)
         fail(2, "--dims, --type and --offset are for --raw input");
     if (raw && (!have_dims || raw_type < 0)) fail(2, "--raw needs --dims X,Y,Z and --type T");
     if (light_count && lights_n) fail(2, "give either --light (one or more) or --lights N");
+
+    if (!iterations)
+        iterations = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS
+                         ? 256 : 24;
 
     /* ---- transfer function ---- */
     if (tf_arg) {
