@@ -446,9 +446,15 @@ static hd_result hd__io_nrrd_sizes(const hd__io_nrrd *h, int64_t dims[3], int *o
     return HD_SUCCESS;
 }
 
+/* Shared by every loader: > 0 and finite, also once rounded to float. */
+static int hd__io_spacing_valid(double s)
+{
+    return s > 0.0 && s < HUGE_VAL && (float)s > 0.0f && isfinite((float)s);
+}
+
 static hd_result hd__io_check_spacing(double s, int axis, int line, const hd_logger *logger)
 {
-    if (!(s > 0.0) || !(s < HUGE_VAL) || !((float)s > 0.0f) || !isfinite((float)s))
+    if (!hd__io_spacing_valid(s))
         return HD__IO_FAIL(logger, HD_ERROR_INVALID_SPACING,
                            "nrrd: line %d: spacing of axis %d is %g (must be finite and > 0)",
                            line, axis, s);
@@ -638,19 +644,21 @@ static int hd__io_inflate(z_stream *zs, const unsigned char **in, size_t *in_lef
 }
 
 static hd_result hd__io_gzip_error(int r, const z_stream *zs, const char *stage,
-                                   const hd_logger *logger)
+                                   const char *what, const hd_logger *logger)
 {
     if (r == Z_MEM_ERROR)
-        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "nrrd: zlib is out of memory");
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: zlib is out of memory", what);
     if (r == Z_BUF_ERROR)
-        return HD__IO_FAIL(logger, HD_ERROR_GZIP, "nrrd: gzip stream is truncated (%s)", stage);
-    return HD__IO_FAIL(logger, HD_ERROR_GZIP, "nrrd: gzip stream is corrupt (%s): %s", stage,
+        return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is truncated (%s)", what,
+                           stage);
+    return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is corrupt (%s): %s", what, stage,
                        zs->msg ? zs->msg : "zlib error");
 }
 
-/* Decompresses skip + bytes bytes; returns the last bytes of them in *out (malloc'd). */
+/* Decompresses skip + bytes bytes of a gzip or zlib stream; returns the last bytes of them in
+   *out (malloc'd). what: "nrrd", "mhd", "nifti", for the messages. */
 static hd_result hd__io_gunzip(const unsigned char *in, size_t in_len, size_t skip, size_t bytes,
-                               unsigned char **out, const hd_logger *logger)
+                               unsigned char **out, const char *what, const hd_logger *logger)
 {
     z_stream zs;
     size_t got = 0;
@@ -662,17 +670,17 @@ static hd_result hd__io_gunzip(const unsigned char *in, size_t in_len, size_t sk
        before allocating anything. */
     if (skip > SIZE_MAX - bytes || (skip + bytes) / 1032 > in_len + 64)
         return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                           "nrrd: header claims %zu bytes of data, a gzip stream of %zu bytes "
-                           "cannot hold that many", bytes, in_len);
+                           "%s: header claims %zu bytes of data, a gzip stream of %zu bytes "
+                           "cannot hold that many", what, bytes, in_len);
     buf = (unsigned char *)malloc(bytes);
     if (!buf)
-        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "nrrd: cannot allocate %zu bytes",
-                           bytes);
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes",
+                           what, bytes);
     memset(&zs, 0, sizeof zs);
     r = inflateInit2(&zs, 15 + 32); /* gzip or zlib header */
     if (r != Z_OK) {
         free(buf);
-        return hd__io_gzip_error(r, &zs, "init", logger);
+        return hd__io_gzip_error(r, &zs, "init", what, logger);
     }
     r = hd__io_inflate(&zs, &in, &in_len, NULL, skip, &got);
     if (r == Z_OK) {
@@ -683,20 +691,21 @@ static hd_result hd__io_gunzip(const unsigned char *in, size_t in_len, size_t sk
             size_t rest;
             do r = hd__io_inflate(&zs, &in, &in_len, NULL, (size_t)1 << 30, &rest);
             while (r == Z_OK);
-            if (r != Z_STREAM_END) res = hd__io_gzip_error(r, &zs, "after the data", logger);
+            if (r != Z_STREAM_END)
+                res = hd__io_gzip_error(r, &zs, "after the data", what, logger);
         } else if (r == Z_STREAM_END) {
             res = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                              "nrrd: header claims %zu bytes of data, gzip stream holds %zu",
-                              bytes, got);
+                              "%s: header claims %zu bytes of data, gzip stream holds %zu",
+                              what, bytes, got);
         } else {
-            res = hd__io_gzip_error(r, &zs, "in the data", logger);
+            res = hd__io_gzip_error(r, &zs, "in the data", what, logger);
         }
     } else if (r == Z_STREAM_END) {
         res = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                          "nrrd: gzip stream holds %zu bytes, less than the byte skip %zu", got,
-                          skip);
+                          "%s: gzip stream holds %zu bytes, less than the byte skip %zu", what,
+                          got, skip);
     } else {
-        res = hd__io_gzip_error(r, &zs, "in the skipped bytes", logger);
+        res = hd__io_gzip_error(r, &zs, "in the skipped bytes", what, logger);
     }
     inflateEnd(&zs);
     if (res != HD_SUCCESS) {
@@ -851,7 +860,8 @@ HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_f
             memset(out, 0, sizeof *out);
             return HD__IO_FAIL(logger, HD_ERROR_SIZE_OVERFLOW, "nrrd: byte skip is too large");
         }
-        r = hd__io_gunzip(buf + pos, avail, (size_t)h.byte_skip, data_bytes, &raw, logger);
+        r = hd__io_gunzip(buf + pos, avail, (size_t)h.byte_skip, data_bytes, &raw, "nrrd",
+                          logger);
         if (r == HD_SUCCESS) r = hd__io_convert(raw, count, h.type, h.big, out, "nrrd", logger);
         free(raw);
         if (r != HD_SUCCESS) memset(out, 0, sizeof *out);

@@ -1,0 +1,352 @@
+/* hd_io_mhd.h - the MetaImage loader (.mhd header + detached .raw/.zraw, or .mha/.mhd with
+   'ElementDataFile = LOCAL'). Part of the implementation of hybriddiff.h; included once, after
+   src/hd_io.h, whose helpers it uses (size checks, conversion, number parsing, gunzip, logging).
+
+   Header: 'Key = Value' lines, keys case-insensitive, up to ElementDataFile (the last field).
+   Read: NDims (1..3), DimSize, ElementSpacing (or ElementSize), ElementType (MET_UCHAR, MET_CHAR,
+   MET_USHORT, MET_SHORT, MET_UINT, MET_INT, MET_ULONG, MET_LONG, MET_ULONG_LONG, MET_LONG_LONG,
+   MET_FLOAT, MET_DOUBLE), ElementNumberOfChannels (1), BinaryData (True),
+   BinaryDataByteOrderMSB / ElementByteOrderMSB, CompressedData (zlib or gzip),
+   CompressedDataSize, HeaderSize (bytes to skip in the data file; -1: the data are its last
+   bytes). ElementDataFile: LOCAL (the bytes after that line) or a file name, relative to the
+   header's directory; LIST and slice patterns are HD_ERROR_UNSUPPORTED_ENCODING.
+   Errors as for NRRD: a data file shorter than the header claims is HD_ERROR_FILE_TRUNCATED,
+   a DimSize product that overflows HD_ERROR_SIZE_OVERFLOW, negative/zero/NaN spacing
+   HD_ERROR_INVALID_SPACING, unknown element types HD_ERROR_UNSUPPORTED_ENCODING, a corrupt or
+   truncated compressed stream HD_ERROR_GZIP. */
+#ifndef HD_IO_MHD_H
+#define HD_IO_MHD_H
+
+#define HD__MHD_FIELD 256
+
+typedef struct hd__io_mhd {
+    int ndims;                    /* 0 unknown */
+    int type;                     /* HD__IO_*, -1 unknown */
+    int big, compressed;
+    int64_t compressed_size;      /* -1 unknown */
+    int64_t header_size;          /* 0, or -1: the data are the last bytes of the data file */
+    char dim_size[HD__MHD_FIELD]; /* texts parsed once NDims is known */
+    char spacing[HD__MHD_FIELD];
+    char element_size[HD__MHD_FIELD];
+    char data_file[HD__MHD_FIELD];
+    int local;                    /* ElementDataFile = LOCAL */
+    size_t data_pos;              /* LOCAL: where the data start in the header buffer */
+} hd__io_mhd;
+
+static int hd__io_mhd_bool(const char *v, int *out)
+{
+    if (!strcmp(v, "true") || !strcmp(v, "1")) *out = 1;
+    else if (!strcmp(v, "false") || !strcmp(v, "0")) *out = 0;
+    else return 0;
+    return 1;
+}
+
+static int hd__io_mhd_type(const char *v)
+{
+    static const struct { const char *name; int type; } names[] = {
+        {"met_uchar", HD__IO_U8}, {"met_char", HD__IO_I8}, {"met_ushort", HD__IO_U16},
+        {"met_short", HD__IO_I16}, {"met_uint", HD__IO_U32}, {"met_int", HD__IO_I32},
+        {"met_ulong", HD__IO_U32}, {"met_long", HD__IO_I32}, {"met_ulong_long", HD__IO_U64},
+        {"met_long_long", HD__IO_I64}, {"met_float", HD__IO_F32}, {"met_double", HD__IO_F64},
+    };
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (strcmp(v, names[i].name) == 0) return names[i].type;
+    return -1;
+}
+
+/* One 'key = value' line; key lower-case without spaces, value as in the file (trimmed). */
+static hd_result hd__io_mhd_field(hd__io_mhd *h, const char *key, const char *raw, int line,
+                                  const hd_logger *logger)
+{
+    char v[HD__MHD_FIELD];
+    int64_t n;
+    int b;
+    const char *e;
+    if (!strcmp(key, "dimsize") || !strcmp(key, "elementspacing") ||
+        !strcmp(key, "elementsize") || !strcmp(key, "elementdatafile")) {
+        char *dst = !strcmp(key, "dimsize") ? h->dim_size
+                    : !strcmp(key, "elementspacing") ? h->spacing
+                    : !strcmp(key, "elementsize") ? h->element_size : h->data_file;
+        if (!hd__io_copy(dst, HD__MHD_FIELD, raw, strlen(raw)))
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: line %d ('%s') is too long",
+                               line, key);
+        return HD_SUCCESS;
+    }
+    if (!hd__io_copy(v, sizeof v, raw, strlen(raw)))
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: line %d ('%s') is too long", line,
+                           key);
+    hd__io_normalize(v);
+    if (!strcmp(key, "ndims")) {
+        e = hd__io_parse_int(v, &n, NULL);
+        if (!e || *e)
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "mhd: line %d: NDims is not an integer: '%s'", line, v);
+        if (n < 1 || n > 3)
+            return HD__IO_FAIL(logger, HD_ERROR_INVALID_DIMENSIONS,
+                               "mhd: line %d: NDims %lld is not supported (1, 2 or 3)", line,
+                               (long long)n);
+        h->ndims = (int)n;
+    } else if (!strcmp(key, "elementtype")) {
+        h->type = hd__io_mhd_type(v);
+        if (h->type < 0)
+            return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                               "mhd: line %d: unsupported ElementType '%s'", line, v);
+    } else if (!strcmp(key, "elementnumberofchannels")) {
+        e = hd__io_parse_int(v, &n, NULL);
+        if (!e || *e || n != 1)
+            return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                               "mhd: line %d: ElementNumberOfChannels '%s' (only 1 is supported)",
+                               line, v);
+    } else if (!strcmp(key, "binarydatabyteordermsb") || !strcmp(key, "elementbyteordermsb") ||
+               !strcmp(key, "byteordermsb") || !strcmp(key, "compresseddata") ||
+               !strcmp(key, "binarydata")) {
+        if (!hd__io_mhd_bool(v, &b))
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "mhd: line %d: '%s' must be True or False, not '%s'", line, key, v);
+        if (!strcmp(key, "compresseddata")) h->compressed = b;
+        else if (!strcmp(key, "binarydata")) {
+            if (!b)
+                return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                                   "mhd: line %d: ASCII data (BinaryData = False) is not supported",
+                                   line);
+        } else h->big = b;
+    } else if (!strcmp(key, "headersize") || !strcmp(key, "compresseddatasize")) {
+        int head = !strcmp(key, "headersize");
+        e = hd__io_parse_int(v, &n, NULL);
+        if (!e || *e || n < (head ? -1 : 0))
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "mhd: line %d: '%s' must be an integer >= %d, not '%s'", line, key,
+                               head ? -1 : 0, v);
+        if (head) h->header_size = n;
+        else h->compressed_size = n;
+    }
+    return HD_SUCCESS; /* ObjectType, Offset, TransformMatrix... are not needed */
+}
+
+/* Parses the header lines up to ElementDataFile. */
+static hd_result hd__io_mhd_header(const unsigned char *buf, size_t size, hd__io_mhd *h,
+                                   const hd_logger *logger)
+{
+    size_t pos = 0;
+    int line = 0;
+    hd_result r;
+    memset(h, 0, sizeof *h);
+    h->type = -1;
+    h->compressed_size = -1;
+    while (pos < size) {
+        size_t start = pos, end, eq, k, nl = 0;
+        char key[64], val[HD__IO_LINE_MAX];
+        const char *s = (const char *)buf + start;
+        ++line;
+        while (pos < size && buf[pos] != '\n') ++pos;
+        end = pos;
+        if (pos < size) ++pos;
+        if (end > start && buf[end - 1] == '\r') --end;
+        if (end == start || s[0] == '#') continue;
+        for (eq = 0; start + eq < end && s[eq] != '='; ++eq) {}
+        if (start + eq == end)
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "mhd: line %d is not 'Key = Value' (no '=')%s", line,
+                               line == 1 ? ": not a MetaImage header" : "");
+        for (k = 0; k < eq; ++k) {
+            int c = (unsigned char)s[k];
+            if (hd__io_space(c)) continue;
+            if (nl + 1 >= sizeof key || c < 32 || c > 126)
+                return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: line %d: bad key", line);
+            key[nl++] = (char)hd__io_lower(c);
+        }
+        key[nl] = 0;
+        if (!nl) return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: line %d: empty key", line);
+        if (!hd__io_copy(val, sizeof val, s + eq + 1, end - start - eq - 1))
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: line %d is too long", line);
+        { /* trim */
+            char *a = val, *z;
+            size_t vl;
+            while (hd__io_space((unsigned char)*a)) ++a;
+            vl = strlen(a);
+            z = a + vl;
+            while (z > a && hd__io_space((unsigned char)z[-1])) --z;
+            *z = 0;
+            memmove(val, a, (size_t)(z - a) + 1);
+        }
+        r = hd__io_mhd_field(h, key, val, line, logger);
+        if (r != HD_SUCCESS) return r;
+        if (!strcmp(key, "elementdatafile")) {
+            h->data_pos = pos;
+            break;
+        }
+    }
+    if (!h->ndims || !h->dim_size[0] || h->type < 0 || !h->data_file[0])
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: header has no '%s' field",
+                           !h->ndims ? "NDims" : !h->dim_size[0] ? "DimSize"
+                           : h->type < 0 ? "ElementType" : "ElementDataFile");
+    {
+        char low[HD__MHD_FIELD];
+        memcpy(low, h->data_file, sizeof low);
+        hd__io_normalize(low);
+        h->local = !strcmp(low, "local");
+        if (!strcmp(low, "list") || strchr(low, '%'))
+            return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                               "mhd: ElementDataFile '%s': slice lists and patterns are not "
+                               "supported", h->data_file);
+    }
+    return HD_SUCCESS;
+}
+
+/* DimSize and spacing, then the data from data[0..data_size) (the whole data file). */
+static hd_result hd__io_mhd_data(const hd__io_mhd *h, const unsigned char *data, size_t data_size,
+                                 hd_volume_file *out, const hd_logger *logger)
+{
+    int64_t dims[3] = {1, 1, 1};
+    int overflow = 0, i;
+    size_t count, bytes, skip;
+    const char *p = h->dim_size;
+    hd_result r;
+    for (i = 0; i < h->ndims; ++i) {
+        p = hd__io_parse_int(p, &dims[i], &overflow);
+        if (!p || (*p && !hd__io_space((unsigned char)*p)))
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: DimSize needs %d integers",
+                               h->ndims);
+    }
+    if (*hd__io_skip_space(p))
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "mhd: DimSize has more than %d values",
+                           h->ndims);
+    r = hd__io_check_dims(dims, hd__io_type_size(h->type), overflow, &count, &bytes, "mhd",
+                          logger);
+    if (r != HD_SUCCESS) return r;
+    out->desc.spacing[0] = out->desc.spacing[1] = out->desc.spacing[2] = 1.0f;
+    p = h->spacing[0] ? h->spacing : h->element_size[0] ? h->element_size : NULL;
+    if (p) {
+        for (i = 0; i < h->ndims; ++i) {
+            double s;
+            p = hd__io_parse_double(p, &s);
+            if (!p || (*p && !hd__io_space((unsigned char)*p)))
+                return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                                   "mhd: ElementSpacing needs %d numbers", h->ndims);
+            if (!hd__io_spacing_valid(s))
+                return HD__IO_FAIL(logger, HD_ERROR_INVALID_SPACING,
+                                   "mhd: spacing of axis %d is %g (must be finite and > 0)", i,
+                                   s);
+            out->desc.spacing[i] = (float)s;
+        }
+    }
+    if (h->compressed) {
+#ifdef HYBRIDDIFF_NO_ZLIB
+        (void)data; (void)data_size;
+        return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                           "mhd: compressed data need zlib (built with HYBRIDDIFF_NO_ZLIB)");
+#else
+        unsigned char *raw = NULL;
+        size_t len = data_size;
+        if (h->header_size < 0)
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "mhd: HeaderSize -1 is only allowed for uncompressed data");
+        if ((uint64_t)h->header_size > (uint64_t)data_size)
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                               "mhd: HeaderSize %lld is past the end of the data (%zu bytes)",
+                               (long long)h->header_size, data_size);
+        skip = (size_t)h->header_size;
+        len -= skip;
+        if (h->compressed_size >= 0) {
+            if ((uint64_t)h->compressed_size > (uint64_t)len)
+                return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                                   "mhd: CompressedDataSize %lld, the file holds %zu bytes",
+                                   (long long)h->compressed_size, len);
+            len = (size_t)h->compressed_size;
+        }
+        r = hd__io_gunzip(data + skip, len, 0, bytes, &raw, "mhd", logger);
+        if (r == HD_SUCCESS) r = hd__io_convert(raw, count, h->type, h->big, out, "mhd", logger);
+        free(raw);
+        if (r != HD_SUCCESS) return r;
+#endif
+    } else {
+        if (h->header_size < 0) {
+            if (data_size < bytes) goto truncated;
+            skip = data_size - bytes;
+        } else {
+            if ((uint64_t)h->header_size > (uint64_t)data_size ||
+                data_size - (size_t)h->header_size < bytes)
+                goto truncated;
+            skip = (size_t)h->header_size;
+        }
+        r = hd__io_convert(data + skip, count, h->type, h->big, out, "mhd", logger);
+        if (r != HD_SUCCESS) return r;
+    }
+    for (i = 0; i < 3; ++i) out->desc.dims[i] = (int)dims[i];
+    return HD_SUCCESS;
+truncated:
+    return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                       "mhd: header claims %zu bytes of data after a HeaderSize of %lld, the data "
+                       "hold %zu", bytes, (long long)h->header_size, data_size);
+}
+
+HDDEF hd_result hd_volume_parse_mhd(const void *header, size_t header_size, const void *data,
+                                    size_t data_size, hd_volume_file *out,
+                                    const hd_logger *logger)
+{
+    hd__io_mhd h;
+    hd_result r;
+    if (out) memset(out, 0, sizeof *out);
+    if (!header || !out)
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "mhd: %s is NULL",
+                           !out ? "out" : "header");
+    r = hd__io_mhd_header((const unsigned char *)header, header_size, &h, logger);
+    if (r != HD_SUCCESS) return r;
+    if (h.local) {
+        data = (const unsigned char *)header + h.data_pos;
+        data_size = header_size - h.data_pos;
+    } else if (!data) {
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER,
+                           "mhd: the data are in '%s' and no data buffer was given", h.data_file);
+    }
+    r = hd__io_mhd_data(&h, (const unsigned char *)data, data_size, out, logger);
+    if (r != HD_SUCCESS) hd_volume_free(out);
+    return r;
+}
+
+HDDEF hd_result hd_volume_load_mhd(const char *path, hd_volume_file *out, const hd_logger *logger)
+{
+    hd__io_path_logger pl;
+    hd_logger wrapped;
+    const hd_logger *lg;
+    unsigned char *bytes = NULL, *data = NULL;
+    size_t size = 0, data_size = 0;
+    hd__io_mhd h;
+    hd_result r;
+    if (out) memset(out, 0, sizeof *out);
+    if (!path || !out)
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "mhd: %s is NULL",
+                           !path ? "path" : "out");
+    lg = hd__io_wrap_logger(logger, path, &pl, &wrapped);
+    r = hd__io_read_file(path, &bytes, &size, lg);
+    if (r != HD_SUCCESS) return r;
+    r = hd__io_mhd_header(bytes, size, &h, lg);
+    if (r == HD_SUCCESS && h.local) {
+        r = hd__io_mhd_data(&h, bytes + h.data_pos, size - h.data_pos, out, lg);
+    } else if (r == HD_SUCCESS) {
+        /* the data file: absolute, or relative to the header's directory */
+        const char *slash = strrchr(path, '/');
+        size_t dir = (h.data_file[0] == '/' || !slash) ? 0 : (size_t)(slash - path) + 1;
+        size_t n = dir + strlen(h.data_file) + 1;
+        char *dpath = (char *)malloc(n);
+        if (!dpath) {
+            r = HD__IO_FAIL(lg, HD_ERROR_OUT_OF_MEMORY, "mhd: cannot allocate a path");
+        } else {
+            hd__io_path_logger pl2;
+            hd_logger wrapped2;
+            memcpy(dpath, path, dir);
+            memcpy(dpath + dir, h.data_file, n - dir);
+            r = hd__io_read_file(dpath, &data, &data_size,
+                                 hd__io_wrap_logger(logger, dpath, &pl2, &wrapped2));
+            if (r == HD_SUCCESS) r = hd__io_mhd_data(&h, data, data_size, out, lg);
+            free(dpath);
+        }
+    }
+    free(bytes);
+    free(data);
+    if (r != HD_SUCCESS) hd_volume_free(out);
+    return r;
+}
+
+#endif /* HD_IO_MHD_H */
