@@ -345,6 +345,17 @@ HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_t
 /* The same parsers on a memory buffer (what the fuzzers drive). */
 HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_file *out,
                                      const hd_logger *log);
+/* MetaImage (.mhd + detached .raw/.zraw, or LOCAL data as in .mha) and NIfTI-1 (.nii, .nii.gz,
+   either byte order; scl_slope/scl_inter applied). parse_mhd: data/data_size are the detached
+   data file's bytes (ignored for LOCAL data). hd_volume_load picks the format by the file's
+   first bytes (or a .mhd/.mha extension). */
+HDDEF hd_result hd_volume_load_mhd(const char *path, hd_volume_file *out, const hd_logger *log);
+HDDEF hd_result hd_volume_parse_mhd(const void *header, size_t header_size, const void *data,
+                                    size_t data_size, hd_volume_file *out, const hd_logger *log);
+HDDEF hd_result hd_volume_load_nifti(const char *path, hd_volume_file *out, const hd_logger *log);
+HDDEF hd_result hd_volume_parse_nifti(const void *bytes, size_t size, hd_volume_file *out,
+                                      const hd_logger *log);
+HDDEF hd_result hd_volume_load(const char *path, hd_volume_file *out, const hd_logger *log);
 HDDEF void hd_volume_free(hd_volume_file *vol);
 
 #ifdef __cplusplus
@@ -375,13 +386,17 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
-#include "backends/hd_vulkan.h"
+/* A backend that is not written yet is an #error here, not a missing #include: the file that
+   lands it replaces the line with #include "backends/hd_vulkan.h" (the same for GL). */
+#error "hybriddiff: the Vulkan backend is not available in this version; use HYBRIDDIFF_BACKEND_CPU or HYBRIDDIFF_BACKEND_OPENCL"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-#include "backends/hd_gl.h"
+#error "hybriddiff: the GL backend is not available in this version; use HYBRIDDIFF_BACKEND_CPU or HYBRIDDIFF_BACKEND_OPENCL"
 #endif
 #include "src/hd_validate.h"
 #include "src/hd_context.h"
 #include "src/hd_io.h"
+#include "src/hd_io_mhd.h"
+#include "src/hd_io_nifti.h"
 
 #endif /* HYBRIDDIFF_IMPLEMENTATION_DONE */
 #endif /* HYBRIDDIFF_IMPLEMENTATION */
