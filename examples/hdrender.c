@@ -76,9 +76,9 @@ static const char *usage_text =
     "\n"
     "camera (default: in front of the face, for the head CT's axes: face +y, top +z)\n"
     "  --eye X,Y,Z             camera position (default 0.6,1.65,0.3: face, three-quarter)\n"
-    "  --target X,Y,Z          looked-at point (default 0,0,0)\n"
+    "  --target X,Y,Z          looked-at point (default 0,0,-0.04)\n"
     "  --up X,Y,Z              up direction (default 0,0,1)\n"
-    "  --fov DEG               vertical field of view (default 40)\n"
+    "  --fov DEG               vertical field of view (default 37)\n"
     "  --size WxH              image size (default 512x512)\n"
     "\n"
     "method\n"
@@ -423,8 +423,9 @@ int main(int argc, char **argv)
     logger.func = log_fn;
     logger.user_data = &ls;
     desc.camera.eye[0] = 0.6f; desc.camera.eye[1] = 1.65f; desc.camera.eye[2] = 0.3f;
+    desc.camera.target[2] = -0.04f;
     desc.camera.up[2] = 1.0f;
-    desc.camera.fov_y = 40.0f;
+    desc.camera.fov_y = 37.0f;
     desc.camera.width = desc.camera.height = 512;
     desc.params.exposure = DEFAULT_EXPOSURE;
 
