@@ -1,0 +1,17 @@
+# mk/hdeval.mk - examples/hdeval, the evaluation harness (Table 1, Figures 2-7, the paper's claims).
+#   make build/hdeval   build it
+#   make eval           the reduced evaluation (examples/eval/head.scene, 256^2; ~15 min on 2 cores)
+#                       -> docs/eval/*; reference images are cached in out/eval-cache
+#   make eval-paper     the paper-scale settings (--paper: 1024^2, 1.3M-path references) -> out/eval-paper
+.PHONY: eval eval-paper
+
+$(B)/hdeval: examples/hdeval.c examples/hd_eval_scene.h examples/hd_tf.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+eval: $(B)/hdeval
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdeval examples/eval/head.scene --out docs/eval --cache out/eval-cache
+
+eval-paper: $(B)/hdeval
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdeval examples/eval/head.scene --paper --out out/eval-paper --cache out/eval-cache
