@@ -1,0 +1,129 @@
+/* test_alloc_fail.c - allocation failure on the CPU backend. A counting allocator hook fails the
+   k-th allocation, for every k in a full cycle: create, iterate HD, switch to CD and iterate,
+   switch to PT_SS and iterate, read the image and illumination, destroy. Each run must return
+   HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never crash, and free every byte it took
+   (live allocations are counted here; under `make asan` LSan checks the rest). */
+#include "hybriddiff.h"
+#include "hd_test.h"
+#include <stdlib.h>
+
+typedef struct af_state {
+    long calls, fail_at; /* fail_at: 1-based index of the allocation to fail, 0: never */
+    long live, failed;
+} af_state;
+
+static void *af_alloc(size_t size, void *user)
+{
+    af_state *s = (af_state *)user;
+    void *p;
+    if (++s->calls == s->fail_at) {
+        ++s->failed;
+        return NULL;
+    }
+    p = malloc(size ? size : 1);
+    if (p) ++s->live;
+    return p;
+}
+
+static void af_free(void *ptr, void *user)
+{
+    af_state *s = (af_state *)user;
+    if (ptr) --s->live;
+    free(ptr);
+}
+
+typedef struct af_log { int errors; hd_result last; } af_log;
+static void af_log_fn(void *user, hd_log_level level, hd_result code, const char *msg,
+                      const char *file, int line)
+{
+    af_log *l = (af_log *)user;
+    (void)msg; (void)file; (void)line;
+    if (level == HD_LOG_ERROR) { ++l->errors; l->last = code; }
+}
+
+#define AF_N 12
+static uint8_t af_vol[AF_N * AF_N * AF_N];
+
+/* One cycle; returns the first error (HD_SUCCESS if all went through). The context is always
+   destroyed if it was created. */
+static hd_result af_cycle(af_state *st, af_log *log)
+{
+    hd_desc d;
+    hd_context ctx;
+    hd_params p;
+    hd_result r;
+    float img[16 * 16 * 4], ill[AF_N * AF_N * AF_N];
+    int i;
+    for (i = 0; i < AF_N * AF_N * AF_N; ++i) af_vol[i] = (uint8_t)((i * 37) & 255);
+    memset(&d, 0, sizeof d);
+    d.volume.type = HD_VOXEL_U8;
+    d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = AF_N;
+    d.volume.data = af_vol;
+    d.camera.width = d.camera.height = 16;
+    d.threads = 2;
+    d.allocator.alloc = af_alloc;
+    d.allocator.free = af_free;
+    d.allocator.user_data = st;
+    d.logger.func = af_log_fn;
+    d.logger.user_data = log;
+    r = hd_create(&d, &ctx);
+    if (r != HD_SUCCESS) return r;
+    r = hd_iterate(ctx, 2);
+    if (r == HD_SUCCESS) r = hd_query_desc(ctx, &d);
+    if (r == HD_SUCCESS) {
+        p = d.params;
+        p.method = HD_METHOD_CD;
+        r = hd_set_params(ctx, &p);
+        if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        p.method = HD_METHOD_PT_SS;
+        if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
+        if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        p.method = HD_METHOD_HD;
+        p.solver = HD_SOLVER_JACOBI;
+        if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
+        if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+    }
+    if (r == HD_SUCCESS) r = hd_read_image_f32(ctx, img, sizeof img / sizeof img[0]);
+    if (r == HD_SUCCESS)
+        r = hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, ill, sizeof ill / sizeof ill[0]);
+    if (hd_destroy(ctx) != HD_SUCCESS) CHECK_MSG(0, "destroy failed after %s", hd_result_string(r));
+    return r;
+}
+
+static void test_alloc_fail_every_k(void)
+{
+    af_state st;
+    af_log log;
+    long total, k, failures = 0;
+    memset(&st, 0, sizeof st);
+    memset(&log, 0, sizeof log);
+    CHECK(af_cycle(&st, &log) == HD_SUCCESS);
+    CHECK(st.live == 0 && log.errors == 0);
+    total = st.calls;
+    CHECK(total >= 5); /* else the hook is not used and the test proves nothing */
+    for (k = 1; k <= total; ++k) {
+        hd_result r;
+        memset(&st, 0, sizeof st);
+        memset(&log, 0, sizeof log);
+        st.fail_at = k;
+        r = af_cycle(&st, &log);
+        CHECK_MSG(st.failed == 1, "k=%ld: the allocation was not reached", k);
+        CHECK_MSG(r == HD_ERROR_OUT_OF_MEMORY || r == HD_SUCCESS, "k=%ld: %s", k,
+                  hd_result_string(r));
+        if (r != HD_SUCCESS) {
+            ++failures;
+            CHECK_MSG(log.errors >= 1 && log.last == r, "k=%ld: no log line for %s", k,
+                      hd_result_string(r));
+        }
+        CHECK_MSG(st.live == 0, "k=%ld: %ld allocations leaked (%s)", k, st.live,
+                  hd_result_string(r));
+    }
+    CHECK(failures >= 1);
+    printf("  %ld allocations per cycle, each failed once: %ld runs returned "
+           "HD_ERROR_OUT_OF_MEMORY, none leaked\n", total, failures);
+}
+
+const hd_test_case hd_tests_alloc_fail[] = {
+    {"alloc_fail_every_k_cpu", test_alloc_fail_every_k},
+};
+const int hd_tests_alloc_fail_count = sizeof hd_tests_alloc_fail / sizeof hd_tests_alloc_fail[0];
