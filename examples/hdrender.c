@@ -45,13 +45,14 @@
 #define DEFAULT_EXPOSURE 8.0f
 
 static const char *usage_text =
-    "usage: hdrender [options] [FILE.nrrd]          (default input: " DEFAULT_INPUT ")\n"
+    "usage: hdrender [options] [FILE]               (default input: " DEFAULT_INPUT ")\n"
     "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
     "\n"
     "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
     "\n"
     "input\n"
-    "  FILE.nrrd               NRRD volume (attached header; raw or gzip encoding)\n"
+    "  FILE                    NRRD (.nrrd: attached header, raw or gzip), MetaImage\n"
+    "                          (.mhd, .mha) or NIfTI-1 (.nii, .nii.gz) volume\n"
     "  --raw FILE              headerless raw volume, x fastest; needs --dims and --type\n"
     "  --dims X,Y,Z            raw: voxels per axis\n"
     "  --type T                raw: u8 i8 u16 i16 u32 i32 f32 f64\n"
@@ -563,7 +564,7 @@ int main(int argc, char **argv)
     }
 
     /* ---- check the combination ---- */
-    if (raw && input) fail(2, "give either FILE.nrrd or --raw FILE, not both");
+    if (raw && input) fail(2, "give either FILE or --raw FILE, not both");
     if (!raw && (have_dims || raw_type >= 0 || offset))
         fail(2, "--dims, --type and --offset are for --raw input");
     if (raw && (!have_dims || raw_type < 0)) fail(2, "--raw needs --dims X,Y,Z and --type T");
@@ -596,7 +597,7 @@ int main(int argc, char **argv)
         if (r != HD_SUCCESS) fail_lib(2, &ls, r, NULL, NULL);
     } else {
         if (!input) input = DEFAULT_INPUT;
-        r = hd_volume_load_nrrd(input, &vol, &logger);
+        r = hd_volume_load(input, &vol, &logger);
         if (r != HD_SUCCESS)
             fail_lib(2, &ls, r, NULL,
                      r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0
