@@ -1,0 +1,26 @@
+/* hd_bind_vk_glsl.h - GLSL 4.50 text, not C: the Vulkan backend's resources, placed before
+   hd_prelude_glsl.h by scripts/build-spirv. The grids (volume, sigma_t, E, phi, Jacobi's phi2,
+   CD's light volumes) are r32f storage image3Ds, read with imageLoad at the (x, y, z) the shared
+   kernels pass beside the linear index (channel c of E / phi at z + c * dz): on lavapipe a
+   storage image ran the diffusion sweep several times faster than a storage buffer
+   (docs/DESIGN-VULKAN.md has the table). The small 1D arrays (TF, majorant grid, image
+   accumulation) stay storage buffers, indexed by HD_GET1 / HD_SET1.
+   Set 0: binding 0 the parameter block (hd_prelude_glsl.h, a dynamic uniform buffer), 1 volume,
+   2 TF, 3 majorants, 4 sigma_t, 5 E, 6 phi, 7 phi2, 8 image, 9 light volume read, 10 light
+   volume written. Push constants: x = red-black parity, y = Jacobi, z = light, w = first. */
+#define HD_GLSL_CUSTOM_BUFFERS 1
+layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
+layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
+layout(std430, binding = 3) readonly buffer hd_b_maj { float maj[]; };
+layout(binding = 4, r32f) uniform image3D hd_i_sig;
+layout(binding = 5, r32f) uniform image3D hd_i_E;
+layout(binding = 6, r32f) uniform image3D hd_i_phi;
+layout(binding = 7, r32f) uniform image3D hd_i_phi2;
+layout(std430, binding = 8) buffer hd_b_img { float img[]; };
+layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
+layout(binding = 10, r32f) uniform image3D hd_i_lv2;
+layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
+#define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
+#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))
+#define HD_GET1(buf, i) buf[(i)]
+#define HD_SET1(buf, i, v) buf[(i)] = (v)

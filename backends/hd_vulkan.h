@@ -1,0 +1,1296 @@
+/* hd_vulkan.h - the Vulkan 1.1 compute backend: the shared kernels (backends/kernels/) as
+   SPIR-V compiled ahead of time by scripts/build-spirv (backends/hd_spirv.h, with the exact
+   glslangValidator command beside each array), so the library needs no shader compiler at run
+   time. Defines the same hd__be_* functions, with the same contracts, as the CPU reference.
+
+   Whose device: desc.vulkan.instance, physical_device, device (all three, or none), queue (or
+   NULL: queue 0 of desc.vulkan.queue_family) as void*. The caller keeps them alive until
+   hd_destroy and synchronises access to the queue. Functions are loaded through
+   desc.vulkan.get_instance_proc_addr (volk's or your own loader's), else through the Vulkan
+   loader's vkGetInstanceProcAddr, the only Vulkan symbol the library links against (none with
+   HD_VK_NO_LOADER defined: then get_instance_proc_addr is required). Without a caller device the
+   backend makes a headless instance and device: the first whose name contains
+   desc.vulkan.device_name or $HD_VK_DEVICE, else a discrete, integrated, virtual, then CPU
+   device. Force lavapipe on a machine with a GPU with
+       VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
+   Validation: desc.vulkan.enable_validation or $HD_VK_VALIDATION=1 (own instance only) enables
+   VK_LAYER_KHRONOS_validation with synchronization validation; every message of its debug
+   messenger is logged as an error ("vulkan validation: ...") and counted.
+
+   Submission: each stage records one command buffer, submits it and waits on a fence (so the
+   core's stage clocks measure the device, as with OpenCL's clFinish). hd_vulkan_record() instead
+   records whole iterations into the caller's command buffer; see hybriddiff.h.
+
+   Memory: the grids (volume, sigma_t, E, phi, phi2, CD's light volumes) are r32f storage
+   image3Ds, the TF, majorants and image accumulation storage buffers, the parameter block a
+   ring of slots in one host-visible uniform buffer (a dynamic offset per iteration, so recorded
+   iterations each see their own parameters). No sub-allocator: there are at most a dozen
+   resources plus one per CD light (<= 66 + 10), each large, far below maxMemoryAllocationCount
+   (4096 guaranteed), so every resource has its own vkAllocateMemory; a sub-allocator would add
+   code and save nothing measurable. The grids as images are not bound by maxStorageBufferRange
+   (128 MiB on lavapipe), only by maxImageDimension3D per axis (channels stack along z).
+   $HD_VK_MEMORY_LIMIT=bytes caps the device memory the backend allocates; an allocation above it
+   fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
+   Errors: every VkResult below zero is logged with the failing call and becomes an hd_result
+   (OUT_OF_DEVICE_MEMORY -> HD_ERROR_OUT_OF_DEVICE_MEMORY, DEVICE_LOST -> HD_ERROR_DEVICE_LOST,
+   which sticks: later calls fail fast, hd_destroy still frees everything). */
+#ifndef VK_NO_PROTOTYPES
+#define VK_NO_PROTOTYPES
+#endif
+#include <vulkan/vulkan.h>
+#include "hd_spirv.h"
+
+#if !defined(HD_VK_NO_LOADER)
+#ifdef __cplusplus
+extern "C" {
+#endif
+VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instance, const char *pName);
+#ifdef __cplusplus
+}
+#endif
+#endif
+
+#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
+#define HD__BE_HAS_PT 1 /* hd__be_path */
+
+/* ---- function table: everything is loaded through vkGetInstanceProcAddr ------------------ */
+#define HD__VK_GLOBAL_FNS(X) X(vkCreateInstance) X(vkEnumerateInstanceLayerProperties) \
+    X(vkEnumerateInstanceExtensionProperties)
+#define HD__VK_INSTANCE_FNS(X) X(vkDestroyInstance) X(vkEnumeratePhysicalDevices) \
+    X(vkGetPhysicalDeviceProperties) X(vkGetPhysicalDeviceQueueFamilyProperties) \
+    X(vkGetPhysicalDeviceMemoryProperties) X(vkCreateDevice) X(vkGetDeviceProcAddr)
+#define HD__VK_DEVICE_FNS(X) X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) \
+    X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) \
+    X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) \
+    X(vkBeginCommandBuffer) X(vkEndCommandBuffer) X(vkResetCommandBuffer) \
+    X(vkCreateBuffer) X(vkDestroyBuffer) X(vkGetBufferMemoryRequirements) X(vkBindBufferMemory) \
+    X(vkCreateImage) X(vkDestroyImage) X(vkGetImageMemoryRequirements) X(vkBindImageMemory) \
+    X(vkCreateImageView) X(vkDestroyImageView) X(vkAllocateMemory) X(vkFreeMemory) \
+    X(vkMapMemory) X(vkUnmapMemory) X(vkCreateShaderModule) X(vkDestroyShaderModule) \
+    X(vkCreateDescriptorSetLayout) X(vkDestroyDescriptorSetLayout) X(vkCreatePipelineLayout) \
+    X(vkDestroyPipelineLayout) X(vkCreateComputePipelines) X(vkDestroyPipeline) \
+    X(vkCreateDescriptorPool) X(vkDestroyDescriptorPool) X(vkResetDescriptorPool) \
+    X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets) X(vkCmdBindPipeline) \
+    X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch) X(vkCmdPipelineBarrier) \
+    X(vkCmdCopyBuffer) X(vkCmdCopyBufferToImage) X(vkCmdCopyImageToBuffer) X(vkCmdFillBuffer) \
+    X(vkCmdClearColorImage) X(vkCmdCopyImage)
+
+typedef struct hd__vk_fns {
+#define HD__VK_FN(name) PFN_##name name;
+    HD__VK_GLOBAL_FNS(HD__VK_FN) HD__VK_INSTANCE_FNS(HD__VK_FN) HD__VK_DEVICE_FNS(HD__VK_FN)
+#undef HD__VK_FN
+    PFN_vkCreateDebugUtilsMessengerEXT vkCreateDebugUtilsMessengerEXT;
+    PFN_vkDestroyDebugUtilsMessengerEXT vkDestroyDebugUtilsMessengerEXT;
+} hd__vk_fns;
+
+enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
+       HD__VK_PATH, HD__VK_PIPELINE_COUNT };
+#define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
+#define HD__VK_BINDINGS 11
+
+typedef struct hd__vk_buffer {
+    VkBuffer buffer;
+    VkDeviceMemory memory;
+    VkDeviceSize bytes;
+    void *map; /* host-visible buffers stay mapped */
+} hd__vk_buffer;
+
+typedef struct hd__vk_image {
+    VkImage image;
+    VkImageView view;
+    VkDeviceMemory memory;
+    VkDeviceSize bytes;
+    int extent[3];
+} hd__vk_image;
+
+struct hd__backend {
+    hd__ctx *ctx;
+    hd__vk_fns fn;
+    PFN_vkGetInstanceProcAddr gipa;
+    VkInstance instance;
+    VkPhysicalDevice phys;
+    VkDevice device;
+    VkQueue queue;
+    uint32_t queue_family;
+    int own_device;               /* 1: instance and device are the backend's */
+    VkDebugUtilsMessengerEXT messenger;
+    VkPhysicalDeviceLimits limits;
+    VkPhysicalDeviceMemoryProperties memprops;
+    char device_name[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
+    /* submission */
+    VkCommandPool pool;
+    VkCommandBuffer cmd;
+    VkFence fence;
+    int open;                     /* cmd is recording */
+    VkCommandBuffer rec;          /* the caller's command buffer (hd_vulkan_record), or NULL */
+    /* pipelines and bindings */
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline pipelines[HD__VK_PIPELINE_COUNT];
+    VkDescriptorPool dpool;
+    VkDescriptorSet sets[HD_MAX_LIGHTS];
+    int sets_valid;
+    /* parameter ring */
+    hd__vk_buffer params;
+    VkDeviceSize slot_bytes;
+    uint32_t slots, next_slot;
+    int have_slot;
+    uint32_t slot;
+    hd__kparams slot_kp;          /* what the current slot holds */
+    /* resources */
+    hd__vk_buffer tf, maj, img, staging, dummy_buffer;
+    hd__vk_image vol, sig, E, phi, phi2, dummy;
+    hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
+    int nlv;
+    size_t illum_floats, img_floats, tf_bytes;
+    VkDeviceSize mem_used, mem_limit;
+    int lost;
+    unsigned long validation_messages;
+};
+
+static const char *hd__be_name(void) { return "vulkan"; }
+
+/* ---- errors ---------------------------------------------------------------------------------- */
+static const char *hd__vk_result_name(VkResult e)
+{
+    switch (e) {
+#define HD__VKE(name) case name: return #name;
+    HD__VKE(VK_SUCCESS) HD__VKE(VK_NOT_READY) HD__VKE(VK_TIMEOUT) HD__VKE(VK_INCOMPLETE)
+    HD__VKE(VK_ERROR_OUT_OF_HOST_MEMORY) HD__VKE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    HD__VKE(VK_ERROR_INITIALIZATION_FAILED) HD__VKE(VK_ERROR_DEVICE_LOST) HD__VKE(VK_ERROR_MEMORY_MAP_FAILED)
+    HD__VKE(VK_ERROR_LAYER_NOT_PRESENT) HD__VKE(VK_ERROR_EXTENSION_NOT_PRESENT)
+    HD__VKE(VK_ERROR_FEATURE_NOT_PRESENT) HD__VKE(VK_ERROR_INCOMPATIBLE_DRIVER) HD__VKE(VK_ERROR_TOO_MANY_OBJECTS)
+    HD__VKE(VK_ERROR_FORMAT_NOT_SUPPORTED) HD__VKE(VK_ERROR_FRAGMENTED_POOL) HD__VKE(VK_ERROR_UNKNOWN)
+    HD__VKE(VK_ERROR_OUT_OF_POOL_MEMORY) HD__VKE(VK_ERROR_INVALID_EXTERNAL_HANDLE) HD__VKE(VK_ERROR_FRAGMENTATION)
+#undef HD__VKE
+    default: return "unknown VkResult";
+    }
+}
+
+/* Logs the failing call with its VkResult name and returns the hd_result it means. */
+static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int line)
+{
+    hd_result r = HD_ERROR_BACKEND;
+    if (e == VK_ERROR_OUT_OF_DEVICE_MEMORY || e == VK_ERROR_FRAGMENTATION || e == VK_ERROR_FRAGMENTED_POOL ||
+        e == VK_ERROR_OUT_OF_POOL_MEMORY || e == VK_ERROR_TOO_MANY_OBJECTS)
+        r = HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    else if (e == VK_ERROR_OUT_OF_HOST_MEMORY)
+        r = HD_ERROR_OUT_OF_MEMORY;
+    else if (e == VK_ERROR_DEVICE_LOST)
+        r = HD_ERROR_DEVICE_LOST;
+    else if (e == VK_ERROR_INITIALIZATION_FAILED || e == VK_ERROR_INCOMPATIBLE_DRIVER || e == VK_ERROR_LAYER_NOT_PRESENT ||
+             e == VK_ERROR_EXTENSION_NOT_PRESENT || e == VK_ERROR_FEATURE_NOT_PRESENT || e == VK_ERROR_FORMAT_NOT_SUPPORTED)
+        r = HD_ERROR_UNSUPPORTED;
+    if (r == HD_ERROR_DEVICE_LOST && ctx->be) ctx->be->lost = 1;
+    hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, line, "vulkan: %s failed: %s (%d)", call, hd__vk_result_name(e), (int)e);
+    return r;
+}
+/* Returns from the calling function when a Vulkan call failed. */
+#define HD__VK_TRY(ctx, call_expr, name) \
+    do { VkResult hd__e = (call_expr); \
+         if (hd__e < 0) return hd__vk_fail((ctx), hd__e, (name), __LINE__); } while (0)
+#define HD__VK_LOST_CHECK(ctx) \
+    do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
+
+/* The validation layer's messages: logged as errors and counted (the tests fail on any). */
+static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                        VkDebugUtilsMessageTypeFlagsEXT types,
+                                                        const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+{
+    hd__backend *be = (hd__backend *)user;
+    (void)types;
+    be->validation_messages++;
+    hd__logf(&be->ctx->log, HD_LOG_ERROR, HD_ERROR_BACKEND, __FILE__, __LINE__, "vulkan validation (%s): %s",
+             severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+             data && data->pMessage ? data->pMessage : "(no message)");
+    return VK_FALSE;
+}
+
+/* ---- instance, device, functions ------------------------------------------------------------- */
+static hd_result hd__vk_load_instance_fns(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+#define HD__VK_LOAD(name) \
+    if (!(be->fn.name = (PFN_##name)be->gipa(be->instance, #name))) \
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(\"%s\") returned NULL", #name);
+    HD__VK_INSTANCE_FNS(HD__VK_LOAD)
+#undef HD__VK_LOAD
+    be->fn.vkCreateDebugUtilsMessengerEXT = (PFN_vkCreateDebugUtilsMessengerEXT)be->gipa(be->instance, "vkCreateDebugUtilsMessengerEXT");
+    be->fn.vkDestroyDebugUtilsMessengerEXT = (PFN_vkDestroyDebugUtilsMessengerEXT)be->gipa(be->instance, "vkDestroyDebugUtilsMessengerEXT");
+    return HD_SUCCESS;
+}
+
+static hd_result hd__vk_load_device_fns(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+#define HD__VK_LOAD(name) \
+    if (!(be->fn.name = (PFN_##name)be->fn.vkGetDeviceProcAddr(be->device, #name))) \
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetDeviceProcAddr(\"%s\") returned NULL", #name);
+    HD__VK_DEVICE_FNS(HD__VK_LOAD)
+#undef HD__VK_LOAD
+    return HD_SUCCESS;
+}
+
+static int hd__vk_env_flag(const char *name)
+{
+    const char *v = getenv(name);
+    return v && v[0] && strcmp(v, "0") != 0;
+}
+
+/* The backend's own headless instance, with the validation layer when asked. */
+static hd_result hd__vk_create_instance(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkApplicationInfo app;
+    VkInstanceCreateInfo ici;
+    VkDebugUtilsMessengerCreateInfoEXT dci;
+    VkValidationFeaturesEXT vf;
+    VkValidationFeatureEnableEXT enables[1];
+    const char *layer = "VK_LAYER_KHRONOS_validation";
+    const char *ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    int validate = ctx->desc.vulkan.enable_validation || hd__vk_env_flag("HD_VK_VALIDATION");
+#define HD__VK_LOAD(name) \
+    if (!(be->fn.name = (PFN_##name)be->gipa(NULL, #name))) \
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(NULL, \"%s\") returned NULL", #name);
+    HD__VK_GLOBAL_FNS(HD__VK_LOAD)
+#undef HD__VK_LOAD
+    memset(&app, 0, sizeof app);
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.pApplicationName = "hybriddiff";
+    app.pEngineName = "hybriddiff";
+    app.apiVersion = VK_API_VERSION_1_1;
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    ici.pApplicationInfo = &app;
+    memset(&dci, 0, sizeof dci);
+    dci.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+    dci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    dci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    dci.pfnUserCallback = hd__vk_messenger;
+    dci.pUserData = be;
+    if (validate) {
+        uint32_t n = 0, i;
+        int found = 0;
+        VkLayerProperties *props;
+        HD__VK_TRY(ctx, be->fn.vkEnumerateInstanceLayerProperties(&n, NULL), "vkEnumerateInstanceLayerProperties");
+        props = (VkLayerProperties *)hd__calloc(ctx, n ? n : 1, sizeof *props);
+        if (!props) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for the layer list");
+        if (be->fn.vkEnumerateInstanceLayerProperties(&n, props) >= 0)
+            for (i = 0; i < n; ++i) found |= strcmp(props[i].layerName, layer) == 0;
+        hd__free(ctx, props);
+        if (!found)
+            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: validation asked for, but %s is not installed (Debian: vulkan-validationlayers)", layer);
+        enables[0] = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+        memset(&vf, 0, sizeof vf);
+        vf.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+        vf.enabledValidationFeatureCount = 1;
+        vf.pEnabledValidationFeatures = enables;
+        vf.pNext = &dci; /* also reports on vkCreateInstance / vkDestroyInstance themselves */
+        ici.pNext = &vf;
+        ici.enabledLayerCount = 1;
+        ici.ppEnabledLayerNames = &layer;
+        ici.enabledExtensionCount = 1;
+        ici.ppEnabledExtensionNames = &ext;
+    }
+    HD__VK_TRY(ctx, be->fn.vkCreateInstance(&ici, NULL, &be->instance), "vkCreateInstance");
+    if (hd__vk_load_instance_fns(ctx) != HD_SUCCESS) return HD_ERROR_UNSUPPORTED;
+    if (validate) {
+        if (!be->fn.vkCreateDebugUtilsMessengerEXT || !be->fn.vkDestroyDebugUtilsMessengerEXT)
+            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: VK_EXT_debug_utils has no vkCreateDebugUtilsMessengerEXT");
+        HD__VK_TRY(ctx, be->fn.vkCreateDebugUtilsMessengerEXT(be->instance, &dci, NULL, &be->messenger), "vkCreateDebugUtilsMessengerEXT");
+        HD__INFO(&ctx->log, "vulkan: VK_LAYER_KHRONOS_validation with synchronization validation");
+    }
+    return HD_SUCCESS;
+}
+
+/* A compute queue family of phys, or -1. */
+static int hd__vk_compute_family(hd__backend *be, VkPhysicalDevice phys)
+{
+    VkQueueFamilyProperties q[32];
+    uint32_t n = 32, i;
+    be->fn.vkGetPhysicalDeviceQueueFamilyProperties(phys, &n, q);
+    for (i = 0; i < n && i < 32; ++i)
+        if (q[i].queueFlags & VK_QUEUE_COMPUTE_BIT) return (int)i;
+    return -1;
+}
+
+/* By name (desc or $HD_VK_DEVICE, substring), else by type: discrete, integrated, virtual, CPU. */
+static hd_result hd__vk_pick_device(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkPhysicalDevice devs[16];
+    uint32_t n = 16, i;
+    const char *want = ctx->desc.vulkan.device_name;
+    static const int rank[] = {4, 1, 0, 2, 3}; /* OTHER, INTEGRATED, DISCRETE, VIRTUAL, CPU */
+    int best = -1, best_rank = 99;
+    VkResult e;
+    if (!want || !*want) want = getenv("HD_VK_DEVICE");
+    e = be->fn.vkEnumeratePhysicalDevices(be->instance, &n, devs);
+    if (e < 0) return hd__vk_fail(ctx, e, "vkEnumeratePhysicalDevices", __LINE__);
+    if (n == 0) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan device (is a driver such as mesa-vulkan-drivers installed?)");
+    for (i = 0; i < n && i < 16; ++i) {
+        VkPhysicalDeviceProperties p;
+        int r;
+        be->fn.vkGetPhysicalDeviceProperties(devs[i], &p);
+        if (hd__vk_compute_family(be, devs[i]) < 0 || p.apiVersion < VK_API_VERSION_1_1) continue;
+        if (want && *want && !strstr(p.deviceName, want)) continue;
+        r = (int)p.deviceType <= 4 ? rank[p.deviceType] : 5;
+        if (r < best_rank) { best_rank = r; best = (int)i; }
+    }
+    if (best < 0) {
+        if (want && *want) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 compute device's name contains \"%s\"", want);
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 device with a compute queue");
+    }
+    be->phys = devs[best];
+    be->queue_family = (uint32_t)hd__vk_compute_family(be, be->phys);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__vk_create_device(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkDeviceQueueCreateInfo qci;
+    VkDeviceCreateInfo dci;
+    float prio = 1.0f;
+    memset(&qci, 0, sizeof qci);
+    qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+    qci.queueFamilyIndex = be->queue_family;
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &prio;
+    memset(&dci, 0, sizeof dci);
+    dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    HD__VK_TRY(ctx, be->fn.vkCreateDevice(be->phys, &dci, NULL, &be->device), "vkCreateDevice");
+    return HD_SUCCESS;
+}
+
+/* ---- memory ------------------------------------------------------------------------------------ */
+static int hd__vk_memory_type(hd__backend *be, uint32_t bits, VkMemoryPropertyFlags want, VkMemoryPropertyFlags prefer)
+{
+    uint32_t i;
+    for (i = 0; i < be->memprops.memoryTypeCount; ++i)
+        if ((bits & (1u << i)) && (be->memprops.memoryTypes[i].propertyFlags & (want | prefer)) == (want | prefer)) return (int)i;
+    for (i = 0; i < be->memprops.memoryTypeCount; ++i)
+        if ((bits & (1u << i)) && (be->memprops.memoryTypes[i].propertyFlags & want) == want) return (int)i;
+    return -1;
+}
+
+/* One vkAllocateMemory, counted against $HD_VK_MEMORY_LIMIT. */
+static hd_result hd__vk_allocate(hd__ctx *ctx, const VkMemoryRequirements *req, VkMemoryPropertyFlags want,
+                                 VkMemoryPropertyFlags prefer, VkDeviceMemory *out, const char *what)
+{
+    hd__backend *be = ctx->be;
+    VkMemoryAllocateInfo mai;
+    int type = hd__vk_memory_type(be, req->memoryTypeBits, want, prefer);
+    if (type < 0) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no memory type for %s", what);
+    if (be->mem_limit && be->mem_used + req->size > be->mem_limit) {
+        hd__logf(&ctx->log, HD_LOG_ERROR, HD_ERROR_OUT_OF_DEVICE_MEMORY, __FILE__, __LINE__,
+                 "vulkan: vkAllocateMemory(%s, %llu bytes) failed: VK_ERROR_OUT_OF_DEVICE_MEMORY (HD_VK_MEMORY_LIMIT %llu, %llu in use)",
+                 what, (unsigned long long)req->size, (unsigned long long)be->mem_limit, (unsigned long long)be->mem_used);
+        return HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    }
+    memset(&mai, 0, sizeof mai);
+    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    mai.allocationSize = req->size;
+    mai.memoryTypeIndex = (uint32_t)type;
+    HD__VK_TRY(ctx, be->fn.vkAllocateMemory(be->device, &mai, NULL, out), "vkAllocateMemory");
+    be->mem_used += req->size;
+    return HD_SUCCESS;
+}
+
+static void hd__vk_free_buffer(hd__ctx *ctx, hd__vk_buffer *b)
+{
+    hd__backend *be = ctx->be;
+    if (b->buffer) be->fn.vkDestroyBuffer(be->device, b->buffer, NULL);
+    if (b->memory) {
+        if (b->map) be->fn.vkUnmapMemory(be->device, b->memory);
+        be->fn.vkFreeMemory(be->device, b->memory, NULL);
+        be->mem_used -= b->bytes;
+    }
+    memset(b, 0, sizeof *b);
+    be->sets_valid = 0;
+}
+
+static void hd__vk_free_image(hd__ctx *ctx, hd__vk_image *im)
+{
+    hd__backend *be = ctx->be;
+    if (im->view) be->fn.vkDestroyImageView(be->device, im->view, NULL);
+    if (im->image) be->fn.vkDestroyImage(be->device, im->image, NULL);
+    if (im->memory) {
+        be->fn.vkFreeMemory(be->device, im->memory, NULL);
+        be->mem_used -= im->bytes;
+    }
+    memset(im, 0, sizeof *im);
+    be->sets_valid = 0;
+}
+
+/* A buffer; host != 0: host-visible, coherent and mapped (else device-local). */
+static hd_result hd__vk_buffer_create(hd__ctx *ctx, hd__vk_buffer *b, VkDeviceSize bytes, VkBufferUsageFlags usage,
+                                      int host, const char *what)
+{
+    hd__backend *be = ctx->be;
+    VkBufferCreateInfo bci;
+    VkMemoryRequirements req;
+    hd_result r;
+    memset(b, 0, sizeof *b);
+    be->sets_valid = 0;
+    if (bytes == 0) bytes = 16;
+    memset(&bci, 0, sizeof bci);
+    bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    bci.size = bytes;
+    bci.usage = usage;
+    bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    HD__VK_TRY(ctx, be->fn.vkCreateBuffer(be->device, &bci, NULL, &b->buffer), "vkCreateBuffer");
+    be->fn.vkGetBufferMemoryRequirements(be->device, b->buffer, &req);
+    r = hd__vk_allocate(ctx, &req, host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                        : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
+                        host ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0, &b->memory, what);
+    if (r != HD_SUCCESS) return r;
+    b->bytes = req.size;
+    HD__VK_TRY(ctx, be->fn.vkBindBufferMemory(be->device, b->buffer, b->memory, 0), "vkBindBufferMemory");
+    if (host) HD__VK_TRY(ctx, be->fn.vkMapMemory(be->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->map), "vkMapMemory");
+    return HD_SUCCESS;
+}
+
+/* An r32f storage image3D (layout GENERAL once the next command buffer has run). */
+static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+{
+    hd__backend *be = ctx->be;
+    VkImageCreateInfo ici;
+    VkImageViewCreateInfo vci;
+    VkMemoryRequirements req;
+    hd_result r;
+    memset(im, 0, sizeof *im);
+    be->sets_valid = 0;
+    if ((uint32_t)w > be->limits.maxImageDimension3D || (uint32_t)h > be->limits.maxImageDimension3D ||
+        (uint32_t)d > be->limits.maxImageDimension3D)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: %s needs a %dx%dx%d image, above maxImageDimension3D = %u",
+                       what, w, h, d, be->limits.maxImageDimension3D);
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    ici.imageType = VK_IMAGE_TYPE_3D;
+    ici.format = VK_FORMAT_R32_SFLOAT;
+    ici.extent.width = (uint32_t)w; ici.extent.height = (uint32_t)h; ici.extent.depth = (uint32_t)d;
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    ici.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    HD__VK_TRY(ctx, be->fn.vkCreateImage(be->device, &ici, NULL, &im->image), "vkCreateImage");
+    be->fn.vkGetImageMemoryRequirements(be->device, im->image, &req);
+    if ((r = hd__vk_allocate(ctx, &req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, &im->memory, what)) != HD_SUCCESS) return r;
+    im->bytes = req.size;
+    HD__VK_TRY(ctx, be->fn.vkBindImageMemory(be->device, im->image, im->memory, 0), "vkBindImageMemory");
+    memset(&vci, 0, sizeof vci);
+    vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    vci.image = im->image;
+    vci.viewType = VK_IMAGE_VIEW_TYPE_3D;
+    vci.format = VK_FORMAT_R32_SFLOAT;
+    vci.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    vci.subresourceRange.levelCount = 1;
+    vci.subresourceRange.layerCount = 1;
+    HD__VK_TRY(ctx, be->fn.vkCreateImageView(be->device, &vci, NULL, &im->view), "vkCreateImageView");
+    im->extent[0] = w; im->extent[1] = h; im->extent[2] = d;
+    return HD_SUCCESS;
+}
+
+/* ---- command buffers -------------------------------------------------------------------------- */
+/* The command buffer to record into: the caller's (hd_vulkan_record) or the backend's, begun. */
+static hd_result hd__vk_cmd(hd__ctx *ctx, VkCommandBuffer *out)
+{
+    hd__backend *be = ctx->be;
+    VkCommandBufferBeginInfo bi;
+    HD__VK_LOST_CHECK(ctx);
+    if (be->rec) { *out = be->rec; return HD_SUCCESS; }
+    if (!be->open) {
+        HD__VK_TRY(ctx, be->fn.vkResetCommandBuffer(be->cmd, 0), "vkResetCommandBuffer");
+        memset(&bi, 0, sizeof bi);
+        bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+        bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+        HD__VK_TRY(ctx, be->fn.vkBeginCommandBuffer(be->cmd, &bi), "vkBeginCommandBuffer");
+        be->open = 1;
+    }
+    *out = be->cmd;
+    return HD_SUCCESS;
+}
+
+/* Submits what the backend recorded and waits for it (nothing when recording for the caller). */
+static hd_result hd__vk_flush(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkSubmitInfo si;
+    VkResult e;
+    if (be->rec || !be->open) return HD_SUCCESS;
+    be->open = 0;
+    HD__VK_TRY(ctx, be->fn.vkEndCommandBuffer(be->cmd), "vkEndCommandBuffer");
+    memset(&si, 0, sizeof si);
+    si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+    si.commandBufferCount = 1;
+    si.pCommandBuffers = &be->cmd;
+    HD__VK_TRY(ctx, be->fn.vkQueueSubmit(be->queue, 1, &si, be->fence), "vkQueueSubmit");
+    e = be->fn.vkWaitForFences(be->device, 1, &be->fence, VK_TRUE, UINT64_MAX);
+    if (e != VK_SUCCESS) return hd__vk_fail(ctx, e < 0 ? e : VK_ERROR_DEVICE_LOST, "vkWaitForFences", __LINE__);
+    HD__VK_TRY(ctx, be->fn.vkResetFences(be->device, 1, &be->fence), "vkResetFences");
+    be->next_slot = 0; /* the parameter slots are free again */
+    be->have_slot = 0;
+    return HD_SUCCESS;
+}
+
+/* Orders everything recorded before against everything after: compute and transfer, both ways. */
+static void hd__vk_barrier(hd__backend *be, VkCommandBuffer cb)
+{
+    VkMemoryBarrier mb;
+    memset(&mb, 0, sizeof mb);
+    mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+    mb.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_HOST_READ_BIT | VK_ACCESS_UNIFORM_READ_BIT;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_HOST_BIT,
+                                0, 1, &mb, 0, NULL, 0, NULL);
+}
+
+/* Layout transitions of up to two images around a transfer: storage images live in GENERAL;
+   copies and clears use the TRANSFER_* layouts (what the validation layer's advice asks for),
+   and each transition is also a full compute/transfer memory barrier. */
+static void hd__vk_layout(hd__backend *be, VkCommandBuffer cb, VkImage a, VkImageLayout a_from, VkImageLayout a_to,
+                          VkImage b, VkImageLayout b_from, VkImageLayout b_to)
+{
+    VkImageMemoryBarrier ib[2];
+    int i, n = b ? 2 : 1;
+    memset(ib, 0, sizeof ib);
+    for (i = 0; i < n; ++i) {
+        ib[i].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        ib[i].srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+        ib[i].dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+        ib[i].oldLayout = i == 0 ? a_from : b_from;
+        ib[i].newLayout = i == 0 ? a_to : b_to;
+        ib[i].srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        ib[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        ib[i].image = i == 0 ? a : b;
+        ib[i].subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+        ib[i].subresourceRange.levelCount = 1;
+        ib[i].subresourceRange.layerCount = 1;
+    }
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL,
+                                (uint32_t)n, ib);
+}
+#define HD__VK_G VK_IMAGE_LAYOUT_GENERAL
+#define HD__VK_SRC VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL
+#define HD__VK_DST VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL
+
+/* Copies image a into image b (same extent), GENERAL before and after. */
+static void hd__vk_copy_image(hd__backend *be, VkCommandBuffer cb, const hd__vk_image *a, const hd__vk_image *b)
+{
+    VkImageCopy ic;
+    memset(&ic, 0, sizeof ic);
+    ic.srcSubresource.aspectMask = ic.dstSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    ic.srcSubresource.layerCount = ic.dstSubresource.layerCount = 1;
+    ic.extent.width = (uint32_t)a->extent[0];
+    ic.extent.height = (uint32_t)a->extent[1];
+    ic.extent.depth = (uint32_t)a->extent[2];
+    hd__vk_layout(be, cb, a->image, HD__VK_G, HD__VK_SRC, b->image, HD__VK_G, HD__VK_DST);
+    be->fn.vkCmdCopyImage(cb, a->image, HD__VK_SRC, b->image, HD__VK_DST, 1, &ic);
+    hd__vk_layout(be, cb, a->image, HD__VK_SRC, HD__VK_G, b->image, HD__VK_DST, HD__VK_G);
+}
+
+/* Zeroes an image, GENERAL before and after (from: its layout now, UNDEFINED when new). */
+static void hd__vk_zero_image(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from)
+{
+    VkClearColorValue zero;
+    VkImageSubresourceRange range;
+    memset(&zero, 0, sizeof zero);
+    memset(&range, 0, sizeof range);
+    range.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    range.levelCount = 1;
+    range.layerCount = 1;
+    hd__vk_layout(be, cb, im, from, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    be->fn.vkCmdClearColorImage(cb, im, HD__VK_DST, &zero, 1, &range);
+    hd__vk_layout(be, cb, im, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+}
+
+/* New images: UNDEFINED -> GENERAL (the only layout they are used in), then zeroed. */
+static hd_result hd__vk_image_init(hd__ctx *ctx, hd__vk_image *im)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_zero_image(ctx->be, cb, im->image, VK_IMAGE_LAYOUT_UNDEFINED);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__vk_image_new(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+{
+    hd_result r;
+    if ((r = hd__vk_image_create(ctx, im, w, h, d, what)) != HD_SUCCESS) return r;
+    return hd__vk_image_init(ctx, im);
+}
+
+static hd_result hd__vk_staging(hd__ctx *ctx, VkDeviceSize bytes)
+{
+    hd__backend *be = ctx->be;
+    if (be->staging.buffer && be->staging.bytes >= bytes) return HD_SUCCESS;
+    hd__vk_free_buffer(ctx, &be->staging);
+    return hd__vk_buffer_create(ctx, &be->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                1, "the staging buffer");
+}
+
+static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
+{
+    VkBufferImageCopy reg;
+    memset(&reg, 0, sizeof reg);
+    reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    reg.imageSubresource.layerCount = 1;
+    reg.imageExtent.width = (uint32_t)im->extent[0];
+    reg.imageExtent.height = (uint32_t)im->extent[1];
+    reg.imageExtent.depth = (uint32_t)im->extent[2];
+    return reg;
+}
+
+/* Whole image <- host floats (x fastest), submitted and waited for. */
+static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float *src)
+{
+    hd__backend *be = ctx->be;
+    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * sizeof(float);
+    VkBufferImageCopy reg = hd__vk_region(im);
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r; /* the staging buffer is free */
+    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
+    memcpy(be->staging.map, src, bytes);
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
+    hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    return hd__vk_flush(ctx);
+}
+
+/* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar). */
+static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst)
+{
+    hd__backend *be = ctx->be;
+    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * sizeof(float);
+    VkBufferImageCopy reg = hd__vk_region(im);
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_SRC, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    be->fn.vkCmdCopyImageToBuffer(cb, im->image, HD__VK_SRC, be->staging.buffer, 1, &reg);
+    hd__vk_layout(be, cb, im->image, HD__VK_SRC, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    hd__vk_barrier(be, cb);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    memcpy(dst, be->staging.map, bytes);
+    return HD_SUCCESS;
+}
+
+/* ---- pipelines -------------------------------------------------------------------------------- */
+static hd_result hd__vk_pipelines(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    static const VkDescriptorType types[HD__VK_BINDINGS] = {
+        VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+    const uint32_t *code[HD__VK_PIPELINE_COUNT];
+    size_t size[HD__VK_PIPELINE_COUNT];
+    VkDescriptorSetLayoutBinding b[HD__VK_BINDINGS];
+    VkDescriptorSetLayoutCreateInfo lci;
+    VkPushConstantRange pcr;
+    VkPipelineLayoutCreateInfo plci;
+    VkDescriptorPoolSize ps[3];
+    VkDescriptorPoolCreateInfo dpci;
+    int i;
+    code[HD__VK_CLASSIFY] = hd__spv_classify; size[HD__VK_CLASSIFY] = sizeof hd__spv_classify;
+    code[HD__VK_DIRECT] = hd__spv_direct; size[HD__VK_DIRECT] = sizeof hd__spv_direct;
+    code[HD__VK_DIFFUSE] = hd__spv_diffuse; size[HD__VK_DIFFUSE] = sizeof hd__spv_diffuse;
+    code[HD__VK_PROJECT] = hd__spv_project; size[HD__VK_PROJECT] = sizeof hd__spv_project;
+    code[HD__VK_CONVECT] = hd__spv_convect; size[HD__VK_CONVECT] = sizeof hd__spv_convect;
+    code[HD__VK_SUM_LIGHT] = hd__spv_sum_light; size[HD__VK_SUM_LIGHT] = sizeof hd__spv_sum_light;
+    code[HD__VK_PATH] = hd__spv_path; size[HD__VK_PATH] = sizeof hd__spv_path;
+    memset(b, 0, sizeof b);
+    for (i = 0; i < HD__VK_BINDINGS; ++i) {
+        b[i].binding = (uint32_t)i;
+        b[i].descriptorType = types[i];
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    memset(&lci, 0, sizeof lci);
+    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    lci.bindingCount = HD__VK_BINDINGS;
+    lci.pBindings = b;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, &be->set_layout), "vkCreateDescriptorSetLayout");
+    memset(&pcr, 0, sizeof pcr);
+    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    pcr.size = 4 * sizeof(int32_t);
+    memset(&plci, 0, sizeof plci);
+    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &be->set_layout;
+    plci.pushConstantRangeCount = 1;
+    plci.pPushConstantRanges = &pcr;
+    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &be->layout), "vkCreatePipelineLayout");
+    for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) {
+        VkShaderModuleCreateInfo smci;
+        VkComputePipelineCreateInfo cpci;
+        VkShaderModule sm;
+        VkResult e;
+        memset(&smci, 0, sizeof smci);
+        smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+        smci.codeSize = size[i];
+        smci.pCode = code[i];
+        HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
+        memset(&cpci, 0, sizeof cpci);
+        cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+        cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+        cpci.stage.module = sm;
+        cpci.stage.pName = "main";
+        cpci.layout = be->layout;
+        e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, &be->pipelines[i]);
+        be->fn.vkDestroyShaderModule(be->device, sm, NULL);
+        if (e < 0) { be->pipelines[i] = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
+    }
+    ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
+    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 3 * HD_MAX_LIGHTS;
+    memset(&dpci, 0, sizeof dpci);
+    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    dpci.maxSets = HD_MAX_LIGHTS;
+    dpci.poolSizeCount = 3;
+    dpci.pPoolSizes = ps;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &be->dpool), "vkCreateDescriptorPool");
+    return HD_SUCCESS;
+}
+
+/* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
+   spare) at bindings 9 and 10; set 0 serves every other stage. Absent resources bind dummies.
+   Nothing may be in flight (the backend waits after each stage; hd_vulkan_record's contract). */
+static hd_result hd__vk_sets(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkDescriptorSetLayout layouts[HD_MAX_LIGHTS];
+    VkDescriptorSetAllocateInfo ai;
+    int n = be->nlv > 0 ? be->nlv : 1, s, i;
+    if (be->sets_valid) return HD_SUCCESS;
+    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, be->dpool, 0), "vkResetDescriptorPool");
+    for (s = 0; s < n; ++s) layouts[s] = be->set_layout;
+    memset(&ai, 0, sizeof ai);
+    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    ai.descriptorPool = be->dpool;
+    ai.descriptorSetCount = (uint32_t)n;
+    ai.pSetLayouts = layouts;
+    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, be->sets), "vkAllocateDescriptorSets");
+    for (s = 0; s < n; ++s) {
+        VkWriteDescriptorSet w[HD__VK_BINDINGS];
+        VkDescriptorBufferInfo bi[HD__VK_BINDINGS];
+        VkDescriptorImageInfo ii[HD__VK_BINDINGS];
+        const hd__vk_image *im[HD__VK_BINDINGS];
+        const hd__vk_buffer *bu[HD__VK_BINDINGS];
+        memset(im, 0, sizeof im);
+        memset(bu, 0, sizeof bu);
+        bu[0] = &be->params; im[1] = &be->vol; bu[2] = &be->tf; bu[3] = &be->maj; im[4] = &be->sig;
+        im[5] = &be->E; im[6] = &be->phi; im[7] = &be->phi2; bu[8] = &be->img;
+        im[9] = be->nlv > 0 ? &be->lv[s] : &be->dummy;
+        im[10] = be->nlv > 0 ? &be->lv[be->nlv] : &be->dummy;
+        for (i = 0; i < HD__VK_BINDINGS; ++i) {
+            memset(&w[i], 0, sizeof w[i]);
+            w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+            w[i].dstSet = be->sets[s];
+            w[i].dstBinding = (uint32_t)i;
+            w[i].descriptorCount = 1;
+            if (bu[i]) {
+                const hd__vk_buffer *x = bu[i]->buffer ? bu[i] : &be->dummy_buffer;
+                bi[i].buffer = x->buffer;
+                bi[i].offset = 0;
+                bi[i].range = i == 0 ? sizeof(hd__kparams) : VK_WHOLE_SIZE;
+                w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+                w[i].pBufferInfo = &bi[i];
+            } else {
+                const hd__vk_image *x = im[i]->image ? im[i] : &be->dummy;
+                ii[i].sampler = VK_NULL_HANDLE;
+                ii[i].imageView = x->view;
+                ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+                w[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+                w[i].pImageInfo = &ii[i];
+            }
+        }
+        be->fn.vkUpdateDescriptorSets(be->device, HD__VK_BINDINGS, w, 0, NULL);
+    }
+    be->sets_valid = 1;
+    return HD_SUCCESS;
+}
+
+/* The parameter ring: ctx->kp in a slot of its own whenever it changed since the last one, so
+   every recorded iteration reads the parameters it was recorded with. */
+static hd_result hd__vk_ring(hd__ctx *ctx, uint32_t slots)
+{
+    hd__backend *be = ctx->be;
+    VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
+    if (be->params.buffer && be->slots >= slots) return HD_SUCCESS;
+    hd__vk_free_buffer(ctx, &be->params);
+    be->slots = 0;
+    be->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
+    if (slots > (1u << 20))
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "vulkan: %u parameter slots (recorded iterations) are too many; record at most 2^20 at a time", slots);
+    {
+        hd_result r = hd__vk_buffer_create(ctx, &be->params, be->slot_bytes * slots, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1,
+                                           "the parameter ring");
+        if (r != HD_SUCCESS) return r;
+    }
+    be->slots = slots;
+    be->next_slot = 0;
+    be->have_slot = 0;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__vk_params(hd__ctx *ctx, uint32_t *offset)
+{
+    hd__backend *be = ctx->be;
+    if (!be->have_slot || memcmp(&be->slot_kp, &ctx->kp, sizeof ctx->kp) != 0) {
+        if (be->next_slot >= be->slots)
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the parameter ring's %u slots are used up", be->slots);
+        be->slot = be->next_slot++;
+        memcpy((char *)be->params.map + be->slot * be->slot_bytes, &ctx->kp, sizeof ctx->kp);
+        be->slot_kp = ctx->kp;
+        be->have_slot = 1;
+    }
+    *offset = (uint32_t)(be->slot * be->slot_bytes);
+    return HD_SUCCESS;
+}
+
+/* Records one dispatch of pipeline p over groups of 64 x 1 x 1 covering nx x ny x nz, with the
+   given set and push constants, after a barrier. */
+static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, int p, int set, int nx, int ny, int nz,
+                                 int pc0, int pc1, int pc2, int pc3)
+{
+    hd__backend *be = ctx->be;
+    int32_t pc[4];
+    uint32_t offset;
+    hd_result r;
+    if (nx <= 0 || ny <= 0 || nz <= 0) return HD_SUCCESS;
+    if ((r = hd__vk_params(ctx, &offset)) != HD_SUCCESS) return r;
+    pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
+    hd__vk_barrier(be, cb);
+    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->pipelines[p]);
+    be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->layout, 0, 1, &be->sets[set], 1, &offset);
+    be->fn.vkCmdPushConstants(cb, be->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
+    be->fn.vkCmdDispatch(cb, ((uint32_t)nx + HD__VK_LOCAL_X - 1) / HD__VK_LOCAL_X, (uint32_t)ny, (uint32_t)nz);
+    return HD_SUCCESS;
+}
+
+/* Everything a stage needs before recording: the sets and a command buffer. */
+static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
+{
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if (!ctx->be->sets_valid) {
+        if (ctx->be->rec)
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: resources changed while recording (internal error)");
+        if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
+    }
+    return hd__vk_cmd(ctx, cb);
+}
+
+/* ---- life cycle -------------------------------------------------------------------------------- */
+static void hd__vk_free_lights(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int l;
+    if (!be->lv) return;
+    for (l = 0; l <= be->nlv; ++l) hd__vk_free_image(ctx, &be->lv[l]);
+    hd__free(ctx, be->lv);
+    be->lv = NULL;
+    be->nlv = 0;
+    be->sets_valid = 0;
+}
+
+static void hd__be_destroy(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int i;
+    if (!be) return;
+    if (be->device && be->fn.vkDeviceWaitIdle) {
+        if (be->open && !be->lost) hd__vk_flush(ctx);
+        be->fn.vkDeviceWaitIdle(be->device); /* also after a lost device: then it returns at once */
+        hd__vk_free_lights(ctx);
+        hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
+        hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2); hd__vk_free_image(ctx, &be->dummy);
+        hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
+        hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
+        for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
+            if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
+        if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
+        if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
+        if (be->set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, be->set_layout, NULL);
+        if (be->fence) be->fn.vkDestroyFence(be->device, be->fence, NULL);
+        if (be->pool) be->fn.vkDestroyCommandPool(be->device, be->pool, NULL);
+        if (be->own_device) be->fn.vkDestroyDevice(be->device, NULL);
+    }
+    if (be->own_device && be->instance && be->fn.vkDestroyInstance) {
+        if (be->messenger) be->fn.vkDestroyDebugUtilsMessengerEXT(be->instance, be->messenger, NULL);
+        be->fn.vkDestroyInstance(be->instance, NULL);
+    }
+    hd__free(ctx, be);
+    ctx->be = NULL;
+}
+
+static hd_result hd__be_create(hd__ctx *ctx)
+{
+    hd__backend *be;
+    hd_result r;
+    VkPhysicalDeviceProperties props;
+    VkCommandPoolCreateInfo cpci;
+    VkCommandBufferAllocateInfo cbai;
+    VkFenceCreateInfo fci;
+    const char *limit = getenv("HD_VK_MEMORY_LIMIT");
+    const hd_desc *d = &ctx->desc;
+    int caller = d->vulkan.instance || d->vulkan.physical_device || d->vulkan.device;
+    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
+    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the backend");
+    ctx->be = be;
+    be->ctx = ctx;
+    if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
+    /* void* -> function pointer by memcpy: a cast is not ISO C */
+    if (d->vulkan.get_instance_proc_addr) memcpy(&be->gipa, &d->vulkan.get_instance_proc_addr, sizeof be->gipa);
+#if !defined(HD_VK_NO_LOADER)
+    if (!be->gipa) be->gipa = vkGetInstanceProcAddr;
+#endif
+    if (!be->gipa)
+        return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "vulkan: built with HD_VK_NO_LOADER: desc.vulkan.get_instance_proc_addr is required");
+    if (caller) {
+        if (!d->vulkan.instance || !d->vulkan.physical_device || !d->vulkan.device)
+            return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "vulkan: give desc.vulkan.instance, physical_device and device together, or none");
+        be->instance = (VkInstance)d->vulkan.instance;
+        be->phys = (VkPhysicalDevice)d->vulkan.physical_device;
+        be->device = (VkDevice)d->vulkan.device;
+        be->queue_family = d->vulkan.queue_family;
+        if ((r = hd__vk_load_instance_fns(ctx)) != HD_SUCCESS) return r;
+    } else {
+        be->own_device = 1;
+        if ((r = hd__vk_create_instance(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_pick_device(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_create_device(ctx)) != HD_SUCCESS) return r;
+    }
+    if ((r = hd__vk_load_device_fns(ctx)) != HD_SUCCESS) {
+        if (be->own_device) be->device = VK_NULL_HANDLE; /* cannot destroy it without its functions */
+        return r;
+    }
+    if (caller && d->vulkan.queue) be->queue = (VkQueue)d->vulkan.queue;
+    else be->fn.vkGetDeviceQueue(be->device, be->queue_family, 0, &be->queue);
+    be->fn.vkGetPhysicalDeviceProperties(be->phys, &props);
+    be->fn.vkGetPhysicalDeviceMemoryProperties(be->phys, &be->memprops);
+    be->limits = props.limits;
+    memcpy(be->device_name, props.deviceName, sizeof be->device_name);
+    be->device_name[sizeof be->device_name - 1] = '\0';
+    HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
+    if (props.limits.maxUniformBufferRange < sizeof(hd__kparams))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: maxUniformBufferRange %u < the %zu-byte parameter block",
+                       props.limits.maxUniformBufferRange, sizeof(hd__kparams));
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    cpci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    cpci.queueFamilyIndex = be->queue_family;
+    HD__VK_TRY(ctx, be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &be->pool), "vkCreateCommandPool");
+    memset(&cbai, 0, sizeof cbai);
+    cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    cbai.commandPool = be->pool;
+    cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbai.commandBufferCount = 1;
+    HD__VK_TRY(ctx, be->fn.vkAllocateCommandBuffers(be->device, &cbai, &be->cmd), "vkAllocateCommandBuffers");
+    memset(&fci, 0, sizeof fci);
+    fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+    HD__VK_TRY(ctx, be->fn.vkCreateFence(be->device, &fci, NULL, &be->fence), "vkCreateFence");
+    if ((r = hd__vk_pipelines(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_ring(ctx, 16)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_buffer_create(ctx, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(ctx, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_buffer_create(ctx, &be->maj, (VkDeviceSize)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float),
+                                  VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the majorant grid")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_create(ctx, &be->vol, ctx->dims[0], ctx->dims[1], ctx->dims[2], "the volume")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_init(ctx, &be->vol)) != HD_SUCCESS) return r;
+    return hd__vk_upload_image(ctx, &be->vol, ctx->vol);
+}
+
+/* TF and majorants: small host-visible buffers written in place (nothing is in flight here). */
+static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
+    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if (tf_bytes != be->tf_bytes) {
+        hd__vk_free_buffer(ctx, &be->tf);
+        be->tf_bytes = 0;
+        if ((r = hd__vk_buffer_create(ctx, &be->tf, tf_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the transfer function")) != HD_SUCCESS)
+            return r;
+        be->tf_bytes = tf_bytes;
+    }
+    memcpy(be->tf.map, ctx->tf, tf_bytes);
+    memcpy(be->maj.map, ctx->majorant, ncell * sizeof(float));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
+{
+    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
+             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int *g = ctx->gdims;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
+    hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
+    be->illum_floats = 0;
+    if (illum_floats == 0) return HD_SUCCESS;
+    if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2], "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, "phi")) != HD_SUCCESS) return r;
+    be->illum_floats = illum_floats;
+    return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    hd__vk_free_image(ctx, &be->phi2);
+    if (!enable || be->illum_floats == 0) return HD_SUCCESS;
+    if ((r = hd__vk_image_new(ctx, &be->phi2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, "Jacobi's buffer")) != HD_SUCCESS)
+        return r;
+    return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+{
+    hd__backend *be = ctx->be;
+    VkDeviceSize bytes = (VkDeviceSize)width * height * 4 * sizeof(float);
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    hd__vk_free_buffer(ctx, &be->img);
+    be->img_floats = 0;
+    if (bytes > be->limits.maxStorageBufferRange)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image needs %llu bytes, above maxStorageBufferRange = %u",
+                       width, height, (unsigned long long)bytes, be->limits.maxStorageBufferRange);
+    if ((r = hd__vk_buffer_create(ctx, &be->img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, "the image")) != HD_SUCCESS)
+        return r;
+    be->img_floats = (size_t)width * height * 4;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+{
+    hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    hd__vk_image *ims[3];
+    int i, n = 0;
+    HD__VK_LOST_CHECK(ctx);
+    if ((what & HD__DIRTY_DIRECT) && be->E.image) ims[n++] = &be->E;
+    if ((what & HD__DIRTY_PHI) && be->phi.image) ims[n++] = &be->phi;
+    if ((what & HD__DIRTY_PHI) && be->phi2.image) ims[n++] = &be->phi2;
+    if (n == 0 && !((what & HD__DIRTY_IMAGE) && be->img.buffer)) return HD_SUCCESS;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_barrier(be, cb);
+    for (i = 0; i < n; ++i) hd__vk_zero_image(be, cb, ims[i]->image, HD__VK_G);
+    if ((what & HD__DIRTY_IMAGE) && be->img.buffer) be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
+    return hd__vk_flush(ctx);
+}
+
+/* ---- stages ------------------------------------------------------------------------------------ */
+static hd_result hd__be_classify(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_direct(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIRECT, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
+}
+
+/* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
+   Jacobi pass, phi -> phi2, and a copy back (the descriptor sets stay fixed, which recorded
+   command buffers need). */
+static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+{
+    hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    int nz = ctx->gdims[2] * ctx->channels;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if (jacobi) {
+        if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIFFUSE, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
+        hd__vk_copy_image(be, cb, &be->phi2, &be->phi);
+    } else {
+        int parity;
+        for (parity = 0; parity < 2; ++parity)
+            if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
+                return r;
+    }
+    return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_project(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
+}
+
+/* ---- read-back ------------------------------------------------------------------------------- */
+static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+{
+    hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkBufferCopy bc;
+    size_t bytes = (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float);
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_barrier(be, cb);
+    memset(&bc, 0, sizeof bc);
+    bc.size = bytes;
+    be->fn.vkCmdCopyBuffer(cb, be->img.buffer, be->staging.buffer, 1, &bc);
+    hd__vk_barrier(be, cb);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    memcpy(dst, be->staging.map, bytes);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    HD__VK_LOST_CHECK(ctx);
+    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst);
+}
+
+/* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
+HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+{
+    HD__VK_LOST_CHECK(ctx);
+    return hd__vk_upload_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
+}
+
+/* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
+/* count + 1 zeroed light volumes (count lights and a spare); count 0 frees them. As hd_cpu.h. */
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int l;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    hd__vk_free_lights(ctx);
+    if (count <= 0) return HD_SUCCESS;
+    be->lv = (hd__vk_image *)hd__calloc(ctx, (size_t)count + 1, sizeof(hd__vk_image));
+    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate %d light volume handles", count);
+    be->nlv = count;
+    for (l = 0; l <= count; ++l)
+        if ((r = hd__vk_image_new(ctx, &be->lv[l], ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], "a CD light volume")) != HD_SUCCESS) {
+            hd__vk_flush(ctx);
+            hd__vk_free_lights(ctx);
+            return r;
+        }
+    return hd__vk_flush(ctx);
+}
+
+/* One convection step of light `light`: its volume -> the spare, copied back (the CPU backend
+   swaps the two instead; a copy keeps the descriptor sets fixed for recorded command buffers). */
+static hd_result hd__be_convect(hd__ctx *ctx, int light)
+{
+    hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_CONVECT, light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
+        return r;
+    hd__vk_copy_image(be, cb, &be->lv[be->nlv], &be->lv[light]);
+    return hd__vk_flush(ctx);
+}
+
+/* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
+static hd_result hd__be_sum_lights(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    int l;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    for (l = 0; l < ctx->be->nlv; ++l)
+        if ((r = hd__vk_dispatch(ctx, cb, HD__VK_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+            return r;
+    return hd__vk_flush(ctx);
+}
+
+/* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
+static hd_result hd__be_path(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
+}
+
+/* ---- recording into the caller's command buffer ------------------------------------------------ */
+static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
+static hd_result hd__prepare(hd__ctx *ctx);
+static hd_result hd__iterate_method(hd__ctx *ctx);
+
+HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+{
+    hd_logger stale;
+    hd__ctx *ctx = hd__lookup(h, &stale);
+    hd__backend *be;
+    hd_result r = HD_SUCCESS;
+    int i;
+    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
+    be = ctx->be;
+    if (!command_buffer) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
+    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
+    /* uploads, allocations and clears are submitted and waited for here; only iterations are
+       recorded, each with its own parameter slot */
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_ring(ctx, (uint32_t)n + 2u)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
+    be->next_slot = 0;
+    be->have_slot = 0;
+    be->rec = (VkCommandBuffer)command_buffer;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__iterate_method(ctx);
+    if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
+    be->rec = VK_NULL_HANDLE;
+    return r;
+}
