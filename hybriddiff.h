@@ -326,6 +326,13 @@ HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, floa
                                      size_t dst_floats);
 HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
 
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): records n iterations of the
+   current method into the caller's VkCommandBuffer (passed as void*, in the recording state,
+   from a pool of desc.vulkan.queue_family) instead of submitting them; hd_iterate submits and
+   waits itself. Changed inputs are uploaded first (submitted and waited for). The caller
+   submits the command buffer and waits for it before the next call on this context. */
+HDDEF hd_result hd_vulkan_record(hd_context ctx, void *command_buffer, int n);
+
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
    types are converted to F32. */
@@ -392,10 +399,10 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
-/* A backend that is not written yet is an #error here, not a missing #include: the file that
-   lands it replaces the line with #include "backends/hd_vulkan.h" (the same for GL). */
-#error "hybriddiff: the Vulkan backend is not available in this version; use HYBRIDDIFF_BACKEND_CPU or HYBRIDDIFF_BACKEND_OPENCL"
+#include "backends/hd_vulkan.h"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
+/* A backend that is not written yet is an #error here, not a missing #include: the file that
+   lands it replaces the line with #include "backends/hd_gl.h". */
 #error "hybriddiff: the GL backend is not available in this version; use HYBRIDDIFF_BACKEND_CPU or HYBRIDDIFF_BACKEND_OPENCL"
 #endif
 #include "src/hd_validate.h"

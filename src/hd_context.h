@@ -625,6 +625,15 @@ HDDEF hd_result hd_iterate(hd_context h, int n)
     return HD_SUCCESS;
 }
 
+#if !defined(HYBRIDDIFF_BACKEND_VULKAN)
+HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+{
+    HD__GET_CTX(ctx, h);
+    (void)command_buffer; (void)n;
+    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd_vulkan_record: this is the %s backend", hd__be_name());
+}
+#endif
+
 /* ---- read-back --------------------------------------------------------------------------------- */
 HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
 {

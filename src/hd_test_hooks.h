@@ -69,6 +69,8 @@ static hd_result hd__test_write_illumination(hd_context h, hd_illumination which
                                          ctx->be->illum_floats * sizeof(float), src, 0, NULL, NULL),
                "clEnqueueWriteBuffer(test illumination)");
     return HD_SUCCESS;
+#elif defined(HYBRIDDIFF_BACKEND_VULKAN)
+    return hd__vk_write_illumination(ctx, which, src);
 #else
     (void)which; (void)src;
     return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
