@@ -1,0 +1,49 @@
+# mk/vulkan.mk - the Vulkan backend: the conformance suite against the CPU reference (plain and
+# under the validation layer), its own tests, the C++17 compile check, the SPIR-V freshness check
+# and the Vulkan benchmark.
+#   make conformance-vulkan             tests/conformance on Vulkan (part of `make test`)
+#   make conformance-vulkan-validation  the same under VK_LAYER_KHRONOS_validation + sync
+#                                       validation; fails on any message (part of `make test`)
+#   make test-vulkan                    tests/vulkan: messenger fires, caller-owned device and
+#                                       recording, out-of-device-memory and destroy
+#   make compile-vulkan-cxx             the Vulkan implementation as C++17, warnings as errors
+#   make bench-vulkan                   build/hdbench_vulkan on the head CT (make data)
+# Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
+VK_LDLIBS := -lvulkan
+VK_CONF := tests/conformance
+VK_DEPS := $(VK_CONF)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
+VK_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
+
+.PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan
+
+$(B)/conf_impl_vk.o: $(VK_CONF)/impl_vk.c $(VK_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/conf_impl_cpu_vk.o: $(VK_CONF)/impl_cpu.c $(VK_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/conformance_vk.o: $(VK_CONF)/conformance.c $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/conformance-vulkan: $(B)/conformance_vk.o $(B)/conf_impl_cpu_vk.o $(B)/conf_impl_vk.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)
+
+conformance-vulkan: $(B)/conformance-vulkan
+	$(B)/conformance-vulkan
+
+conformance-vulkan-validation: $(B)/conformance-vulkan
+	HD_VK_VALIDATION=1 $(B)/conformance-vulkan
+
+$(B)/test_vulkan: tests/vulkan/test_vulkan.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
+
+test-vulkan: $(B)/test_vulkan
+	$(B)/test_vulkan
+
+compile-vulkan-cxx: | $(B)
+	$(CXX) $(CPPFLAGS) $(VK_CXXWARN) -O1 -x c++ -c $(VK_CONF)/impl_vk.c -o $(B)/conf_impl_vk_cxx.o
+
+$(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
+
+bench-vulkan: $(B)/hdbench_vulkan data
+	$(B)/hdbench_vulkan
+
+test: conformance-vulkan conformance-vulkan-validation compile-vulkan-cxx
