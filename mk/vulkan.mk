@@ -46,4 +46,4 @@ $(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(LIB_SRC) | $(B)
 bench-vulkan: $(B)/hdbench_vulkan data
 	$(B)/hdbench_vulkan
 
-test: conformance-vulkan conformance-vulkan-validation compile-vulkan-cxx
+test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx

@@ -1,0 +1,299 @@
+/* test_vulkan.c - the Vulkan backend's own checks (`make test-vulkan`), beside the conformance
+   suite:
+     1. the debug messenger really fires: a deliberately invalid vkCreateBuffer (usage 0) on the
+        backend's device under the validation layer must produce a message;
+     2. a caller-owned instance/device (validation and synchronization validation on, through the
+        caller's messenger), functions loaded through the caller's vkGetInstanceProcAddr, and
+        hd_vulkan_record into the caller's command buffer: the same E, phi and image, bit for bit,
+        as hd_iterate on a context of the backend's own, and no validation message;
+     3. HD_VK_MEMORY_LIMIT provokes HD_ERROR_OUT_OF_DEVICE_MEMORY in hd_create and in hd_iterate;
+        the contexts are destroyed without leaks (validation on: the layer reports objects left
+        alive at vkDestroyDevice / vkDestroyInstance as messages, and there must be none).
+   A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
+#define HYBRIDDIFF_IMPLEMENTATION
+#define HYBRIDDIFF_BACKEND_VULKAN
+#include "hybriddiff.h"
+#include <stdio.h>
+
+static int failures;
+static unsigned long messages;   /* "vulkan validation" lines from the library's logger */
+static unsigned long caller_messages; /* from the caller's own messenger (test 2) */
+static unsigned long gipa_calls;
+
+#define CHECK(cond) \
+    do { if (!(cond)) { ++failures; fprintf(stderr, "  %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
+
+static void count_log(void *user, hd_log_level level, hd_result code, const char *msg, const char *file, int line)
+{
+    (void)user; (void)code; (void)file; (void)line;
+    if (strncmp(msg, "vulkan validation", 17) == 0) ++messages;
+    if (level == HD_LOG_ERROR) fprintf(stderr, "  log: %s\n", msg);
+}
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL caller_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT s, VkDebugUtilsMessageTypeFlagsEXT t,
+                                                       const VkDebugUtilsMessengerCallbackDataEXT *d, void *u)
+{
+    (void)s; (void)t; (void)u;
+    ++caller_messages;
+    fprintf(stderr, "  caller's messenger: %s\n", d->pMessage);
+    return VK_FALSE;
+}
+
+static PFN_vkVoidFunction VKAPI_CALL counting_gipa(VkInstance instance, const char *name)
+{
+    ++gipa_calls;
+    return vkGetInstanceProcAddr(instance, name);
+}
+
+static unsigned char vox[24 * 20 * 16];
+
+static hd_desc test_desc(void)
+{
+    hd_desc d;
+    int i;
+    for (i = 0; i < (int)sizeof vox; ++i) vox[i] = (unsigned char)((i * 37) ^ (i >> 5));
+    memset(&d, 0, sizeof d);
+    d.volume.type = HD_VOXEL_U8;
+    d.volume.dims[0] = 24; d.volume.dims[1] = 20; d.volume.dims[2] = 16;
+    d.volume.data = vox;
+    d.camera.width = 32; d.camera.height = 24;
+    d.logger.func = count_log;
+    return d;
+}
+
+/* 1: the messenger fires on a broken call. */
+static int test_messenger(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_result r;
+    hd__ctx *ctx;
+    VkBufferCreateInfo bci;
+    VkBuffer buf = VK_NULL_HANDLE;
+    unsigned long before;
+    d.vulkan.enable_validation = 1;
+    r = hd_create(&d, &h);
+    if (r != HD_SUCCESS) { printf("SKIPPED messenger: %s\n", hd_result_string(r)); return 0; }
+    CHECK(messages == 0);
+    ctx = hd__lookup(h, NULL);
+    memset(&bci, 0, sizeof bci);
+    bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    bci.size = 16;
+    bci.usage = 0; /* invalid: VUID-VkBufferCreateInfo-usage-requiredbitmask */
+    before = messages;
+    if (ctx->be->fn.vkCreateBuffer(ctx->be->device, &bci, NULL, &buf) == VK_SUCCESS && buf)
+        ctx->be->fn.vkDestroyBuffer(ctx->be->device, buf, NULL);
+    CHECK(messages > before);
+    printf("%s messenger fires on a broken call (%lu message%s)\n", messages > before ? "PASS" : "FAIL",
+           messages - before, messages - before == 1 ? "" : "s");
+    hd_destroy(h);
+    messages = 0;
+    return 1;
+}
+
+/* 2: caller-owned device, caller's loader, recording into the caller's command buffer. */
+static void test_caller_device(void)
+{
+    const char *layer = "VK_LAYER_KHRONOS_validation", *ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    PFN_vkCreateInstance create_instance = (PFN_vkCreateInstance)vkGetInstanceProcAddr(NULL, "vkCreateInstance");
+    VkApplicationInfo app;
+    VkInstanceCreateInfo ici;
+    VkValidationFeaturesEXT vf;
+    VkValidationFeatureEnableEXT sync = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkDebugUtilsMessengerCreateInfoEXT mci;
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    VkInstance inst = VK_NULL_HANDLE;
+    VkPhysicalDevice phys[8];
+    uint32_t nphys = 8;
+    VkDevice dev = VK_NULL_HANDLE;
+    VkQueue queue;
+    float prio = 1.0f;
+    VkDeviceQueueCreateInfo qci;
+    VkDeviceCreateInfo dci;
+    VkCommandPoolCreateInfo cpci;
+    VkCommandPool pool;
+    VkCommandBufferAllocateInfo cbai;
+    VkCommandBuffer cb;
+    VkCommandBufferBeginInfo bi;
+    VkSubmitInfo si;
+    hd_desc d = test_desc();
+    hd_context mine, theirs;
+    hd_result r1, r2;
+    size_t n = (size_t)24 * 20 * 16, ni = (size_t)32 * 24 * 4;
+    float *a = (float *)calloc(n > ni ? n : ni, sizeof(float)), *b = (float *)calloc(n > ni ? n : ni, sizeof(float));
+    int k, same = 1;
+    PFN_vkDestroyInstance destroy_instance;
+    PFN_vkDestroyDevice destroy_device;
+    PFN_vkCreateCommandPool create_pool;
+    PFN_vkDestroyCommandPool destroy_pool;
+    PFN_vkAllocateCommandBuffers alloc_cb;
+    PFN_vkBeginCommandBuffer begin_cb;
+    PFN_vkEndCommandBuffer end_cb;
+    PFN_vkQueueSubmit submit;
+    PFN_vkQueueWaitIdle wait_idle;
+    PFN_vkGetDeviceQueue get_queue;
+    PFN_vkCreateDebugUtilsMessengerEXT create_messenger;
+    PFN_vkDestroyDebugUtilsMessengerEXT destroy_messenger;
+
+    memset(&app, 0, sizeof app);
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.apiVersion = VK_API_VERSION_1_1;
+    memset(&mci, 0, sizeof mci);
+    mci.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                      VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+    mci.pfnUserCallback = caller_messenger;
+    memset(&vf, 0, sizeof vf);
+    vf.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
+    vf.enabledValidationFeatureCount = 1;
+    vf.pEnabledValidationFeatures = &sync;
+    vf.pNext = &mci;
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    ici.pNext = &vf;
+    ici.pApplicationInfo = &app;
+    ici.enabledLayerCount = 1;
+    ici.ppEnabledLayerNames = &layer;
+    ici.enabledExtensionCount = 1;
+    ici.ppEnabledExtensionNames = &ext;
+    if (!create_instance || create_instance(&ici, NULL, &inst) != VK_SUCCESS) {
+        printf("SKIPPED caller device: cannot create an instance with %s\n", layer);
+        free(a); free(b);
+        return;
+    }
+#define LOAD(var, type, name) var = (type)vkGetInstanceProcAddr(inst, name)
+    LOAD(destroy_instance, PFN_vkDestroyInstance, "vkDestroyInstance");
+    LOAD(create_messenger, PFN_vkCreateDebugUtilsMessengerEXT, "vkCreateDebugUtilsMessengerEXT");
+    LOAD(destroy_messenger, PFN_vkDestroyDebugUtilsMessengerEXT, "vkDestroyDebugUtilsMessengerEXT");
+    create_messenger(inst, &mci, NULL, &messenger);
+    ((PFN_vkEnumeratePhysicalDevices)vkGetInstanceProcAddr(inst, "vkEnumeratePhysicalDevices"))(inst, &nphys, phys);
+    memset(&qci, 0, sizeof qci);
+    qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
+    qci.queueFamilyIndex = 0; /* lavapipe's one family does compute */
+    qci.queueCount = 1;
+    qci.pQueuePriorities = &prio;
+    memset(&dci, 0, sizeof dci);
+    dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+    dci.queueCreateInfoCount = 1;
+    dci.pQueueCreateInfos = &qci;
+    ((PFN_vkCreateDevice)vkGetInstanceProcAddr(inst, "vkCreateDevice"))(phys[0], &dci, NULL, &dev);
+    LOAD(destroy_device, PFN_vkDestroyDevice, "vkDestroyDevice");
+    LOAD(create_pool, PFN_vkCreateCommandPool, "vkCreateCommandPool");
+    LOAD(destroy_pool, PFN_vkDestroyCommandPool, "vkDestroyCommandPool");
+    LOAD(alloc_cb, PFN_vkAllocateCommandBuffers, "vkAllocateCommandBuffers");
+    LOAD(begin_cb, PFN_vkBeginCommandBuffer, "vkBeginCommandBuffer");
+    LOAD(end_cb, PFN_vkEndCommandBuffer, "vkEndCommandBuffer");
+    LOAD(submit, PFN_vkQueueSubmit, "vkQueueSubmit");
+    LOAD(wait_idle, PFN_vkQueueWaitIdle, "vkQueueWaitIdle");
+    LOAD(get_queue, PFN_vkGetDeviceQueue, "vkGetDeviceQueue");
+#undef LOAD
+    get_queue(dev, 0, 0, &queue);
+
+    /* the library on the caller's device, loading through the caller's vkGetInstanceProcAddr */
+    d.vulkan.instance = inst;
+    d.vulkan.physical_device = phys[0];
+    d.vulkan.device = dev;
+    d.vulkan.queue = queue;
+    d.vulkan.queue_family = 0;
+    {
+        PFN_vkGetInstanceProcAddr f = counting_gipa;
+        memcpy(&d.vulkan.get_instance_proc_addr, &f, sizeof f);
+    }
+    r1 = hd_create(&d, &theirs);
+    CHECK(r1 == HD_SUCCESS);
+    CHECK(gipa_calls > 0);
+    memset(&d.vulkan, 0, sizeof d.vulkan);
+    r2 = hd_create(&d, &mine);
+    CHECK(r2 == HD_SUCCESS);
+    if (r1 == HD_SUCCESS && r2 == HD_SUCCESS) {
+        memset(&cpci, 0, sizeof cpci);
+        cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+        cpci.queueFamilyIndex = 0;
+        create_pool(dev, &cpci, NULL, &pool);
+        memset(&cbai, 0, sizeof cbai);
+        cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+        cbai.commandPool = pool;
+        cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+        cbai.commandBufferCount = 1;
+        alloc_cb(dev, &cbai, &cb);
+        memset(&bi, 0, sizeof bi);
+        bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+        begin_cb(cb, &bi);
+        CHECK(hd_vulkan_record(theirs, cb, 6) == HD_SUCCESS);
+        end_cb(cb);
+        memset(&si, 0, sizeof si);
+        si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        si.commandBufferCount = 1;
+        si.pCommandBuffers = &cb;
+        CHECK(submit(queue, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS);
+        wait_idle(queue);
+        CHECK(hd_iterate(mine, 6) == HD_SUCCESS);
+        for (k = 0; k < 3; ++k) {
+            size_t cnt = k < 2 ? n : ni;
+            if (k < 2) {
+                CHECK(hd_read_illumination(theirs, (hd_illumination)k, a, n) == HD_SUCCESS);
+                CHECK(hd_read_illumination(mine, (hd_illumination)k, b, n) == HD_SUCCESS);
+            } else {
+                CHECK(hd_read_image_f32(theirs, a, ni) == HD_SUCCESS);
+                CHECK(hd_read_image_f32(mine, b, ni) == HD_SUCCESS);
+            }
+            if (memcmp(a, b, cnt * sizeof(float)) != 0) same = 0;
+        }
+        CHECK(same);
+        destroy_pool(dev, pool, NULL);
+    }
+    if (r1 == HD_SUCCESS) hd_destroy(theirs);
+    if (r2 == HD_SUCCESS) hd_destroy(mine);
+    destroy_device(dev, NULL);
+    if (messenger) destroy_messenger(inst, messenger, NULL);
+    destroy_instance(inst, NULL);
+    CHECK(caller_messages == 0);
+    printf("%s caller-owned device: 6 recorded iterations %s 6 submitted ones; %lu loads through the caller's "
+           "vkGetInstanceProcAddr; %lu validation messages\n", same && caller_messages == 0 ? "PASS" : "FAIL",
+           same ? "equal (bit for bit)" : "DIFFER from", gipa_calls, caller_messages);
+    free(a);
+    free(b);
+}
+
+/* 3: out of device memory, in create and in iterate; clean destroy. */
+static void test_out_of_memory(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_result r;
+    int ok = 1;
+    d.vulkan.enable_validation = 1;
+    messages = 0;
+    setenv("HD_VK_MEMORY_LIMIT", "20000", 1); /* below the 36 KB parameter ring and the 30 KB volume */
+    r = hd_create(&d, &h);
+    CHECK(r == HD_ERROR_OUT_OF_DEVICE_MEMORY);
+    ok &= r == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    if (r == HD_SUCCESS) hd_destroy(h);
+    setenv("HD_VK_MEMORY_LIMIT", "150000", 1); /* the volume fits, the illumination grids do not */
+    r = hd_create(&d, &h);
+    CHECK(r == HD_SUCCESS);
+    ok &= r == HD_SUCCESS;
+    if (r == HD_SUCCESS) {
+        r = hd_iterate(h, 2);
+        CHECK(r == HD_ERROR_OUT_OF_DEVICE_MEMORY);
+        ok &= r == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+        CHECK(hd_destroy(h) == HD_SUCCESS);
+    }
+    unsetenv("HD_VK_MEMORY_LIMIT");
+    /* validation messages counted here: only the layer's, the OOM errors are logged separately */
+    CHECK(messages == 0);
+    ok &= messages == 0;
+    printf("%s out of device memory in hd_create and hd_iterate, destroyed with no object left (%lu validation messages)\n",
+           ok ? "PASS" : "FAIL", messages);
+}
+
+int main(void)
+{
+    if (test_messenger()) {
+        test_caller_device();
+        test_out_of_memory();
+    }
+    printf("%s\n", failures ? "FAILED" : "all passed");
+    return failures ? 1 : 0;
+}
