@@ -191,6 +191,22 @@ static double hd__io_value(const unsigned char *p, int type, int big)
     }
 }
 
+/* value_min/max and desc.value_range; a constant volume gets {v, v + a little} (or {v - a little,
+   v} at the top of the float range, so that the range stays finite and non-empty). */
+static void hd__io_set_range(hd_volume_file *out, double lo, double hi)
+{
+    out->value_min = (float)lo;
+    out->value_max = (float)hi;
+    out->desc.value_range[0] = out->value_min;
+    out->desc.value_range[1] = out->value_max;
+    if (!(out->desc.value_range[1] > out->desc.value_range[0])) {
+        float v = out->desc.value_range[0], a = v < 0 ? -v : v;
+        float d = a > 1.0f ? a * 1e-3f : 1.0f;
+        if (isfinite(v + d)) out->desc.value_range[1] = v + d;
+        else out->desc.value_range[0] = v - d;
+    }
+}
+
 /* Converts count elements of type at src into out->data (allocated here) and fills out->desc
    (but dims and spacing), value_min and value_max. */
 static hd_result hd__io_convert(const unsigned char *src, size_t count, int type, int big,
@@ -247,14 +263,7 @@ static hd_result hd__io_convert(const unsigned char *src, size_t count, int type
         out->desc.type = HD_VOXEL_F32;
     }
     out->desc.data = out->data;
-    out->value_min = (float)lo;
-    out->value_max = (float)hi;
-    out->desc.value_range[0] = out->value_min;
-    out->desc.value_range[1] = out->value_max;
-    if (!(out->desc.value_range[1] > out->desc.value_range[0])) {
-        float v = out->desc.value_range[0], a = v < 0 ? -v : v;
-        out->desc.value_range[1] = v + (a > 1.0f ? a * 1e-3f : 1.0f);
-    }
+    hd__io_set_range(out, lo, hi);
     return HD_SUCCESS;
 oom:
     return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu voxels", what,

@@ -60,14 +60,7 @@ static hd_result hd__io_rescale(hd_volume_file *out, size_t count, double slope,
     if (bad)
         HD__IO_WARN(logger, "nifti: %zu voxel values became non-finite after scl_slope/scl_inter "
                             "and were replaced by 0", bad);
-    out->value_min = (float)lo;
-    out->value_max = (float)hi;
-    out->desc.value_range[0] = out->value_min;
-    out->desc.value_range[1] = out->value_max;
-    if (!(out->desc.value_range[1] > out->desc.value_range[0])) {
-        float v = out->desc.value_range[0], a = v < 0 ? -v : v;
-        out->desc.value_range[1] = v + (a > 1.0f ? a * 1e-3f : 1.0f);
-    }
+    hd__io_set_range(out, lo, hi);
     return HD_SUCCESS;
 }
 
