@@ -1,0 +1,95 @@
+# mk/reliability.mk - hostile input, sanitizers and checkers (issue 8). Each job exits non-zero
+# on any report. Timings measured on the 2-core CI machine are in README.md, "Guarantees".
+#   make fuzz-smoke   libFuzzer, FUZZ_RUNS executions per loader from generated seeds plus
+#                     tests/fuzz/regressions/ (part of `make test`)
+#   make fuzz-long    FUZZ_SECONDS per loader (local; keeps new corpus in build/fuzz/work_*)
+#   make asan         build/hdtest and the OpenCL conformance suite under ASan+UBSan+LSan
+#   make tsan         the CPU backend's threaded tests under TSan
+#   make valgrind     build/hdtest (CPU) under memcheck, built without AVX-512 (-march=x86-64-v2)
+#   make soak         bench/hdsoak: 10,000 HD iterations, RSS and device bytes over time
+#   make check-all    test + asan + tsan + valgrind (what .ci/run should call)
+SAN_CC      ?= clang
+FUZZ_RUNS   ?= 200000
+FUZZ_SECONDS ?= 180
+FUZZ_TARGETS := nrrd mhd nifti
+FZ          := $(B)/fuzz
+SAN         := $(B)/san
+SAN_COMMON  := -g -O1 -fno-omit-frame-pointer
+ASAN_FLAGS  := $(SAN_COMMON) -fsanitize=address,undefined -fno-sanitize-recover=all
+TSAN_FLAGS  := $(SAN_COMMON) -fsanitize=thread
+# halt_on_error: the first report fails the job; LSan is on by default with ASan on x86-64.
+ASAN_ENV    := ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:abort_on_error=0:exitcode=23 \
+               UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+TSAN_ENV    := TSAN_OPTIONS=halt_on_error=1:exitcode=24
+TEST_SRC    := $(wildcard tests/*.c)
+VG_CFLAGS   := -O1 -g -march=x86-64-v2
+
+.PHONY: fuzz-smoke fuzz-long asan tsan valgrind soak check-all
+
+$(FZ) $(SAN):
+	mkdir -p $@
+
+# ---- fuzzing ----
+$(FZ)/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/hd_fuzz_check.h $(LIB_SRC) | $(FZ)
+	$(SAN_CC) $(CPPFLAGS) $(WARN) $(SAN_COMMON) -fsanitize=fuzzer,address,undefined \
+		-fno-sanitize-recover=all $< -o $@ $(LDLIBS)
+$(FZ)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/hd_fuzz_gen.h | $(FZ)
+	$(CC) $(CPPFLAGS) $(WARN) -O1 $< -o $@ -lz
+$(FZ)/seeds.stamp: $(FZ)/make_seeds
+	rm -rf $(FZ)/seeds && $(FZ)/make_seeds $(FZ)/seeds && touch $@
+
+FUZZ_ARGS := -seed=1 -max_len=4096 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+# A fresh copy of the seeds each run: the smoke run's length does not grow with its corpus.
+fuzz-smoke: $(FUZZ_TARGETS:%=$(FZ)/fuzz_%) $(FZ)/seeds.stamp
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	  rm -rf $(FZ)/work_$$t; cp -r $(FZ)/seeds/$$t $(FZ)/work_$$t; \
+	  start=$$(date +%s); \
+	  if ! $(FZ)/fuzz_$$t -runs=$(FUZZ_RUNS) $(FUZZ_ARGS) -artifact_prefix=$(FZ)/crash-$$t- \
+	       $(FZ)/work_$$t tests/fuzz/regressions/$$t > $(FZ)/fuzz_$$t.log 2>&1; then \
+	    tail -n 60 $(FZ)/fuzz_$$t.log; echo "fuzz-smoke: $$t FAILED (input in $(FZ)/crash-$$t-*)"; exit 1; fi; \
+	  echo "fuzz-smoke: $$t: $(FUZZ_RUNS) runs, nothing found ($$(( $$(date +%s) - start )) s)"; \
+	done
+
+fuzz-long: $(FUZZ_TARGETS:%=$(FZ)/fuzz_%) $(FZ)/seeds.stamp
+	@set -e; for t in $(FUZZ_TARGETS); do \
+	  mkdir -p $(FZ)/work_$$t; cp -n $(FZ)/seeds/$$t/* $(FZ)/work_$$t/ 2>/dev/null || true; \
+	  $(FZ)/fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -max_len=8192 -timeout=10 -rss_limit_mb=2048 \
+	    -artifact_prefix=tests/fuzz/regressions/$$t/crash- $(FZ)/work_$$t tests/fuzz/regressions/$$t \
+	    2>&1 | tail -n 3; \
+	done
+
+# ---- ASan + UBSan (+ LSan) ----
+$(SAN)/hdtest-asan: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+	$(SAN_CC) $(CPPFLAGS) -I$(B) $(WARN) $(ASAN_FLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
+$(SAN)/conf_impl_cpu.o: $(CONF_DIR)/impl_cpu.c $(CONF_DEPS) | $(SAN)
+	$(SAN_CC) $(CPPFLAGS) $(WARN) $(ASAN_FLAGS) -c $< -o $@
+$(SAN)/conf_impl_opencl.o: $(CONF_DIR)/impl_backend.c $(CONF_DEPS) | $(SAN)
+	$(SAN_CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_OPENCL $(WARN) $(ASAN_FLAGS) -c $< -o $@
+$(SAN)/conformance.o: $(CONF_DIR)/conformance.c $(CONF_DIR)/hd_api.h hybriddiff.h | $(SAN)
+	$(SAN_CC) $(CPPFLAGS) $(WARN) $(ASAN_FLAGS) -c $< -o $@
+$(SAN)/conformance-asan: $(SAN)/conformance.o $(SAN)/conf_impl_cpu.o $(SAN)/conf_impl_opencl.o
+	$(SAN_CC) $(ASAN_FLAGS) $^ -o $@ $(LDLIBS) $(CL_LDLIBS)
+
+# PoCL and its LLVM keep allocations for the process lifetime: tests/lsan-pocl.supp names them
+# (their libraries only; a leak with a hybriddiff frame on top is still reported).
+asan: $(SAN)/hdtest-asan $(SAN)/conformance-asan
+	$(ASAN_ENV) $(SAN)/hdtest-asan
+	$(ASAN_ENV) LSAN_OPTIONS=suppressions=tests/lsan-pocl.supp:print_suppressions=0 \
+		$(SAN)/conformance-asan --quick
+
+# ---- TSan: every test that runs the CPU backend's worker threads ----
+$(SAN)/hdtest-tsan: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+	$(SAN_CC) $(CPPFLAGS) -I$(B) $(WARN) $(TSAN_FLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
+tsan: $(SAN)/hdtest-tsan
+	$(TSAN_ENV) $(SAN)/hdtest-tsan $(TSAN_FILTER)
+
+# ---- valgrind memcheck (no AVX-512 in valgrind) ----
+$(SAN)/hdtest-vg: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(VG_CFLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
+valgrind: $(SAN)/hdtest-vg
+	valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect \
+		--show-leak-kinds=definite,indirect $(SAN)/hdtest-vg $(VG_FILTER)
+
+check-all: test asan tsan valgrind
+
+test: fuzz-smoke

@@ -1,0 +1,13 @@
+/* fuzz_nifti.c - libFuzzer target: hd_volume_parse_nifti (.nii and .nii.gz bytes). */
+#define HYBRIDDIFF_IMPLEMENTATION
+#define HYBRIDDIFF_BACKEND_CPU
+#include "hybriddiff.h"
+#include "tests/fuzz/hd_fuzz_check.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    hd_volume_file v;
+    hd_fuzz_check(hd_volume_parse_nifti(data, size, &v, hd_fuzz_logger()), &v);
+    return 0;
+}
