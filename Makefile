@@ -20,7 +20,7 @@ help:
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
 
-$(B)/%.o: tests/%.c $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(B)
+$(B)/%.o: tests/%.c $(LIB_SRC) $(wildcard examples/*.h) tests/hd_test.h $(B)/hd_suites.h | $(B)
 	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(CFLAGS) -c $< -o $@
 
 # Every tests/*.c that defines `const hd_test_case hd_tests_NAME[]` is a suite of build/hdtest.
