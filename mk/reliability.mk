@@ -93,3 +93,13 @@ valgrind: $(SAN)/hdtest-vg
 check-all: test asan tsan valgrind
 
 test: fuzz-smoke
+
+# ---- soak ----
+$(B)/hdsoak: bench/hdsoak.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+soak: $(B)/hdsoak
+	$(B)/hdsoak 10000 32
+.PHONY: soak-short
+soak-short: $(B)/hdsoak
+	$(B)/hdsoak 500 24
+test: soak-short
