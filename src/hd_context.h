@@ -83,13 +83,12 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
 {
     float lo = v->value_range[0], hi = v->value_range[1], scale;
     size_t i, ncell;
-    int d, x, y, z, maxdim = 0;
+    int d, x, y, z;
     float extent[3], emax = 0.0f;
     for (d = 0; d < 3; ++d) {
         ctx->dims[d] = v->dims[d];
         extent[d] = (float)v->dims[d] * v->spacing[d];
         if (extent[d] > emax) emax = extent[d];
-        if (v->dims[d] > maxdim) maxdim = v->dims[d];
         ctx->mdims[d] = (v->dims[d] + HD__MAJORANT_CELL - 1) / HD__MAJORANT_CELL;
     }
     for (d = 0; d < 3; ++d) ctx->box[d] = extent[d] / emax;
@@ -127,7 +126,6 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
                             if (val > r[1]) r[1] = val;
                         }
             }
-    (void)maxdim;
     return HD_SUCCESS;
 }
 
