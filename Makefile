@@ -17,6 +17,9 @@ help:
 	@echo "make data      fetch the head CT into data/ (Debian package invesalius-examples)"
 	@echo "make render    fetch the data, build hdrender and render the head to out/head.png"
 	@echo "make bench     print the benchmark figures (bench/hdbench)"
+	@echo "make dist      regenerate dist/hybriddiff.h (after every source change; see mk/dist.mk)"
+	@echo "make check-generated   embedded kernels, SPIR-V and dist/hybriddiff.h are up to date"
+	@echo "mk/*.mk        per-backend and per-tool targets, each listed at the top of its file"
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
 

@@ -389,7 +389,8 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #elif (defined(HYBRIDDIFF_BACKEND_CPU) + defined(HYBRIDDIFF_BACKEND_OPENCL) + \
        defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL)) > 1
 #error "hybriddiff: more than one backend defined; define exactly one of HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN, HYBRIDDIFF_BACKEND_GL"
-#endif
+#else /* exactly one backend: the implementation (skipped after an #error, so that is all the
+         compiler reports) */
 
 #include "backends/hd_prelude_c.h"
 #include "src/hd_internal.h"
@@ -411,6 +412,7 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #include "src/hd_io_mhd.h"
 #include "src/hd_io_nifti.h"
 
+#endif /* exactly one backend */
 #endif /* HYBRIDDIFF_IMPLEMENTATION_DONE */
 #endif /* HYBRIDDIFF_IMPLEMENTATION */
 
