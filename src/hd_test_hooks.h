@@ -71,6 +71,8 @@ static hd_result hd__test_write_illumination(hd_context h, hd_illumination which
     return HD_SUCCESS;
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
     return hd__vk_write_illumination(ctx, which, src);
+#elif defined(HYBRIDDIFF_BACKEND_GL)
+    return hd__gl_write_illumination(ctx, which, src);
 #else
     (void)which; (void)src;
     return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
@@ -83,6 +85,8 @@ static hd_result hd__test_finish(hd_context h)
     HD__GET_CTX(ctx, h);
 #if defined(HYBRIDDIFF_BACKEND_OPENCL)
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+#elif defined(HYBRIDDIFF_BACKEND_GL)
+    return hd__gl_finish(ctx);
 #endif
     (void)ctx;
     return HD_SUCCESS;

@@ -1,0 +1,28 @@
+/* hd_bind_gl_glsl.h - GLSL 4.30 text, not C: the OpenGL backend's resources, placed before
+   hd_prelude_glsl.h by scripts/embed-glsl (backends/hd_glsl_embedded.h). The same layout as the
+   Vulkan backend's hd_bind_vk_glsl.h, measured again under GL (docs/DESIGN-GL.md): the grids
+   (volume, sigma_t, E, phi, Jacobi's phi2, CD's light volumes) are r32f image3Ds read with
+   imageLoad at the (x, y, z) the shared kernels pass beside the linear index (channel c of E / phi
+   at z + c * dz); the small 1D arrays (TF, majorant grid, image accumulation) are storage buffers.
+   GL keeps separate binding points per kind, numbered within GL 4.3's minimums (8 image units,
+   8 storage buffers): uniform block 0 the parameter block (hd_prelude_glsl.h); image units
+   0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written; storage
+   buffers 0 TF, 1 majorants, 2 image accumulation. GL has no push
+   constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
+   uniform at location 0. */
+#define HD_GLSL_CUSTOM_BUFFERS 1
+layout(binding = 0, r32f) uniform readonly image3D hd_i_vol;
+layout(std430, binding = 0) readonly buffer hd_b_tf { float tf[]; };
+layout(std430, binding = 1) readonly buffer hd_b_maj { float maj[]; };
+layout(binding = 1, r32f) uniform image3D hd_i_sig;
+layout(binding = 2, r32f) uniform image3D hd_i_E;
+layout(binding = 3, r32f) uniform image3D hd_i_phi;
+layout(binding = 4, r32f) uniform image3D hd_i_phi2;
+layout(std430, binding = 2) buffer hd_b_img { float img[]; };
+layout(binding = 5, r32f) uniform readonly image3D hd_i_lv;
+layout(binding = 6, r32f) uniform image3D hd_i_lv2;
+layout(location = 0) uniform ivec4 hd_pc;
+#define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
+#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))
+#define HD_GET1(buf, i) buf[(i)]
+#define HD_SET1(buf, i, v) buf[(i)] = (v)

@@ -1,0 +1,894 @@
+/* hd_gl.h - the OpenGL 4.3 compute backend: the shared kernels (backends/kernels/) as GLSL 4.30
+   compute shaders, embedded as strings (backends/hd_glsl_embedded.h, from scripts/embed-glsl)
+   and compiled by the driver at run time, each stage on its first use. Defines the same hd__be_*
+   functions, with the same contracts, as the CPU reference.
+
+   Whose context: with desc.gl.use_current_context the caller's GL context, current on the
+   calling thread at hd_create and at every later call on the hd context; otherwise a headless
+   context of the backend's own through EGL (the surfaceless platform, EGL_MESA_platform_
+   surfaceless, else the first EGL_EXT_platform_device device, else the default display), the
+   OpenGL API, 4.5 core, else 4.3 core. The own context is made current for each call and the
+   context that was current before is made current again afterwards (none before: the backend's
+   stays current, to save the switch on the next call). The EGL display is initialised and never
+   terminated (EGL displays are not reference counted: terminating it would break other users).
+   Functions are loaded through desc.gl.get_proc_address (glfwGetProcAddress, SDL_GL_
+   GetProcAddress, ...), else eglGetProcAddress; the library links -lEGL only.
+
+   Host state: every call restores what it touched: the program, uniform block binding 0, storage
+   buffer bindings 0..2, image units 0..6, the generic buffer bindings (uniform, storage, copy
+   read/write, pixel pack/unpack), the active texture and the 2D/3D texture bindings of unit 0,
+   and the pixel pack/unpack parameters (tests/gl/test_gl.c checks it).
+
+   Resources (docs/DESIGN-GL.md has the measurements): the grids (volume, sigma_t, E, phi, phi2,
+   CD's light volumes) are GL_R32F 3D textures used as r32f images (channels stacked along z);
+   the TF, majorant grid and image accumulation are storage buffers; the parameter block a
+   uniform buffer rewritten when it changes; hd_pc a plain uniform. Jacobi's phi2 and CD's spare
+   swap names with phi / the light's volume, as the CPU backend swaps pointers.
+
+   Errors: a shader that fails to compile or link is HD_ERROR_BACKEND with the driver's info log
+   (source-string numbers in it name the files listed in hd_glsl_embedded.h); a GL error after a
+   stage is HD_ERROR_BACKEND naming the stage (OUT_OF_MEMORY: HD_ERROR_OUT_OF_DEVICE_MEMORY).
+   Errors already pending when a call starts are not ours: they are logged (info) and cleared.
+   Debug builds (no NDEBUG) with the own context create a debug context and pass KHR_debug
+   messages above notification severity to the logger (warning; type ERROR as error). The
+   caller's context keeps its own debug callback.
+
+   Output without a CPU round trip: hd_gl_render_to_texture() writes the sRGB-encoded image into
+   the caller's GL_RGBA8 2D texture (hybriddiff.h). */
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/glcorearb.h>
+#include "hd_glsl_embedded.h"
+
+#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
+#define HD__BE_HAS_PT 1 /* hd__be_path */
+
+/* ---- function table: every GL function through the loader ------------------------------- */
+#define HD__GL_FNS(X) \
+    X(GETERROR, GetError) X(GETINTEGERV, GetIntegerv) X(GETINTEGERI_V, GetIntegeri_v) \
+    X(GETINTEGER64I_V, GetInteger64i_v) X(GETSTRING, GetString) X(FINISH, Finish) X(ENABLE, Enable) \
+    X(CREATESHADER, CreateShader) X(SHADERSOURCE, ShaderSource) X(COMPILESHADER, CompileShader) \
+    X(GETSHADERIV, GetShaderiv) X(GETSHADERINFOLOG, GetShaderInfoLog) X(DELETESHADER, DeleteShader) \
+    X(CREATEPROGRAM, CreateProgram) X(ATTACHSHADER, AttachShader) X(LINKPROGRAM, LinkProgram) \
+    X(GETPROGRAMIV, GetProgramiv) X(GETPROGRAMINFOLOG, GetProgramInfoLog) X(DELETEPROGRAM, DeleteProgram) \
+    X(USEPROGRAM, UseProgram) X(UNIFORM4I, Uniform4i) X(UNIFORM1F, Uniform1f) \
+    X(DISPATCHCOMPUTE, DispatchCompute) X(MEMORYBARRIER, MemoryBarrier) \
+    X(GENBUFFERS, GenBuffers) X(DELETEBUFFERS, DeleteBuffers) X(BINDBUFFER, BindBuffer) \
+    X(BUFFERDATA, BufferData) X(BUFFERSUBDATA, BufferSubData) X(GETBUFFERSUBDATA, GetBufferSubData) \
+    X(BINDBUFFERBASE, BindBufferBase) X(BINDBUFFERRANGE, BindBufferRange) X(CLEARBUFFERDATA, ClearBufferData) \
+    X(GENTEXTURES, GenTextures) X(DELETETEXTURES, DeleteTextures) X(BINDTEXTURE, BindTexture) \
+    X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
+    X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
+    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei)
+/* optional: GL 4.4 / ARB_clear_texture, KHR_debug */
+#define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
+    X(DEBUGMESSAGECONTROL, DebugMessageControl)
+
+typedef struct hd__gl_fns {
+#define HD__GL_FN(up, name) PFNGL##up##PROC name;
+    HD__GL_FNS(HD__GL_FN) HD__GL_OPT_FNS(HD__GL_FN)
+#undef HD__GL_FN
+} hd__gl_fns;
+
+enum { HD__GL_CLASSIFY, HD__GL_DIRECT, HD__GL_DIFFUSE, HD__GL_PROJECT, HD__GL_CONVECT, HD__GL_SUM_LIGHT,
+       HD__GL_PATH, HD__GL_TO_TEXTURE, HD__GL_PROGRAM_COUNT };
+static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
+    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "render_to_texture"};
+#define HD__GL_LOCAL_X 64 /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
+#define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
+#define HD__GL_SSBOS 3       /* storage buffers 0..2 */
+
+typedef struct hd__gl_tex {
+    GLuint name;
+    int extent[3];
+} hd__gl_tex;
+
+/* The host state a call may touch (saved on entry, restored on exit). */
+typedef struct hd__gl_state {
+    EGLDisplay egl_dpy;
+    EGLSurface egl_draw, egl_read;
+    EGLContext egl_ctx;
+    int switched;
+    GLint program, active_texture, tex2d, tex3d;
+    GLint ubo0, ssbo[HD__GL_SSBOS];
+    GLint64 ubo0_start, ubo0_size, ssbo_start[HD__GL_SSBOS], ssbo_size[HD__GL_SSBOS];
+    GLint image[HD__GL_IMAGE_UNITS][6];
+    GLint generic[6];
+    GLint pixel[16];
+} hd__gl_state;
+
+struct hd__backend {
+    hd__ctx *ctx;
+    hd__gl_fns gl;
+    void *(*gpa)(const char *);
+    int own;                    /* 1: the EGL context is the backend's */
+    EGLDisplay dpy;
+    EGLContext egl;
+    int version;                /* major * 10 + minor */
+    int depth;                  /* nesting of hd__gl_enter */
+    hd__gl_state saved;
+    GLuint programs[HD__GL_PROGRAM_COUNT];
+    GLuint params;              /* uniform buffer of hd__kparams */
+    hd__kparams params_kp;      /* what it holds */
+    int params_valid;
+    GLuint tf, maj, img, dummy_buffer;
+    hd__gl_tex vol, sig, E, phi, phi2, dummy;
+    hd__gl_tex *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
+    int nlv;
+    size_t illum_floats, img_floats, tf_bytes;
+    GLint max_3d, max_ssbo_block;
+};
+
+static const char *hd__be_name(void) { return "gl"; }
+
+/* ---- loading --------------------------------------------------------------------------------- */
+typedef void (*hd__gl_proc)(void);
+static hd__gl_proc hd__gl_load(hd__backend *be, const char *name)
+{
+    hd__gl_proc f = NULL;
+    if (be->gpa) {
+        void *p = be->gpa(name);
+        memcpy(&f, &p, sizeof f); /* void* -> function pointer: a cast is not ISO C */
+    } else {
+        f = (hd__gl_proc)eglGetProcAddress(name);
+    }
+    return f;
+}
+
+static hd_result hd__gl_load_fns(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+#define HD__GL_LOAD(up, name) \
+    be->gl.name = (PFNGL##up##PROC)hd__gl_load(be, "gl" #name); \
+    if (!be->gl.name) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: cannot load gl" #name);
+    HD__GL_FNS(HD__GL_LOAD)
+#undef HD__GL_LOAD
+#define HD__GL_LOAD_OPT(up, name) be->gl.name = (PFNGL##up##PROC)hd__gl_load(be, "gl" #name);
+    HD__GL_OPT_FNS(HD__GL_LOAD_OPT)
+#undef HD__GL_LOAD_OPT
+    return HD_SUCCESS;
+}
+
+/* ---- errors ------------------------------------------------------------------------------------ */
+static const char *hd__gl_error_name(GLenum e)
+{
+    switch (e) {
+    case GL_INVALID_ENUM: return "GL_INVALID_ENUM";
+    case GL_INVALID_VALUE: return "GL_INVALID_VALUE";
+    case GL_INVALID_OPERATION: return "GL_INVALID_OPERATION";
+    case GL_INVALID_FRAMEBUFFER_OPERATION: return "GL_INVALID_FRAMEBUFFER_OPERATION";
+    case GL_OUT_OF_MEMORY: return "GL_OUT_OF_MEMORY";
+    case GL_STACK_OVERFLOW: return "GL_STACK_OVERFLOW";
+    case GL_STACK_UNDERFLOW: return "GL_STACK_UNDERFLOW";
+    default: return "unknown GL error";
+    }
+}
+
+/* The GL errors raised since the last check, as one hd_result (logged with what failed). */
+static hd_result hd__gl_check(hd__ctx *ctx, const char *what, int line)
+{
+    hd__backend *be = ctx->be;
+    hd_result r = HD_SUCCESS;
+    GLenum e;
+    int n = 0;
+    while ((e = be->gl.GetError()) != GL_NO_ERROR && n++ < 16) {
+        hd_result c = e == GL_OUT_OF_MEMORY ? HD_ERROR_OUT_OF_DEVICE_MEMORY : HD_ERROR_BACKEND;
+        hd__logf(&ctx->log, HD_LOG_ERROR, c, __FILE__, line, "gl: %s after %s (0x%04x)", hd__gl_error_name(e), what, (unsigned)e);
+        if (r == HD_SUCCESS) r = c;
+    }
+    return r;
+}
+#define HD__GL_CHECK(ctx, what) \
+    do { hd_result hd__r = hd__gl_check((ctx), (what), __LINE__); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
+
+#ifndef NDEBUG
+static void APIENTRY hd__gl_debug(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
+                                    const GLchar *message, const void *user)
+{
+    const hd__ctx *ctx = (const hd__ctx *)user;
+    (void)source; (void)length; (void)severity;
+    hd__logf(&ctx->log, type == GL_DEBUG_TYPE_ERROR ? HD_LOG_ERROR : HD_LOG_WARNING, HD_SUCCESS, __FILE__, __LINE__,
+             "gl debug (id %u): %s", (unsigned)id, message);
+}
+#endif
+
+/* ---- the host's state: saved on entry, restored on exit ---------------------------------- */
+static const GLenum hd__gl_generic_targets[6][2] = {
+    {GL_UNIFORM_BUFFER, GL_UNIFORM_BUFFER_BINDING}, {GL_SHADER_STORAGE_BUFFER, GL_SHADER_STORAGE_BUFFER_BINDING},
+    {GL_COPY_READ_BUFFER, GL_COPY_READ_BUFFER_BINDING}, {GL_COPY_WRITE_BUFFER, GL_COPY_WRITE_BUFFER_BINDING},
+    {GL_PIXEL_PACK_BUFFER, GL_PIXEL_PACK_BUFFER_BINDING}, {GL_PIXEL_UNPACK_BUFFER, GL_PIXEL_UNPACK_BUFFER_BINDING}};
+static const GLenum hd__gl_pixel_params[16] = {
+    GL_PACK_ALIGNMENT, GL_PACK_ROW_LENGTH, GL_PACK_IMAGE_HEIGHT, GL_PACK_SKIP_PIXELS, GL_PACK_SKIP_ROWS,
+    GL_PACK_SKIP_IMAGES, GL_PACK_SWAP_BYTES, GL_PACK_LSB_FIRST, GL_UNPACK_ALIGNMENT, GL_UNPACK_ROW_LENGTH,
+    GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_PIXELS, GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_IMAGES,
+    GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST};
+static const GLenum hd__gl_image_queries[6] = {GL_IMAGE_BINDING_NAME, GL_IMAGE_BINDING_LEVEL, GL_IMAGE_BINDING_LAYERED,
+                                               GL_IMAGE_BINDING_LAYER, GL_IMAGE_BINDING_ACCESS, GL_IMAGE_BINDING_FORMAT};
+
+static void hd__gl_restore_indexed(hd__backend *be, GLenum target, GLuint index, GLint name, GLint64 start, GLint64 size)
+{
+    if (name != 0 && size > 0) be->gl.BindBufferRange(target, index, (GLuint)name, (GLintptr)start, (GLsizeiptr)size);
+    else be->gl.BindBufferBase(target, index, (GLuint)name);
+}
+
+/* Makes the context current (own context) and saves the host's bindings. Nested calls (a stage
+   inside hd_gl_render_to_texture's prepare) save once. Pending GL errors are not ours. */
+static hd_result hd__gl_enter(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_state *s = &be->saved;
+    GLenum e;
+    int i, j;
+    if (be->depth++ > 0) return HD_SUCCESS;
+    s->switched = 0;
+    if (be->own && eglGetCurrentContext() != be->egl) {
+        s->egl_dpy = eglGetCurrentDisplay();
+        s->egl_draw = eglGetCurrentSurface(EGL_DRAW);
+        s->egl_read = eglGetCurrentSurface(EGL_READ);
+        s->egl_ctx = eglGetCurrentContext();
+        if (!eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, be->egl)) {
+            be->depth--;
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)eglGetError());
+        }
+        s->switched = 1;
+    }
+    while ((e = be->gl.GetError()) != GL_NO_ERROR)
+        HD__INFO(&ctx->log, "gl: %s was pending before this call (not hybriddiff's; cleared)", hd__gl_error_name(e));
+    be->gl.GetIntegerv(GL_CURRENT_PROGRAM, &s->program);
+    be->gl.GetIntegerv(GL_ACTIVE_TEXTURE, &s->active_texture);
+    be->gl.ActiveTexture(GL_TEXTURE0);
+    be->gl.GetIntegerv(GL_TEXTURE_BINDING_2D, &s->tex2d);
+    be->gl.GetIntegerv(GL_TEXTURE_BINDING_3D, &s->tex3d);
+    be->gl.GetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, 0, &s->ubo0);
+    be->gl.GetInteger64i_v(GL_UNIFORM_BUFFER_START, 0, &s->ubo0_start);
+    be->gl.GetInteger64i_v(GL_UNIFORM_BUFFER_SIZE, 0, &s->ubo0_size);
+    for (i = 0; i < HD__GL_SSBOS; ++i) {
+        be->gl.GetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, (GLuint)i, &s->ssbo[i]);
+        be->gl.GetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, (GLuint)i, &s->ssbo_start[i]);
+        be->gl.GetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, (GLuint)i, &s->ssbo_size[i]);
+    }
+    for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
+        for (j = 0; j < 6; ++j) be->gl.GetIntegeri_v(hd__gl_image_queries[j], (GLuint)i, &s->image[i][j]);
+    for (i = 0; i < 6; ++i) be->gl.GetIntegerv(hd__gl_generic_targets[i][1], &s->generic[i]);
+    for (i = 0; i < 16; ++i) be->gl.GetIntegerv(hd__gl_pixel_params[i], &s->pixel[i]);
+    /* what the backend's transfers assume */
+    be->gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    be->gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    for (i = 0; i < 16; ++i) be->gl.PixelStorei(hd__gl_pixel_params[i], (i & 7) == 0 ? 4 : 0);
+    return HD_SUCCESS;
+}
+
+/* Restores what hd__gl_enter saved; r is the result of the call, returned unless the restore
+   itself raised a GL error. */
+static hd_result hd__gl_leave(hd__ctx *ctx, hd_result r)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_state *s = &be->saved;
+    hd_result r2;
+    int i;
+    if (--be->depth > 0) return r;
+    r2 = hd__gl_check(ctx, "the stage", __LINE__); /* errors of this call not caught yet */
+    if (r == HD_SUCCESS) r = r2;
+    be->gl.UseProgram((GLuint)s->program);
+    hd__gl_restore_indexed(be, GL_UNIFORM_BUFFER, 0, s->ubo0, s->ubo0_start, s->ubo0_size);
+    for (i = 0; i < HD__GL_SSBOS; ++i)
+        hd__gl_restore_indexed(be, GL_SHADER_STORAGE_BUFFER, (GLuint)i, s->ssbo[i], s->ssbo_start[i], s->ssbo_size[i]);
+    for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
+        be->gl.BindImageTexture((GLuint)i, (GLuint)s->image[i][0], s->image[i][1], (GLboolean)s->image[i][2], s->image[i][3],
+                                (GLenum)s->image[i][4], (GLenum)s->image[i][5]);
+    /* after the indexed ones: glBindBufferBase sets the generic binding too */
+    for (i = 0; i < 6; ++i) be->gl.BindBuffer(hd__gl_generic_targets[i][0], (GLuint)s->generic[i]);
+    for (i = 0; i < 16; ++i) be->gl.PixelStorei(hd__gl_pixel_params[i], s->pixel[i]);
+    be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)s->tex2d);
+    be->gl.BindTexture(GL_TEXTURE_3D, (GLuint)s->tex3d);
+    be->gl.ActiveTexture((GLenum)s->active_texture);
+    r2 = hd__gl_check(ctx, "restoring the host's state", __LINE__);
+    if (r == HD_SUCCESS) r = r2;
+    if (s->switched && s->egl_ctx != EGL_NO_CONTEXT)
+        eglMakeCurrent(s->egl_dpy, s->egl_draw, s->egl_read, s->egl_ctx);
+    return r;
+}
+
+/* ---- programs ---------------------------------------------------------------------------------- */
+static const char *const hd__gl_to_texture_src =
+    "#version 430 core\n"
+    "layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;\n"
+    "layout(std430, binding = 2) readonly buffer hd_b_img { float img[]; };\n"
+    "layout(binding = 0, rgba8) uniform writeonly image2D hd_o;\n"
+    "layout(location = 0) uniform ivec4 hd_pc; /* x = width, y = height */\n"
+    "layout(location = 1) uniform float hd_exposure;\n"
+    "float hd_srgb(float v) {\n"
+    "    if (!(v > 0.0)) return 0.0;\n"
+    "    if (v >= 1.0) return 1.0;\n"
+    "    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;\n"
+    "}\n"
+    "void main() {\n"
+    "    ivec2 p = ivec2(gl_GlobalInvocationID.xy);\n"
+    "    if (p.x >= hd_pc.x || p.y >= hd_pc.y) return;\n"
+    "    int i = 4 * (p.y * hd_pc.x + p.x);\n"
+    "    float e = hd_exposure;\n"
+    "    vec4 c = vec4(hd_srgb(img[i] * e), hd_srgb(img[i + 1] * e), hd_srgb(img[i + 2] * e), clamp(img[i + 3], 0.0, 1.0));\n"
+    "    imageStore(hd_o, ivec2(p.x, hd_pc.y - 1 - p.y), c); /* GL rows: bottom first */\n"
+    "}\n";
+
+/* Compiles and links one program (on its first use). */
+static hd_result hd__gl_program(hd__ctx *ctx, int p)
+{
+    hd__backend *be = ctx->be;
+    const char *src[1 + HD__GL_SOURCE_LINES];
+    char prefix[256], log[4096];
+    GLuint sh, prog;
+    GLint ok = 0;
+    GLsizei n = 0;
+    size_t i;
+    if (be->programs[p]) return HD_SUCCESS;
+    if (p == HD__GL_TO_TEXTURE) {
+        src[0] = hd__gl_to_texture_src;
+        n = 1;
+    } else {
+        snprintf(prefix, sizeof prefix,
+                 "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
+                 "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
+                 HD_MAX_LIGHTS, p + 1, HD__GL_LOCAL_X);
+        src[0] = prefix;
+        for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
+        n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
+    }
+    sh = be->gl.CreateShader(GL_COMPUTE_SHADER);
+    if (!sh) return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: glCreateShader(GL_COMPUTE_SHADER) failed");
+    be->gl.ShaderSource(sh, n, src, NULL);
+    be->gl.CompileShader(sh);
+    be->gl.GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        log[0] = '\0';
+        be->gl.GetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
+        be->gl.DeleteShader(sh);
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s shader does not compile (source-string numbers: "
+                       "backends/hd_glsl_embedded.h):\n%s", hd__gl_stage_names[p], log);
+    }
+    prog = be->gl.CreateProgram();
+    be->gl.AttachShader(prog, sh);
+    be->gl.LinkProgram(prog);
+    be->gl.DeleteShader(sh);
+    be->gl.GetProgramiv(prog, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        log[0] = '\0';
+        be->gl.GetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
+        be->gl.DeleteProgram(prog);
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", hd__gl_stage_names[p], log);
+    }
+    be->programs[p] = prog;
+    HD__GL_CHECK(ctx, "building a program");
+    return HD_SUCCESS;
+}
+
+/* ---- resources ----------------------------------------------------------------------------------- */
+static void hd__gl_free_tex(hd__backend *be, hd__gl_tex *t)
+{
+    if (t->name) be->gl.DeleteTextures(1, &t->name);
+    memset(t, 0, sizeof *t);
+}
+
+static void hd__gl_free_buffer(hd__backend *be, GLuint *b)
+{
+    if (*b) be->gl.DeleteBuffers(1, b);
+    *b = 0;
+}
+
+/* A w x h x d GL_R32F 3D texture, zeroed (or filled from src). */
+static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, const float *src, const char *what)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    hd__gl_free_tex(be, t);
+    if (w > be->max_3d || h > be->max_3d || d > be->max_3d)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: %s needs a %dx%dx%d 3D texture, above GL_MAX_3D_TEXTURE_SIZE = %d",
+                       what, w, h, d, be->max_3d);
+    be->gl.GenTextures(1, &t->name);
+    be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    be->gl.TexStorage3D(GL_TEXTURE_3D, 1, GL_R32F, w, h, d);
+    t->extent[0] = w; t->extent[1] = h; t->extent[2] = d;
+    if ((r = hd__gl_check(ctx, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
+    if (src) be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, src);
+    else if (be->gl.ClearTexImage && be->version >= 44) be->gl.ClearTexImage(t->name, 0, GL_RED, GL_FLOAT, NULL);
+    else {
+        float *zero = (float *)hd__calloc(ctx, (size_t)w * h * d, sizeof(float));
+        if (!zero) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to clear %s", what);
+        be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, zero);
+        hd__free(ctx, zero);
+    }
+    if ((r = hd__gl_check(ctx, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
+    return HD_SUCCESS;
+}
+
+static hd_result hd__gl_tex_zero(hd__ctx *ctx, hd__gl_tex *t)
+{
+    if (!t->name) return HD_SUCCESS;
+    return hd__gl_tex_new(ctx, t, t->extent[0], t->extent[1], t->extent[2], NULL, "clearing an illumination grid");
+}
+
+static hd_result hd__gl_buffer_data(hd__ctx *ctx, GLuint *b, size_t bytes, const void *src, GLenum usage, const char *what)
+{
+    hd__backend *be = ctx->be;
+    if (!*b) be->gl.GenBuffers(1, b);
+    be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, *b);
+    be->gl.BufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(bytes ? bytes : 16), src, usage);
+    return hd__gl_check(ctx, what, __LINE__);
+}
+
+/* Binds every resource to its unit (placeholders for the absent ones) and the program. */
+static void hd__gl_bind_image(hd__backend *be, GLuint unit, const hd__gl_tex *t, GLenum access)
+{
+    const hd__gl_tex *u = t && t->name ? t : &be->dummy;
+    be->gl.BindImageTexture(unit, u->name, 0, GL_TRUE, 0, access, GL_R32F);
+}
+
+static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
+                                 int pc_w)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    const hd__gl_tex *lv = be->lv && light < be->nlv ? &be->lv[light] : NULL;
+    const hd__gl_tex *lv2 = be->lv ? &be->lv[be->nlv] : NULL;
+    if ((r = hd__gl_program(ctx, p)) != HD_SUCCESS) return r;
+    if (!be->params_valid || memcmp(&be->params_kp, &ctx->kp, sizeof ctx->kp) != 0) {
+        be->gl.BindBuffer(GL_UNIFORM_BUFFER, be->params);
+        be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof ctx->kp, &ctx->kp, GL_STREAM_DRAW);
+        be->params_kp = ctx->kp;
+        be->params_valid = 1;
+    }
+    be->gl.UseProgram(be->programs[p]);
+    be->gl.Uniform4i(0, pc_x, pc_y, pc_z, pc_w);
+    be->gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, be->params);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->tf ? be->tf : be->dummy_buffer);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->maj ? be->maj : be->dummy_buffer);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
+    hd__gl_bind_image(be, 0, &be->vol, GL_READ_ONLY);
+    hd__gl_bind_image(be, 1, &be->sig, GL_READ_WRITE);
+    hd__gl_bind_image(be, 2, &be->E, GL_READ_WRITE);
+    hd__gl_bind_image(be, 3, &be->phi, GL_READ_WRITE);
+    hd__gl_bind_image(be, 4, &be->phi2, GL_READ_WRITE);
+    hd__gl_bind_image(be, 5, lv, GL_READ_ONLY);
+    hd__gl_bind_image(be, 6, lv2, GL_READ_WRITE);
+    be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
+    be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
+    return hd__gl_check(ctx, hd__gl_stage_names[p], __LINE__);
+}
+
+/* Runs one stage between hd__gl_enter and hd__gl_leave. */
+#define HD__GL_STAGE(ctx, body) \
+    do { hd_result hd__r = hd__gl_enter(ctx); \
+         if (hd__r != HD_SUCCESS) return hd__r; \
+         hd__r = (body); \
+         return hd__gl_leave((ctx), hd__r); } while (0)
+
+/* ---- the context --------------------------------------------------------------------------------- */
+static int hd__gl_has_ext(const char *list, const char *name)
+{
+    size_t n = strlen(name);
+    const char *p = list;
+    while (p && (p = strstr(p, name)) != NULL) {
+        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return 1;
+        p += n;
+    }
+    return 0;
+}
+
+/* A headless display: surfaceless, else the first EGL device, else the default display. */
+static hd_result hd__gl_egl_display(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    const char *cext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display =
+        (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLint major = 0, minor = 0;
+    const char *how = "the default display";
+    be->dpy = EGL_NO_DISPLAY;
+    if (cext && get_platform_display && hd__gl_has_ext(cext, "EGL_MESA_platform_surfaceless")) {
+        be->dpy = get_platform_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+        how = "EGL_MESA_platform_surfaceless";
+        if (be->dpy != EGL_NO_DISPLAY && !eglInitialize(be->dpy, &major, &minor)) be->dpy = EGL_NO_DISPLAY;
+    }
+    if (be->dpy == EGL_NO_DISPLAY && cext && get_platform_display && hd__gl_has_ext(cext, "EGL_EXT_platform_device")) {
+        PFNEGLQUERYDEVICESEXTPROC query_devices = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
+        EGLDeviceEXT devices[8];
+        EGLint count = 0, i;
+        if (query_devices && query_devices(8, devices, &count))
+            for (i = 0; i < count && be->dpy == EGL_NO_DISPLAY; ++i) {
+                be->dpy = get_platform_display(EGL_PLATFORM_DEVICE_EXT, devices[i], NULL);
+                how = "EGL_EXT_platform_device";
+                if (be->dpy != EGL_NO_DISPLAY && !eglInitialize(be->dpy, &major, &minor)) be->dpy = EGL_NO_DISPLAY;
+            }
+    }
+    if (be->dpy == EGL_NO_DISPLAY) {
+        be->dpy = eglGetDisplay(EGL_DEFAULT_DISPLAY);
+        how = "the default display";
+        if (be->dpy != EGL_NO_DISPLAY && !eglInitialize(be->dpy, &major, &minor)) be->dpy = EGL_NO_DISPLAY;
+    }
+    if (be->dpy == EGL_NO_DISPLAY)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no EGL display (surfaceless, device or default): 0x%04x",
+                       (unsigned)eglGetError());
+    HD__INFO(&ctx->log, "gl: EGL %d.%d through %s (%s)", (int)major, (int)minor, how, eglQueryString(be->dpy, EGL_VENDOR));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__gl_egl_context(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    static const EGLint config_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
+    static const int versions[2][2] = {{4, 5}, {4, 3}};
+    EGLConfig config = NULL;
+    EGLint nconfig = 0;
+    int v;
+    hd_result r;
+    if ((r = hd__gl_egl_display(ctx)) != HD_SUCCESS) return r;
+    if (!eglBindAPI(EGL_OPENGL_API))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglBindAPI(EGL_OPENGL_API) failed: 0x%04x", (unsigned)eglGetError());
+    if (!eglChooseConfig(be->dpy, config_attrs, &config, 1, &nconfig) || nconfig < 1) {
+        if (!hd__gl_has_ext(eglQueryString(be->dpy, EGL_EXTENSIONS), "EGL_KHR_no_config_context"))
+            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no EGL config with EGL_OPENGL_BIT and no EGL_KHR_no_config_context");
+        config = (EGLConfig)0; /* EGL_NO_CONFIG_KHR */
+    }
+    for (v = 0; v < 2 && !be->egl; ++v) {
+        EGLint attrs[16], n = 0;
+        attrs[n++] = EGL_CONTEXT_MAJOR_VERSION; attrs[n++] = versions[v][0];
+        attrs[n++] = EGL_CONTEXT_MINOR_VERSION; attrs[n++] = versions[v][1];
+        attrs[n++] = EGL_CONTEXT_OPENGL_PROFILE_MASK; attrs[n++] = EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT;
+#ifndef NDEBUG
+        attrs[n++] = EGL_CONTEXT_OPENGL_DEBUG; attrs[n++] = EGL_TRUE;
+#endif
+        attrs[n++] = EGL_NONE;
+        be->egl = eglCreateContext(be->dpy, config, EGL_NO_CONTEXT, attrs);
+        if (be->egl == EGL_NO_CONTEXT) be->egl = NULL;
+    }
+    if (!be->egl)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglCreateContext: no OpenGL 4.5 or 4.3 core context (0x%04x)",
+                       (unsigned)eglGetError());
+    return HD_SUCCESS;
+}
+
+static void hd__gl_free_lights(hd__backend *be)
+{
+    int l;
+    if (be->lv)
+        for (l = 0; l <= be->nlv; ++l) hd__gl_free_tex(be, &be->lv[l]);
+    hd__free(be->ctx, be->lv);
+    be->lv = NULL;
+    be->nlv = 0;
+}
+
+static void hd__be_destroy(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int i;
+    if (!be) return;
+    if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__gl_enter(ctx) == HD_SUCCESS) {
+        for (i = 0; i < HD__GL_PROGRAM_COUNT; ++i)
+            if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
+        hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
+        hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
+        hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
+        hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2); hd__gl_free_tex(be, &be->dummy);
+        hd__gl_free_lights(be);
+        hd__gl_leave(ctx, HD_SUCCESS);
+    }
+    hd__free(ctx, be->lv);
+    if (be->own && be->egl) {
+        if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        eglDestroyContext(be->dpy, be->egl);
+    }
+    hd__free(ctx, be);
+    ctx->be = NULL;
+}
+
+static hd_result hd__gl_setup(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    GLint major = 0, minor = 0, units = 0, ssbos = 0;
+    hd_result r;
+    be->gl.GetIntegerv(GL_MAJOR_VERSION, &major);
+    be->gl.GetIntegerv(GL_MINOR_VERSION, &minor);
+    be->version = major * 10 + minor;
+    HD__INFO(&ctx->log, "gl: %s, %s (%s context)", (const char *)be->gl.GetString(GL_RENDERER),
+             (const char *)be->gl.GetString(GL_VERSION), be->own ? "own EGL" : "the caller's");
+    if (be->version < 43)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
+    be->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &be->max_3d);
+    be->gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &be->max_ssbo_block);
+    be->gl.GetIntegerv(GL_MAX_IMAGE_UNITS, &units);
+    be->gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &ssbos);
+    if (units < HD__GL_IMAGE_UNITS || ssbos < HD__GL_SSBOS)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: %d image units and %d storage buffer bindings; %d and %d needed",
+                       (int)units, (int)ssbos, HD__GL_IMAGE_UNITS, HD__GL_SSBOS);
+#ifndef NDEBUG
+    if (be->own && be->gl.DebugMessageCallback && be->gl.DebugMessageControl) {
+        be->gl.Enable(GL_DEBUG_OUTPUT);
+        be->gl.DebugMessageCallback(hd__gl_debug, ctx);
+        be->gl.DebugMessageControl(GL_DONT_CARE, GL_DONT_CARE, GL_DEBUG_SEVERITY_NOTIFICATION, 0, NULL, GL_FALSE);
+    }
+#endif
+    be->gl.GenBuffers(1, &be->params);
+    if ((r = hd__gl_buffer_data(ctx, &be->dummy_buffer, 16, NULL, GL_STATIC_DRAW, "a placeholder buffer")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(ctx, &be->dummy, 1, 1, 1, NULL, "a placeholder image")) != HD_SUCCESS) return r;
+    return hd__gl_tex_new(ctx, &be->vol, ctx->dims[0], ctx->dims[1], ctx->dims[2], ctx->vol, "the volume");
+}
+
+static hd_result hd__be_create(hd__ctx *ctx)
+{
+    hd__backend *be;
+    hd_result r;
+    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
+    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the backend");
+    ctx->be = be;
+    be->ctx = ctx;
+    be->gpa = ctx->desc.gl.get_proc_address;
+    be->own = !ctx->desc.gl.use_current_context;
+    if (be->own) {
+        if ((r = hd__gl_egl_context(ctx)) != HD_SUCCESS) return r;
+        if (!eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, be->egl))
+            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglMakeCurrent(surfaceless) failed: 0x%04x", (unsigned)eglGetError());
+    } else if (!be->gpa && eglGetCurrentContext() == EGL_NO_CONTEXT) {
+        HD__INFO(&ctx->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
+    }
+    if ((r = hd__gl_load_fns(ctx)) != HD_SUCCESS) {
+        be->gl.GetError = NULL; /* hd__be_destroy must not call into GL */
+        return r;
+    }
+    if (!be->gl.GetString(GL_VERSION)) {
+        be->gl.GetError = NULL;
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no GL context is current (use_current_context = %d)",
+                       ctx->desc.gl.use_current_context);
+    }
+    HD__GL_STAGE(ctx, hd__gl_setup(ctx));
+}
+
+/* ---- inputs and allocations ---------------------------------------------------------------------- */
+static hd_result hd__gl_upload_inputs(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    if ((r = hd__gl_buffer_data(ctx, &be->tf, (size_t)ctx->tf_count * 4 * sizeof(float), ctx->tf, GL_DYNAMIC_DRAW,
+                                "uploading the transfer function")) != HD_SUCCESS)
+        return r;
+    return hd__gl_buffer_data(ctx, &be->maj, ncell * sizeof(float), ctx->majorant, GL_DYNAMIC_DRAW, "uploading the majorant grid");
+}
+static hd_result hd__be_upload_inputs(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_upload_inputs(ctx)); }
+
+static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
+{
+    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
+             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int *g = ctx->gdims;
+    hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
+    hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
+    be->illum_floats = 0;
+    if (illum_floats == 0) return HD_SUCCESS;
+    if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2], NULL, "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, NULL, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, NULL, "phi")) != HD_SUCCESS) return r;
+    be->illum_floats = illum_floats;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+{
+    HD__GL_STAGE(ctx, hd__gl_alloc_illumination(ctx, illum_floats));
+}
+
+static hd_result hd__gl_alloc_jacobi(hd__ctx *ctx, int enable)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_free_tex(be, &be->phi2);
+    if (!enable || be->illum_floats == 0) return HD_SUCCESS;
+    return hd__gl_tex_new(ctx, &be->phi2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, NULL, "Jacobi's buffer");
+}
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gl_alloc_jacobi(ctx, enable)); }
+
+static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height)
+{
+    hd__backend *be = ctx->be;
+    size_t bytes = (size_t)width * height * 4 * sizeof(float);
+    hd_result r;
+    hd__gl_free_buffer(be, &be->img);
+    be->img_floats = 0;
+    if (bytes > (size_t)be->max_ssbo_block)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
+                       width, height, bytes, (int)be->max_ssbo_block);
+    if ((r = hd__gl_buffer_data(ctx, &be->img, bytes, NULL, GL_DYNAMIC_COPY, "the image")) != HD_SUCCESS) return r;
+    be->img_floats = (size_t)width * height * 4;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+{
+    HD__GL_STAGE(ctx, hd__gl_alloc_image(ctx, width, height));
+}
+
+static hd_result hd__gl_clear(hd__ctx *ctx, unsigned what)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    if ((what & HD__DIRTY_DIRECT) && (r = hd__gl_tex_zero(ctx, &be->E)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi2)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_IMAGE) && be->img) {
+        be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->img);
+        be->gl.ClearBufferData(GL_COPY_WRITE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, NULL);
+    }
+    return hd__gl_check(ctx, "clearing", __LINE__);
+}
+static hd_result hd__be_clear(hd__ctx *ctx, unsigned what) { HD__GL_STAGE(ctx, hd__gl_clear(ctx, what)); }
+
+/* ---- stages ------------------------------------------------------------------------------------ */
+static hd_result hd__be_classify(hd__ctx *ctx)
+{
+    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
+}
+
+static hd_result hd__be_direct(hd__ctx *ctx)
+{
+    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
+}
+
+/* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
+   Jacobi pass phi -> phi2 and a swap of the two names. */
+static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int nz = ctx->gdims[2] * ctx->channels, parity;
+    if (jacobi) {
+        hd__gl_tex t;
+        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
+        t = be->phi; be->phi = be->phi2; be->phi2 = t;
+        return HD_SUCCESS;
+    }
+    for (parity = 0; parity < 2; ++parity)
+        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
+            return r;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { HD__GL_STAGE(ctx, hd__gl_diffuse(ctx, jacobi)); }
+
+static hd_result hd__be_project(hd__ctx *ctx)
+{
+    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0));
+}
+
+/* ---- read-back ------------------------------------------------------------------------------- */
+static hd_result hd__gl_read_image(hd__ctx *ctx, float *dst)
+{
+    hd__backend *be = ctx->be;
+    be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
+    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float)), dst);
+    return hd__gl_check(ctx, "reading the image", __LINE__);
+}
+static hd_result hd__be_read_image(hd__ctx *ctx, float *dst) { HD__GL_STAGE(ctx, hd__gl_read_image(ctx, dst)); }
+
+static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, float *dst)
+{
+    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    ctx->be->gl.GetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, dst);
+    return hd__gl_check(ctx, "reading an illumination grid", __LINE__);
+}
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst));
+}
+
+/* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
+static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float *src)
+{
+    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED, GL_FLOAT, src);
+    return hd__gl_check(ctx, "writing an illumination grid", __LINE__);
+}
+HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+{
+    HD__GL_STAGE(ctx, hd__gl_write_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src));
+}
+static hd_result hd__gl_finish_now(hd__ctx *ctx)
+{
+    ctx->be->gl.Finish();
+    return HD_SUCCESS;
+}
+/* For src/hd_test_hooks.h: waits until the GL has done everything queued. */
+HD__MAYBE_UNUSED static hd_result hd__gl_finish(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_finish_now(ctx)); }
+
+/* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
+static hd_result hd__gl_alloc_lights(hd__ctx *ctx, int count)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int l;
+    hd__gl_free_lights(be);
+    if (count <= 0) return HD_SUCCESS;
+    be->lv = (hd__gl_tex *)hd__calloc(ctx, (size_t)count + 1, sizeof(hd__gl_tex));
+    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate %d light volume handles", count);
+    be->nlv = count;
+    for (l = 0; l <= count; ++l)
+        if ((r = hd__gl_tex_new(ctx, &be->lv[l], ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], NULL, "a CD light volume")) != HD_SUCCESS) {
+            hd__gl_free_lights(be);
+            return r;
+        }
+    return HD_SUCCESS;
+}
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { HD__GL_STAGE(ctx, hd__gl_alloc_lights(ctx, count)); }
+
+/* One convection step of light `light`: its volume -> the spare, and the two swap names. */
+static hd_result hd__gl_convect(hd__ctx *ctx, int light)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    hd__gl_tex t;
+    if ((r = hd__gl_dispatch(ctx, HD__GL_CONVECT, light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
+        return r;
+    t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_convect(hd__ctx *ctx, int light) { HD__GL_STAGE(ctx, hd__gl_convect(ctx, light)); }
+
+/* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
+static hd_result hd__gl_sum_lights(hd__ctx *ctx)
+{
+    hd_result r;
+    int l;
+    for (l = 0; l < ctx->be->nlv; ++l)
+        if ((r = hd__gl_dispatch(ctx, HD__GL_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+            return r;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_sum_lights(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_sum_lights(ctx)); }
+
+/* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
+static hd_result hd__be_path(hd__ctx *ctx)
+{
+    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0));
+}
+
+/* ---- the image into the caller's texture ---------------------------------------------------------- */
+static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
+static hd_result hd__prepare(hd__ctx *ctx);
+
+static hd_result hd__gl_to_texture(hd__ctx *ctx, GLuint texture)
+{
+    hd__backend *be = ctx->be;
+    GLint w = 0, h = 0, format = 0;
+    hd_result r;
+    be->gl.BindTexture(GL_TEXTURE_2D, texture);
+    if (be->gl.GetError() != GL_NO_ERROR)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_gl_render_to_texture: %u is not a 2D texture name", texture);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+    if (w != ctx->camera.width || h != ctx->camera.height || format != GL_RGBA8)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
+                       "hd_gl_render_to_texture: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
+                       texture, (int)w, (int)h, (unsigned)format, ctx->camera.width, ctx->camera.height);
+    if ((r = hd__gl_program(ctx, HD__GL_TO_TEXTURE)) != HD_SUCCESS) return r;
+    be->gl.UseProgram(be->programs[HD__GL_TO_TEXTURE]);
+    be->gl.Uniform4i(0, w, h, 0, 0);
+    be->gl.Uniform1f(1, ctx->params.exposure);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img);
+    be->gl.BindImageTexture(0, texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
+    be->gl.DispatchCompute((GLuint)((w + 7) / 8), (GLuint)((h + 7) / 8), 1);
+    be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
+    return hd__gl_check(ctx, "render_to_texture", __LINE__);
+}
+
+HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+{
+    hd_logger stale;
+    hd__ctx *ctx = hd__lookup(h, &stale);
+    hd_result r;
+    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
+    if (texture == 0) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_gl_render_to_texture: texture 0");
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    HD__GL_STAGE(ctx, hd__gl_to_texture(ctx, (GLuint)texture));
+}
