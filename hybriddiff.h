@@ -333,6 +333,12 @@ HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
    submits the command buffer and waits for it before the next call on this context. */
 HDDEF hd_result hd_vulkan_record(hd_context ctx, void *command_buffer, int n);
 
+/* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
+   hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must
+   be the camera's) by a compute shader, with no CPU round trip; rows bottom first, GL's order.
+   The context must be current (desc.gl.use_current_context) or share objects with the backend's. */
+HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
+
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
    types are converted to F32. */
@@ -402,9 +408,7 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
 #include "backends/hd_vulkan.h"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-/* A backend that is not written yet is an #error here, not a missing #include: the file that
-   lands it replaces the line with #include "backends/hd_gl.h". */
-#error "hybriddiff: the GL backend is not available in this version; use HYBRIDDIFF_BACKEND_CPU or HYBRIDDIFF_BACKEND_OPENCL"
+#include "backends/hd_gl.h"
 #endif
 #include "src/hd_validate.h"
 #include "src/hd_context.h"

@@ -623,6 +623,15 @@ HDDEF hd_result hd_iterate(hd_context h, int n)
     return HD_SUCCESS;
 }
 
+#if !defined(HYBRIDDIFF_BACKEND_GL)
+HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+{
+    HD__GET_CTX(ctx, h);
+    (void)texture;
+    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture: this is the %s backend", hd__be_name());
+}
+#endif
+
 #if !defined(HYBRIDDIFF_BACKEND_VULKAN)
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
