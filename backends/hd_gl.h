@@ -586,6 +586,9 @@ static hd_result hd__gl_setup(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     GLint major = 0, minor = 0, units = 0, ssbos = 0;
     hd_result r;
+    if (!be->gl.GetString(GL_VERSION))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no GL context is current (use_current_context = %d)",
+                       ctx->desc.gl.use_current_context);
     be->gl.GetIntegerv(GL_MAJOR_VERSION, &major);
     be->gl.GetIntegerv(GL_MINOR_VERSION, &minor);
     be->version = major * 10 + minor;
@@ -625,8 +628,6 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->own = !ctx->desc.gl.use_current_context;
     if (be->own) {
         if ((r = hd__gl_egl_context(ctx)) != HD_SUCCESS) return r;
-        if (!eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, be->egl))
-            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglMakeCurrent(surfaceless) failed: 0x%04x", (unsigned)eglGetError());
     } else if (!be->gpa && eglGetCurrentContext() == EGL_NO_CONTEXT) {
         HD__INFO(&ctx->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
     }
@@ -634,11 +635,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
         be->gl.GetError = NULL; /* hd__be_destroy must not call into GL */
         return r;
     }
-    if (!be->gl.GetString(GL_VERSION)) {
-        be->gl.GetError = NULL;
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no GL context is current (use_current_context = %d)",
-                       ctx->desc.gl.use_current_context);
-    }
+    /* the own context is made current by hd__gl_enter, which makes the caller's current again */
     HD__GL_STAGE(ctx, hd__gl_setup(ctx));
 }
 

@@ -1,0 +1,280 @@
+/* test_gl.c - the GL backend's own checks (make test-gl):
+   1. host state survives: a host GL context (EGL, surfaceless) with its own program, uniform and
+      storage buffer bindings (ranges), image units, active texture, 2D/3D textures, generic
+      buffer bindings and pixel store parameters; hd_create / hd_set_* / hd_iterate /
+      hd_read_image_* / hd_read_illumination / hd_gl_render_to_texture / hd_destroy on
+      (a) the caller's context (desc.gl.use_current_context) and (b) the backend's own EGL
+      context while the host's is current; every queried value is unchanged afterwards, the
+      host's context is still current and no GL error is pending;
+   2. hd_gl_render_to_texture writes the same pixels as hd_read_image_rgba8 (rows flipped: GL's
+      bottom-first order), within 1/255 (the GPU's sRGB pow and unorm rounding), every method;
+   3. a texture of the wrong size or format is refused with HD_ERROR_INVALID_PARAMETER, and the
+      other backends' hd_gl_render_to_texture is HD_ERROR_UNSUPPORTED (tests/test_core.c side:
+      the CPU build of this call is compiled in every other test program).
+   Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
+   driver's info log into HD__ERR) and KHR_debug delivery. */
+#define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
+#define HYBRIDDIFF_IMPLEMENTATION
+#define HYBRIDDIFF_BACKEND_GL
+#include "hybriddiff.h"
+#include <GL/glcorearb.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+static int failures;
+#define CHECK(cond, ...) do { if (!(cond)) { printf("FAIL %s:%d: ", __FILE__, __LINE__); printf(__VA_ARGS__); printf("\n"); ++failures; } } while (0)
+
+typedef struct host_state {
+    GLint v[128];
+    GLint64 v64[16];
+    int n, n64;
+} host_state;
+
+static void snap(host_state *s)
+{
+    static const GLenum pix[16] = {GL_PACK_ALIGNMENT, GL_PACK_ROW_LENGTH, GL_PACK_IMAGE_HEIGHT, GL_PACK_SKIP_PIXELS,
+                                   GL_PACK_SKIP_ROWS, GL_PACK_SKIP_IMAGES, GL_PACK_SWAP_BYTES, GL_PACK_LSB_FIRST,
+                                   GL_UNPACK_ALIGNMENT, GL_UNPACK_ROW_LENGTH, GL_UNPACK_IMAGE_HEIGHT, GL_UNPACK_SKIP_PIXELS,
+                                   GL_UNPACK_SKIP_ROWS, GL_UNPACK_SKIP_IMAGES, GL_UNPACK_SWAP_BYTES, GL_UNPACK_LSB_FIRST};
+    static const GLenum gen[7] = {GL_UNIFORM_BUFFER_BINDING, GL_SHADER_STORAGE_BUFFER_BINDING, GL_COPY_READ_BUFFER_BINDING,
+                                  GL_COPY_WRITE_BUFFER_BINDING, GL_PIXEL_PACK_BUFFER_BINDING, GL_PIXEL_UNPACK_BUFFER_BINDING,
+                                  GL_ARRAY_BUFFER_BINDING};
+    static const GLenum img[6] = {GL_IMAGE_BINDING_NAME, GL_IMAGE_BINDING_LEVEL, GL_IMAGE_BINDING_LAYERED,
+                                  GL_IMAGE_BINDING_LAYER, GL_IMAGE_BINDING_ACCESS, GL_IMAGE_BINDING_FORMAT};
+    GLint active;
+    int i, j, u;
+    s->n = s->n64 = 0;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &s->v[s->n++]);
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &active);
+    s->v[s->n++] = active;
+    for (u = 0; u < 4; ++u) { /* texture bindings of units 0..3 */
+        glActiveTexture((GLenum)(GL_TEXTURE0 + u));
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, &s->v[s->n++]);
+        glGetIntegerv(GL_TEXTURE_BINDING_3D, &s->v[s->n++]);
+    }
+    glActiveTexture((GLenum)active);
+    for (i = 0; i < 16; ++i) glGetIntegerv(pix[i], &s->v[s->n++]);
+    for (i = 0; i < 7; ++i) glGetIntegerv(gen[i], &s->v[s->n++]);
+    for (i = 0; i < 8; ++i)
+        for (j = 0; j < 6; ++j) glGetIntegeri_v(img[j], (GLuint)i, &s->v[s->n++]);
+    for (i = 0; i < 4; ++i) {
+        glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, (GLuint)i, &s->v[s->n++]);
+        glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_START, (GLuint)i, &s->v64[s->n64++]);
+        glGetInteger64i_v(GL_SHADER_STORAGE_BUFFER_SIZE, (GLuint)i, &s->v64[s->n64++]);
+    }
+    glGetIntegeri_v(GL_UNIFORM_BUFFER_BINDING, 0, &s->v[s->n++]);
+    glGetInteger64i_v(GL_UNIFORM_BUFFER_START, 0, &s->v64[s->n64++]);
+    glGetInteger64i_v(GL_UNIFORM_BUFFER_SIZE, 0, &s->v64[s->n64++]);
+}
+
+static void compare(const host_state *a, const host_state *b, const char *what)
+{
+    int i, bad = 0;
+    for (i = 0; i < a->n; ++i)
+        if (a->v[i] != b->v[i]) { printf("  %s: state value %d was %d, is %d\n", what, i, (int)a->v[i], (int)b->v[i]); ++bad; }
+    for (i = 0; i < a->n64; ++i)
+        if (a->v64[i] != b->v64[i]) { printf("  %s: 64-bit state value %d was %lld, is %lld\n", what, i, (long long)a->v64[i], (long long)b->v64[i]); ++bad; }
+    CHECK(bad == 0, "%s: %d host state values changed", what, bad);
+}
+
+/* A host application's state: everything the backend touches set to something non-default. */
+static void set_host_state(void)
+{
+    static const char *src = "#version 430 core\nlayout(local_size_x = 1) in;\nvoid main() {}\n";
+    GLuint sh = glCreateShader(GL_COMPUTE_SHADER), prog = glCreateProgram(), bufs[6], tex[4];
+    int i;
+    glShaderSource(sh, 1, &src, NULL);
+    glCompileShader(sh);
+    glAttachShader(prog, sh);
+    glLinkProgram(prog);
+    glUseProgram(prog);
+    glGenBuffers(6, bufs);
+    for (i = 0; i < 6; ++i) {
+        glBindBuffer(GL_COPY_WRITE_BUFFER, bufs[i]);
+        glBufferData(GL_COPY_WRITE_BUFFER, 4096, NULL, GL_STATIC_DRAW);
+    }
+    glBindBufferRange(GL_UNIFORM_BUFFER, 0, bufs[0], 256, 512);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 0, bufs[1], 256, 1024);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bufs[2]);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, 2, bufs[3], 512, 256);
+    glBindBuffer(GL_UNIFORM_BUFFER, bufs[4]);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[5]);
+    glBindBuffer(GL_COPY_READ_BUFFER, bufs[0]);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, bufs[1]);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, bufs[2]);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, bufs[3]);
+    glBindBuffer(GL_ARRAY_BUFFER, bufs[4]);
+    glGenTextures(4, tex);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, tex[0]);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 4, 4);
+    glBindTexture(GL_TEXTURE_3D, tex[1]);
+    glTexStorage3D(GL_TEXTURE_3D, 1, GL_R32F, 4, 4, 4);
+    glBindImageTexture(0, tex[0], 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA8);
+    glBindImageTexture(3, tex[1], 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindImageTexture(6, tex[1], 0, GL_FALSE, 2, GL_READ_WRITE, GL_R32F);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, tex[2]);
+    glBindTexture(GL_TEXTURE_3D, tex[3]);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 7);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 2);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 5);
+    glPixelStorei(GL_UNPACK_SKIP_IMAGES, 1);
+    glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, 3);
+    CHECK(glGetError() == GL_NO_ERROR, "setting the host state raised a GL error");
+}
+
+static const float tf[] = {0, 0, 0, 0, 0.9f, 0.6f, 0.5f, 0.1f, 1, 1, 0.9f, 0.6f, 1, 1, 1, 1};
+
+static void make_desc(hd_desc *d, uint8_t *vox, int n)
+{
+    int x, y, z;
+    for (z = 0; z < n; ++z)
+        for (y = 0; y < n; ++y)
+            for (x = 0; x < n; ++x) {
+                float u = (x + 0.5f) / n - 0.5f, v = (y + 0.5f) / n - 0.5f, w = (z + 0.5f) / n - 0.5f;
+                float r = sqrtf(u * u + v * v + w * w);
+                vox[(z * n + y) * n + x] = (uint8_t)(r < 0.4f ? 255.0f * (1.0f - r / 0.4f) : 0.0f);
+            }
+    memset(d, 0, sizeof *d);
+    d->volume.type = HD_VOXEL_U8;
+    d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = n;
+    d->volume.data = vox;
+    d->transfer_function.rgba = tf;
+    d->transfer_function.count = 4;
+    d->camera.width = 48;
+    d->camera.height = 40;
+    d->params.seed = 7;
+}
+
+/* Every call a host app makes, with the host's state checked around it all. */
+static void run_calls(int use_current, const char *what)
+{
+    static uint8_t vox[24 * 24 * 24];
+    static float img[48 * 40 * 4], illum[24 * 24 * 24];
+    static uint8_t px[48 * 40 * 4], tpx[48 * 40 * 4];
+    static const hd_method methods[4] = {HD_METHOD_HD, HD_METHOD_CD, HD_METHOD_PT_SS, HD_METHOD_PT_MS};
+    host_state before, after;
+    EGLContext cur = eglGetCurrentContext();
+    hd_desc d;
+    hd_context c;
+    hd_result r;
+    GLuint tex, wrong;
+    int m, i, maxd;
+    make_desc(&d, vox, 24);
+    d.gl.use_current_context = use_current;
+    d.logger.func = hd_log_stderr;
+    /* the texture is made before the snapshot: it is the host's */
+    glGenTextures(1, &tex);
+    glGenTextures(1, &wrong);
+    {
+        GLint prev;
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, &prev);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 48, 40);
+        glBindTexture(GL_TEXTURE_2D, wrong);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 40, 48);
+        glBindTexture(GL_TEXTURE_2D, (GLuint)prev);
+    }
+    set_host_state();
+    snap(&before);
+    r = hd_create(&d, &c);
+    CHECK(r == HD_SUCCESS, "%s: hd_create: %s", what, hd_result_string(r));
+    if (r != HD_SUCCESS) return;
+    for (m = 0; m < 4; ++m) {
+        hd_params p;
+        hd_query_desc(c, &d);
+        p = d.params;
+        p.method = methods[m];
+        CHECK(hd_set_params(c, &p) == HD_SUCCESS, "%s: set_params", what);
+        r = hd_iterate(c, 3);
+        CHECK(r == HD_SUCCESS, "%s %s: hd_iterate: %s", what, hd_method_name(methods[m]), hd_result_string(r));
+        CHECK(hd_read_image_f32(c, img, sizeof img / sizeof img[0]) == HD_SUCCESS, "%s: read f32", what);
+        CHECK(hd_read_image_rgba8(c, px, sizeof px) == HD_SUCCESS, "%s: read rgba8", what);
+        if (m < 2) CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, illum, sizeof illum / sizeof illum[0]) == HD_SUCCESS, "%s: illum", what);
+        r = hd_gl_render_to_texture(c, tex);
+        CHECK(r == HD_SUCCESS, "%s: hd_gl_render_to_texture: %s", what, hd_result_string(r));
+        /* the texture's pixels (read on the host's context, default pack state) */
+        {
+            host_state mid;
+            GLint prev;
+            snap(&mid);
+            compare(&before, &mid, what);
+            glGetIntegerv(GL_TEXTURE_BINDING_2D, &prev);
+            glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+            glPixelStorei(GL_PACK_ALIGNMENT, 4);
+            glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+            glBindTexture(GL_TEXTURE_2D, tex);
+            glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_UNSIGNED_BYTE, tpx);
+            glBindTexture(GL_TEXTURE_2D, (GLuint)prev);
+            glPixelStorei(GL_PACK_ALIGNMENT, 1);
+            glPixelStorei(GL_PACK_ROW_LENGTH, 7);
+            glBindBuffer(GL_PIXEL_PACK_BUFFER, (GLuint)before.v[2 + 8 + 16 + 4]);
+        }
+        maxd = 0;
+        for (i = 0; i < 48 * 40 * 4; ++i) {
+            int y = i / (48 * 4), rest = i % (48 * 4);
+            int dv = abs((int)tpx[(39 - y) * 48 * 4 + rest] - (int)px[i]);
+            if (dv > maxd) maxd = dv;
+        }
+        CHECK(maxd <= 1, "%s %s: render_to_texture differs from hd_read_image_rgba8 by %d/255", what, hd_method_name(methods[m]), maxd);
+        printf("%s %s: render_to_texture vs read_image_rgba8: max difference %d/255\n", what, hd_method_name(methods[m]), maxd);
+    }
+    r = hd_gl_render_to_texture(c, wrong);
+    CHECK(r == HD_ERROR_INVALID_PARAMETER, "%s: a 40x48 texture for a 48x40 image: %s", what, hd_result_string(r));
+    CHECK(hd_destroy(c) == HD_SUCCESS, "%s: destroy", what);
+    snap(&after);
+    compare(&before, &after, what);
+    CHECK(eglGetCurrentContext() == cur, "%s: the host's EGL context is no longer current", what);
+    CHECK(glGetError() == GL_NO_ERROR, "%s: a GL error is pending after the calls", what);
+    glDeleteTextures(1, &tex);
+    glDeleteTextures(1, &wrong);
+}
+
+int main(void)
+{
+    static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
+    static const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
+                                       EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    EGLDisplay dpy = gpd ? gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL) : EGL_NO_DISPLAY;
+    EGLConfig cfg;
+    EGLint n = 0;
+    EGLContext host;
+    if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, NULL, NULL) || !eglBindAPI(EGL_OPENGL_API) ||
+        !eglChooseConfig(dpy, cfg_attrs, &cfg, 1, &n) || n < 1 ||
+        (host = eglCreateContext(dpy, cfg, EGL_NO_CONTEXT, ctx_attrs)) == EGL_NO_CONTEXT ||
+        !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, host)) {
+        printf("SKIPPED test_gl: no surfaceless EGL OpenGL 4.5 context for the host\n");
+        return getenv("HD_CONFORMANCE_REQUIRE") && getenv("HD_CONFORMANCE_REQUIRE")[0] == '1' ? 1 : 0;
+    }
+    printf("host context: %s\n", (const char *)glGetString(GL_RENDERER));
+    run_calls(1, "caller's context");
+    /* the backend's own EGL context while the host's is current: it cannot render into the host's
+       texture (different context, no sharing), so only the state is checked there */
+    {
+        static uint8_t vox[24 * 24 * 24];
+        host_state before, after;
+        hd_desc d;
+        hd_context c;
+        hd_result r;
+        make_desc(&d, vox, 24);
+        d.logger.func = hd_log_stderr;
+        set_host_state();
+        snap(&before);
+        r = hd_create(&d, &c);
+        CHECK(r == HD_SUCCESS, "own context: hd_create: %s", hd_result_string(r));
+        if (r == HD_SUCCESS) {
+            CHECK(eglGetCurrentContext() == host, "own context: hd_create left the host's context not current");
+            CHECK(hd_iterate(c, 2) == HD_SUCCESS, "own context: iterate");
+            CHECK(eglGetCurrentContext() == host, "own context: hd_iterate left the host's context not current");
+            hd_destroy(c);
+        }
+        snap(&after);
+        compare(&before, &after, "own context");
+        CHECK(eglGetCurrentContext() == host, "own context: the host's context is not current after hd_destroy");
+    }
+    printf("%s\n", failures ? "test_gl: FAILED" : "test_gl: all checks passed");
+    return failures ? 1 : 0;
+}
