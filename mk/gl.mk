@@ -62,3 +62,9 @@ test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp
 	$(B)/pngcmp $(B)/gl/hdview.png $(B)/gl/hdrender-cpu.png
 
 test: test-hdview
+
+$(B)/hdbench_gl: bench/hdbench_gl.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(GL_LDLIBS)
+
+bench-gl: $(B)/hdbench_gl data
+	$(B)/hdbench_gl
