@@ -1,4 +1,5 @@
-/* test_alloc_fail.c - allocation failure on the CPU backend. A counting allocator hook fails the
+/* test_alloc_fail.c - allocation failure, on the CPU backend in build/hdtest and on OpenCL in
+   build/afgpu/alloc-fail-opencl (mk/alloc_fail_gpu.mk). A counting allocator hook fails the
    k-th allocation, for every k in a full cycle: create, iterate HD, switch to CD and iterate,
    switch to PT_SS and iterate, read the image and illumination, destroy. Each run must return
    HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never crash, and free every byte it took
@@ -119,11 +120,11 @@ static void test_alloc_fail_every_k(void)
                   hd_result_string(r));
     }
     CHECK(failures >= 1);
-    printf("  %ld allocations per cycle, each failed once: %ld runs returned "
-           "HD_ERROR_OUT_OF_MEMORY, none leaked\n", total, failures);
+    printf("  %s: %ld allocations per cycle, each failed once: %ld runs returned "
+           "HD_ERROR_OUT_OF_MEMORY, none leaked\n", hd_backend_name(), total, failures);
 }
 
 const hd_test_case hd_tests_alloc_fail[] = {
-    {"alloc_fail_every_k_cpu", test_alloc_fail_every_k},
+    {"alloc_fail_every_k", test_alloc_fail_every_k},
 };
 const int hd_tests_alloc_fail_count = sizeof hd_tests_alloc_fail / sizeof hd_tests_alloc_fail[0];
