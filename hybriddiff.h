@@ -237,6 +237,10 @@ typedef struct hd_params {
                                follows the converging illumination; 0 -> 8 */
     float exposure;         /* scale applied before the sRGB encoding of RGBA8 output; 0 -> 1 */
     int max_bounces;        /* PT_MS bounce cap, 0 -> 64 */
+    int illumination_downsample; /* E and phi (and sigma_t for the diffusion) live on a grid of
+                               the volume's dims divided by this factor per axis, rounded up,
+                               sampled trilinearly by the projection: 1..8, 0 -> 1. Direct light
+                               is still tracked through the full-resolution volume. */
 } hd_params;
 
 typedef struct hd_desc {
@@ -307,6 +311,7 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      albedo, anisotropy, disable_diffusion     -> phi, image
      camera, step, background, frame_window    -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
+     illumination_downsample                   -> E, phi, image (new grid)
      solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);

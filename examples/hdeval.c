@@ -172,6 +172,8 @@ static void *xmalloc(size_t n)
 }
 
 /* ---- contexts ------------------------------------------------------------------------------------- */
+static int g_downsample = 1; /* params.illumination_downsample of HD and CD contexts */
+
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
 {
     hd_desc d;
@@ -208,6 +210,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.frame_window = S.frame_window;
     d.params.exposure = S.exposure;
     d.params.max_bounces = S.max_bounces;
+    d.params.illumination_downsample = g_downsample;
     d.threads = S.threads;
     d.logger.func = hd_log_stderr;
     r = hd_create(&d, &ctx);
@@ -746,9 +749,67 @@ static void make_plots(const char *work, const char *out, curve cur[HDE_METHODS]
 }
 
 /* ---- main -------------------------------------------------------------------------------------------- */
+/* Beyond the paper: HD with its illumination stored at the data's resolution / 1, 2, 4 per axis.
+   For each factor: the grid, the bytes per data voxel, iterations/s and PSNR against the 1-light
+   PT_MS reference after the scene's HD iteration count, and at equal time: after the CPU time
+   factor 1 takes for a quarter of those iterations. docs/eval/downsample.md and check lines. */
+static void run_downsample_study(const ref_img *ref, const char *out)
+{
+    static const int factors[3] = {1, 2, 4};
+    size_t npix = (size_t)S.size * S.size;
+    float *img = (float *)xmalloc(npix * 4 * sizeof(float));
+    double nvox = (double)g_vol.desc.dims[0] * g_vol.desc.dims[1] * g_vol.desc.dims[2];
+    double budget = 0.0, rate1 = 0.0;
+    int k, n = S.iterations[HDE_HD];
+    FILE *md = open_w(out, "downsample.md", NULL);
+    fprintf(md, "| factor | illumination grid | state bytes per data voxel | HD it/s | speed-up | PSNR vs PT_MS after %d it | lit part | PSNR at equal time | lit part |\n"
+                "|---|---|---|---|---|---|---|---|---|\n", n);
+    for (k = 0; k < 3; ++k) {
+        hd_context ctx;
+        hd_stats st;
+        double t0, t, rate, eq = 0, eq_lit = 0;
+        err2 e, en;
+        int done = 0;
+        g_downsample = factors[k];
+        ctx = make_ctx(HDE_HD, 1, S.size, 1u);
+        t0 = cpu_now();
+        t = 0.0;
+        /* n iterations, and on until the equal-time budget is spent */
+        while (done < n || eq == 0) {
+            iterate(ctx, 1);
+            ++done;
+            if (k == 0 && done == (n + 3) / 4) budget = cpu_now() - t0;
+            if (budget > 0 && eq == 0 && cpu_now() - t0 >= budget) {
+                read_image(ctx, img, S.size);
+                e = compare(img, ref, npix);
+                eq = psnr(e.mse); eq_lit = psnr(e.mse_lit);
+            }
+            if (done == n) {
+                t = cpu_now() - t0;
+                read_image(ctx, img, S.size);
+                en = compare(img, ref, npix);
+            }
+        }
+        e = en;
+        if (hd_get_stats(ctx, &st) != HD_SUCCESS) die("hd_get_stats");
+        rate = n / t;
+        if (k == 0) rate1 = rate;
+        fprintf(md, "| %d | %dx%dx%d | %.2f | %.3f | %.2fx | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", factors[k],
+                st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2],
+                (double)st.method_bytes / nvox, rate, rate / rate1, psnr(e.mse), psnr(e.mse_lit), eq, eq_lit);
+        check_line("downsample %d: grid %dx%dx%d, %.2f B/voxel, %.3f it/s (%.2fx), PSNR vs PT_MS %.2f dB (lit %.2f) after %d it",
+                   factors[k], st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2],
+                   (double)st.method_bytes / nvox, rate, rate / rate1, psnr(e.mse), psnr(e.mse_lit), n);
+        hd_destroy(ctx);
+    }
+    g_downsample = 1;
+    fclose(md);
+    free(img);
+}
+
 static const char *usage =
     "usage: hdeval [SCENE] [--paper] [--out DIR] [--cache DIR] [--work DIR] [--size N] [--table-size N]\n"
-    "              [--skip-table]\n"
+    "              [--skip-table] [--downsample-study]\n"
     "  SCENE           scene file (default examples/eval/head.scene): every setting\n"
     "  --paper         use the scene's paper.* settings (1024^2, paper-scale iterations/references)\n"
     "  --out DIR       tables, plots, figures (default docs/eval)\n"
@@ -756,13 +817,15 @@ static const char *usage =
     "  --work DIR      gnuplot scripts and data (default out/eval-work)\n"
     "  --size N        override the scene's image size of the curves and figures\n"
     "  --table-size N  override the scene's image size of Table 1 (default 1024, like the paper)\n"
-    "  --skip-table    no Table 1 (quality only)\n";
+    "  --skip-table    no Table 1 (quality only)\n"
+    "  --downsample-study  only HD with its illumination at 1/1, 1/2, 1/4 resolution against the\n"
+    "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n";
 
 int main(int argc, char **argv)
 {
     const char *scene_path = "examples/eval/head.scene", *out = "docs/eval", *cache = "out/eval-cache";
     const char *work = "out/eval-work";
-    int paper = 0, size = 0, table_size = 0, skip_table = 0, i, m, li, k;
+    int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, i, m, li, k;
     char err[1024];
     static ref_img refs[HDE_METHODS][2];
     static curve cur[HDE_METHODS][2];
@@ -782,6 +845,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--size")) size = atoi(NEXT());
         else if (!strcmp(a, "--table-size")) table_size = atoi(NEXT());
         else if (!strcmp(a, "--skip-table")) skip_table = 1;
+        else if (!strcmp(a, "--downsample-study")) downsample_study = 1;
         else if (a[0] == '-') { fprintf(stderr, "hdeval: unknown option %s\n%s", a, usage); return 2; }
         else scene_path = a;
 #undef NEXT
@@ -813,7 +877,7 @@ int main(int argc, char **argv)
     if (r != HD_SUCCESS) die("%s: %s (make data fetches the head CT)", S.volume, hd_result_string(r));
     if (g_tf.data_domain) hdx_tf_set_domain(&g_tf, g_vol.value_min, g_vol.value_max);
 
-    g_checks = open_w(out, "checks.txt", NULL);
+    g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : "checks.txt", NULL);
     check_line("hdeval: %s%s, %s %dx%dx%d, tf %s, backend %s, curves %dx%d, table %dx%d", scene_path,
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
                S.tf, hd_backend_name(), S.size, S.size, S.table_size, S.table_size);
@@ -822,6 +886,13 @@ int main(int argc, char **argv)
                S.iterations[HDE_HD], S.iterations[HDE_CD], S.iterations[HDE_SS], S.iterations[HDE_MS],
                S.ref_paths[HDE_SS], S.ref_paths[HDE_MS], (double)S.extinction, (double)S.albedo,
                (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps);
+
+    if (downsample_study) {
+        ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
+        run_downsample_study(&refs[HDE_MS][0], out);
+        fclose(g_checks);
+        return 0;
+    }
 
     /* 1. Table 1 */
     if (!skip_table) run_table(rows, out);

@@ -211,6 +211,13 @@ static hd_result hd__check_majorant(hd__ctx *ctx, const hd_params *p)
 /* The path tracers keep no illumination grid: the image is their whole state. */
 static int hd__method_is_pt(hd_method m) { return m == HD_METHOD_PT_SS || m == HD_METHOD_PT_MS; }
 
+/* The illumination grid: the volume's dims over the downsampling factor, rounded up. */
+static void hd__set_grid(hd__ctx *ctx)
+{
+    int d, f = ctx->params.illumination_downsample;
+    for (d = 0; d < 3; ++d) ctx->gdims[d] = (ctx->dims[d] + f - 1) / f;
+}
+
 /* ---- the kernels' parameter block ------------------------------------------------------------ */
 static void hd__fill_kparams(hd__ctx *ctx)
 {
@@ -353,7 +360,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     if ((r = hd__prepare_volume(ctx, &d.volume)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
     hd__build_majorants(ctx);
     if ((r = hd__check_majorant(ctx, &ctx->params)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
-    memcpy(ctx->gdims, ctx->dims, sizeof ctx->gdims);
+    hd__set_grid(ctx);
     ctx->dirty = HD__DIRTY_ALL;
     if ((r = hd__be_create(ctx)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
 
@@ -465,7 +472,10 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
         memcmp(p.background, o->background, sizeof p.background) != 0)
         ctx->dirty |= HD__DIRTY_IMAGE;
     if ((p.solver == HD_SOLVER_JACOBI) != (o->solver == HD_SOLVER_JACOBI)) ctx->dirty |= HD__DIRTY_JACOBI;
+    if (p.illumination_downsample != o->illumination_downsample)
+        ctx->dirty |= HD__DIRTY_ALLOC | HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     ctx->params = p;
+    if (ctx->dirty & HD__DIRTY_ALLOC) hd__set_grid(ctx);
     if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
     return HD_SUCCESS;
 }

@@ -114,6 +114,7 @@ static void hd__params_defaults(hd_params *p)
     if (p->frame_window == 0) p->frame_window = 8;
     if (p->exposure == 0.0f) p->exposure = 1.0f;
     if (p->max_bounces == 0) p->max_bounces = 64;
+    if (p->illumination_downsample == 0) p->illumination_downsample = 1;
 }
 
 /* Checks parameters whose defaults are filled in. */
@@ -145,6 +146,8 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.exposure = %g must be >= 0 and finite", (double)p->exposure);
     if (p->max_bounces < 0 || p->max_bounces > 100000)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.max_bounces = %d is outside 1..100000", p->max_bounces);
+    if (p->illumination_downsample < 1 || p->illumination_downsample > 8)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.illumination_downsample = %d is outside 1..8", p->illumination_downsample);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
 #ifndef HD__BE_HAS_CD
