@@ -11,6 +11,7 @@
 #define HD_STREAM_DIRECT 0x68bc21ebu
 #define HD_STREAM_PROJECT 0x02e5be93u
 #define HD_STREAM_PATH 0x967a889bu
+#define HD_STREAM_LIGHT 0x3c6ef372u
 #define HD_INV_4PI 0.0795774715f
 /* Ratio tracking stops by Russian roulette below this transmittance (unbiased). */
 #define HD_RR_THRESHOLD 0.1f
