@@ -930,8 +930,12 @@ static hd_result hd__io_read_file(const char *path, unsigned char **out, size_t 
     return HD_SUCCESS;
 }
 
-HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out,
-                                    const hd_logger *logger)
+/* A loader of a one-file format: the whole file in memory, then its parser, with the path in
+   front of every logged message. */
+typedef hd_result (*hd__io_parse_fn)(const void *bytes, size_t size, hd_volume_file *out,
+                                     const hd_logger *logger);
+static hd_result hd__io_load_whole(const char *path, hd_volume_file *out, const hd_logger *logger,
+                                   const char *format, hd__io_parse_fn parse)
 {
     hd__io_path_logger pl;
     hd_logger wrapped;
@@ -941,14 +945,20 @@ HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out,
     hd_result r;
     if (out) memset(out, 0, sizeof *out);
     if (!path || !out)
-        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "nrrd: %s is NULL",
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "%s: %s is NULL", format,
                            !path ? "path" : "out");
     lg = hd__io_wrap_logger(logger, path, &pl, &wrapped);
     r = hd__io_read_file(path, &bytes, &size, lg);
     if (r != HD_SUCCESS) return r;
-    r = hd_volume_parse_nrrd(bytes, size, out, lg);
+    r = parse(bytes, size, out, lg);
     free(bytes);
     return r;
+}
+
+HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out,
+                                    const hd_logger *logger)
+{
+    return hd__io_load_whole(path, out, logger, "nrrd", hd_volume_parse_nrrd);
 }
 
 HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_type type,

@@ -218,22 +218,7 @@ HDDEF hd_result hd_volume_parse_nifti(const void *bytes, size_t size, hd_volume_
 HDDEF hd_result hd_volume_load_nifti(const char *path, hd_volume_file *out,
                                      const hd_logger *logger)
 {
-    hd__io_path_logger pl;
-    hd_logger wrapped;
-    const hd_logger *lg;
-    unsigned char *bytes;
-    size_t size;
-    hd_result r;
-    if (out) memset(out, 0, sizeof *out);
-    if (!path || !out)
-        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "nifti: %s is NULL",
-                           !path ? "path" : "out");
-    lg = hd__io_wrap_logger(logger, path, &pl, &wrapped);
-    r = hd__io_read_file(path, &bytes, &size, lg);
-    if (r != HD_SUCCESS) return r;
-    r = hd_volume_parse_nifti(bytes, size, out, lg);
-    free(bytes);
-    return r;
+    return hd__io_load_whole(path, out, logger, "nifti", hd_volume_parse_nifti);
 }
 
 /* ---- any format -------------------------------------------------------------------------- */
