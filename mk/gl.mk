@@ -40,7 +40,7 @@ test: conformance-gl test-gl compile-gl-cxx
 
 # ---- the viewer -------------------------------------------------------------------------------
 VIEW_LDLIBS := -lglfw -lOpenGL -lEGL
-$(B)/hdview: examples/hdview.c examples/hd_tf.h $(LIB_SRC) | $(B)
+$(B)/hdview: examples/hdview.c $(wildcard examples/*.h) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VIEW_LDLIBS)
 hdview: $(B)/hdview
 

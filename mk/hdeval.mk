@@ -5,7 +5,7 @@
 #   make eval-paper     the paper-scale settings (--paper: 1024^2, 1.3M-path references) -> out/eval-paper
 .PHONY: eval eval-paper
 
-$(B)/hdeval: examples/hdeval.c examples/hd_eval_scene.h examples/hd_tf.h $(LIB_SRC) | $(B)
+$(B)/hdeval: examples/hdeval.c $(wildcard examples/*.h) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 eval: $(B)/hdeval
