@@ -32,6 +32,41 @@ extern int hd_test_failures; /* failures in the running test */
         } \
     } while (0)
 
+/* A logger that counts what the library reports and keeps the last error, for tests that check
+   "returns code X and logs a message". Only for files that include hybriddiff.h first. */
+#ifdef HYBRIDDIFF_H
+typedef struct hd_test_log {
+    int errors, warnings;
+    hd_result last_code;
+    char last[1024];
+} hd_test_log;
+
+static inline void hd_test_log_fn(void *user, hd_log_level level, hd_result code, const char *message,
+                                  const char *file, int line)
+{
+    hd_test_log *l = (hd_test_log *)user;
+    (void)file;
+    (void)line;
+    if (level == HD_LOG_ERROR) {
+        ++l->errors;
+        l->last_code = code;
+        snprintf(l->last, sizeof l->last, "%s", message ? message : "");
+    } else {
+        ++l->warnings;
+    }
+}
+
+/* Clears *l and returns a logger that fills it. */
+static inline hd_logger hd_test_logger(hd_test_log *l)
+{
+    hd_logger lg;
+    memset(l, 0, sizeof *l);
+    lg.func = hd_test_log_fn;
+    lg.user_data = l;
+    return lg;
+}
+#endif
+
 /* Runs every case whose name contains filter (NULL: all); returns the number of failed cases. */
 int hd_test_run(const hd_test_case *cases, int count, const char *filter, int *passed, int *failed);
 

@@ -10,35 +10,9 @@
 #include <zlib.h>
 
 /* ---- helpers ---------------------------------------------------------------------------------- */
-typedef struct io_log {
-    int errors, warnings;
-    hd_result last_code;
-    char last[1024];
-} io_log;
-
-static void io_log_fn(void *user, hd_log_level level, hd_result code, const char *message,
-                      const char *file, int line)
-{
-    io_log *l = (io_log *)user;
-    (void)file;
-    (void)line;
-    if (level == HD_LOG_ERROR) {
-        ++l->errors;
-        l->last_code = code;
-        snprintf(l->last, sizeof l->last, "%s", message ? message : "");
-    } else {
-        ++l->warnings;
-    }
-}
-
-static hd_logger io_logger(io_log *l)
-{
-    hd_logger lg;
-    memset(l, 0, sizeof *l);
-    lg.func = io_log_fn;
-    lg.user_data = l;
-    return lg;
-}
+/* io_log: the shared capturing logger of hd_test.h */
+typedef hd_test_log io_log;
+#define io_logger hd_test_logger
 
 static char io_dir[256];
 

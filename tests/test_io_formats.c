@@ -9,30 +9,9 @@
 #include <stdlib.h>
 #include <unistd.h>
 
-typedef struct fmt_log { int errors, warnings; hd_result last_code; char last[1024]; } fmt_log;
-
-static void fmt_log_fn(void *user, hd_log_level level, hd_result code, const char *message,
-                       const char *file, int line)
-{
-    fmt_log *l = (fmt_log *)user;
-    (void)file; (void)line;
-    if (level == HD_LOG_ERROR) {
-        ++l->errors;
-        l->last_code = code;
-        snprintf(l->last, sizeof l->last, "%s", message ? message : "");
-    } else {
-        ++l->warnings;
-    }
-}
-
-static hd_logger fmt_logger(fmt_log *l)
-{
-    hd_logger lg;
-    memset(l, 0, sizeof *l);
-    lg.func = fmt_log_fn;
-    lg.user_data = l;
-    return lg;
-}
+/* fmt_log: the shared capturing logger of hd_test.h */
+typedef hd_test_log fmt_log;
+#define fmt_logger hd_test_logger
 
 static char fmt_dir[256];
 static void fmt_cleanup(void) { if (fmt_dir[0]) rmdir(fmt_dir); }
