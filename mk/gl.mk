@@ -50,7 +50,8 @@ $(B)/pngcmp: tests/gl/pngcmp.c | $(B)
 # hdview under Xvfb: camera moves, then a restart at the default camera and 4 frames; the
 # screenshot must not be blank and must match hdrender on the CPU backend, same scene, seed and
 # iterations (tests/gl/pngcmp.c: within 1/255 per channel, and why). 256x256 on the head CT.
-test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp
+# `data` first: make test (and so CI) fetches the head CT, so this test runs rather than skips.
+test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	@if [ ! -f data/head.nrrd ]; then echo "test-hdview SKIPPED: no data/head.nrrd (make data)"; exit 0; fi; \
 	mkdir -p $(B)/gl && rm -f $(B)/gl/hdview.png $(B)/gl/hdview-moved.png && \
 	{ xvfb-run -a -s "-screen 0 640x480x24" $(B)/hdview --size 256x256 --script tests/gl/hdview.script data/head.nrrd \
