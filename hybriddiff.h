@@ -241,6 +241,11 @@ typedef struct hd_params {
                                the volume's dims divided by this factor per axis, rounded up,
                                sampled trilinearly by the projection: 1..8, 0 -> 1. Direct light
                                is still tracked through the full-resolution volume. */
+    int rgb_scattering;     /* 1: multiple scattering per colour channel: the diffusion uses
+                               sigma_s,c = albedo * TF colour_c * sigma_t, so light that scatters
+                               deep takes the colour shift PT_MS shows (3 channels of E and phi and
+                               a colour grid: +28 bytes per voxel). 0 (default): grey diffusion,
+                               tinted once at projection, as in the paper. */
 } hd_params;
 
 typedef struct hd_desc {
@@ -311,7 +316,7 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      albedo, anisotropy, disable_diffusion     -> phi, image
      camera, step, background, frame_window    -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
-     illumination_downsample                   -> E, phi, image (new grid)
+     illumination_downsample, rgb_scattering  -> E, phi, image (new grids)
      solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);

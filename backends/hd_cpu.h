@@ -196,7 +196,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     be->k.sig = be->k.E = be->k.phi = be->k.phi2 = NULL;
     be->illum_floats = 0;
     if (illum_floats == 0) return HD_SUCCESS;
-    be->sig = (float *)hd__calloc(ctx, gvox, sizeof(float));
+    be->sig = (float *)hd__calloc(ctx, gvox * (size_t)ctx->sig_channels, sizeof(float));
     be->E = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
     be->phi = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
     if (!be->sig || !be->E || !be->phi)
@@ -266,10 +266,18 @@ static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
         hd_diffuse_row(K, y, z, c, be->parity, be->jacobi);
         return;
     }
-    /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them */
-    for (x = 1; x < gx - 1; ++x) {
-        float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, &den);
-        row[x] = num / den;
+    /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them.
+       The RGB-scattering flag is a literal in each loop, so neither keeps a branch. */
+    if (be->ctx->params.rgb_scattering) {
+        for (x = 1; x < gx - 1; ++x) {
+            float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, &den);
+            row[x] = num / den;
+        }
+    } else {
+        for (x = 1; x < gx - 1; ++x) {
+            float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 0, &den);
+            row[x] = num / den;
+        }
     }
     {
         float den, num = hd_diffuse_terms(K, 0, y, z, c, &den);

@@ -668,7 +668,7 @@ static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
     be->illum_floats = 0;
     if (illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2], NULL, "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, NULL, "sigma_t")) != HD_SUCCESS) return r;
     if ((r = hd__gl_tex_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, NULL, "E")) != HD_SUCCESS) return r;
     if ((r = hd__gl_tex_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, NULL, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;

@@ -348,7 +348,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
     be->illum_floats = 0;
-    if ((r = hd__cl_buffer(ctx, &be->sig, gvox * sizeof(float), NULL, "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->sig, gvox * (size_t)ctx->sig_channels * sizeof(float), NULL, "sigma_t")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->E, illum_floats * sizeof(float), NULL, "E")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->phi, illum_floats * sizeof(float), NULL, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;

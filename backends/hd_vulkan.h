@@ -1059,7 +1059,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
     be->illum_floats = 0;
     if (illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2], "sigma_t")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS) return r;
     if ((r = hd__vk_image_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, "E")) != HD_SUCCESS) return r;
     if ((r = hd__vk_image_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;

@@ -162,6 +162,7 @@ static void *xmalloc(size_t n)
 
 /* ---- contexts ------------------------------------------------------------------------------------- */
 static int g_downsample = 1; /* params.illumination_downsample of HD and CD contexts */
+static int g_rgb = 0;        /* params.rgb_scattering of HD and CD contexts */
 
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
 {
@@ -200,6 +201,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.exposure = S.exposure;
     d.params.max_bounces = S.max_bounces;
     d.params.illumination_downsample = g_downsample;
+    d.params.rgb_scattering = g_rgb;
     d.threads = S.threads;
     d.logger.func = hd_log_stderr;
     r = hd_create(&d, &ctx);
@@ -796,9 +798,52 @@ static void run_downsample_study(const ref_img *ref, const char *out)
     free(img);
 }
 
+/* Beyond the paper: HD with grey diffusion (the paper) against RGB scattering, both against the
+   1-light PT_MS reference, at the scene's HD iteration count and at 4x it; rgb.md, rgb-checks
+   lines and the side-by-side figure rgb_scattering.png (grey HD | RGB HD | PT_MS). */
+static void run_rgb_study(const ref_img *ref, const char *out)
+{
+    size_t npix = (size_t)S.size * S.size;
+    float *img[2];
+    const float *tiles[3];
+    int k, n = S.iterations[HDE_HD];
+    FILE *md = open_w(out, "rgb.md", NULL);
+    fprintf(md, "| diffusion | state bytes per voxel | PSNR vs PT_MS after %d it | lit part | after %d it | lit part |\n"
+                "|---|---|---|---|---|---|\n", n, 4 * n);
+    for (k = 0; k < 2; ++k) {
+        hd_context ctx;
+        hd_stats st;
+        err2 e1, e4;
+        img[k] = (float *)xmalloc(npix * 4 * sizeof(float));
+        g_rgb = k;
+        ctx = make_ctx(HDE_HD, 1, S.size, 1u);
+        iterate(ctx, n);
+        read_image(ctx, img[k], S.size);
+        e1 = compare(img[k], ref, npix);
+        iterate(ctx, 3 * n);
+        read_image(ctx, img[k], S.size);
+        e4 = compare(img[k], ref, npix);
+        if (hd_get_stats(ctx, &st) != HD_SUCCESS) die("hd_get_stats");
+        fprintf(md, "| %s | %.1f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", k ? "RGB" : "grey",
+                (double)st.method_bytes / ((double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2]),
+                psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
+        check_line("rgb_scattering %d: PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, %.2f dB (lit %.2f) after %d it",
+                   k, psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
+        hd_destroy(ctx);
+    }
+    g_rgb = 0;
+    fclose(md);
+    tiles[0] = img[0];
+    tiles[1] = img[1];
+    tiles[2] = ref->lin;
+    write_grid(out, "rgb_scattering.png", tiles, 3, 1);
+    free(img[0]);
+    free(img[1]);
+}
+
 static const char *usage =
     "usage: hdeval [SCENE] [--paper] [--out DIR] [--cache DIR] [--work DIR] [--size N] [--table-size N]\n"
-    "              [--skip-table] [--downsample-study]\n"
+    "              [--skip-table] [--downsample-study] [--rgb-study]\n"
     "  SCENE           scene file (default examples/eval/head.scene): every setting\n"
     "  --paper         use the scene's paper.* settings (1024^2, paper-scale iterations/references)\n"
     "  --out DIR       tables, plots, figures (default docs/eval)\n"
@@ -808,13 +853,15 @@ static const char *usage =
     "  --table-size N  override the scene's image size of Table 1 (default 1024, like the paper)\n"
     "  --skip-table    no Table 1 (quality only)\n"
     "  --downsample-study  only HD with its illumination at 1/1, 1/2, 1/4 resolution against the\n"
-    "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n";
+    "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n"
+    "  --rgb-study     only HD with grey against RGB scattering, against the 1-light PT_MS\n"
+    "                  reference (OUT/rgb.md, OUT/rgb_scattering.png), then stop\n";
 
 int main(int argc, char **argv)
 {
     const char *scene_path = "examples/eval/head.scene", *out = "docs/eval", *cache = "out/eval-cache";
     const char *work = "out/eval-work";
-    int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, i, m, li, k;
+    int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, rgb_study = 0, i, m, li, k;
     char err[1024];
     static ref_img refs[HDE_METHODS][2];
     static curve cur[HDE_METHODS][2];
@@ -835,6 +882,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--table-size")) table_size = atoi(NEXT());
         else if (!strcmp(a, "--skip-table")) skip_table = 1;
         else if (!strcmp(a, "--downsample-study")) downsample_study = 1;
+        else if (!strcmp(a, "--rgb-study")) rgb_study = 1;
         else if (a[0] == '-') { fprintf(stderr, "hdeval: unknown option %s\n%s", a, usage); return 2; }
         else scene_path = a;
 #undef NEXT
@@ -866,7 +914,7 @@ int main(int argc, char **argv)
     if (r != HD_SUCCESS) die("%s: %s (make data fetches the head CT)", S.volume, hd_result_string(r));
     if (g_tf.data_domain) hdx_tf_set_domain(&g_tf, g_vol.value_min, g_vol.value_max);
 
-    g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : "checks.txt", NULL);
+    g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : rgb_study ? "rgb-checks.txt" : "checks.txt", NULL);
     check_line("hdeval: %s%s, %s %dx%dx%d, tf %s, backend %s, curves %dx%d, table %dx%d", scene_path,
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
                S.tf, hd_backend_name(), S.size, S.size, S.table_size, S.table_size);
@@ -876,6 +924,12 @@ int main(int argc, char **argv)
                S.ref_paths[HDE_SS], S.ref_paths[HDE_MS], (double)S.extinction, (double)S.albedo,
                (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps);
 
+    if (rgb_study) {
+        ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
+        run_rgb_study(&refs[HDE_MS][0], out);
+        fclose(g_checks);
+        return 0;
+    }
     if (downsample_study) {
         ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
         run_downsample_study(&refs[HDE_MS][0], out);

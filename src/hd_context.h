@@ -181,7 +181,16 @@ static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
     return HD_SUCCESS;
 }
 
-/* Lights of one colour need one illumination channel; mixed colours need three. */
+/* Lights of one colour and grey scattering need one illumination channel; lights of different
+   colours or RGB scattering need three (and RGB scattering the TF colour beside sigma_t). */
+static void hd__set_channels(hd__ctx *ctx)
+{
+    int i, grey = ctx->lights_one_colour && !ctx->params.rgb_scattering;
+    ctx->channels = grey ? 1 : 3;
+    ctx->sig_channels = ctx->params.rgb_scattering ? 4 : 1;
+    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] : 1.0f;
+}
+
 static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
 {
     int i, same = 1;
@@ -193,8 +202,8 @@ static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
         if (i > 0 && memcmp(l.color, ctx->lights[0].color, sizeof l.color) != 0) same = 0;
     }
     ctx->light_count = count;
-    ctx->channels = same ? 1 : 3;
-    for (i = 0; i < 3; ++i) ctx->chan_color[i] = same ? ctx->lights[0].color[i] : 1.0f;
+    ctx->lights_one_colour = same;
+    hd__set_channels(ctx);
     ctx->desc.lights = ctx->lights;
     ctx->desc.light_count = count;
 }
@@ -232,7 +241,8 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->counts.x = ctx->light_count;
     k->counts.y = ctx->params.tracking == HD_TRACKING_DELTA ? HD_TRACK_DELTA : HD_TRACK_RATIO;
     k->counts.z = (ctx->params.majorant > 0.0f ? HD_FLAG_GLOBAL_MAJORANT : 0) |
-                  (ctx->params.disable_diffusion ? HD_FLAG_NO_DIFFUSION : 0);
+                  (ctx->params.disable_diffusion ? HD_FLAG_NO_DIFFUSION : 0) |
+                  (ctx->params.rgb_scattering ? HD_FLAG_RGB_SCATTERING : 0);
     /* PT_SS is the path kernel with one vertex and the isotropic phase (hd_k_path.h) */
     k->counts.w = ctx->params.method == HD_METHOD_PT_SS ? 1 : ctx->params.max_bounces;
     k->frame.x = (int32_t)ctx->iterations;
@@ -472,9 +482,10 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
         memcmp(p.background, o->background, sizeof p.background) != 0)
         ctx->dirty |= HD__DIRTY_IMAGE;
     if ((p.solver == HD_SOLVER_JACOBI) != (o->solver == HD_SOLVER_JACOBI)) ctx->dirty |= HD__DIRTY_JACOBI;
-    if (p.illumination_downsample != o->illumination_downsample)
+    if (p.illumination_downsample != o->illumination_downsample || p.rgb_scattering != o->rgb_scattering)
         ctx->dirty |= HD__DIRTY_ALLOC | HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     ctx->params = p;
+    hd__set_channels(ctx);
     if (ctx->dirty & HD__DIRTY_ALLOC) hd__set_grid(ctx);
     if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
     return HD_SUCCESS;
@@ -729,7 +740,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
        plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
-    out->method_bytes = gvox * sizeof(float) +
+    out->method_bytes = gvox * sizeof(float) * (size_t)ctx->sig_channels +
                         hd__illum_floats(ctx) * sizeof(float) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;

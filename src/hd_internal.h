@@ -59,6 +59,8 @@ typedef struct hd__ctx {
     /* method state */
     int gdims[3];            /* illumination grid */
     int channels;            /* 1 or 3 */
+    int lights_one_colour;   /* every light has the same colour */
+    int sig_channels;        /* sigma_t grid channels: 1, or 4 with the TF colour (RGB scattering) */
     float chan_color[3];
     unsigned dirty;
     uint64_t iterations;

@@ -252,6 +252,43 @@ static void test_illumination_downsample(void)
     free(b);
 }
 
+/* RGB scattering: with a TF colour of (1, 0.5, 0.25), the red channel scatters exactly as the
+   grey diffusion does (same bits: albedo * 1), green and blue lose more light at every
+   scattering, so phi_r > phi_g > phi_b; E is the same in every channel (white light) and equal
+   to the grey E. State: sigma_t + 3 colours + 3 E + 3 phi = 40 bytes per voxel. */
+static void test_rgb_scattering(void)
+{
+    static const float tf[12] = {1, 0.5f, 0.25f, 0, 1, 0.5f, 0.25f, 0.3f, 1, 0.5f, 0.25f, 1};
+    hd_desc d;
+    hd_context grey, rgb;
+    hd_stats sg, sr;
+    size_t n = (size_t)N * N * N, i;
+    float *Eg = (float *)malloc(n * 4), *Pg = (float *)malloc(n * 4);
+    float *Er = (float *)malloc(n * 12), *Pr = (float *)malloc(n * 12);
+    double sum[3] = {0, 0, 0};
+    make_desc(&d, NULL);
+    d.transfer_function.rgba = tf;
+    CHECK(hd_create(&d, &grey) == HD_SUCCESS);
+    d.params.rgb_scattering = 1;
+    CHECK(hd_create(&d, &rgb) == HD_SUCCESS);
+    CHECK(hd_iterate(grey, 6) == HD_SUCCESS && hd_iterate(rgb, 6) == HD_SUCCESS);
+    CHECK(hd_get_stats(grey, &sg) == HD_SUCCESS && hd_get_stats(rgb, &sr) == HD_SUCCESS);
+    CHECK(sg.illumination_channels == 1 && sr.illumination_channels == 3);
+    CHECK(sr.method_bytes == n * 40 && sg.method_bytes == n * 12);
+    CHECK(hd_read_illumination(grey, HD_ILLUMINATION_DIRECT, Eg, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(grey, HD_ILLUMINATION_SCATTERED, Pg, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(rgb, HD_ILLUMINATION_DIRECT, Er, 3 * n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(rgb, HD_ILLUMINATION_SCATTERED, Pr, 3 * n) == HD_SUCCESS);
+    for (i = 0; i < 3; ++i) CHECK_MSG(memcmp(Eg, Er + i * n, n * 4) == 0, "E channel %zu", i);
+    CHECK(memcmp(Pg, Pr, n * 4) == 0); /* red: colour 1, the grey solution bit for bit */
+    for (i = 0; i < 3 * n; ++i) sum[i / n] += Pr[i];
+    printf("  RGB scattering, TF colour (1, 0.5, 0.25): sum of phi r %.4g g %.4g b %.4g\n", sum[0], sum[1], sum[2]);
+    CHECK(sum[0] > sum[1] && sum[1] > sum[2] && sum[2] > 0.0);
+    hd_destroy(grey);
+    hd_destroy(rgb);
+    free(Eg); free(Pg); free(Er); free(Pr);
+}
+
 /* ---- bad input: each case its own code, and a logged message -------------------------------- */
 typedef struct bad_case { const char *name; hd_result expect; void (*mutate)(hd_desc *d); } bad_case;
 static float nan_f(void) { volatile float z = 0.0f; return z / z; }
@@ -396,6 +433,7 @@ const hd_test_case hd_tests_core[] = {
     {"core_invalidation", test_invalidation},
     {"core_memory_independent_of_lights", test_memory_independent_of_lights},
     {"core_illumination_downsample", test_illumination_downsample},
+    {"core_rgb_scattering", test_rgb_scattering},
     {"core_bad_desc", test_bad_desc},
     {"core_bad_calls", test_bad_calls},
 };

@@ -1,5 +1,7 @@
 /* hd_k_classify.h - sigma_t at the illumination grid's voxel centres, for the diffusion stencil
-   (shared source). Rerun when the transfer function or the extinction changes. */
+   (shared source), and with RGB scattering the TF colour there in channels 1..3 (channel k at
+   index i + k * voxels, image z + k * dz, like E and phi). Rerun when the transfer function or
+   the extinction changes. */
 HD_FN void hd_classify_voxel(HD_KARGS int x, int y, int z)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
@@ -11,5 +13,14 @@ HD_FN void hd_classify_voxel(HD_KARGS int x, int y, int z)
         v = hd_sample_value(HD_KPASS HD_V3((HD_F(x) + 0.5f) / HD_F(gx), (HD_F(y) + 0.5f) / HD_F(gy),
                                            (HD_F(z) + 0.5f) / HD_F(gz)));
     }
-    HD_SET(sig, i, x, y, z, hd_tf(HD_KPASS v).w * HD_PRM(medium).x);
+    {
+        hd_v4 c = hd_tf(HD_KPASS v);
+        HD_SET(sig, i, x, y, z, c.w * HD_PRM(medium).x);
+        if ((HD_PRM(counts).z & HD_FLAG_RGB_SCATTERING) != 0) {
+            int nvox = gx * gy * gz;
+            HD_SET(sig, i + nvox, x, y, z + gz, c.x);
+            HD_SET(sig, i + 2 * nvox, x, y, z + 2 * gz, c.y);
+            HD_SET(sig, i + 3 * nvox, x, y, z + 3 * gz, c.z);
+        }
+    }
 }
