@@ -307,6 +307,9 @@ static void m_bad_g(hd_desc *d) { d->params.anisotropy = 1.0f; }
 static void m_neg_sweeps(hd_desc *d) { d->params.diffusion_sweeps = -1; }
 static void m_low_majorant(hd_desc *d) { d->params.majorant = 1.0f; }
 static void m_bad_method(hd_desc *d) { d->params.method = (hd_method)42; }
+static void m_bad_downsample(hd_desc *d) { d->params.illumination_downsample = -2; }
+static void m_big_downsample(hd_desc *d) { d->params.illumination_downsample = 9; }
+static void m_bad_rgb(hd_desc *d) { d->params.rgb_scattering = 2; }
 static const float tf_nan[8] = {0, 0, 0, 0, 1, 1, 1, 1};
 static float tf_bad[8];
 static void m_tf_nan(hd_desc *d) { memcpy(tf_bad, tf_nan, sizeof tf_bad); tf_bad[7] = nan_f(); d->transfer_function.rgba = tf_bad; d->transfer_function.count = 2; }
@@ -343,6 +346,9 @@ static const bad_case bad_cases[] = {
     {"negative sweeps", HD_ERROR_INVALID_PARAMETER, m_neg_sweeps},
     {"majorant below extinction", HD_ERROR_INVALID_PARAMETER, m_low_majorant},
     {"method enum", HD_ERROR_INVALID_ENUM, m_bad_method},
+    {"negative illumination_downsample", HD_ERROR_INVALID_PARAMETER, m_bad_downsample},
+    {"illumination_downsample 9", HD_ERROR_INVALID_PARAMETER, m_big_downsample},
+    {"rgb_scattering 2", HD_ERROR_INVALID_PARAMETER, m_bad_rgb},
     {"NaN TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_nan},
     {"negative TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_neg},
     {"one TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_one},
