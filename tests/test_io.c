@@ -3,6 +3,7 @@
    can return is provoked and must come with a logged message. */
 #include "hybriddiff.h"
 #include "hd_test.h"
+#include "tests/fuzz/hd_fuzz_gen.h" /* gen_cat, gen_put, gen_deflate: shared with the fuzz seeds */
 #include <stdlib.h>
 #include <stdint.h>
 #include <limits.h>
@@ -60,45 +61,6 @@ static int io_write(const char *path, const void *a, size_t na, const void *b, s
     return fclose(f) == 0 && ok;
 }
 
-/* header text (ending with the blank line) + data, in one malloc'd buffer */
-static unsigned char *io_nrrd(const char *header, const void *data, size_t n, size_t *size)
-{
-    size_t h = strlen(header);
-    unsigned char *b = (unsigned char *)malloc(h + n + 1);
-    memcpy(b, header, h);
-    if (n) memcpy(b + h, data, n);
-    *size = h + n;
-    return b;
-}
-
-static void io_put(unsigned char *p, uint64_t v, int n, int big)
-{
-    int i;
-    for (i = 0; i < n; ++i) p[big ? n - 1 - i : i] = (unsigned char)(v >> (8 * i));
-}
-
-/* gzip (not zlib) member of n bytes, malloc'd */
-static unsigned char *io_gzip(const void *data, size_t n, size_t *out_n)
-{
-    z_stream zs;
-    size_t cap = n + n / 100 + 64;
-    unsigned char *out = (unsigned char *)malloc(cap);
-    memset(&zs, 0, sizeof zs);
-    if (deflateInit2(&zs, 9, Z_DEFLATED, 15 + 16, 8, Z_DEFAULT_STRATEGY) != Z_OK) return NULL;
-    zs.next_in = (Bytef *)data;
-    zs.avail_in = (uInt)n;
-    zs.next_out = out;
-    zs.avail_out = (uInt)cap;
-    if (deflate(&zs, Z_FINISH) != Z_STREAM_END) {
-        deflateEnd(&zs);
-        free(out);
-        return NULL;
-    }
-    *out_n = cap - zs.avail_out;
-    deflateEnd(&zs);
-    return out;
-}
-
 /* Parses from memory and, through a file, with the file loader; both must agree. */
 static hd_result io_parse_both(const unsigned char *b, size_t n, hd_volume_file *out, io_log *l)
 {
@@ -140,7 +102,7 @@ static hd_result io_parse_text(const char *text, io_log *l)
 {
     hd_volume_file v;
     size_t n;
-    unsigned char *b = io_nrrd(text, NULL, 0, &n);
+    unsigned char *b = gen_cat(text, NULL, 0, &n);
     hd_result r = io_parse_both(b, n, &v, l);
     CHECK(v.data == NULL || r == HD_SUCCESS);
     hd_volume_free(&v);
@@ -157,7 +119,7 @@ static void io_nrrd_roundtrip(void)
     size_t n, i;
     unsigned char *b;
     for (i = 0; i < sizeof data; ++i) data[i] = (unsigned char)(10 + i * 7);
-    b = io_nrrd("NRRD0004\n# a comment\ntype: uchar\ndimension: 3\nsizes: 4 3 2\n"
+    b = gen_cat("NRRD0004\n# a comment\ntype: uchar\ndimension: 3\nsizes: 4 3 2\n"
                 "spacings: 0.5 1 2.25\nencoding: raw\ncontent:=anything at all\n\n",
                 data, sizeof data, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
@@ -199,7 +161,7 @@ static void io_nrrd_type_spellings(void)
         unsigned char *b; \
         snprintf(text, sizeof text, "NRRD0004\ntype:   %s \ndimension: 3\nsizes: 2 2 2\n" \
                  "endian: little\nencoding: raw\n\n", list[i]); \
-        b = io_nrrd(text, data, sizeof data, &n); \
+        b = gen_cat(text, data, sizeof data, &n); \
         lg = io_logger(&l); \
         CHECK_MSG(hd_volume_parse_nrrd(b, n, &v, &lg) == HD_SUCCESS, "type '%s': %s", list[i], \
                   l.last); \
@@ -227,11 +189,11 @@ static void io_nrrd_u16_endian(void)
         int i;
         unsigned char *b;
         char text[200];
-        for (i = 0; i < 6; ++i) io_put(data + 2 * i, vals[i], 2, big);
+        for (i = 0; i < 6; ++i) gen_put(data + 2 * i, vals[i], 2, big);
         snprintf(text, sizeof text,
                  "NRRD0005\ntype: unsigned short\ndimension: 3\nsizes: 3 2 1\nendian: %s\n"
                  "encoding: raw\n\n", big ? "big" : "little");
-        b = io_nrrd(text, data, sizeof data, &n);
+        b = gen_cat(text, data, sizeof data, &n);
         CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
         CHECK(v.desc.type == HD_VOXEL_U16);
         if (v.data) {
@@ -257,13 +219,13 @@ static void io_nrrd_int16_to_f32(void)
         int i;
         unsigned char *b;
         char text[256];
-        for (i = 0; i < 8; ++i) io_put(data + 2 * i, (uint16_t)vals[i], 2, big);
+        for (i = 0; i < 8; ++i) gen_put(data + 2 * i, (uint16_t)vals[i], 2, big);
         snprintf(text, sizeof text,
                  "NRRD0004\r\ntype: int16\r\ndimension: 3\r\nsizes: 2 2 2\r\n"
                  "space: left-posterior-superior\r\n"
                  "space directions: (0.5,0,0) (0, 0.6, 0.8) (0,0,-3)\r\n"
                  "endian: %s\r\nencoding: raw\r\n\r\n", big ? "big" : "little");
-        b = io_nrrd(text, data, sizeof data, &n);
+        b = gen_cat(text, data, sizeof data, &n);
         CHECK_MSG(io_parse_both(b, n, &v, &l) == HD_SUCCESS, "%s", l.last);
         CHECK(v.desc.type == HD_VOXEL_F32);
         if (v.data)
@@ -291,9 +253,9 @@ static void io_nrrd_float_double(void)
     uint64_t u64;
     for (i = 0; i < 4; ++i) {
         memcpy(&u, &fv[i], 4);
-        io_put(data + 4 * i, u, 4, 0);
+        gen_put(data + 4 * i, u, 4, 0);
     }
-    b = io_nrrd("NRRD0004\ntype: float\ndimension: 2\nsizes: 2 2\nspacings: 2 3\n"
+    b = gen_cat("NRRD0004\ntype: float\ndimension: 2\nsizes: 2 2\nspacings: 2 3\n"
                 "endian: little\nencoding: raw\n\n", data, 16, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
     CHECK(v.desc.type == HD_VOXEL_F32);
@@ -307,9 +269,9 @@ static void io_nrrd_float_double(void)
     for (i = 0; i < 4; ++i) {
         double d = (double)fv[i];
         memcpy(&u64, &d, 8);
-        io_put(data + 8 * i, u64, 8, 1);
+        gen_put(data + 8 * i, u64, 8, 1);
     }
-    b = io_nrrd("NRRD0004\ntype: double\ndimension: 1\nsizes: 4\nendian: big\nencoding: raw\n\n",
+    b = gen_cat("NRRD0004\ntype: double\ndimension: 1\nsizes: 4\nendian: big\nencoding: raw\n\n",
                 data, 32, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
     CHECK(v.desc.dims[0] == 4 && v.desc.dims[1] == 1 && v.desc.dims[2] == 1);
@@ -332,9 +294,9 @@ static void io_nrrd_nonfinite_and_constant(void)
     for (i = 0; i < 4; ++i) {
         uint32_t u;
         memcpy(&u, &f[i], 4);
-        io_put(data + 4 * i, u, 4, 0);
+        gen_put(data + 4 * i, u, 4, 0);
     }
-    b = io_nrrd("NRRD0004\ntype: float\ndimension: 3\nsizes: 4 1 1\nendian: little\n"
+    b = gen_cat("NRRD0004\ntype: float\ndimension: 3\nsizes: 4 1 1\nendian: little\n"
                 "encoding: raw\n\n", data, 16, &n);
     CHECK(hd_volume_parse_nrrd(b, n, &v, &lg) == HD_SUCCESS);
     CHECK(l.warnings == 1); /* non-finite values replaced by 0 */
@@ -344,7 +306,7 @@ static void io_nrrd_nonfinite_and_constant(void)
     free(b);
 
     memset(data, 42, sizeof data); /* constant: the range is never empty */
-    b = io_nrrd("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 2 2\nencoding: raw\n\n", data, 16,
+    b = gen_cat("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 4 2 2\nencoding: raw\n\n", data, 16,
                 &n);
     CHECK(hd_volume_parse_nrrd(b, n, &v, &lg) == HD_SUCCESS);
     CHECK(v.value_min == 42.0f && v.value_max == 42.0f);
@@ -362,21 +324,21 @@ static void io_nrrd_skips(void)
     unsigned char *b;
     for (i = 0; i < sizeof data; ++i) data[i] = (unsigned char)i;
     /* byte skip 8: the data are bytes 8..15 */
-    b = io_nrrd("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nbyte skip: 8\n"
+    b = gen_cat("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nbyte skip: 8\n"
                 "encoding: raw\n\n", data, sizeof data, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
     if (v.data) CHECK(((const unsigned char *)v.data)[0] == 8);
     hd_volume_free(&v);
     free(b);
     /* byte skip -1: the data are the last bytes */
-    b = io_nrrd("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 1\nbyteskip: -1\n"
+    b = gen_cat("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 1\nbyteskip: -1\n"
                 "encoding: raw\n\n", data, sizeof data, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
     if (v.data) CHECK(((const unsigned char *)v.data)[0] == 12);
     hd_volume_free(&v);
     free(b);
     /* line skip 1 */
-    b = io_nrrd("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nline skip: 1\n"
+    b = gen_cat("NRRD0004\ntype: uint8\ndimension: 3\nsizes: 2 2 2\nline skip: 1\n"
                 "encoding: raw\n\nskip me\n", data, 8, &n);
     CHECK(io_parse_both(b, n, &v, &l) == HD_SUCCESS);
     if (v.data) CHECK(memcmp(v.data, data, 8) == 0);
@@ -400,12 +362,12 @@ static void io_nrrd_gzip(void)
     gzFile gz;
     for (i = 0; i < NX * NY * NZ; ++i) {
         vals[i] = (int16_t)((int)(i * 37 % 4096) - 1024);
-        io_put(raw + 2 * i, (uint16_t)vals[i], 2, 1);
+        gen_put(raw + 2 * i, (uint16_t)vals[i], 2, 1);
     }
     /* in memory, through deflate */
-    z = io_gzip(raw, sizeof raw, &zn);
+    z = gen_deflate(raw, sizeof raw, 1, &zn);
     CHECK(z != NULL);
-    b = io_nrrd(header, z, zn, &n);
+    b = gen_cat(header, z, zn, &n);
     CHECK_MSG(io_parse_both(b, n, &v, &l) == HD_SUCCESS, "%s", l.last);
     CHECK(v.desc.type == HD_VOXEL_F32 && v.desc.spacing[2] == 1.5f);
     if (v.data)
@@ -444,7 +406,7 @@ static void io_raw_loader(void)
     hd_logger lg = io_logger(&l);
     int i;
     memset(buf, 0xee, 5); /* a 5-byte header to skip */
-    for (i = 0; i < 24; ++i) io_put(buf + 5 + 2 * i, (uint16_t)(i * 1000 - 5000), 2, 1);
+    for (i = 0; i < 24; ++i) gen_put(buf + 5 + 2 * i, (uint16_t)(i * 1000 - 5000), 2, 1);
     CHECK(io_write(path, buf, sizeof buf, NULL, 0));
 
     CHECK(hd_volume_load_raw(path, dims, HD_RAW_I16, HD_ENDIAN_BIG, 5, &v, &lg) == HD_SUCCESS);
@@ -681,7 +643,7 @@ static void io_error_truncated(void)
     const char *path = io_path("short.raw");
     memset(data, 1, sizeof data);
     /* a header that lies: 256 x 256 x 108 uchar = 7077888 bytes, 1000 present */
-    b = io_nrrd("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 256 256 108\nencoding: raw\n\n",
+    b = gen_cat("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 256 256 108\nencoding: raw\n\n",
                 data, sizeof data, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_FILE_TRUNCATED, l);
@@ -689,7 +651,7 @@ static void io_error_truncated(void)
     CHECK(v.data == NULL);
     free(b);
     /* one byte short; header with no blank line and no data; byte skip past the end */
-    b = io_nrrd("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 10 10 10\nencoding: raw\n\n", data,
+    b = gen_cat("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 10 10 10\nencoding: raw\n\n", data,
                 999, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_FILE_TRUNCATED, l);
@@ -734,45 +696,45 @@ static void io_error_gzip(void)
         s = s * 1664525u + 1013904223u;
         raw[i] = (unsigned char)((s >> 24) & 0x3f);
     }
-    z = io_gzip(raw, N, &zn);
+    z = gen_deflate(raw, N, 1, &zn);
     CHECK(z != NULL && zn > 200);
     if (!z) return;
     /* cut in the middle of the deflate data */
-    b = io_nrrd(header, z, zn / 2, &n);
+    b = gen_cat(header, z, zn / 2, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_GZIP, l);
     CHECK(v.data == NULL);
     free(b);
     /* all data there but the 8-byte trailer (CRC, size) cut */
-    b = io_nrrd(header, z, zn - 4, &n);
+    b = gen_cat(header, z, zn - 4, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_GZIP, l);
     free(b);
     /* a wrong CRC */
-    b = io_nrrd(header, z, zn, &n);
+    b = gen_cat(header, z, zn, &n);
     b[n - 6] ^= 0x55;
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_GZIP, l);
     free(b);
     /* garbage instead of a gzip stream */
-    b = io_nrrd(header, raw, 500, &n);
+    b = gen_cat(header, raw, 500, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_GZIP, l);
     free(b);
     /* a corrupt byte inside the deflate data */
-    b = io_nrrd(header, z, zn, &n);
+    b = gen_cat(header, z, zn, &n);
     for (i = n - zn + 20; i < n - zn + 40; ++i) b[i] ^= 0xa5;
     r = io_parse_both(b, n, &v, &l);
     CHECK_MSG(r == HD_ERROR_GZIP, "got %s", hd_result_string(r));
     free(b);
     /* a complete stream that holds less than the header claims */
-    b = io_nrrd("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 64 64 9\nencoding: gzip\n\n", z, zn,
+    b = gen_cat("NRRD0004\ntype: uchar\ndimension: 3\nsizes: 64 64 9\nencoding: gzip\n\n", z, zn,
                 &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_FILE_TRUNCATED, l);
     free(b);
     /* a header claiming far more than any stream of this size can hold: refused unallocated */
-    b = io_nrrd("NRRD0004\ntype: double\ndimension: 3\nsizes: 8192 8192 8192\nendian: big\n"
+    b = gen_cat("NRRD0004\ntype: double\ndimension: 3\nsizes: 8192 8192 8192\nendian: big\n"
                 "encoding: gzip\n\n", z, zn, &n);
     r = io_parse_both(b, n, &v, &l);
     IO_EXPECT(r, HD_ERROR_FILE_TRUNCATED, l);
@@ -793,13 +755,13 @@ static void io_nrrd_hostile(void)
     const char *hdr_gz = "NRRD0004\ntype: int16\ndimension: 3\nsizes: 5 4 3\n"
                          "space directions: (1,0,0) (0,1,0) (0,0,1)\nbyte skip: 2\n"
                          "endian: big\nencoding: gzip\n\n";
-    for (i = 0; i < 60; ++i) io_put(data + 2 * i, (uint16_t)vals[i], 2, 0);
-    files[0] = io_nrrd(hdr_raw, data, sizeof data, &sizes[0]);
+    for (i = 0; i < 60; ++i) gen_put(data + 2 * i, (uint16_t)vals[i], 2, 0);
+    files[0] = gen_cat(hdr_raw, data, sizeof data, &sizes[0]);
     memset(gz, 0xab, 2); /* the 2 bytes the gzip header skips */
     memcpy(gz + 2, data, sizeof data);
-    z = io_gzip(gz, sizeof gz, &zn);
-    files[1] = io_nrrd(hdr_gz, z, zn, &sizes[1]);
-    files[2] = io_nrrd("NRRD0004\ntype: uchar\ndimension: 2\nsizes: 10 6\nencoding: raw\n\n", data,
+    z = gen_deflate(gz, sizeof gz, 1, &zn);
+    files[1] = gen_cat(hdr_gz, z, zn, &sizes[1]);
+    files[2] = gen_cat("NRRD0004\ntype: uchar\ndimension: 2\nsizes: 10 6\nencoding: raw\n\n", data,
                        60, &sizes[2]);
     free(z);
     for (f = 0; f < 3; ++f) {
