@@ -7,7 +7,9 @@
 #   make test-vulkan                    tests/vulkan: messenger fires, caller-owned device and
 #                                       recording, out-of-device-memory and destroy
 #   make compile-vulkan-cxx             the Vulkan implementation as C++17, warnings as errors
-#   make bench-vulkan                   build/hdbench_vulkan on the head CT (make data)
+#   make bench-vulkan                   build/hdbench_vulkan on the head CT (make data): the
+#                                       sweep against a plain stencil (image3D, SSBO, C), then
+#                                       it/s per method; BENCH_ARGS=--sweeps for the first part
 # Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 VK_LDLIBS := -lvulkan
 VK_CONF := tests/conformance
@@ -40,10 +42,14 @@ test-vulkan: $(B)/test_vulkan
 compile-vulkan-cxx: | $(B)
 	$(CXX) $(CPPFLAGS) $(VK_CXXWARN) -O1 -x c++ -c $(VK_CONF)/impl_vk.c -o $(B)/conf_impl_vk_cxx.o
 
-$(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
+# the benchmark's own stencil shaders, compiled here (glslangValidator) rather than committed
+$(B)/hdbench_vulkan_spirv.h: bench/hdbench_stencil.comp scripts/build-spirv | $(B)
+	scripts/build-spirv --bench $@
+
+$(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(B)/hdbench_vulkan_spirv.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
 
 bench-vulkan: $(B)/hdbench_vulkan data
-	$(B)/hdbench_vulkan
+	$(B)/hdbench_vulkan data/head.nrrd 2 $(BENCH_ARGS)
 
 test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx
