@@ -7,7 +7,11 @@
    accumulation) stay storage buffers, indexed by HD_GET1 / HD_SET1.
    Set 0: binding 0 the parameter block (hd_prelude_glsl.h, a dynamic uniform buffer), 1 volume,
    2 TF, 3 majorants, 4 sigma_t, 5 E, 6 phi, 7 phi2, 8 image, 9 light volume read, 10 light
-   volume written. Push constants: x = red-black parity, y = Jacobi, z = light, w = first. */
+   volume written. Push constants: x = red-black parity, y = Jacobi, z = light, w = first.
+   Specialization constant 0, hd_sc_flags: in the diffusion module, the flags word (counts.z) as
+   a constant fixed when hd_vulkan.h makes the pipeline, one per flags value, read by the kernel
+   through HD_DIFFUSE_FLAGS: lavapipe runs both sides of every branch, so a flag tested at run
+   time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT). */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
@@ -20,6 +24,10 @@ layout(std430, binding = 8) buffer hd_b_img { float img[]; };
 layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 10, r32f) uniform image3D hd_i_lv2;
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
+layout(constant_id = 0) const int hd_sc_flags = 0;
+#if HD_STAGE == 3 /* HD_STAGE_DIFFUSE (hd_entry_glsl.h); the other stages read counts.z */
+#define HD_DIFFUSE_FLAGS hd_sc_flags
+#endif
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))
 #define HD_GET1(buf, i) buf[(i)]

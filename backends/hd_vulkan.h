@@ -86,6 +86,7 @@ typedef struct hd__vk_fns {
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
+#define HD__VK_DIFFUSE_VARIANTS 32 /* diffusion pipelines per context, one per flags value (16 today) */
 #define HD__VK_BINDINGS 11
 
 typedef struct hd__vk_buffer {
@@ -126,7 +127,10 @@ struct hd__backend {
     /* pipelines and bindings */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
-    VkPipeline pipelines[HD__VK_PIPELINE_COUNT];
+    VkPipeline pipelines[HD__VK_PIPELINE_COUNT]; /* [HD__VK_DIFFUSE] unused: see diffuse */
+    VkPipeline diffuse[HD__VK_DIFFUSE_VARIANTS];  /* the diffusion stage specialized for flags diffuse_flags[i] */
+    int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS];
+    int ndiffuse;
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -691,6 +695,68 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
 }
 
 /* ---- pipelines -------------------------------------------------------------------------------- */
+/* Pipeline of stage p from its SPIR-V. The diffusion stage's is specialized: its specialization
+   constant hd_sc_flags (constant_id 0, hd_bind_vk_glsl.h) is the flags word, so the kernels'
+   branches on the flags (RGB scattering, boundary condition) fold away at pipeline creation.
+   Lavapipe executes both sides of every branch, uniform ones included, so each flag left to a
+   run-time test makes every voxel pay for the paths it does not take. */
+static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, VkPipeline *out)
+{
+    hd__backend *be = ctx->be;
+    static const uint32_t *const code[HD__VK_PIPELINE_COUNT] = {hd__spv_classify, hd__spv_direct, hd__spv_diffuse,
+        hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path};
+    static const size_t size[HD__VK_PIPELINE_COUNT] = {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse,
+        sizeof hd__spv_project, sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path};
+    VkSpecializationMapEntry sme;
+    VkSpecializationInfo spec;
+    VkShaderModuleCreateInfo smci;
+    VkComputePipelineCreateInfo cpci;
+    VkShaderModule sm;
+    VkResult e;
+    sme.constantID = 0;
+    sme.offset = 0;
+    sme.size = sizeof flags;
+    spec.mapEntryCount = 1;
+    spec.pMapEntries = &sme;
+    spec.dataSize = sizeof flags;
+    spec.pData = &flags;
+    memset(&smci, 0, sizeof smci);
+    smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    smci.codeSize = size[p];
+    smci.pCode = code[p];
+    HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpci.stage.module = sm;
+    cpci.stage.pName = "main";
+    cpci.stage.pSpecializationInfo = p == HD__VK_DIFFUSE ? &spec : NULL;
+    cpci.layout = be->layout;
+    e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, out);
+    be->fn.vkDestroyShaderModule(be->device, sm, NULL);
+    if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
+    return HD_SUCCESS;
+}
+
+/* The diffusion pipeline for the current flags, made on first use and kept until hd_destroy
+   (a command buffer recorded by hd_vulkan_record may still name an older one). */
+static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, VkPipeline *out)
+{
+    hd__backend *be = ctx->be;
+    int32_t flags = ctx->kp.counts.z;
+    hd_result r;
+    int i;
+    for (i = 0; i < be->ndiffuse; ++i)
+        if (be->diffuse_flags[i] == flags) { *out = be->diffuse[i]; return HD_SUCCESS; }
+    if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag combinations for the diffusion stage", HD__VK_DIFFUSE_VARIANTS);
+    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+    be->diffuse_flags[be->ndiffuse] = flags;
+    *out = be->diffuse[be->ndiffuse++];
+    return HD_SUCCESS;
+}
+
 static hd_result hd__vk_pipelines(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -699,22 +765,14 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-    const uint32_t *code[HD__VK_PIPELINE_COUNT];
-    size_t size[HD__VK_PIPELINE_COUNT];
     VkDescriptorSetLayoutBinding b[HD__VK_BINDINGS];
     VkDescriptorSetLayoutCreateInfo lci;
     VkPushConstantRange pcr;
     VkPipelineLayoutCreateInfo plci;
     VkDescriptorPoolSize ps[3];
     VkDescriptorPoolCreateInfo dpci;
+    hd_result r;
     int i;
-    code[HD__VK_CLASSIFY] = hd__spv_classify; size[HD__VK_CLASSIFY] = sizeof hd__spv_classify;
-    code[HD__VK_DIRECT] = hd__spv_direct; size[HD__VK_DIRECT] = sizeof hd__spv_direct;
-    code[HD__VK_DIFFUSE] = hd__spv_diffuse; size[HD__VK_DIFFUSE] = sizeof hd__spv_diffuse;
-    code[HD__VK_PROJECT] = hd__spv_project; size[HD__VK_PROJECT] = sizeof hd__spv_project;
-    code[HD__VK_CONVECT] = hd__spv_convect; size[HD__VK_CONVECT] = sizeof hd__spv_convect;
-    code[HD__VK_SUM_LIGHT] = hd__spv_sum_light; size[HD__VK_SUM_LIGHT] = sizeof hd__spv_sum_light;
-    code[HD__VK_PATH] = hd__spv_path; size[HD__VK_PATH] = sizeof hd__spv_path;
     memset(b, 0, sizeof b);
     for (i = 0; i < HD__VK_BINDINGS; ++i) {
         b[i].binding = (uint32_t)i;
@@ -737,27 +795,8 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
     plci.pushConstantRangeCount = 1;
     plci.pPushConstantRanges = &pcr;
     HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &be->layout), "vkCreatePipelineLayout");
-    for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) {
-        VkShaderModuleCreateInfo smci;
-        VkComputePipelineCreateInfo cpci;
-        VkShaderModule sm;
-        VkResult e;
-        memset(&smci, 0, sizeof smci);
-        smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-        smci.codeSize = size[i];
-        smci.pCode = code[i];
-        HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
-        memset(&cpci, 0, sizeof cpci);
-        cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-        cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-        cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-        cpci.stage.module = sm;
-        cpci.stage.pName = "main";
-        cpci.layout = be->layout;
-        e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, &be->pipelines[i]);
-        be->fn.vkDestroyShaderModule(be->device, sm, NULL);
-        if (e < 0) { be->pipelines[i] = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
-    }
+    for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
+        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
     ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 3 * HD_MAX_LIGHTS;
@@ -866,9 +905,9 @@ static hd_result hd__vk_params(hd__ctx *ctx, uint32_t *offset)
     return HD_SUCCESS;
 }
 
-/* Records one dispatch of pipeline p over groups of 64 x 1 x 1 covering nx x ny x nz, with the
-   given set and push constants, after a barrier. */
-static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, int p, int set, int nx, int ny, int nz,
+/* Records one dispatch of pipeline pipe over groups of 64 x 1 x 1 covering nx x ny x nz, with
+   the given set and push constants, after a barrier. */
+static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pipe, int set, int nx, int ny, int nz,
                                  int pc0, int pc1, int pc2, int pc3)
 {
     hd__backend *be = ctx->be;
@@ -879,7 +918,7 @@ static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, int p, int se
     if ((r = hd__vk_params(ctx, &offset)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
     hd__vk_barrier(be, cb);
-    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->pipelines[p]);
+    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
     be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->layout, 0, 1, &be->sets[set], 1, &offset);
     be->fn.vkCmdPushConstants(cb, be->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
     be->fn.vkCmdDispatch(cb, ((uint32_t)nx + HD__VK_LOCAL_X - 1) / HD__VK_LOCAL_X, (uint32_t)ny, (uint32_t)nz);
@@ -928,6 +967,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
+        for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
         if (be->set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, be->set_layout, NULL);
@@ -1123,7 +1163,7 @@ static hd_result hd__be_classify(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CLASSIFY], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1132,7 +1172,7 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIRECT, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_DIRECT], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1145,14 +1185,16 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     int nz = ctx->gdims[2] * ctx->channels;
+    VkPipeline pipe;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_diffuse_pipeline(ctx, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
-        if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIFFUSE, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
         hd__vk_copy_image(be, cb, &be->phi2, &be->phi);
     } else {
         int parity;
         for (parity = 0; parity < 2; ++parity)
-            if ((r = hd__vk_dispatch(ctx, cb, HD__VK_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
+            if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
                 return r;
     }
     return hd__vk_flush(ctx);
@@ -1163,7 +1205,7 @@ static hd_result hd__be_project(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_PROJECT], 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1233,7 +1275,7 @@ static hd_result hd__be_convect(hd__ctx *ctx, int light)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_CONVECT, light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
+    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CONVECT], light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
         return r;
     hd__vk_copy_image(be, cb, &be->lv[be->nlv], &be->lv[light]);
     return hd__vk_flush(ctx);
@@ -1247,7 +1289,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     int l;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     for (l = 0; l < ctx->be->nlv; ++l)
-        if ((r = hd__vk_dispatch(ctx, cb, HD__VK_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+        if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_SUM_LIGHT], l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return hd__vk_flush(ctx);
 }
@@ -1258,7 +1300,7 @@ static hd_result hd__be_path(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, HD__VK_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_PATH], 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
