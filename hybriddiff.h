@@ -155,6 +155,12 @@ typedef enum hd_solver {
     HD_SOLVER_COUNT
 } hd_solver;
 
+typedef enum hd_boundary {
+    HD_BOUNDARY_BOX = 0,     /* phi = 0 outside the volume box (METHOD.md's convention) */
+    HD_BOUNDARY_SURFACE,     /* Marshak vacuum condition at the medium's surface */
+    HD_BOUNDARY_COUNT
+} hd_boundary;
+
 typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_log_level;
 
 typedef enum hd_illumination {
@@ -246,6 +252,11 @@ typedef struct hd_params {
                                deep takes the colour shift PT_MS shows (3 channels of E and phi and
                                a colour grid: +28 bytes per voxel). 0 (default): grey diffusion,
                                tinted once at projection, as in the paper. */
+    hd_boundary diffusion_boundary; /* where the diffusion's vacuum is: HD_BOUNDARY_BOX (default,
+                               METHOD.md: phi = 0 outside the volume box, empty voxels solved
+                               with a floored D, so air drains light) or HD_BOUNDARY_SURFACE
+                               (empty voxels hold phi = 0 and the medium's surface carries the
+                               Marshak vacuum condition; closer to PT_MS, see docs/EVALUATION.md) */
 } hd_params;
 
 typedef struct hd_desc {
@@ -313,7 +324,8 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
 /* Setters invalidate only what depends on them:
      transfer function, extinction, majorant   -> majorant grid, E, phi, image
      lights, seed                              -> E, phi, image
-     albedo, anisotropy, disable_diffusion     -> phi, image
+     albedo, anisotropy, disable_diffusion,
+     diffusion_boundary                        -> phi, image
      camera, step, background, frame_window    -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering  -> E, phi, image (new grids)

@@ -256,6 +256,14 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
    arithmetic is thrown away, still a 5x gain. Same function, same operations: the same bits as
    hd_diffuse_row. Edge rows and the two end voxels take the general path. */
 #define HD__CPU_ROW_MAX 8192
+/* The interior voxels of the row through `terms` (box or surface boundary) with rgb a literal. */
+#define HD__CPU_ROW_LOOP(terms, rgb)                                                             \
+    do {                                                                                        \
+        for (x = 1; x < gx - 1; ++x) {                                                          \
+            float den_, num_ = terms(K, x, y, z, c, 1, 1, 1, 1, 1, 1, rgb, &den_);               \
+            row[x] = num_ / den_;                                                               \
+        }                                                                                       \
+    } while (0)
 static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
 {
     const hd__kctx *K = &be->k;
@@ -267,17 +275,13 @@ static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
         return;
     }
     /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them.
-       The RGB-scattering flag is a literal in each loop, so neither keeps a branch. */
-    if (be->ctx->params.rgb_scattering) {
-        for (x = 1; x < gx - 1; ++x) {
-            float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, &den);
-            row[x] = num / den;
-        }
+       The RGB-scattering flag and the boundary are literals in each loop, so none keeps a test. */
+    if (!(K->p->counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+        if (be->ctx->params.rgb_scattering) HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1);
+        else HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0);
     } else {
-        for (x = 1; x < gx - 1; ++x) {
-            float den, num = hd_diffuse_terms_at(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 0, &den);
-            row[x] = num / den;
-        }
+        if (be->ctx->params.rgb_scattering) HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1);
+        else HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0);
     }
     {
         float den, num = hd_diffuse_terms(K, 0, y, z, c, &den);

@@ -163,6 +163,7 @@ static void *xmalloc(size_t n)
 /* ---- contexts ------------------------------------------------------------------------------------- */
 static int g_downsample = 1; /* params.illumination_downsample of HD and CD contexts */
 static int g_rgb = 0;        /* params.rgb_scattering of HD and CD contexts */
+static hd_boundary g_boundary = HD_BOUNDARY_BOX; /* params.diffusion_boundary of HD and CD contexts */
 
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
 {
@@ -202,6 +203,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.max_bounces = S.max_bounces;
     d.params.illumination_downsample = g_downsample;
     d.params.rgb_scattering = g_rgb;
+    d.params.diffusion_boundary = g_boundary;
     d.threads = S.threads;
     d.logger.func = hd_log_stderr;
     r = hd_create(&d, &ctx);
@@ -798,24 +800,37 @@ static void run_downsample_study(const ref_img *ref, const char *out)
     free(img);
 }
 
-/* Beyond the paper: HD with grey diffusion (the paper) against RGB scattering, both against the
-   1-light PT_MS reference, at the scene's HD iteration count and at 4x it; rgb.md, rgb-checks
-   lines and the side-by-side figure rgb_scattering.png (grey HD | RGB HD | PT_MS). */
+/* Beyond the paper: HD's diffusion variants against the 1-light PT_MS reference, at the scene's HD
+   iteration count and at 4x it: grey (the paper) and RGB scattering, each with the box boundary
+   (METHOD.md) and the surface (Marshak) boundary. rgb.md, rgb-checks lines, the mean radiance of
+   each image against the reference's (the diffusion's energy balance), and the side-by-side
+   figure rgb_scattering.png (the four variants, then PT_MS). */
+static double mean_radiance(const float *img, size_t npix)
+{
+    double s = 0.0;
+    size_t i;
+    for (i = 0; i < npix; ++i) s += (double)img[4 * i] + img[4 * i + 1] + img[4 * i + 2];
+    return s / (3.0 * (double)npix);
+}
+
 static void run_rgb_study(const ref_img *ref, const char *out)
 {
     size_t npix = (size_t)S.size * S.size;
-    float *img[2];
-    const float *tiles[3];
+    float *img[4];
+    const float *tiles[5];
     int k, n = S.iterations[HDE_HD];
+    double ref_mean = mean_radiance(ref->lin, npix);
     FILE *md = open_w(out, "rgb.md", NULL);
-    fprintf(md, "| diffusion | state bytes per voxel | PSNR vs PT_MS after %d it | lit part | after %d it | lit part |\n"
-                "|---|---|---|---|---|---|\n", n, 4 * n);
-    for (k = 0; k < 2; ++k) {
+    fprintf(md, "| diffusion | boundary | state bytes per voxel | mean radiance / PT_MS's | PSNR vs PT_MS after %d it | lit part | after %d it | lit part |\n"
+                "|---|---|---|---|---|---|---|---|\n", n, 4 * n);
+    for (k = 0; k < 4; ++k) {
         hd_context ctx;
         hd_stats st;
         err2 e1, e4;
+        double mean;
         img[k] = (float *)xmalloc(npix * 4 * sizeof(float));
-        g_rgb = k;
+        g_rgb = k & 1;
+        g_boundary = k >= 2 ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
         ctx = make_ctx(HDE_HD, 1, S.size, 1u);
         iterate(ctx, n);
         read_image(ctx, img[k], S.size);
@@ -823,22 +838,24 @@ static void run_rgb_study(const ref_img *ref, const char *out)
         iterate(ctx, 3 * n);
         read_image(ctx, img[k], S.size);
         e4 = compare(img[k], ref, npix);
+        mean = mean_radiance(img[k], npix) / ref_mean;
         if (hd_get_stats(ctx, &st) != HD_SUCCESS) die("hd_get_stats");
-        fprintf(md, "| %s | %.1f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", k ? "RGB" : "grey",
+        fprintf(md, "| %s | %s | %.1f | %.3f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", g_rgb ? "RGB" : "grey",
+                k >= 2 ? "surface" : "box",
                 (double)st.method_bytes / ((double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2]),
-                psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
-        check_line("rgb_scattering %d: PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, %.2f dB (lit %.2f) after %d it",
-                   k, psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
+                mean, psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
+        check_line("rgb_scattering %d, boundary %s: mean radiance %.3f x PT_MS, PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, "
+                   "%.2f dB (lit %.2f) after %d it", g_rgb, k >= 2 ? "surface" : "box", mean, psnr(e1.mse),
+                   psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
         hd_destroy(ctx);
     }
     g_rgb = 0;
+    g_boundary = HD_BOUNDARY_BOX;
     fclose(md);
-    tiles[0] = img[0];
-    tiles[1] = img[1];
-    tiles[2] = ref->lin;
-    write_grid(out, "rgb_scattering.png", tiles, 3, 1);
-    free(img[0]);
-    free(img[1]);
+    for (k = 0; k < 4; ++k) tiles[k] = img[k];
+    tiles[4] = ref->lin;
+    write_grid(out, "rgb_scattering.png", tiles, 5, 1);
+    for (k = 0; k < 4; ++k) free(img[k]);
 }
 
 static const char *usage =
@@ -854,8 +871,9 @@ static const char *usage =
     "  --skip-table    no Table 1 (quality only)\n"
     "  --downsample-study  only HD with its illumination at 1/1, 1/2, 1/4 resolution against the\n"
     "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n"
-    "  --rgb-study     only HD with grey against RGB scattering, against the 1-light PT_MS\n"
-    "                  reference (OUT/rgb.md, OUT/rgb_scattering.png), then stop\n";
+    "  --rgb-study     only HD with grey and RGB scattering, each with the box and the surface\n"
+    "                  boundary, against the 1-light PT_MS reference (OUT/rgb.md,\n"
+    "                  OUT/rgb_scattering.png), then stop\n";
 
 int main(int argc, char **argv)
 {

@@ -70,7 +70,9 @@ static const char *usage_text =
     "  --up X,Y,Z              up direction (default 0,0,1)\n"
     "  --fov DEG               vertical field of view (default 37)\n"
     "  --size WxH              image size (default 512x512)\n"
-    "\n"
+    "\n";
+/* the rest of --help (one string would exceed the 4095 characters C99 guarantees) */
+static const char *usage_text_method =
     "method\n"
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
     "  --iterations N          progressive iterations (default 24; 256 for pt_ss, pt_ms,\n"
@@ -82,6 +84,8 @@ static const char *usage_text =
     "  --sweeps N              diffusion solver sweeps per iteration (default 4)\n"
     "  --solver rb|jacobi      diffusion solver (default rb: red-black Gauss-Seidel)\n"
     "  --tracking ratio|delta  transmittance estimator (default ratio)\n"
+    "  --boundary box|surface  the diffusion's vacuum: phi = 0 outside the volume box (default,\n"
+    "                          the paper's), or the Marshak condition at the medium's surface\n"
     "  --no-diffusion          direct light only (single scattering)\n"
     "  --seed N                random seed (default 0)\n"
     "  --threads N             CPU threads, 0 = all cores (default 0)\n"
@@ -438,6 +442,7 @@ int main(int argc, char **argv)
 #define FLAG() do { if (eq) fail(2, "%s takes no value", a); } while (0)
         if (IS("-h") || IS("--help")) {
             fputs(usage_text, stdout);
+            fputs(usage_text_method, stdout);
             return 0;
         } else if (IS("--raw")) {
             raw = VAL();
@@ -519,6 +524,11 @@ int main(int argc, char **argv)
             if (strcmp(v, "ratio") == 0) desc.params.tracking = HD_TRACKING_RATIO;
             else if (strcmp(v, "delta") == 0) desc.params.tracking = HD_TRACKING_DELTA;
             else fail(2, "--tracking: '%s' is not ratio or delta", v);
+        } else if (IS("--boundary")) {
+            VAL();
+            if (strcmp(v, "box") == 0) desc.params.diffusion_boundary = HD_BOUNDARY_BOX;
+            else if (strcmp(v, "surface") == 0) desc.params.diffusion_boundary = HD_BOUNDARY_SURFACE;
+            else fail(2, "--boundary: '%s' is not box or surface", v);
         } else if (IS("--no-diffusion")) {
             FLAG();
             desc.params.disable_diffusion = 1;

@@ -12,7 +12,7 @@
      L         1 / 3 lights                        E / shift+E   extinction x1.25 / /1.25
      A / shift+A  albedo +0.05 / -0.05             R   restart     S   screenshot (hdview-N.png)
      H         the default camera                  G   illumination grid 1/1 -> 1/2 -> 1/4 resolution
-     C         grey / RGB multiple scattering
+     C         grey / RGB multiple scattering         B   diffusion boundary: box / surface
      Esc / Q   quit
    The title shows the method, iterations, iterations/s and the bytes the method holds.
 
@@ -259,6 +259,10 @@ static void key_char(viewer *v, int c)
     case 'r': case 'R': restart(v); break;
     case 'h': case 'H': camera_default(v); break;
     case 'c': case 'C': v->params.rgb_scattering = !v->params.rgb_scattering; apply_params(v); break;
+    case 'b': case 'B':
+        v->params.diffusion_boundary = v->params.diffusion_boundary == HD_BOUNDARY_BOX ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+        apply_params(v);
+        break;
     case 'g': case 'G': /* params.illumination_downsample: 8x less memory per step */
         v->params.illumination_downsample = v->params.illumination_downsample >= 4 ? 1 : v->params.illumination_downsample * 2;
         apply_params(v);

@@ -242,7 +242,8 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->counts.y = ctx->params.tracking == HD_TRACKING_DELTA ? HD_TRACK_DELTA : HD_TRACK_RATIO;
     k->counts.z = (ctx->params.majorant > 0.0f ? HD_FLAG_GLOBAL_MAJORANT : 0) |
                   (ctx->params.disable_diffusion ? HD_FLAG_NO_DIFFUSION : 0) |
-                  (ctx->params.rgb_scattering ? HD_FLAG_RGB_SCATTERING : 0);
+                  (ctx->params.rgb_scattering ? HD_FLAG_RGB_SCATTERING : 0) |
+                  (ctx->params.diffusion_boundary == HD_BOUNDARY_SURFACE ? HD_FLAG_SURFACE_BOUNDARY : 0);
     /* PT_SS is the path kernel with one vertex and the isotropic phase (hd_k_path.h) */
     k->counts.w = ctx->params.method == HD_METHOD_PT_SS ? 1 : ctx->params.max_bounces;
     k->frame.x = (int32_t)ctx->iterations;
@@ -256,6 +257,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
     for (i = 0; i < 3; ++i) {
         float h = ctx->box[i] / (float)ctx->gdims[i];
         (&k->grid.x)[i] = 1.0f / (h * h);
+        (&k->gridh.x)[i] = h;
     }
     k->grid.w = 1e-3f; /* sigma' floor: keeps D finite in empty space */
     {
@@ -476,7 +478,8 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
     if (p.extinction != o->extinction || p.majorant != o->majorant)
         ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     if (p.seed != o->seed) ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
-    if (p.albedo != o->albedo || p.anisotropy != o->anisotropy || p.disable_diffusion != o->disable_diffusion)
+    if (p.albedo != o->albedo || p.anisotropy != o->anisotropy || p.disable_diffusion != o->disable_diffusion ||
+        p.diffusion_boundary != o->diffusion_boundary)
         ctx->dirty |= HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     if (p.step != o->step || p.frame_window != o->frame_window ||
         memcmp(p.background, o->background, sizeof p.background) != 0)

@@ -150,6 +150,8 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.illumination_downsample = %d is outside 1..8", p->illumination_downsample);
     if (p->rgb_scattering != 0 && p->rgb_scattering != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.rgb_scattering = %d must be 0 or 1", p->rgb_scattering);
+    if ((int)p->diffusion_boundary < 0 || (int)p->diffusion_boundary >= (int)HD_BOUNDARY_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_boundary = %d is not an hd_boundary", (int)p->diffusion_boundary);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
 #ifndef HD__BE_HAS_CD

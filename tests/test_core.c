@@ -159,6 +159,15 @@ static void test_invalidation(void)
     CHECK(memcmp(E0, E1, n * 4) == 0);
     CHECK(P1[n / 2 + N / 2] == 0.0f && P0[n / 2 + N / 2] != 0.0f);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 4 && s.frames == 0);
+    /* the diffusion boundary: phi and the image restart, E is kept */
+    CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
+    read_both(ctx, E0, P0, n);
+    p.diffusion_boundary = HD_BOUNDARY_SURFACE;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    read_both(ctx, E1, P1, n);
+    CHECK(memcmp(E0, E1, n * 4) == 0);
+    CHECK(P1[n / 2 + N / 2] == 0.0f && P0[n / 2 + N / 2] != 0.0f);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 6 && s.frames == 0);
     /* solver, sweeps and exposure change nothing */
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
     read_both(ctx, E0, P0, n);
@@ -166,7 +175,7 @@ static void test_invalidation(void)
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     read_both(ctx, E1, P1, n);
     CHECK(memcmp(E0, E1, n * 4) == 0 && memcmp(P0, P1, n * 4) == 0);
-    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 6 && s.frames == 2);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 8 && s.frames == 2);
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS); /* Jacobi runs from the kept phi */
     /* lights: E restarts */
     memset(l, 0, sizeof l);
@@ -310,6 +319,7 @@ static void m_bad_method(hd_desc *d) { d->params.method = (hd_method)42; }
 static void m_bad_downsample(hd_desc *d) { d->params.illumination_downsample = -2; }
 static void m_big_downsample(hd_desc *d) { d->params.illumination_downsample = 9; }
 static void m_bad_rgb(hd_desc *d) { d->params.rgb_scattering = 2; }
+static void m_bad_boundary(hd_desc *d) { d->params.diffusion_boundary = (hd_boundary)7; }
 static const float tf_nan[8] = {0, 0, 0, 0, 1, 1, 1, 1};
 static float tf_bad[8];
 static void m_tf_nan(hd_desc *d) { memcpy(tf_bad, tf_nan, sizeof tf_bad); tf_bad[7] = nan_f(); d->transfer_function.rgba = tf_bad; d->transfer_function.count = 2; }
@@ -349,6 +359,7 @@ static const bad_case bad_cases[] = {
     {"negative illumination_downsample", HD_ERROR_INVALID_PARAMETER, m_bad_downsample},
     {"illumination_downsample 9", HD_ERROR_INVALID_PARAMETER, m_big_downsample},
     {"rgb_scattering 2", HD_ERROR_INVALID_PARAMETER, m_bad_rgb},
+    {"diffusion_boundary 7", HD_ERROR_INVALID_PARAMETER, m_bad_boundary},
     {"NaN TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_nan},
     {"negative TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_neg},
     {"one TF entry", HD_ERROR_INVALID_TRANSFER_FUNCTION, m_tf_one},

@@ -11,6 +11,7 @@ HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = unused */
 HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / (4 pi) */
 HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
 HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */
+HD_PARAM_F4(gridh)      /* xyz = h of the illumination grid (world), w = unused */
 HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = unused */
 HD_PARAM_F4(cam_pos)    /* eye */
 HD_PARAM_F4(cam_u)      /* image right, scaled by tan(fov/2) * aspect */

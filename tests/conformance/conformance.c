@@ -401,9 +401,10 @@ static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed
     scene_free(&s);
 }
 
-/* HD on a coarser illumination grid (params.illumination_downsample) and/or with RGB
-   scattering (params.rgb_scattering): whole iterations. */
-static void case_downsample(hd_voxel_type type, const int *d, int factor, int rgb, int lights, int n)
+/* HD on a coarser illumination grid (params.illumination_downsample), with RGB scattering
+   (params.rgb_scattering) and/or the surface boundary (params.diffusion_boundary): whole
+   iterations. */
+static void case_downsample(hd_voxel_type type, const int *d, int factor, int rgb, int surface, int lights, int n)
 {
     scene s;
     guard g;
@@ -413,9 +414,10 @@ static void case_downsample(hd_voxel_type type, const int *d, int factor, int rg
     scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
     s.params.illumination_downsample = factor;
     s.params.rgb_scattering = rgb;
+    s.params.diffusion_boundary = surface ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
     guard_take(&g, &s);
-    snprintf(name, sizeof name, "iterate x%d %s %dx%dx%d %dL grid /%d%s", n, type_name(type), d[0], d[1], d[2], lights, factor,
-             rgb ? " rgb-scattering" : "");
+    snprintf(name, sizeof name, "iterate x%d %s %dx%dx%d %dL grid /%d%s%s", n, type_name(type), d[0], d[1], d[2], lights, factor,
+             rgb ? " rgb-scattering" : "", surface ? " surface-boundary" : "");
     if (pair_create(&p, &s)) {
         BOTH(&p, iterate, (p.ref, n), (p.dut, n));
         pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
@@ -510,10 +512,12 @@ int main(int argc, char **argv)
     case_iterate(HD_VOXEL_F32, odd, 16, 0, 1, CHANGE_CAMERA, 8);
     case_iterate(HD_VOXEL_U8, other, 3, 0, 1, CHANGE_CAMERA, 8);
     /* the baselines */
-    case_downsample(HD_VOXEL_U8, odd, 2, 0, 1, 8);
-    case_downsample(HD_VOXEL_F32, other, 3, 0, 3, 8);
-    case_downsample(HD_VOXEL_U16, odd, 1, 1, 3, 8);
-    case_downsample(HD_VOXEL_U8, other, 2, 1, 1, 8);
+    case_downsample(HD_VOXEL_U8, odd, 2, 0, 0, 1, 8);
+    case_downsample(HD_VOXEL_F32, other, 3, 0, 0, 3, 8);
+    case_downsample(HD_VOXEL_U16, odd, 1, 1, 0, 3, 8);
+    case_downsample(HD_VOXEL_U8, other, 2, 1, 0, 1, 8);
+    case_downsample(HD_VOXEL_U16, odd, 1, 0, 1, 1, 8);
+    case_downsample(HD_VOXEL_F32, other, 2, 1, 1, 3, 8);
     case_method(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 0, 0, 8);
     case_method(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 1, 1, 8);
     case_method(HD_METHOD_CD, HD_VOXEL_F32, other, 16, 0, 1, 4);
