@@ -14,6 +14,13 @@
      condition J = phi_s / 2 (no light enters from outside): conductance 1 / (h / (2D) + 2) per
      area, i.e. w = 1 / (h^2 / (2 D) + 2 h) = 1 / (1.5 sigma' h^2 + 2 h). */
 
+/* The flags word the diffusion tests (RGB scattering, boundary). A backend may define it as a
+   compile-time constant per pipeline (Vulkan: a specialization constant, hd_bind_vk_glsl.h), so
+   the untaken variant costs nothing where both sides of a branch would run. */
+#ifndef HD_DIFFUSE_FLAGS
+#define HD_DIFFUSE_FLAGS HD_PRM(counts).z
+#endif
+
 /* sigma' = sigma_t (1 - albedo g) of grid voxel j (image coordinates x, y, z) in channel c.
    With RGB scattering the albedo of channel c is albedo * TF colour_c(j), read from the sigma_t
    grid's channel 1 + c; otherwise ag = 1 - albedo g, the same for every voxel. */
@@ -140,11 +147,11 @@ HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in
 /* The update's numerator and denominator at (x, y, z) under the configured boundary. */
 HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) den)
 {
-    int rgb = (HD_PRM(counts).z & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
+    int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
     int in_xm = x > 0 ? 1 : 0, in_xp = x < HD_PRM(gdims).x - 1 ? 1 : 0;
     int in_ym = y > 0 ? 1 : 0, in_yp = y < HD_PRM(gdims).y - 1 ? 1 : 0;
     int in_zm = z > 0 ? 1 : 0, in_zp = z < HD_PRM(gdims).z - 1 ? 1 : 0;
-    if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0)
+    if ((HD_DIFFUSE_FLAGS & HD_FLAG_SURFACE_BOUNDARY) != 0)
         return hd_diffuse_terms_surface(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, den);
     return hd_diffuse_terms_box(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, den);
 }
