@@ -31,6 +31,9 @@
    (128 MiB on lavapipe), only by maxImageDimension3D per axis (channels stack along z).
    $HD_VK_MEMORY_LIMIT=bytes caps the device memory the backend allocates; an allocation above it
    fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
+   $HD_VK_LOSE_DEVICE=n makes the n-th queue submission since hd_create fail as
+   VK_ERROR_DEVICE_LOST instead of being submitted (the other test knob: the error path of a lost
+   device cannot be provoked on lavapipe).
    Errors: every VkResult below zero is logged with the failing call and becomes an hd_result
    (OUT_OF_DEVICE_MEMORY -> HD_ERROR_OUT_OF_DEVICE_MEMORY, DEVICE_LOST -> HD_ERROR_DEVICE_LOST,
    which sticks: later calls fail fast, hd_destroy still frees everything). */
@@ -148,6 +151,7 @@ struct hd__backend {
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
+    unsigned long submits, lose_at; /* queue submissions so far; HD_VK_LOSE_DEVICE (0: off) */
     int lost;
     unsigned long validation_messages;
 };
@@ -535,6 +539,7 @@ static hd_result hd__vk_flush(hd__ctx *ctx)
     si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
     si.commandBufferCount = 1;
     si.pCommandBuffers = &be->cmd;
+    if (++be->submits == be->lose_at) return hd__vk_fail(ctx, VK_ERROR_DEVICE_LOST, "vkQueueSubmit (HD_VK_LOSE_DEVICE)", __LINE__);
     HD__VK_TRY(ctx, be->fn.vkQueueSubmit(be->queue, 1, &si, be->fence), "vkQueueSubmit");
     e = be->fn.vkWaitForFences(be->device, 1, &be->fence, VK_TRUE, UINT64_MAX);
     if (e != VK_SUCCESS) return hd__vk_fail(ctx, e < 0 ? e : VK_ERROR_DEVICE_LOST, "vkWaitForFences", __LINE__);
@@ -991,7 +996,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     VkCommandPoolCreateInfo cpci;
     VkCommandBufferAllocateInfo cbai;
     VkFenceCreateInfo fci;
-    const char *limit = getenv("HD_VK_MEMORY_LIMIT");
+    const char *limit = getenv("HD_VK_MEMORY_LIMIT"), *lose = getenv("HD_VK_LOSE_DEVICE");
     const hd_desc *d = &ctx->desc;
     int caller = d->vulkan.instance || d->vulkan.physical_device || d->vulkan.device;
     be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
@@ -999,6 +1004,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     ctx->be = be;
     be->ctx = ctx;
     if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
+    if (lose && *lose) be->lose_at = strtoul(lose, NULL, 10);
     /* void* -> function pointer by memcpy: a cast is not ISO C */
     if (d->vulkan.get_instance_proc_addr) memcpy(&be->gipa, &d->vulkan.get_instance_proc_addr, sizeof be->gipa);
 #if !defined(HD_VK_NO_LOADER)

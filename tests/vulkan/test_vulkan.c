@@ -8,7 +8,11 @@
         as hd_iterate on a context of the backend's own, and no validation message;
      3. HD_VK_MEMORY_LIMIT provokes HD_ERROR_OUT_OF_DEVICE_MEMORY in hd_create and in hd_iterate;
         the contexts are destroyed without leaks (validation on: the layer reports objects left
-        alive at vkDestroyDevice / vkDestroyInstance as messages, and there must be none).
+        alive at vkDestroyDevice / vkDestroyInstance as messages, and there must be none);
+     4. HD_VK_LOSE_DEVICE=n turns the n-th queue submission into VK_ERROR_DEVICE_LOST: whether it
+        hits hd_create or hd_iterate, the call returns HD_ERROR_DEVICE_LOST with the failing call
+        logged, later calls fail fast with the same code, hd_destroy frees everything (validation
+        on, no message).
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
@@ -19,6 +23,7 @@ static int failures;
 static unsigned long messages;   /* "vulkan validation" lines from the library's logger */
 static unsigned long caller_messages; /* from the caller's own messenger (test 2) */
 static unsigned long gipa_calls;
+static char lost_log[512];    /* the last error logged that mentions VK_ERROR_DEVICE_LOST */
 
 #define CHECK(cond) \
     do { if (!(cond)) { ++failures; fprintf(stderr, "  %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
@@ -27,6 +32,7 @@ static void count_log(void *user, hd_log_level level, hd_result code, const char
 {
     (void)user; (void)code; (void)file; (void)line;
     if (strncmp(msg, "vulkan validation", 17) == 0) ++messages;
+    if (strstr(msg, "VK_ERROR_DEVICE_LOST")) snprintf(lost_log, sizeof lost_log, "%s", msg);
     if (level == HD_LOG_ERROR) fprintf(stderr, "  log: %s\n", msg);
 }
 
@@ -288,11 +294,52 @@ static void test_out_of_memory(void)
            ok ? "PASS" : "FAIL", messages);
 }
 
+/* 4: the device lost at submission n (1, 2: inside hd_create; later: inside hd_iterate). */
+static void test_device_lost(void)
+{
+    static const int at[] = {1, 2, 3, 5, 8, 12};
+    hd_desc d = test_desc();
+    hd_context h;
+    static float px[32 * 24 * 4];
+    int k, in_create = 0, in_iterate = 0, ok = 1;
+    char n[16];
+    d.vulkan.enable_validation = 1;
+    messages = 0;
+    for (k = 0; k < (int)(sizeof at / sizeof at[0]); ++k) {
+        hd_result r;
+        snprintf(n, sizeof n, "%d", at[k]);
+        setenv("HD_VK_LOSE_DEVICE", n, 1);
+        lost_log[0] = '\0';
+        r = hd_create(&d, &h);
+        if (r == HD_SUCCESS) {
+            r = hd_iterate(h, 2); /* two HD iterations submit more than 12 times */
+            ++in_iterate;
+            ok &= hd_iterate(h, 1) == HD_ERROR_DEVICE_LOST; /* sticky: fails fast */
+            ok &= hd_read_image_f32(h, px, sizeof px / sizeof px[0]) == HD_ERROR_DEVICE_LOST;
+            ok &= hd_destroy(h) == HD_SUCCESS;
+        } else {
+            ++in_create;
+        }
+        if (r != HD_ERROR_DEVICE_LOST || !strstr(lost_log, "vkQueueSubmit")) {
+            fprintf(stderr, "  HD_VK_LOSE_DEVICE=%d: %s, log \"%s\"\n", at[k], hd_result_string(r), lost_log);
+            ok = 0;
+        }
+    }
+    unsetenv("HD_VK_LOSE_DEVICE");
+    CHECK(ok);
+    CHECK(in_create > 0 && in_iterate > 0);
+    CHECK(messages == 0);
+    printf("%s device lost at submission 1..12: HD_ERROR_DEVICE_LOST from hd_create (%d) and hd_iterate (%d), logged with "
+           "vkQueueSubmit, sticky, destroyed with no object left (%lu validation messages)\n",
+           ok && in_create > 0 && in_iterate > 0 && messages == 0 ? "PASS" : "FAIL", in_create, in_iterate, messages);
+}
+
 int main(void)
 {
     if (test_messenger()) {
         test_caller_device();
         test_out_of_memory();
+        test_device_lost();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
