@@ -27,10 +27,14 @@
 #define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
 #define HD__BE_HAS_PT 1 /* hd__be_path */
 
-enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT, HD__CL_CONVECT, HD__CL_SUM_LIGHT,
-       HD__CL_PATH, HD__CL_KERNEL_COUNT };
+/* the eight diffusion kernels from HD__CL_DIFFUSE on, indexed by 4 * Jacobi + 2 * surface
+   boundary + RGB scattering */
+enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_DIFFUSE + 8, HD__CL_CONVECT,
+       HD__CL_SUM_LIGHT, HD__CL_PATH, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
-    "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_project", "hd_k_convect", "hd_k_sum_light", "hd_k_path"};
+    "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
+    "hd_k_diffuse_surface_rgb", "hd_k_diffuse_jacobi", "hd_k_diffuse_jacobi_rgb", "hd_k_diffuse_jacobi_surface",
+    "hd_k_diffuse_jacobi_surface_rgb", "hd_k_project", "hd_k_convect", "hd_k_sum_light", "hd_k_path"};
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -409,14 +413,19 @@ static hd_result hd__cl_bind(hd__ctx *ctx, int k)
     return HD_SUCCESS;
 }
 
-static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+static hd_result hd__cl_run_local(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz, const size_t *local)
 {
     size_t global[3];
     global[0] = gx; global[1] = gy; global[2] = gz;
     if (gx == 0 || gy == 0 || gz == 0) return HD_SUCCESS;
-    HD__CL_TRY(ctx, clEnqueueNDRangeKernel(ctx->be->queue, ctx->be->kernels[k], dims, NULL, global, NULL, 0, NULL, NULL),
+    HD__CL_TRY(ctx, clEnqueueNDRangeKernel(ctx->be->queue, ctx->be->kernels[k], dims, NULL, global, local, 0, NULL, NULL),
                hd__cl_kernel_names[k]);
     return HD_SUCCESS;
+}
+
+static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+{
+    return hd__cl_run_local(ctx, k, dims, gx, gy, gz, NULL);
 }
 
 static hd_result hd__be_classify(hd__ctx *ctx)
@@ -437,20 +446,26 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
+/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. Work-groups are
+   one x-row each (gx work-items): PoCL vectorises a work-group along x, and its own choice of
+   local size can cut a row into pieces as small as one item (it did for a prime row length).
+   A row longer than the kernel's largest work-group leaves the choice to the runtime. */
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
-    cl_kernel kd = be->kernels[HD__CL_DIFFUSE];
-    cl_int parity, jac = jacobi ? 1 : 0;
+    int k = HD__CL_DIFFUSE + (jacobi ? 4 : 0) + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) +
+            ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+    size_t gx = (size_t)ctx->gdims[0], local[3], wg = 0;
     hd_result r;
-    int pass;
-    if ((r = hd__cl_bind(ctx, HD__CL_DIFFUSE)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(kd, 10, sizeof jac, &jac), "clSetKernelArg(jacobi)");
-    for (pass = 0; pass < (jacobi ? 1 : 2); ++pass) {
-        parity = pass;
-        HD__CL_TRY(ctx, clSetKernelArg(kd, 9, sizeof parity, &parity), "clSetKernelArg(parity)");
-        if ((r = hd__cl_run(ctx, HD__CL_DIFFUSE, 3, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2], (size_t)ctx->channels)) != HD_SUCCESS)
+    cl_int parity;
+    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+               "clGetKernelWorkGroupInfo");
+    local[0] = gx; local[1] = 1; local[2] = 1;
+    for (parity = 0; parity < (jacobi ? 1 : 2); ++parity) {
+        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], 9, sizeof parity, &parity), "clSetKernelArg(parity)");
+        if ((r = hd__cl_run_local(ctx, k, 3, gx, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels,
+                                  gx <= wg ? local : NULL)) != HD_SUCCESS)
             return r;
     }
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }

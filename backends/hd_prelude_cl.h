@@ -3,7 +3,9 @@
    scripts/embed-kernels turns this file, the shared kernels and hd_entry_cl.h into string
    literals in hd_kernels_embedded.h, which hd_opencl.h compiles at run time. The host passes
    -DHD_MAX_LIGHTS=n, so the parameter block has one definition of its size. */
-#define HD_FN inline
+/* Forced inlining: PoCL's compiler left hd_diffuse_terms_at, hd_track and hd_sample_value as
+   calls, and a call in a work-item loop keeps it from vectorising that loop (the diffusion). */
+#define HD_FN inline __attribute__((always_inline))
 #define HD_LANG_CL 1
 /* The C reference does not fuse a*b+c (ISO C modes, -std=c99, default to -ffp-contract=off);
    OpenCL C would by default. Off, so the deterministic stages round exactly as the CPU does. */
@@ -96,12 +98,22 @@ typedef struct hd__kctx {
     __global float *img;
     __global const float *lv;   /* CD: the light volume being read */
     __global float *lv2;        /* CD: the light volume being written */
+    int flags;                  /* what the diffusion reads as HD_DIFFUSE_FLAGS */
+    size_t dx;                  /* 0, or the diffusion work-item's x: see HD_GET */
 } hd__kctx;
+
+/* The diffusion's flags come from K, so a kernel can make them literals (hd_entry_cl.h). */
+#define HD_DIFFUSE_FLAGS (K->flags)
 
 #define HD_KARGS const hd__kctx *K,
 #define HD_KPASS K,
 #define HD_PRM(name) (K->p->name)
-#define HD_GET(buf, i, x, y, z) (K->buf[(i)])
-#define HD_SET(buf, i, x, y, z, v) (K->buf[(i)] = (v))
+/* Grid reads and writes at (i) = (z * gy + y) * gx + x. K->dx is 0 except in the diffusion
+   kernels, where it is the work-item's x (as a 64-bit value): element i is then addressed as
+   (buf + dx)[i - x], the same element, but after the compiler cancels x from i the address is
+   affine in the work-item index and PoCL loads neighbours as vectors; through the shared 32-bit
+   index it gathered them one by one. */
+#define HD_GET(buf, i, x, y, z) ((K->buf + K->dx)[(i) - (int)K->dx])
+#define HD_SET(buf, i, x, y, z, v) ((K->buf + K->dx)[(i) - (int)K->dx] = (v))
 #define HD_GET1(buf, i) (K->buf[(i)])
 #define HD_SET1(buf, i, v) (K->buf[(i)] = (v))
