@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 typedef void (*hd__cpu_job)(hd__backend *be, int item);
+static void hd__cpu_mg_free(hd__ctx *ctx); /* hd_cpu_multigrid.h */
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -26,6 +27,9 @@ struct hd__backend {
     hd__kctx k;
     int parity, jacobi;      /* the diffusion pass being run */
     int row_group;           /* red-black: rows with (y + z) & 1 == row_group */
+    const struct hd__cpu_grid *grid; /* the grid the diffusion pass works on */
+    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    struct hd__cpu_mg *mg;   /* multigrid levels (hd_cpu_multigrid.h), NULL until first used */
     /* CD: one light volume per light plus one spare, rotated through them as the ping-pong */
     float **lv;
     int nlv;                 /* lights with a volume (the buffers are nlv + 1) */
@@ -117,6 +121,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         pthread_mutex_destroy(&be->mu);
     }
     hd__free(ctx, be->workers);
+    hd__cpu_mg_free(ctx);
     hd__free(ctx, be->sig);
     hd__free(ctx, be->E);
     hd__free(ctx, be->phi);
@@ -249,47 +254,70 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
     int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_direct_voxel(&be->k, x, r % gy, r / gy);
 }
-/* Rows inside the grid in y and z relax their interior voxels through a contiguous loop over a
-   row buffer: hd_diffuse_terms_at with literal in-grid flags has no branches, so the compiler
-   vectorises it (the strided red-black loop of hd_diffuse_row did not: 50 ms against 10 ms per
-   sweep on the head CT with AVX-512); red-black then copies back one colour, so half the row's
-   arithmetic is thrown away, still a 5x gain. Same function, same operations: the same bits as
-   hd_diffuse_row. Edge rows and the two end voxels take the general path. */
+/* ---- diffusion -------------------------------------------------------------------------------
+   A pass works on be->grid: the illumination grid itself, or a multigrid level
+   (hd_cpu_multigrid.h), each with its own kernel context (parameters and buffers).
+   Rows inside the grid in y and z relax their interior voxels through a contiguous loop over a
+   row buffer: hd_diffuse_terms_box / _surface with literal in-grid flags have no branches, so
+   the compiler vectorises them (the strided red-black loop of hd_diffuse_row did not: 50 ms
+   against 10 ms per sweep on the head CT with AVX-512); red-black then copies back one colour,
+   so half the row's arithmetic is thrown away, still a 5x gain. Same function, same operations:
+   the same bits as hd_diffuse_row. Edge rows and the two end voxels take the general path. */
 #define HD__CPU_ROW_MAX 8192
-/* The interior voxels of the row through `terms` (box or surface boundary) with rgb a literal. */
-#define HD__CPU_ROW_LOOP(terms, rgb)                                                             \
+/* The interior voxels of the row through `terms` with rgb and rhs literals; row[x] = expr of
+   num_ and den_. */
+#define HD__CPU_ROW_LOOP(terms, rgb, rhs, expr)                                                  \
     do {                                                                                        \
         for (x = 1; x < gx - 1; ++x) {                                                          \
-            float den_, num_ = terms(K, x, y, z, c, 1, 1, 1, 1, 1, 1, rgb, &den_);               \
-            row[x] = num_ / den_;                                                               \
+            float den_, num_ = terms(K, x, y, z, c, 1, 1, 1, 1, 1, 1, rgb, rhs, &den_);          \
+            row[x] = (expr);                                                                    \
         }                                                                                       \
     } while (0)
+/* The loop for the grid's flags: each combination a loop of its own, so none keeps a test. */
+#define HD__CPU_ROW_VARIANTS(expr)                                                               \
+    switch (hd__cpu_row_variant(K)) {                                                           \
+    case 0: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 0, expr); break;                          \
+    case 1: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 0, expr); break;                          \
+    case 2: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 1, expr); break;                          \
+    case 3: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 1, expr); break;                          \
+    case 4: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 0, expr); break;                      \
+    case 5: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 0, expr); break;                      \
+    case 6: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 1, expr); break;                      \
+    default: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 1, expr); break;                     \
+    }
+
+/* A grid the diffusion passes work on. */
+typedef struct hd__cpu_grid {
+    const hd__kctx *k;       /* its parameters (gdims, 1/h^2, flags) and buffers */
+    float *res;              /* the residual pass's output (multigrid) */
+} hd__cpu_grid;
+
+static int hd__cpu_row_variant(const hd__kctx *K)
+{
+    int f = K->p->counts.z;
+    return ((f & HD_FLAG_RGB_SCATTERING) ? 1 : 0) | ((f & HD_FLAG_DIFFUSE_RHS) ? 2 : 0) |
+           ((f & HD_FLAG_SURFACE_BOUNDARY) ? 4 : 0);
+}
+
 static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
 {
-    const hd__kctx *K = &be->k;
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], gz = be->ctx->gdims[2], x, x0;
+    const hd__kctx *K = be->grid->k;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x, x0;
     float row[HD__CPU_ROW_MAX];
     float *dst;
     if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
         hd_diffuse_row(K, y, z, c, be->parity, be->jacobi);
         return;
     }
-    /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them.
-       The RGB-scattering flag and the boundary are literals in each loop, so none keeps a test. */
-    if (!(K->p->counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
-        if (be->ctx->params.rgb_scattering) HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1);
-        else HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0);
-    } else {
-        if (be->ctx->params.rgb_scattering) HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1);
-        else HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0);
-    }
+    /* all voxels of the row, contiguously (vectorised); red-black keeps one colour of them */
+    HD__CPU_ROW_VARIANTS(num_ / den_)
     {
         float den, num = hd_diffuse_terms(K, 0, y, z, c, &den);
         row[0] = num / den;
         num = hd_diffuse_terms(K, gx - 1, y, z, c, &den);
         row[gx - 1] = num / den;
     }
-    dst = (be->jacobi ? be->phi2 : be->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
+    dst = (be->jacobi ? K->phi2 : K->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
     x0 = be->jacobi ? 0 : ((y + z + be->parity) & 1);
     if (be->jacobi) memcpy(dst, row, (size_t)gx * sizeof(float));
     else for (x = x0; x < gx; x += 2) dst[x] = row[x];
@@ -298,7 +326,7 @@ static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
 /* Jacobi: any row, any order. */
 static void hd__cpu_diffuse_row(hd__backend *be, int r)
 {
-    int gy = be->ctx->gdims[1], gz = be->ctx->gdims[2];
+    int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z;
     hd__cpu_diffuse_row_at(be, r % gy, (r / gy) % gz, r / (gy * gz));
 }
 
@@ -307,11 +335,47 @@ static void hd__cpu_diffuse_row(hd__backend *be, int r)
    group, which no thread writes during this pass: no data race. */
 static void hd__cpu_diffuse_row_group(hd__backend *be, int r)
 {
-    int gy = be->ctx->gdims[1], gz = be->ctx->gdims[2], hy = (gy + 1) / 2;
+    int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z, hy = (gy + 1) / 2;
     int z = (r / hy) % gz, c = r / (hy * gz);
     int y = 2 * (r % hy) + ((be->row_group + z) & 1);
     if (y < gy) hd__cpu_diffuse_row_at(be, y, z, c);
 }
+
+/* The residual f - A phi of row r (= (c * gz + z) * gy + y) of be->grid into row[]. */
+static void hd__cpu_residual_row_into(const hd__backend *be, int r, float *row)
+{
+    const hd__kctx *K = be->grid->k;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
+    const float *prow = K->phi + ((size_t)(c * gz + z) * gy + y) * gx;
+    float rhs;
+    if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
+        for (x = 0; x < gx; ++x) row[x] = hd_diffuse_residual(K, x, y, z, c, &rhs);
+        return;
+    }
+    HD__CPU_ROW_VARIANTS(num_ - den_ * prow[x])
+    row[0] = hd_diffuse_residual(K, 0, y, z, c, &rhs);
+    row[gx - 1] = hd_diffuse_residual(K, gx - 1, y, z, c, &rhs);
+}
+
+/* The residual of row r into be->grid->res. */
+static void hd__cpu_residual_row(hd__backend *be, int r)
+{
+    hd__cpu_residual_row_into(be, r, be->grid->res + (size_t)r * be->grid->k->p->gdims.x);
+}
+
+/* Red-black sweeps on be->grid: per colour, the two row groups. */
+static void hd__cpu_red_black(hd__backend *be, int sweeps)
+{
+    const hd__kparams *p = be->grid->k->p;
+    int half_rows = (p->gdims.y + 1) / 2 * p->gdims.z * p->gdims.w, s;
+    be->jacobi = 0;
+    for (s = 0; s < sweeps; ++s)
+        for (be->parity = 0; be->parity < 2; ++be->parity)
+            for (be->row_group = 0; be->row_group < 2; ++be->row_group)
+                hd__cpu_parallel(be, hd__cpu_diffuse_row_group, half_rows);
+}
+
 static void hd__cpu_project_row(hd__backend *be, int py)
 {
     int px, w = be->ctx->kp.image.x;
@@ -320,6 +384,7 @@ static void hd__cpu_project_row(hd__backend *be, int py)
 
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
+    ++ctx->be->sig_gen;
     hd__cpu_parallel(ctx->be, hd__cpu_classify_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
@@ -328,24 +393,28 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
-/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
+#include "hd_cpu_multigrid.h"
+
+/* One full sweep on the illumination grid: two half-sweeps (red, black) or one Jacobi pass and
+   a swap. */
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
-    int rows = ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
-    be->jacobi = jacobi;
+    hd__cpu_grid fine;
+    fine.k = &be->k;
+    fine.res = NULL;
+    be->grid = &fine;
     if (jacobi) {
         float *t;
+        be->jacobi = 1;
         be->parity = 0;
-        hd__cpu_parallel(be, hd__cpu_diffuse_row, rows);
+        hd__cpu_parallel(be, hd__cpu_diffuse_row, ctx->gdims[1] * ctx->gdims[2] * ctx->channels);
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
         be->k.phi = be->phi; be->k.phi2 = be->phi2;
     } else {
-        int half_rows = (ctx->gdims[1] + 1) / 2 * ctx->gdims[2] * ctx->channels;
-        for (be->parity = 0; be->parity < 2; ++be->parity)
-            for (be->row_group = 0; be->row_group < 2; ++be->row_group)
-                hd__cpu_parallel(be, hd__cpu_diffuse_row_group, half_rows);
+        hd__cpu_red_black(be, 1);
     }
+    be->grid = NULL;
     return HD_SUCCESS;
 }
 static hd_result hd__be_project(hd__ctx *ctx)

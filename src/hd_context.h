@@ -540,36 +540,42 @@ static hd_result hd__prepare(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* One sweep of the selected solver (multigrid: one V-cycle). */
+static hd_result hd__diffuse_once(hd__ctx *ctx)
+{
+#ifdef HD__BE_HAS_MULTIGRID
+    if (ctx->params.solver == HD_SOLVER_MULTIGRID) return hd__be_multigrid(ctx);
+#endif
+    return hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI);
+}
+
+/* The diffusion sweeps of HD and CD (none with disable_diffusion). */
+static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
+{
+    hd_result r;
+    int s;
+    if (!ctx->params.disable_diffusion)
+        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
+            if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
 /* One HD iteration: a direct-light sample per voxel, the diffusion sweeps, one frame. */
 static hd_result hd__iterate_hd(hd__ctx *ctx)
 {
     hd_result r;
     double t0 = hd__now(), t1, t2;
-    int s;
     ctx->iterations++;
     ctx->frames++;
     hd__fill_kparams(ctx);
     if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
     t1 = hd__now();
-    if (!ctx->params.disable_diffusion)
-        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
-            if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
     t2 = hd__now();
     if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
     ctx->seconds[0] += t1 - t0;
     ctx->seconds[1] += t2 - t1;
     ctx->seconds[2] += hd__now() - t2;
-    return HD_SUCCESS;
-}
-
-/* The diffusion sweeps of HD and CD (none with disable_diffusion). */
-HD__MAYBE_UNUSED static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
-{
-    hd_result r;
-    int s;
-    if (!ctx->params.disable_diffusion)
-        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
-            if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
     return HD_SUCCESS;
 }
 
@@ -746,6 +752,9 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->method_bytes = gvox * sizeof(float) * (size_t)ctx->sig_channels +
                         hd__illum_floats(ctx) * sizeof(float) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
+#ifdef HD__BE_HAS_SOLVER_BYTES
+    out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (CPU multigrid levels) */
+#endif
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
     out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
     hd__be_volume_bytes(ctx, &out->volume_bytes);

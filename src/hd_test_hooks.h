@@ -5,14 +5,14 @@
    Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does. */
 
 /* The state a hook starts from: allocations, sigma_t, cleared accumulations. */
-static hd_result hd__test_prepare(hd_context h)
+HD__MAYBE_UNUSED static hd_result hd__test_prepare(hd_context h)
 {
     HD__GET_CTX(ctx, h);
     return hd__prepare(ctx);
 }
 
 /* n direct-light passes (HD stage 1 only), each one iteration of the progressive mean. */
-static hd_result hd__test_direct(hd_context h, int n)
+HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
 {
     hd_result r;
     int i;
@@ -26,8 +26,8 @@ static hd_result hd__test_direct(hd_context h, int n)
     return HD_SUCCESS;
 }
 
-/* n diffusion sweeps of the selected solver on the current E and phi. */
-static hd_result hd__test_diffuse(hd_context h, int n)
+/* n diffusion sweeps of the selected solver (multigrid: V-cycles) on the current E and phi. */
+HD__MAYBE_UNUSED static hd_result hd__test_diffuse(hd_context h, int n)
 {
     hd_result r;
     int i;
@@ -35,12 +35,23 @@ static hd_result hd__test_diffuse(hd_context h, int n)
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     hd__fill_kparams(ctx);
     for (i = 0; i < n; ++i)
-        if ((r = hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+        if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
     return HD_SUCCESS;
 }
 
+#ifdef HYBRIDDIFF_BACKEND_CPU
+/* The relative residual |f - A phi| / |f| of the diffusion equation for the current E and phi. */
+HD__MAYBE_UNUSED static hd_result hd__test_residual(hd_context h, double *out)
+{
+    HD__GET_CTX(ctx, h);
+    hd__fill_kparams(ctx);
+    *out = hd__cpu_residual(ctx);
+    return HD_SUCCESS;
+}
+#endif
+
 /* n projection frames of the current E and phi into the image. */
-static hd_result hd__test_project(hd_context h, int n)
+HD__MAYBE_UNUSED static hd_result hd__test_project(hd_context h, int n)
 {
     hd_result r;
     int i;
@@ -56,7 +67,7 @@ static hd_result hd__test_project(hd_context h, int n)
 
 /* Overwrites E or phi (channel-planar, hd_stats' dims and channels) with src: the only hook that
    reaches into a backend's buffers, so it has one branch per backend. */
-static hd_result hd__test_write_illumination(hd_context h, hd_illumination which, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_illumination which, const float *src)
 {
     hd_result r;
     HD__GET_CTX(ctx, h);
@@ -80,7 +91,7 @@ static hd_result hd__test_write_illumination(hd_context h, hd_illumination which
 }
 
 /* Waits until the device has done everything queued (for timing). */
-static hd_result hd__test_finish(hd_context h)
+HD__MAYBE_UNUSED static hd_result hd__test_finish(hd_context h)
 {
     HD__GET_CTX(ctx, h);
 #if defined(HYBRIDDIFF_BACKEND_OPENCL)

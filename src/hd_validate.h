@@ -107,8 +107,8 @@ static void hd__params_defaults(hd_params *p)
     if (p->method == HD_METHOD_DEFAULT) p->method = HD_METHOD_HD;
     if (p->extinction == 0.0f) p->extinction = 100.0f;
     if (p->albedo == 0.0f) p->albedo = 0.9f;
-    if (p->diffusion_sweeps == 0) p->diffusion_sweeps = 4;
     if (p->solver == HD_SOLVER_DEFAULT) p->solver = HD_SOLVER_RED_BLACK;
+    if (p->diffusion_sweeps == 0) p->diffusion_sweeps = p->solver == HD_SOLVER_MULTIGRID ? 1 : 4;
     if (p->tracking == HD_TRACKING_DEFAULT) p->tracking = HD_TRACKING_RATIO;
     if (p->step == 0.0f) p->step = 0.5f;
     if (p->frame_window == 0) p->frame_window = 8;
@@ -157,6 +157,10 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
 #ifndef HD__BE_HAS_CD
     if (p->method == HD_METHOD_CD)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method CD is not available on the %s backend", hd__be_name());
+#endif
+#ifndef HD__BE_HAS_MULTIGRID
+    if (p->solver == HD_SOLVER_MULTIGRID)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "solver MULTIGRID is not available on the %s backend (CPU only so far)", hd__be_name());
 #endif
 #ifndef HD__BE_HAS_PT
     if (p->method == HD_METHOD_PT_SS || p->method == HD_METHOD_PT_MS)

@@ -7,6 +7,7 @@
 #define HD_FLAG_NO_DIFFUSION 2
 #define HD_FLAG_RGB_SCATTERING 4 /* the sigma_t grid carries the TF colour in channels 1..3 */
 #define HD_FLAG_SURFACE_BOUNDARY 8 /* diffusion: vacuum (Marshak) condition at the medium's surface */
+#define HD_FLAG_DIFFUSE_RHS 16 /* diffusion: E holds the right-hand side itself (multigrid's coarse levels) */
 #define HD_TRACK_RATIO 1
 #define HD_TRACK_DELTA 2
 /* Decorrelates the random streams of the stages that share a pixel or voxel index. */

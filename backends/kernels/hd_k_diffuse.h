@@ -67,9 +67,10 @@ HD_FN float hd_diffuse_surface_face(float scale, float h, float spi, float spj, 
    goes to *den. in_xm ... in_zp say whether the neighbour on each side lies inside the grid, rgb
    whether the albedo is per channel (HD_FLAG_RGB_SCATTERING): the CPU backend passes literals for
    interior voxels so the compiler drops the tests (see hd_cpu.h). With rgb = 0 and a white TF the
-   RGB path computes the same bits as the grey one. */
+   RGB path computes the same bits as the grey one. rhs (HD_FLAG_DIFFUSE_RHS): E holds the whole
+   right-hand side (multigrid's coarse levels solve for a correction), not the direct light. */
 HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
-                                 int in_ym, int in_yp, int in_zm, int in_zp, int rgb, HD_INOUT(float) den)
+                                 int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
@@ -79,7 +80,7 @@ HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm,
     float fl = HD_PRM(grid).w;
     float st = HD_GET(sig, i, x, y, z);
     float sp = st * ag;
-    float num = a * st * HD_GET(E, ic, x, y, zc);
+    float num = rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
     float dn = (1.0f - a) * st;
     float w;
     w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : sp, fl);
@@ -109,7 +110,7 @@ HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm,
    Marshak weight and no neighbour term. Every select is arithmetic, so the CPU's row loop stays
    branch-free. */
 HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
-                                     int in_ym, int in_yp, int in_zm, int in_zp, int rgb, HD_INOUT(float) den)
+                                     int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
@@ -119,7 +120,7 @@ HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in
     float fl = HD_PRM(grid).w;
     float st = HD_GET(sig, i, x, y, z);
     float sp = st * ag;
-    float num = a * st * HD_GET(E, ic, x, y, zc);
+    float num = rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
     float dn = (1.0f - a) * st;
     float w, open, self = sp + sp < fl ? 0.0f : 1.0f;
     w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : 0.0f, in_xm, fl, HD_REF(open));
@@ -148,12 +149,13 @@ HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in
 HD_FN float hd_diffuse_terms(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) den)
 {
     int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
+    int rhs = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? 1 : 0;
     int in_xm = x > 0 ? 1 : 0, in_xp = x < HD_PRM(gdims).x - 1 ? 1 : 0;
     int in_ym = y > 0 ? 1 : 0, in_yp = y < HD_PRM(gdims).y - 1 ? 1 : 0;
     int in_zm = z > 0 ? 1 : 0, in_zp = z < HD_PRM(gdims).z - 1 ? 1 : 0;
     if ((HD_DIFFUSE_FLAGS & HD_FLAG_SURFACE_BOUNDARY) != 0)
-        return hd_diffuse_terms_surface(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, den);
-    return hd_diffuse_terms_box(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, den);
+        return hd_diffuse_terms_surface(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, rhs, den);
+    return hd_diffuse_terms_box(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, rhs, den);
 }
 
 /* Relaxes the voxels x0, x0 + xstep, ... of row (y, z), channel c. Red-black Gauss-Seidel:
@@ -180,6 +182,7 @@ HD_FN float hd_diffuse_residual(HD_KARGS int x, int y, int z, int c, HD_INOUT(fl
     int i = (z * gy + y) * gx + x, ic = i + c * gx * gy * gz;
     float den;
     float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
-    HD_DEREF(rhs) = HD_PRM(medium).y * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
+    HD_DEREF(rhs) = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? HD_GET(E, ic, x, y, z + c * gz)
+                  : HD_PRM(medium).y * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
     return num - den * HD_GET(phi, ic, x, y, z + c * gz);
 }

@@ -1,0 +1,104 @@
+/* hdbench_multigrid - the multigrid target of issue 9, in one run: on the head CT (256x256x108,
+   full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
+   source), the time single-level red-black sweeps and multigrid V-cycles take to bring the
+   diffusion's relative residual |f - A phi| / |f| from phi = 0 below 1e-4, for the box and the
+   surface boundary. Times: wall clock of the solver calls only (residual checks excluded) and
+   process CPU seconds / threads (robust to other load on the machine). Red-black stops at
+   --cap seconds (default 300) if it has not converged: its ratio is then a lower bound.
+   Usage: hdbench_multigrid [data/head.nrrd] [--cap SECONDS] [--tol T] [--downsample N]
+                            [--print-every STEPS] [--surface-only]
+   Figures, not a test: nothing here passes or fails. */
+#define HYBRIDDIFF_IMPLEMENTATION
+#define HYBRIDDIFF_BACKEND_CPU
+#include "hybriddiff.h"
+#include "src/hd_test_hooks.h"
+#include <time.h>
+
+static const float mg_tf[] = {
+    0.0f, 0.0f, 0.0f, 0.0f,     0.0f, 0.0f, 0.0f, 0.0f,       /* -1024, -512: air */
+    0.93f, 0.73f, 0.62f, 0.02f, 0.93f, 0.73f, 0.62f, 0.05f,   /* 0, 512: soft tissue */
+    1.0f, 0.98f, 0.9f, 0.5f,    1.0f, 1.0f, 1.0f, 1.0f,       /* 1024, 1536: bone */
+    1.0f, 1.0f, 1.0f, 1.0f,     1.0f, 1.0f, 1.0f, 1.0f};
+
+typedef struct mg_run { int steps; double wall, cpu, res; } mg_run;
+
+static double cpu_seconds(void) { return (double)clock() / CLOCKS_PER_SEC; }
+
+/* Runs the context's solver `batch` steps at a time until the residual is below tol or cap
+   wall seconds have passed; prints the residual every `print_every` steps. */
+static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threads, int print_every, const char *name)
+{
+    mg_run r;
+    double res = 1.0;
+    r.steps = 0; r.wall = 0.0; r.cpu = 0.0;
+    while (!(res < tol) && r.wall < cap && res == res) {
+        double w0 = hd__now(), c0 = cpu_seconds();
+        if (hd__test_diffuse(ctx, batch) != HD_SUCCESS) { fprintf(stderr, "hd__test_diffuse failed\n"); exit(1); }
+        r.wall += hd__now() - w0;
+        r.cpu += (cpu_seconds() - c0) / threads;
+        r.steps += batch;
+        hd__test_residual(ctx, &res);
+        if (r.steps % (batch * print_every) == 0 || res < tol)
+            printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, residual %.3e\n", name, r.steps, r.wall, r.cpu, res);
+        fflush(stdout);
+    }
+    r.res = res;
+    return r;
+}
+
+int main(int argc, char **argv)
+{
+    const char *path = "data/head.nrrd";
+    double cap = 300.0, tol = 1e-4;
+    int i, boundary, threads = (int)sysconf(_SC_NPROCESSORS_ONLN), downsample = 1, print_every = 20, first = HD_BOUNDARY_BOX;
+    hd_volume_file vf;
+    for (i = 1; i < argc; ++i) {
+        if (strcmp(argv[i], "--cap") == 0 && i + 1 < argc) cap = atof(argv[++i]);
+        else if (strcmp(argv[i], "--tol") == 0 && i + 1 < argc) tol = atof(argv[++i]);
+        else if (strcmp(argv[i], "--downsample") == 0 && i + 1 < argc) downsample = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--print-every") == 0 && i + 1 < argc) print_every = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--surface-only") == 0) first = HD_BOUNDARY_SURFACE;
+        else path = argv[i];
+    }
+    if (hd_volume_load_nrrd(path, &vf, NULL) != HD_SUCCESS) {
+        fprintf(stderr, "hdbench_multigrid: cannot load %s (run `make data` first)\n", path);
+        return 2;
+    }
+    printf("hdbench_multigrid: %s %dx%dx%d, %d threads, tolerance %.0e, red-black cap %.0f s\n", path, vf.desc.dims[0],
+           vf.desc.dims[1], vf.desc.dims[2], threads, tol, cap);
+    for (boundary = first; boundary <= HD_BOUNDARY_SURFACE; ++boundary) {
+        hd_desc d;
+        hd_context rb, mg;
+        hd_stats s_rb, s_mg;
+        mg_run a, b;
+        memset(&d, 0, sizeof d);
+        d.volume = vf.desc;
+        d.volume.value_range[0] = -1024.0f;
+        d.volume.value_range[1] = 3071.0f;
+        d.transfer_function.rgba = mg_tf;
+        d.transfer_function.count = (int)(sizeof mg_tf / sizeof mg_tf[0] / 4);
+        d.camera.width = d.camera.height = 16;
+        d.params.diffusion_boundary = (hd_boundary)boundary;
+        d.params.illumination_downsample = downsample;
+        d.logger.func = hd_log_stderr;
+        if (hd_create(&d, &rb) != HD_SUCCESS) return 1;
+        d.params.solver = HD_SOLVER_MULTIGRID;
+        if (hd_create(&d, &mg) != HD_SUCCESS) return 1;
+        if (hd__test_direct(rb, 4) != HD_SUCCESS || hd__test_direct(mg, 4) != HD_SUCCESS) return 1;
+        printf("\nboundary %s:\n", boundary == HD_BOUNDARY_BOX ? "box" : "surface");
+        b = solve(mg, 1, tol, cap, threads, print_every, "multigrid V-cycles");
+        a = solve(rb, 25, tol, cap, threads, print_every, "red-black sweeps  ");
+        hd_get_stats(rb, &s_rb);
+        hd_get_stats(mg, &s_mg);
+        printf("| boundary | solver | steps | wall s | cpu s / thread | residual |\n|---|---|---|---|---|---|\n");
+        printf("| %s | red-black | %d sweeps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", a.steps, a.wall, a.cpu, a.res);
+        printf("| %s | multigrid | %d V-cycles | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
+        printf("multigrid is %s%.1fx faster in wall time, %s%.1fx in CPU time (target >= 10x); its levels add %.2f bytes per voxel\n",
+               a.res >= tol ? ">= " : "", a.wall / b.wall, a.res >= tol ? ">= " : "", a.cpu / b.cpu,
+               ((double)s_mg.method_bytes - (double)s_rb.method_bytes) / ((double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2]));
+        hd_destroy(rb);
+        hd_destroy(mg);
+    }
+    hd_volume_free(&vf);
+    return 0;
+}

@@ -1,0 +1,9 @@
+# mk/multigrid.mk - the multigrid diffusion solver's benchmark (issue 9).
+#   make bench-multigrid   build/hdbench_multigrid on the head CT (make data): time to a relative
+#                          residual of 1e-4, red-black sweeps against multigrid V-cycles
+.PHONY: bench-multigrid
+$(B)/hdbench_multigrid: bench/hdbench_multigrid.c $(LIB_SRC) src/hd_test_hooks.h | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+bench-multigrid: $(B)/hdbench_multigrid data
+	$(B)/hdbench_multigrid
