@@ -82,7 +82,8 @@ static const char *usage_text_method =
     "  --anisotropy G          Henyey-Greenstein g in (-1,1) (default 0)\n"
     "  --majorant F            global majorant, 0 = grid of local majorants (default 0)\n"
     "  --sweeps N              diffusion solver sweeps per iteration (default 4)\n"
-    "  --solver rb|jacobi      diffusion solver (default rb: red-black Gauss-Seidel)\n"
+    "  --solver S              diffusion solver: rb (red-black Gauss-Seidel, default), jacobi,\n"
+    "                          multigrid (V-cycles; --sweeps counts cycles; CPU only)\n"
     "  --tracking ratio|delta  transmittance estimator (default ratio)\n"
     "  --boundary box|surface  the diffusion's vacuum: phi = 0 outside the volume box (default,\n"
     "                          the paper's), or the Marshak condition at the medium's surface\n"
@@ -518,7 +519,8 @@ int main(int argc, char **argv)
             VAL();
             if (strcmp(v, "rb") == 0) desc.params.solver = HD_SOLVER_RED_BLACK;
             else if (strcmp(v, "jacobi") == 0) desc.params.solver = HD_SOLVER_JACOBI;
-            else fail(2, "--solver: '%s' is not rb or jacobi", v);
+            else if (strcmp(v, "multigrid") == 0) desc.params.solver = HD_SOLVER_MULTIGRID;
+            else fail(2, "--solver: '%s' is not rb, jacobi or multigrid", v);
         } else if (IS("--tracking")) {
             VAL();
             if (strcmp(v, "ratio") == 0) desc.params.tracking = HD_TRACKING_RATIO;

@@ -83,6 +83,12 @@ static hd_result af_cycle(af_state *st, af_log *log)
         p.solver = HD_SOLVER_JACOBI;
         if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
         if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        if (strcmp(hd_backend_name(), "cpu") == 0) { /* multigrid: CPU only so far */
+            p.solver = HD_SOLVER_MULTIGRID;           /* its levels come with the first V-cycle */
+            p.diffusion_sweeps = 1;
+            if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
+            if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        }
     }
     if (r == HD_SUCCESS) r = hd_read_image_f32(ctx, img, sizeof img / sizeof img[0]);
     if (r == HD_SUCCESS)
