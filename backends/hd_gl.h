@@ -74,6 +74,22 @@ enum { HD__GL_CLASSIFY, HD__GL_DIRECT, HD__GL_DIFFUSE, HD__GL_PROJECT, HD__GL_CO
        HD__GL_PATH, HD__GL_TO_TEXTURE, HD__GL_PROGRAM_COUNT };
 static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
     "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "render_to_texture"};
+/* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
+   surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
+   sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
+   (Vulkan measured 1.4-1.6x from the same specialization). Program slots past
+   HD__GL_PROGRAM_COUNT hold these variants. */
+#define HD__GL_DIFFUSE_VARIANTS 4
+#define HD__GL_SLOTS (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)
+static int hd__gl_diffuse_flags(int variant)
+{
+    return ((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0);
+}
+static int hd__gl_diffuse_slot(int counts_z)
+{
+    return HD__GL_PROGRAM_COUNT + ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) +
+           ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
+}
 #define HD__GL_LOCAL_X 64 /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 #define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
 #define HD__GL_SSBOS 3       /* storage buffers 0..2 */
@@ -107,7 +123,7 @@ struct hd__backend {
     int version;                /* major * 10 + minor */
     int depth;                  /* nesting of hd__gl_enter */
     hd__gl_state saved;
-    GLuint programs[HD__GL_PROGRAM_COUNT];
+    GLuint programs[HD__GL_SLOTS]; /* by stage, then the diffusion variants */
     GLuint params;              /* uniform buffer of hd__kparams */
     hd__kparams params_kp;      /* what it holds */
     int params_valid;
@@ -311,9 +327,10 @@ static const char *const hd__gl_to_texture_src =
     "    imageStore(hd_o, ivec2(p.x, hd_pc.y - 1 - p.y), c); /* GL rows: bottom first */\n"
     "}\n";
 
-/* Compiles and links one program (on its first use). */
+/* Compiles and links the program of slot p (a stage, or a diffusion variant) on its first use. */
 static hd_result hd__gl_program(hd__ctx *ctx, int p)
 {
+    int stage = p < HD__GL_PROGRAM_COUNT ? p : HD__GL_DIFFUSE;
     hd__backend *be = ctx->be;
     const char *src[1 + HD__GL_SOURCE_LINES];
     char prefix[256], log[4096];
@@ -326,10 +343,13 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         src[0] = hd__gl_to_texture_src;
         n = 1;
     } else {
-        snprintf(prefix, sizeof prefix,
-                 "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
-                 "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                 HD_MAX_LIGHTS, p + 1, HD__GL_LOCAL_X);
+        int len = snprintf(prefix, sizeof prefix,
+                           "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
+                           "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
+                           HD_MAX_LIGHTS, stage + 1, HD__GL_LOCAL_X);
+        if (p >= HD__GL_PROGRAM_COUNT)
+            snprintf(prefix + len, sizeof prefix - (size_t)len, "#define HD_DIFFUSE_FLAGS %d\n",
+                     hd__gl_diffuse_flags(p - HD__GL_PROGRAM_COUNT));
         src[0] = prefix;
         for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
         n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
@@ -344,7 +364,7 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         be->gl.GetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteShader(sh);
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s shader does not compile (source-string numbers: "
-                       "backends/hd_glsl_embedded.h):\n%s", hd__gl_stage_names[p], log);
+                       "backends/hd_glsl_embedded.h):\n%s", hd__gl_stage_names[stage], log);
     }
     prog = be->gl.CreateProgram();
     be->gl.AttachShader(prog, sh);
@@ -355,7 +375,7 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         log[0] = '\0';
         be->gl.GetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteProgram(prog);
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", hd__gl_stage_names[p], log);
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", hd__gl_stage_names[stage], log);
     }
     be->programs[p] = prog;
     HD__GL_CHECK(ctx, "building a program");
@@ -430,14 +450,15 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     hd_result r;
     const hd__gl_tex *lv = be->lv && light < be->nlv ? &be->lv[light] : NULL;
     const hd__gl_tex *lv2 = be->lv ? &be->lv[be->nlv] : NULL;
-    if ((r = hd__gl_program(ctx, p)) != HD_SUCCESS) return r;
+    int slot = p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p;
+    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
     if (!be->params_valid || memcmp(&be->params_kp, &ctx->kp, sizeof ctx->kp) != 0) {
         be->gl.BindBuffer(GL_UNIFORM_BUFFER, be->params);
         be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof ctx->kp, &ctx->kp, GL_STREAM_DRAW);
         be->params_kp = ctx->kp;
         be->params_valid = 1;
     }
-    be->gl.UseProgram(be->programs[p]);
+    be->gl.UseProgram(be->programs[slot]);
     be->gl.Uniform4i(0, pc_x, pc_y, pc_z, pc_w);
     be->gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, be->params);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->tf ? be->tf : be->dummy_buffer);
@@ -563,7 +584,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     int i;
     if (!be) return;
     if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__gl_enter(ctx) == HD_SUCCESS) {
-        for (i = 0; i < HD__GL_PROGRAM_COUNT; ++i)
+        for (i = 0; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
