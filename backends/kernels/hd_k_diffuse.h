@@ -63,6 +63,22 @@ HD_FN float hd_diffuse_surface_face(float scale, float h, float spi, float spj, 
     return empty != 0.0f ? hd_diffuse_vacuum_face(h, spi) : hd_diffuse_face(scale, spi, spj, fl);
 }
 
+/* The voxel's own part of its update: returns the source term (sigma_s E, or with rhs the
+   right-hand side E holds) and gives its absorption sigma_a in *dn, its sigma' in *sp and
+   1 - albedo g in *ag (with RGB scattering the albedo of channel c). */
+HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, int rhs, HD_INOUT(float) sp,
+                           HD_INOUT(float) ag, HD_INOUT(float) dn)
+{
+    int nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * HD_PRM(gdims).z, gz = HD_PRM(gdims).z;
+    int ic = i + c * nvox, zc = z + c * gz;
+    float a = rgb != 0 ? HD_PRM(medium).y * HD_GET(sig, i + (1 + c) * nvox, x, y, z + (1 + c) * gz) : HD_PRM(medium).y;
+    float st = HD_GET(sig, i, x, y, z);
+    HD_DEREF(ag) = 1.0f - a * HD_PRM(medium).z;
+    HD_DEREF(sp) = st * HD_DEREF(ag);
+    HD_DEREF(dn) = (1.0f - a) * st;
+    return rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
+}
+
 /* The numerator of voxel (x,y,z)'s update in channel c under the box boundary; its denominator
    goes to *den. in_xm ... in_zp say whether the neighbour on each side lies inside the grid, rgb
    whether the albedo is per channel (HD_FLAG_RGB_SCATTERING): the CPU backend passes literals for
@@ -73,15 +89,10 @@ HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm,
                                  int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
-    int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
-    int ic = i + c * nvox, zc = z + c * gz, sxy = gx * gy;
-    float a = rgb != 0 ? HD_PRM(medium).y * HD_GET(sig, i + (1 + c) * nvox, x, y, z + (1 + c) * gz) : HD_PRM(medium).y;
-    float ag = 1.0f - a * HD_PRM(medium).z;
-    float fl = HD_PRM(grid).w;
-    float st = HD_GET(sig, i, x, y, z);
-    float sp = st * ag;
-    float num = rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
-    float dn = (1.0f - a) * st;
+    int i = (z * gy + y) * gx + x;
+    int ic = i + c * gx * gy * gz, zc = z + c * gz, sxy = gx * gy;
+    float fl = HD_PRM(grid).w, sp, ag, dn;
+    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     float w;
     w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : sp, fl);
     if (in_xm != 0) num += w * HD_GET(phi, ic - 1, x - 1, y, zc);
@@ -113,15 +124,10 @@ HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in
                                      int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
-    int i = (z * gy + y) * gx + x, nvox = gx * gy * gz;
-    int ic = i + c * nvox, zc = z + c * gz, sxy = gx * gy;
-    float a = rgb != 0 ? HD_PRM(medium).y * HD_GET(sig, i + (1 + c) * nvox, x, y, z + (1 + c) * gz) : HD_PRM(medium).y;
-    float ag = 1.0f - a * HD_PRM(medium).z;
-    float fl = HD_PRM(grid).w;
-    float st = HD_GET(sig, i, x, y, z);
-    float sp = st * ag;
-    float num = rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
-    float dn = (1.0f - a) * st;
+    int i = (z * gy + y) * gx + x;
+    int ic = i + c * gx * gy * gz, zc = z + c * gz, sxy = gx * gy;
+    float fl = HD_PRM(grid).w, sp, ag, dn;
+    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     float w, open, self = sp + sp < fl ? 0.0f : 1.0f;
     w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : 0.0f, in_xm, fl, HD_REF(open));
     if (in_xm != 0) num += open * w * HD_GET(phi, ic - 1, x - 1, y, zc);
