@@ -333,9 +333,13 @@ static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
    bit). Per sweep that is 2 passes over the grid (plus the thin last-row passes) where one pass
    per (colour, y + z parity) group made 4. Jacobi: one pass, every row. */
 #define HD__CPU_BLOCK_ROWS 16
+/* Blocks per channel: HD__CPU_BLOCK_ROWS rows each, the last one taking the remainder; a
+   remainder of one row joins the block before it, so every block but a lone one has two rows
+   or more and no two blocks' last rows are neighbours (they are the second pass's rows). */
 static int hd__cpu_blocks(const hd__backend *be)
 {
-    return (be->grid->k->p->gdims.y + HD__CPU_BLOCK_ROWS - 1) / HD__CPU_BLOCK_ROWS;
+    int gy = be->grid->k->p->gdims.y, nb = (gy + HD__CPU_BLOCK_ROWS - 1) / HD__CPU_BLOCK_ROWS;
+    return nb > 1 && gy - (nb - 1) * HD__CPU_BLOCK_ROWS == 1 ? nb - 1 : nb;
 }
 
 /* Item r = c * blocks + b: block b of channel c; be->block_pass 0: its rows (all for Jacobi, all
@@ -343,8 +347,7 @@ static int hd__cpu_blocks(const hd__backend *be)
 static void hd__cpu_diffuse_block(hd__backend *be, int r)
 {
     int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z, nb = hd__cpu_blocks(be);
-    int b = r % nb, c = r / nb, y0 = b * HD__CPU_BLOCK_ROWS, y1 = y0 + HD__CPU_BLOCK_ROWS, y, z;
-    if (y1 > gy) y1 = gy;
+    int b = r % nb, c = r / nb, y0 = b * HD__CPU_BLOCK_ROWS, y1 = b == nb - 1 ? gy : y0 + HD__CPU_BLOCK_ROWS, y, z;
     if (be->block_pass == 1) y0 = y1 - 1;
     else if (!be->jacobi) --y1;
     for (z = 0; z < gz; ++z)
