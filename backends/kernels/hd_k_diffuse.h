@@ -38,8 +38,8 @@ HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb,
 /* The weight w = D_ij / h^2 of the face between two voxels with sigma' spi and spj: the harmonic
    mean of their D = 1 / (3 sigma'), 2 / (3 (spi + spj)), floored at fl so empty space stays finite,
    times the axis' 1 / h^2 (scale). A face on the box boundary passes spj = spi: phi = 0 outside
-   with the voxel's own D. The one place this formula lives: the CPU backend's face cache
-   (hd_cpu.h) calls it too, so both compute the same bits (a + b == b + a in IEEE arithmetic). */
+   with the voxel's own D. Both voxels of a face get the same bits (a + b == b + a in IEEE
+   arithmetic). */
 HD_FN float hd_diffuse_face(float scale, float spi, float spj, float fl)
 {
     return scale * (0.6666667f / hd_maxf(spi + spj, fl));
