@@ -165,6 +165,12 @@ typedef enum hd_boundary {
     HD_BOUNDARY_COUNT
 } hd_boundary;
 
+typedef enum hd_precision {
+    HD_PRECISION_FLOAT32 = 0, /* 4 bytes per voxel and channel (default) */
+    HD_PRECISION_FLOAT16,     /* IEEE binary16 storage, float32 arithmetic: half the bytes */
+    HD_PRECISION_COUNT
+} hd_precision;
+
 typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_log_level;
 
 typedef enum hd_illumination {
@@ -261,6 +267,13 @@ typedef struct hd_params {
                                with a floored D, so air drains light) or HD_BOUNDARY_SURFACE
                                (empty voxels hold phi = 0 and the medium's surface carries the
                                Marshak vacuum condition; closer to PT_MS, see docs/EVALUATION.md) */
+    hd_precision illumination_precision; /* storage of E and phi (and Jacobi's buffer):
+                               HD_PRECISION_FLOAT16 stores them as IEEE binary16, rounded to
+                               nearest even, while every operation stays float32: 2 bytes per
+                               voxel and channel instead of 4 (see docs/EVALUATION.md for the
+                               PSNR cost). CPU and OpenCL; the other backends and the multigrid
+                               solver return HD_ERROR_UNSUPPORTED. hd_read_illumination still
+                               returns floats. */
 } hd_params;
 
 typedef struct hd_desc {
@@ -332,7 +345,8 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      diffusion_boundary                        -> phi, image
      camera, step, background, frame_window    -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
-     illumination_downsample, rgb_scattering  -> E, phi, image (new grids)
+     illumination_downsample, rgb_scattering,
+     illumination_precision                    -> E, phi, image (new grids)
      solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);

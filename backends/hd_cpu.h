@@ -23,7 +23,9 @@ struct hd__backend {
     unsigned generation;
     /* buffers */
     float *sig, *E, *phi, *phi2, *img;
-    size_t illum_floats;
+    uint16_t *Eh, *phih, *phi2h; /* E, phi, phi2 as binary16 (illumination_precision FLOAT16),
+                                    the float pointers then NULL */
+    size_t illum_floats;     /* elements of E (and of phi, phi2), whatever their precision */
     hd__kctx k;
     int parity, jacobi;      /* the diffusion pass being run */
     int block_pass;          /* the diffusion's block schedule: 0 the blocks' rows, 1 their last rows */
@@ -126,6 +128,9 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__free(ctx, be->E);
     hd__free(ctx, be->phi);
     hd__free(ctx, be->phi2);
+    hd__free(ctx, be->Eh);
+    hd__free(ctx, be->phih);
+    hd__free(ctx, be->phi2h);
     hd__free(ctx, be->img);
     hd__cpu_free_lights(ctx);
     hd__free(ctx, be);
@@ -190,24 +195,56 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
     return HD_SUCCESS;
 }
 
-/* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid and channels.
-   illum_floats == 0 frees them: the path tracers keep no illumination grid. */
+#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: Eh, phih, phi2h */
+
+/* Frees an illumination buffer of either precision and clears its pointers. */
+static void hd__cpu_free_illum(hd__ctx *ctx, float **f, uint16_t **h)
+{
+    hd__free(ctx, *f); hd__free(ctx, *h);
+    *f = NULL; *h = NULL;
+}
+
+/* A zeroed illumination buffer of n elements in the context's precision (the other pointer NULL);
+   0 when the allocation failed. Zero bits are 0.0 in both precisions. */
+static int hd__cpu_alloc_illum(hd__ctx *ctx, size_t n, float **f, uint16_t **h)
+{
+    hd__cpu_free_illum(ctx, f, h);
+    if (ctx->params.illumination_precision == HD_PRECISION_FLOAT16) *h = (uint16_t *)hd__calloc(ctx, n, sizeof(uint16_t));
+    else *f = (float *)hd__calloc(ctx, n, sizeof(float));
+    return *f != NULL || *h != NULL;
+}
+
+/* Points the kernel context at the backend's illumination buffers. */
+static void hd__cpu_bind_illum(hd__backend *be)
+{
+    be->k.E = be->E; be->k.phi = be->phi; be->k.phi2 = be->phi2;
+    be->k.Eh = be->Eh; be->k.phih = be->phih; be->k.phi2h = be->phi2h;
+    be->k.f16 = be->ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+}
+
+/* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid, channels and
+   precision. illum_floats == 0 frees them: the path tracers keep no illumination grid. */
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
     size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
-    hd__free(ctx, be->sig); hd__free(ctx, be->E); hd__free(ctx, be->phi); hd__free(ctx, be->phi2);
-    be->sig = be->E = be->phi = be->phi2 = NULL;
-    be->k.sig = be->k.E = be->k.phi = be->k.phi2 = NULL;
+    int ok;
+    hd__free(ctx, be->sig);
+    be->sig = be->k.sig = NULL;
+    hd__cpu_free_illum(ctx, &be->E, &be->Eh);
+    hd__cpu_free_illum(ctx, &be->phi, &be->phih);
+    hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
+    hd__cpu_bind_illum(be);
     be->illum_floats = 0;
     if (illum_floats == 0) return HD_SUCCESS;
     be->sig = (float *)hd__calloc(ctx, gvox * (size_t)ctx->sig_channels, sizeof(float));
-    be->E = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
-    be->phi = (float *)hd__calloc(ctx, illum_floats, sizeof(float));
-    if (!be->sig || !be->E || !be->phi)
+    ok = hd__cpu_alloc_illum(ctx, illum_floats, &be->E, &be->Eh);
+    ok &= hd__cpu_alloc_illum(ctx, illum_floats, &be->phi, &be->phih);
+    if (!be->sig || !ok)
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", illum_floats);
     be->illum_floats = illum_floats;
-    be->k.sig = be->sig; be->k.E = be->E; be->k.phi = be->phi;
+    be->k.sig = be->sig;
+    hd__cpu_bind_illum(be);
     return HD_SUCCESS;
 }
 
@@ -215,12 +252,13 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
     hd__backend *be = ctx->be;
-    hd__free(ctx, be->phi2);
-    be->phi2 = be->k.phi2 = NULL;
+    int ok;
+    hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
+    hd__cpu_bind_illum(be);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    be->phi2 = (float *)hd__calloc(ctx, be->illum_floats, sizeof(float));
-    if (!be->phi2) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
-    be->k.phi2 = be->phi2;
+    ok = hd__cpu_alloc_illum(ctx, be->illum_floats, &be->phi2, &be->phi2h);
+    hd__cpu_bind_illum(be);
+    if (!ok) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
     return HD_SUCCESS;
 }
 
@@ -236,9 +274,13 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
-    if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, be->illum_floats * sizeof(float));
-    if ((what & HD__DIRTY_PHI) && be->phi) memset(be->phi, 0, be->illum_floats * sizeof(float));
-    if ((what & HD__DIRTY_PHI) && be->phi2) memset(be->phi2, 0, be->illum_floats * sizeof(float));
+    size_t n = be->illum_floats;
+    if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, n * sizeof(float));
+    if ((what & HD__DIRTY_PHI) && be->phi) memset(be->phi, 0, n * sizeof(float));
+    if ((what & HD__DIRTY_PHI) && be->phi2) memset(be->phi2, 0, n * sizeof(float));
+    if ((what & HD__DIRTY_DIRECT) && be->Eh) memset(be->Eh, 0, n * sizeof(uint16_t));
+    if ((what & HD__DIRTY_PHI) && be->phih) memset(be->phih, 0, n * sizeof(uint16_t));
+    if ((what & HD__DIRTY_PHI) && be->phi2h) memset(be->phi2h, 0, n * sizeof(uint16_t));
     if ((what & HD__DIRTY_IMAGE) && be->img)
         memset(be->img, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
     return HD_SUCCESS;
@@ -299,9 +341,28 @@ static int hd__cpu_row_variant(const hd__kctx *K)
            ((f & HD_FLAG_SURFACE_BOUNDARY) ? 4 : 0);
 }
 
-static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
+/* HD__CPU_FLATTEN: every call inside inlined, so each variant's loop is one body the compiler
+   can vectorise (with both precisions GCC 12 stopped inlining the terms into half the loops) */
+#if defined(__GNUC__) || defined(__clang__)
+#define HD__CPU_INLINE static inline __attribute__((always_inline))
+#define HD__CPU_FLATTEN __attribute__((flatten))
+#else
+#define HD__CPU_INLINE static inline
+#define HD__CPU_FLATTEN
+#endif
+
+/* Stores the relaxed colour (red-black) or the whole row (Jacobi) of row[] into phi or phi2 as
+   binary16 (illumination_precision FLOAT16). */
+static void hd__cpu_store_row_half(const hd__backend *be, const hd__kctx *K, const float *row, int y, int z, int c)
 {
-    const hd__kctx *K = be->grid->k;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    uint16_t *dst = (be->jacobi ? K->phi2h : K->phih) + ((size_t)(c * gz + z) * gy + y) * gx;
+    if (be->jacobi) for (x = 0; x < gx; ++x) dst[x] = hd_f2h(row[x]);
+    else for (x = (y + z + be->parity) & 1; x < gx; x += 2) dst[x] = hd_f2h(row[x]);
+}
+
+HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, int y, int z, int c)
+{
     int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x, x0;
     float row[HD__CPU_ROW_MAX];
     float *dst;
@@ -317,10 +378,21 @@ static void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
         num = hd_diffuse_terms(K, gx - 1, y, z, c, &den);
         row[gx - 1] = num / den;
     }
+    if (K->f16) { hd__cpu_store_row_half(be, K, row, y, z, c); return; }
     dst = (be->jacobi ? K->phi2 : K->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
     x0 = be->jacobi ? 0 : ((y + z + be->parity) & 1);
     if (be->jacobi) memcpy(dst, row, (size_t)gx * sizeof(float));
     else for (x = x0; x < gx; x += 2) dst[x] = row[x];
+}
+
+/* The row on a copy of the grid's kernel context whose storage precision (f16) is a literal:
+   the compiler drops the kernels' per-load precision test (hd_prelude_c.h's HD_GET) from each
+   inlined copy, so the float32 loop is the loop it was and the binary16 one converts inline. */
+static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c)
+{
+    hd__kctx k = *be->grid->k;
+    if (k.f16) { k.f16 = 1; hd__cpu_diffuse_row_k(be, &k, y, z, c); }
+    else { k.f16 = 0; hd__cpu_diffuse_row_k(be, &k, y, z, c); }
 }
 
 /* The sweep's schedule: blocks of HD__CPU_BLOCK_ROWS rows (y) per work item, each walked through
@@ -418,12 +490,14 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     be->grid = &fine;
     if (jacobi) {
         float *t;
+        uint16_t *th;
         be->jacobi = 1;
         be->parity = 0;
         be->block_pass = 0;
         hd__cpu_parallel(be, hd__cpu_diffuse_block, hd__cpu_blocks(be) * ctx->channels);
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
-        be->k.phi = be->phi; be->k.phi2 = be->phi2;
+        th = be->phih; be->phih = be->phi2h; be->phi2h = th;
+        hd__cpu_bind_illum(be);
     } else {
         hd__cpu_red_black(be, 1);
     }
@@ -443,8 +517,14 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 }
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
-    const float *src = which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi;
-    memcpy(dst, src, ctx->be->illum_floats * sizeof(float));
+    const hd__backend *be = ctx->be;
+    const uint16_t *h = which == HD_ILLUMINATION_DIRECT ? be->Eh : be->phih;
+    size_t i;
+    if (h) {
+        for (i = 0; i < be->illum_floats; ++i) dst[i] = hd_h2f(h[i]);
+        return HD_SUCCESS;
+    }
+    memcpy(dst, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, be->illum_floats * sizeof(float));
     return HD_SUCCESS;
 }
 

@@ -9,7 +9,8 @@
     __global float *restrict img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; k.dx = 0
+    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; k.dx = 0; \
+    k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
 /* One work-item per voxel: global size = illumination grid (x, y, z). */
 __kernel void hd_k_classify(HD__CL_BUFFERS)
@@ -19,11 +20,17 @@ __kernel void hd_k_classify(HD__CL_BUFFERS)
 }
 
 /* One work-item per voxel: tracking cost varies per voxel, so fine-grained items balance. */
-__kernel void hd_k_direct(HD__CL_BUFFERS)
-{
-    HD__CL_KCTX;
-    hd_direct_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2));
-}
+/* Each stage that touches E or phi has a twin with a _half suffix whose k.f16 is the literal 1:
+   binary16 storage (params.illumination_precision), float32 arithmetic. */
+#define HD__CL_DIRECT(name, is16) \
+    __kernel void name(HD__CL_BUFFERS) \
+    { \
+        HD__CL_KCTX; \
+        k.f16 = (is16); \
+        hd_direct_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); \
+    }
+HD__CL_DIRECT(hd_k_direct, 0)
+HD__CL_DIRECT(hd_k_direct_half, 1)
 
 /* Diffusion: one work-item per voxel, global size (gx, gy, gz * channels), one x-row per
    work-group (hd_opencl.h), so PoCL runs each row as one loop and vectorises it along x; the
@@ -37,8 +44,10 @@ __kernel void hd_k_direct(HD__CL_BUFFERS)
      the update under the condition and give up). No voxel changes value while it is read:
      the updated colour reads only the other one, whose rewrites store the bits already there;
    - K->dx = x makes the neighbour addresses affine (the prelude's HD_GET);
-   - the buffer arguments are restrict, so the parameter block's loads leave the loop. */
-#define HD__CL_DIFFUSE(name, bits, jacobi) \
+   - the buffer arguments are restrict, so the parameter block's loads leave the loop.
+   Binary16 storage (f16): the other colour's work-items write back the half they read, the
+   same bits (a half converts to float and back exactly). */
+#define HD__CL_DIFFUSE(name, bits, jacobi, is16) \
     __kernel void name(HD__CL_BUFFERS, int parity) \
     { \
         HD__CL_KCTX; \
@@ -49,30 +58,42 @@ __kernel void hd_k_direct(HD__CL_BUFFERS)
         float den, num, v; \
         k.flags = (k.flags & ~(HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY)) | (bits); \
         k.dx = get_global_id(0); \
+        k.f16 = (is16); \
         num = hd_diffuse_terms(&k, x, y, z, c, &den); \
         v = num / den; \
         if (jacobi) { \
-            phi2[i] = v; \
+            if (is16) vstore_half_rte(v, i, k.phi2h); \
+            else phi2[i] = v; \
         } else { \
             uint mine = 0u - (uint)(((x + y + z + parity) & 1) == 0); \
-            phi[i] = as_float((as_uint(v) & mine) | (as_uint(phi[i]) & ~mine)); \
+            float old = (is16) ? vload_half(i, k.phih) : phi[i]; \
+            v = as_float((as_uint(v) & mine) | (as_uint(old) & ~mine)); \
+            if (is16) vstore_half_rte(v, i, k.phih); \
+            else phi[i] = v; \
         } \
     }
-HD__CL_DIFFUSE(hd_k_diffuse, 0, 0)
-HD__CL_DIFFUSE(hd_k_diffuse_rgb, HD_FLAG_RGB_SCATTERING, 0)
-HD__CL_DIFFUSE(hd_k_diffuse_surface, HD_FLAG_SURFACE_BOUNDARY, 0)
-HD__CL_DIFFUSE(hd_k_diffuse_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING, 0)
-HD__CL_DIFFUSE(hd_k_diffuse_jacobi, 0, 1)
-HD__CL_DIFFUSE(hd_k_diffuse_jacobi_rgb, HD_FLAG_RGB_SCATTERING, 1)
-HD__CL_DIFFUSE(hd_k_diffuse_jacobi_surface, HD_FLAG_SURFACE_BOUNDARY, 1)
-HD__CL_DIFFUSE(hd_k_diffuse_jacobi_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING, 1)
+#define HD__CL_DIFFUSE_SET(suffix, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse##suffix, 0, 0, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_rgb##suffix, HD_FLAG_RGB_SCATTERING, 0, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_surface##suffix, HD_FLAG_SURFACE_BOUNDARY, 0, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_surface_rgb##suffix, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING, 0, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_jacobi##suffix, 0, 1, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_jacobi_rgb##suffix, HD_FLAG_RGB_SCATTERING, 1, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_jacobi_surface##suffix, HD_FLAG_SURFACE_BOUNDARY, 1, is16) \
+    HD__CL_DIFFUSE(hd_k_diffuse_jacobi_surface_rgb##suffix, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING, 1, is16)
+HD__CL_DIFFUSE_SET(, 0)
+HD__CL_DIFFUSE_SET(_half, 1)
 
 /* One work-item per pixel (x, y). */
-__kernel void hd_k_project(HD__CL_BUFFERS)
-{
-    HD__CL_KCTX;
-    hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
-}
+#define HD__CL_PROJECT(name, is16) \
+    __kernel void name(HD__CL_BUFFERS) \
+    { \
+        HD__CL_KCTX; \
+        k.f16 = (is16); \
+        hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
+    }
+HD__CL_PROJECT(hd_k_project, 0)
+HD__CL_PROJECT(hd_k_project_half, 1)
 
 /* CD: one upwind convection step of light l, reading lv and writing lv2; one work-item per
    voxel (global size = illumination grid). */
@@ -85,12 +106,16 @@ __kernel void hd_k_convect(HD__CL_BUFFERS, __global const float *lv, __global fl
 }
 
 /* CD: adds light l's volume into E (first != 0: overwrites); one work-item per voxel. */
-__kernel void hd_k_sum_light(HD__CL_BUFFERS, __global const float *lv, int l, int first)
-{
-    HD__CL_KCTX;
-    k.lv = lv;
-    hd_sum_light_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l, first);
-}
+#define HD__CL_SUM_LIGHT(name, is16) \
+    __kernel void name(HD__CL_BUFFERS, __global const float *lv, int l, int first) \
+    { \
+        HD__CL_KCTX; \
+        k.lv = lv; \
+        k.f16 = (is16); \
+        hd_sum_light_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l, first); \
+    }
+HD__CL_SUM_LIGHT(hd_k_sum_light, 0)
+HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
 
 /* PT_SS / PT_MS: one path per pixel (x, y). */
 __kernel void hd_k_path(HD__CL_BUFFERS)

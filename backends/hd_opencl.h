@@ -26,15 +26,22 @@
 
 #define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
 #define HD__BE_HAS_PT 1 /* hd__be_path */
+#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: the _half kernels */
 
 /* the eight diffusion kernels from HD__CL_DIFFUSE on, indexed by 4 * Jacobi + 2 * surface
-   boundary + RGB scattering */
+   boundary + RGB scattering; then the binary16-storage twins of the stages that touch E or phi
+   (hd__cl_k picks them), the diffusion's in the same order */
 enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_DIFFUSE + 8, HD__CL_CONVECT,
-       HD__CL_SUM_LIGHT, HD__CL_PATH, HD__CL_KERNEL_COUNT };
+       HD__CL_SUM_LIGHT, HD__CL_PATH, HD__CL_DIRECT_HALF, HD__CL_DIFFUSE_HALF,
+       HD__CL_PROJECT_HALF = HD__CL_DIFFUSE_HALF + 8, HD__CL_SUM_LIGHT_HALF, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
     "hd_k_diffuse_surface_rgb", "hd_k_diffuse_jacobi", "hd_k_diffuse_jacobi_rgb", "hd_k_diffuse_jacobi_surface",
-    "hd_k_diffuse_jacobi_surface_rgb", "hd_k_project", "hd_k_convect", "hd_k_sum_light", "hd_k_path"};
+    "hd_k_diffuse_jacobi_surface_rgb", "hd_k_project", "hd_k_convect", "hd_k_sum_light", "hd_k_path",
+    "hd_k_direct_half", "hd_k_diffuse_half", "hd_k_diffuse_rgb_half", "hd_k_diffuse_surface_half",
+    "hd_k_diffuse_surface_rgb_half", "hd_k_diffuse_jacobi_half", "hd_k_diffuse_jacobi_rgb_half",
+    "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
+    "hd_k_sum_light_half"};
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -48,6 +55,7 @@ struct hd__backend {
     cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
     int nlv;
     size_t tf_bytes, illum_floats, img_floats;
+    int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
     int params_valid;
@@ -344,17 +352,37 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
     return HD_SUCCESS;
 }
 
+/* Bytes of an illumination buffer (E, phi, phi2) of n elements: 4 per float, 2 per binary16,
+   rounded up to whole floats so hd__cl_buffer's and hd__cl_zero's 4-byte fill reaches the end. */
+static size_t hd__cl_illum_bytes(const hd__backend *be, size_t n)
+{
+    return be->f16 ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float);
+}
+
+/* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
+static int hd__cl_k(const hd__ctx *ctx, int k)
+{
+    if (!ctx->be->f16) return k;
+    if (k == HD__CL_DIRECT) return HD__CL_DIRECT_HALF;
+    if (k == HD__CL_PROJECT) return HD__CL_PROJECT_HALF;
+    if (k == HD__CL_SUM_LIGHT) return HD__CL_SUM_LIGHT_HALF;
+    if (k >= HD__CL_DIFFUSE && k < HD__CL_DIFFUSE + 8) return k - HD__CL_DIFFUSE + HD__CL_DIFFUSE_HALF;
+    return k;
+}
+
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
-    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], bytes;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
     be->illum_floats = 0;
+    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    bytes = hd__cl_illum_bytes(be, illum_floats);
     if ((r = hd__cl_buffer(ctx, &be->sig, gvox * (size_t)ctx->sig_channels * sizeof(float), NULL, "sigma_t")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->E, illum_floats * sizeof(float), NULL, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->phi, illum_floats * sizeof(float), NULL, "phi")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->E, bytes, NULL, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(ctx, &be->phi, bytes, NULL, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
     return HD_SUCCESS;
 }
@@ -365,7 +393,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->phi2);
     if (!enable) return HD_SUCCESS;
-    return hd__cl_buffer(ctx, &be->phi2, be->illum_floats * sizeof(float), NULL, "Jacobi's buffer");
+    return hd__cl_buffer(ctx, &be->phi2, hd__cl_illum_bytes(be, be->illum_floats), NULL, "Jacobi's buffer");
 }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
@@ -384,10 +412,11 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r = HD_SUCCESS;
+    size_t n = hd__cl_illum_bytes(be, be->illum_floats) / sizeof(float); /* in floats' worth of bytes */
     HD__CL_LOST_CHECK(ctx);
-    if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, be->illum_floats)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, be->illum_floats)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi2, be->illum_floats)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, n)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, n)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi2, n)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && (r = hd__cl_zero(ctx, be->img, be->img_floats)) != HD_SUCCESS) return r;
     return r;
 }
@@ -438,8 +467,9 @@ static hd_result hd__be_classify(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     hd_result r;
-    if ((r = hd__cl_bind(ctx, HD__CL_DIRECT)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_run(ctx, HD__CL_DIRECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
+    int k = hd__cl_k(ctx, HD__CL_DIRECT);
+    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
     /* each stage returns when its work is done, as on the CPU, so the core's per-stage clocks
        measure the device rather than the enqueueing (cost: one clFinish per stage) */
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
@@ -453,8 +483,8 @@ static hd_result hd__be_direct(hd__ctx *ctx)
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
-    int k = HD__CL_DIFFUSE + (jacobi ? 4 : 0) + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) +
-            ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+    int k = hd__cl_k(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0) + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) +
+                          ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0));
     size_t gx = (size_t)ctx->gdims[0], local[3], wg = 0;
     hd_result r;
     cl_int parity;
@@ -476,8 +506,9 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 static hd_result hd__be_project(hd__ctx *ctx)
 {
     hd_result r;
-    if ((r = hd__cl_bind(ctx, HD__CL_PROJECT)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_run(ctx, HD__CL_PROJECT, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
+    int k = hd__cl_k(ctx, HD__CL_PROJECT);
+    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
     return HD_SUCCESS;
 }
@@ -492,13 +523,25 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     return HD_SUCCESS;
 }
 
+/* Binary16 storage is read into the second half of dst (2 bytes per element fit in the 4
+   each float takes) and widened in place from the front, with the CPU's exact hd_h2f: float i
+   ends at byte 4i + 4, at or before half i + 1 starts (byte 2n + 2i at least, n odd). The halves
+   are read with memcpy, which the compiler must order against the float stores. */
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
     hd__backend *be = ctx->be;
+    size_t n = be->illum_floats, i;
+    unsigned char *h = (unsigned char *)(dst + n / 2);
     HD__CL_LOST_CHECK(ctx);
     HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, 0,
-                                        be->illum_floats * sizeof(float), dst, 0, NULL, NULL),
+                                        n * (be->f16 ? 2 : sizeof(float)), be->f16 ? (void *)h : (void *)dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(illumination)");
+    if (be->f16)
+        for (i = 0; i < n; ++i) {
+            uint16_t v;
+            memcpy(&v, h + 2 * i, 2);
+            dst[i] = hd_h2f(v);
+        }
     return HD_SUCCESS;
 }
 
@@ -547,16 +590,17 @@ static hd_result hd__be_convect(hd__ctx *ctx, int light)
 static hd_result hd__be_sum_lights(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    cl_kernel k = be->kernels[HD__CL_SUM_LIGHT];
+    int ki = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
+    cl_kernel k = be->kernels[ki];
     hd_result r;
     int l;
-    if ((r = hd__cl_bind(ctx, HD__CL_SUM_LIGHT)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_bind(ctx, ki)) != HD_SUCCESS) return r;
     for (l = 0; l < be->nlv; ++l) {
         cl_int li = l, first = l == 0;
         HD__CL_TRY(ctx, clSetKernelArg(k, 9, sizeof(cl_mem), &be->lv[l]), "clSetKernelArg(lv)");
         HD__CL_TRY(ctx, clSetKernelArg(k, 10, sizeof li, &li), "clSetKernelArg(light)");
         HD__CL_TRY(ctx, clSetKernelArg(k, 11, sizeof first, &first), "clSetKernelArg(first)");
-        if ((r = hd__cl_run(ctx, HD__CL_SUM_LIGHT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+        if ((r = hd__cl_run(ctx, ki, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
             return r;
     }
     HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");

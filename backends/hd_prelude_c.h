@@ -7,6 +7,7 @@
 #define HD_PRELUDE_C_H
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #define HD_FN static inline
 #define HD_LANG_C 1
@@ -56,6 +57,39 @@ HD_FN int hd_maxi(int a, int b) { return a > b ? a : b; }
 HD_FN float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 HD_FN int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
+/* IEEE binary16 <-> float32, portable: the storage of E and phi with
+   params.illumination_precision = HD_PRECISION_FLOAT16 (the arithmetic stays float32). Both are
+   selects on integer bit patterns, no branches, so a loop over them vectorises. hd_h2f is exact
+   (every half is a float); hd_f2h rounds to nearest, ties to even, as OpenCL's vstore_half_rte:
+   overflow gives inf, tiny values give subnormal halves or zero, NaN stays NaN (quiet, its sign
+   and top payload bits kept). */
+HD_FN uint32_t hd_f2u(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+HD_FN float hd_u2f(uint32_t u) { float f; memcpy(&f, &u, 4); return f; }
+HD_FN float hd_h2f(uint16_t h)
+{
+    uint32_t sign = (uint32_t)(h & 0x8000u) << 16, em = h & 0x7fffu;
+    /* normal: rebias the exponent (127 - 15 = 112); inf/NaN (exponent 31): exponent 255 */
+    uint32_t normal = (em << 13) + (112u << 23) + (uint32_t)(em >= 0x7c00u) * (112u << 23);
+    /* subnormal (and zero): mantissa * 2^-24, exact in float; picked by a mask, as a ?: here
+       kept GCC 12 from vectorising */
+    uint32_t sub = hd_f2u((float)em * 5.9604644775390625e-8f), m = 0u - (uint32_t)(em < 0x0400u);
+    return hd_u2f(sign | (sub & m) | (normal & ~m));
+}
+HD_FN uint16_t hd_f2h(float f)
+{
+    uint32_t u = hd_f2u(f), sign = (u >> 16) & 0x8000u, a = u & 0x7fffffffu;
+    /* NaN: quiet, top 10 payload bits; >= 65520 (rounds past the largest half 65504): inf */
+    uint32_t special = a > 0x7f800000u ? 0x7e00u | ((a >> 13) & 0x3ffu) : 0x7c00u;
+    /* normal half (a >= 2^-14): drop 13 mantissa bits with round-to-nearest-even; a carry into
+       the exponent is the right result (up to inf at the top) */
+    uint32_t normal = (a - (112u << 23) + 0x0fffu + ((a >> 13) & 1u)) >> 13;
+    /* subnormal half (a < 2^-14): adding 0.5 (2^-1) lines the half's last mantissa bit up with
+       the float's last one (2^-24 = 2^-1 * 2^-23), and the float adder rounds to nearest even */
+    uint32_t sub = hd_f2u(hd_u2f(a) + 0.5f) - 0x3f000000u;
+    uint32_t h = a >= 0x477ff000u ? special : (a >= 0x38800000u ? normal : sub);
+    return (uint16_t)(sign | h);
+}
+
 /* Structs: GLSL has no typedef. */
 #define HD_STRUCT(name) typedef struct name {
 #define HD_STRUCT_END(name) } name;
@@ -89,6 +123,9 @@ typedef struct hd__kctx {
     float *E;          /* direct light, channel-planar */
     float *phi;        /* scattered light (fluence), channel-planar */
     float *phi2;       /* Jacobi's second buffer */
+    int f16;           /* 1: E, phi and phi2 are stored as binary16 in Eh, phih, phi2h (and the
+                          float pointers are NULL); see HD_GET */
+    uint16_t *Eh, *phih, *phi2h;
     float *img;        /* RGBA float accumulation, width*height*4 */
     const float *lv;   /* CD: the light volume being read (one light's rho) */
     float *lv2;        /* CD: the light volume being written (ping-pong) */
@@ -98,9 +135,27 @@ typedef struct hd__kctx {
 #define HD_KPASS K,
 #define HD_PRM(name) (K->p->name)
 /* Buffer element i; x,y,z is the same element as image coordinates (channel c at z + c*dz), which
-   image-backed GPU preludes use instead of i. */
-#define HD_GET(buf, i, x, y, z) ((void)(x), (void)(y), (void)(z), K->buf[(i)])
-#define HD_SET(buf, i, x, y, z, v) ((void)(x), (void)(y), (void)(z), K->buf[(i)] = (v))
+   image-backed GPU preludes use instead of i. The illumination buffers E, phi, phi2 go through
+   HD__LD_ / HD__ST_ (pasted on the buffer's name): float32 or binary16 by K->f16. The CPU
+   backend runs its vectorised rows on a copy of K whose f16 is a literal, so the compiler drops
+   the test there (hd_cpu.h); elsewhere it is one well-predicted branch. */
+#define HD_GET(buf, i, x, y, z) ((void)(x), (void)(y), (void)(z), HD__LD_##buf(i))
+#define HD_SET(buf, i, x, y, z, v) ((void)(x), (void)(y), (void)(z), HD__ST_##buf((i), (v)))
+#define HD__LD_PLAIN(buf, i) (K->buf[(i)])
+#define HD__LD_vol(i) HD__LD_PLAIN(vol, i)
+#define HD__LD_sig(i) HD__LD_PLAIN(sig, i)
+#define HD__LD_lv(i) HD__LD_PLAIN(lv, i)
+#define HD__LD_lv2(i) HD__LD_PLAIN(lv2, i)
+#define HD__ST_sig(i, v) (K->sig[(i)] = (v))
+#define HD__ST_lv2(i, v) (K->lv2[(i)] = (v))
+#define HD__LD_HALF(buf, i) (K->f16 != 0 ? hd_h2f(K->buf##h[(i)]) : K->buf[(i)])
+#define HD__ST_HALF(buf, i, v) (K->f16 != 0 ? (void)(K->buf##h[(i)] = hd_f2h(v)) : (void)(K->buf[(i)] = (v)))
+#define HD__LD_E(i) HD__LD_HALF(E, i)
+#define HD__LD_phi(i) HD__LD_HALF(phi, i)
+#define HD__LD_phi2(i) HD__LD_HALF(phi2, i)
+#define HD__ST_E(i, v) HD__ST_HALF(E, i, v)
+#define HD__ST_phi(i, v) HD__ST_HALF(phi, i, v)
+#define HD__ST_phi2(i, v) HD__ST_HALF(phi2, i, v)
 #define HD_GET1(buf, i) (K->buf[(i)])
 #define HD_SET1(buf, i, v) (K->buf[(i)] = (v))
 #endif

@@ -95,6 +95,14 @@ typedef struct hd__kctx {
     __global float *E;
     __global float *phi;
     __global float *phi2;
+    /* E, phi, phi2 as binary16 (params.illumination_precision FLOAT16): the same buffers seen
+       as half, read and written through vload_half / vstore_half_rte, core OpenCL C 1.2 (no
+       cl_khr_fp16: the arithmetic stays float); f16 says which view HD_GET uses. The entry
+       points set it as a literal, so the compiler keeps one of the two. */
+    __global half *Eh;
+    __global half *phih;
+    __global half *phi2h;
+    int f16;
     __global float *img;
     __global const float *lv;   /* CD: the light volume being read */
     __global float *lv2;        /* CD: the light volume being written */
@@ -113,7 +121,25 @@ typedef struct hd__kctx {
    (buf + dx)[i - x], the same element, but after the compiler cancels x from i the address is
    affine in the work-item index and PoCL loads neighbours as vectors; through the shared 32-bit
    index it gathered them one by one. */
-#define HD_GET(buf, i, x, y, z) ((K->buf + K->dx)[(i) - (int)K->dx])
-#define HD_SET(buf, i, x, y, z, v) ((K->buf + K->dx)[(i) - (int)K->dx] = (v))
+#define HD_GET(buf, i, x, y, z) HD__LD_##buf(i)
+#define HD_SET(buf, i, x, y, z, v) HD__ST_##buf((i), (v))
+#define HD__LD_PLAIN(buf, i) ((K->buf + K->dx)[(i) - (int)K->dx])
+#define HD__LD_vol(i) HD__LD_PLAIN(vol, i)
+#define HD__LD_sig(i) HD__LD_PLAIN(sig, i)
+#define HD__LD_lv(i) HD__LD_PLAIN(lv, i)
+#define HD__LD_lv2(i) HD__LD_PLAIN(lv2, i)
+#define HD__ST_sig(i, v) (HD__LD_PLAIN(sig, i) = (v))
+#define HD__ST_lv2(i, v) (HD__LD_PLAIN(lv2, i) = (v))
+/* The illumination buffers: float, or binary16 rounded to nearest even (as the C prelude's
+   hd_f2h, so both backends store the same bits for the same float). */
+#define HD__LD_HALF(buf, i) (K->f16 != 0 ? vload_half((size_t)((i) - (int)K->dx), K->buf##h + K->dx) : HD__LD_PLAIN(buf, i))
+#define HD__ST_HALF(buf, i, v) \
+    (K->f16 != 0 ? vstore_half_rte((v), (size_t)((i) - (int)K->dx), K->buf##h + K->dx) : (void)(HD__LD_PLAIN(buf, i) = (v)))
+#define HD__LD_E(i) HD__LD_HALF(E, i)
+#define HD__LD_phi(i) HD__LD_HALF(phi, i)
+#define HD__LD_phi2(i) HD__LD_HALF(phi2, i)
+#define HD__ST_E(i, v) HD__ST_HALF(E, i, v)
+#define HD__ST_phi(i, v) HD__ST_HALF(phi, i, v)
+#define HD__ST_phi2(i, v) HD__ST_HALF(phi2, i, v)
 #define HD_GET1(buf, i) (K->buf[(i)])
 #define HD_SET1(buf, i, v) (K->buf[(i)] = (v))

@@ -485,7 +485,8 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
         memcmp(p.background, o->background, sizeof p.background) != 0)
         ctx->dirty |= HD__DIRTY_IMAGE;
     if ((p.solver == HD_SOLVER_JACOBI) != (o->solver == HD_SOLVER_JACOBI)) ctx->dirty |= HD__DIRTY_JACOBI;
-    if (p.illumination_downsample != o->illumination_downsample || p.rgb_scattering != o->rgb_scattering)
+    if (p.illumination_downsample != o->illumination_downsample || p.rgb_scattering != o->rgb_scattering ||
+        p.illumination_precision != o->illumination_precision)
         ctx->dirty |= HD__DIRTY_ALLOC | HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     ctx->params = p;
     hd__set_channels(ctx);
@@ -495,6 +496,12 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
 }
 
 /* ---- the schedule ---------------------------------------------------------------------------- */
+/* Bytes per stored element of E, phi and Jacobi's buffer: binary16 or float32. */
+static size_t hd__illum_elem_bytes(const hd__ctx *ctx)
+{
+    return ctx->params.illumination_precision == HD_PRECISION_FLOAT16 ? 2 : sizeof(float);
+}
+
 static size_t hd__illum_floats(const hd__ctx *ctx)
 {
     return (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2] * (size_t)ctx->channels;
@@ -750,7 +757,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
        plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
     out->method_bytes = gvox * sizeof(float) * (size_t)ctx->sig_channels +
-                        hd__illum_floats(ctx) * sizeof(float) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+                        hd__illum_floats(ctx) * hd__illum_elem_bytes(ctx) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
 #ifdef HD__BE_HAS_SOLVER_BYTES
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (CPU multigrid levels) */

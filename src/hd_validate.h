@@ -152,6 +152,9 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.rgb_scattering = %d must be 0 or 1", p->rgb_scattering);
     if ((int)p->diffusion_boundary < 0 || (int)p->diffusion_boundary >= (int)HD_BOUNDARY_COUNT)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_boundary = %d is not an hd_boundary", (int)p->diffusion_boundary);
+    if ((int)p->illumination_precision < 0 || (int)p->illumination_precision >= (int)HD_PRECISION_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.illumination_precision = %d is not an hd_precision",
+                       (int)p->illumination_precision);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
 #ifndef HD__BE_HAS_CD
@@ -162,6 +165,14 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
     if (p->solver == HD_SOLVER_MULTIGRID)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "solver MULTIGRID is not available on the %s backend (CPU only so far)", hd__be_name());
 #endif
+#ifndef HD__BE_HAS_HALF
+    if (p->illumination_precision == HD_PRECISION_FLOAT16)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 is not available on the %s backend (CPU and OpenCL only)",
+                       hd__be_name());
+#endif
+    /* the multigrid levels (hd_cpu_multigrid.h) restrict and prolong float32 fine grids */
+    if (p->illumination_precision == HD_PRECISION_FLOAT16 && p->solver == HD_SOLVER_MULTIGRID)
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 with solver MULTIGRID is not available (float32 levels only)");
 #ifndef HD__BE_HAS_PT
     if (p->method == HD_METHOD_PT_SS || p->method == HD_METHOD_PT_MS)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",

@@ -93,6 +93,7 @@ static hd_result c_p_window_neg(void) { hd_params p = P0; p.frame_window = -1; r
 static hd_result c_p_exp_inf(void) { hd_params p = P0; p.exposure = hs_inf(); return hd_set_params(C, &p); }
 static hd_result c_p_bounces(void) { hd_params p = P0; p.max_bounces = -5; return hd_set_params(C, &p); }
 static hd_result c_p_dd(void) { hd_params p = P0; p.disable_diffusion = 2; return hd_set_params(C, &p); }
+static hd_result c_p_prec(void) { hd_params p = P0; p.illumination_precision = (hd_precision)5; return hd_set_params(C, &p); }
 static hd_result c_it_zero(void) { return hd_iterate(C, 0); }
 static hd_result c_it_min(void) { return hd_iterate(C, INT_MIN); }
 static hd_result c_rgba_null(void) { return hd_read_image_rgba8(C, NULL, 8 * 8 * 4); }
@@ -154,6 +155,7 @@ static const hs_case hs_cases[] = {
     {"exposure Inf", HD_ERROR_INVALID_PARAMETER, c_p_exp_inf},
     {"max_bounces -5", HD_ERROR_INVALID_PARAMETER, c_p_bounces},
     {"disable_diffusion 2", HD_ERROR_INVALID_PARAMETER, c_p_dd},
+    {"illumination_precision 5", HD_ERROR_INVALID_ENUM, c_p_prec},
     {"iterate 0", HD_ERROR_INVALID_PARAMETER, c_it_zero},
     {"iterate INT_MIN", HD_ERROR_INVALID_PARAMETER, c_it_min},
     {"rgba8 NULL", HD_ERROR_NULL_POINTER, c_rgba_null},
