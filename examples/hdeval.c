@@ -164,6 +164,7 @@ static void *xmalloc(size_t n)
 static int g_downsample = 1; /* params.illumination_downsample of HD and CD contexts */
 static int g_rgb = 0;        /* params.rgb_scattering of HD and CD contexts */
 static hd_boundary g_boundary = HD_BOUNDARY_BOX; /* params.diffusion_boundary of HD and CD contexts */
+static hd_precision g_precision = HD_PRECISION_FLOAT32; /* params.illumination_precision of HD and CD */
 
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
 {
@@ -204,6 +205,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.illumination_downsample = g_downsample;
     d.params.rgb_scattering = g_rgb;
     d.params.diffusion_boundary = g_boundary;
+    d.params.illumination_precision = g_precision;
     d.threads = S.threads;
     d.logger.func = hd_log_stderr;
     r = hd_create(&d, &ctx);
@@ -858,9 +860,66 @@ static void run_rgb_study(const ref_img *ref, const char *out)
     for (k = 0; k < 4; ++k) free(img[k]);
 }
 
+/* Beyond the paper: HD with E and phi stored as float32 and as float16 (params.
+   illumination_precision), box boundary, 1 light, against the 1-light PT_MS reference at the
+   scene's HD iteration count and 4x it; the bytes per voxel of E + phi and of the whole state,
+   and the float16 image's PSNR against the float32 one (what the rounding alone costs).
+   OUT/half.md and half-checks lines. */
+static void run_half_study(const ref_img *ref, const char *out)
+{
+    size_t npix = (size_t)S.size * S.size;
+    float *img[2][2];
+    int k, j, n = S.iterations[HDE_HD];
+    FILE *md = open_w(out, "half.md", NULL);
+    fprintf(md, "| storage | E + phi bytes per voxel | state bytes per voxel | PSNR vs PT_MS after %d it | lit part | after %d it | lit part |\n"
+                "|---|---|---|---|---|---|---|\n", n, 4 * n);
+    for (k = 0; k < 2; ++k) {
+        hd_context ctx;
+        hd_stats st;
+        err2 e1, e4;
+        double gvox, illum;
+        g_precision = k ? HD_PRECISION_FLOAT16 : HD_PRECISION_FLOAT32;
+        for (j = 0; j < 2; ++j) img[k][j] = (float *)xmalloc(npix * 4 * sizeof(float));
+        ctx = make_ctx(HDE_HD, 1, S.size, 1u);
+        iterate(ctx, n);
+        read_image(ctx, img[k][0], S.size);
+        e1 = compare(img[k][0], ref, npix);
+        iterate(ctx, 3 * n);
+        read_image(ctx, img[k][1], S.size);
+        e4 = compare(img[k][1], ref, npix);
+        if (hd_get_stats(ctx, &st) != HD_SUCCESS) die("hd_get_stats");
+        gvox = (double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2];
+        illum = 2.0 * st.illumination_channels * (k ? 2.0 : 4.0); /* E and phi, per channel */
+        fprintf(md, "| %s | %.0f | %.1f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", k ? "float16" : "float32", illum,
+                (double)st.method_bytes / gvox, psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
+        check_line("precision %s: E+phi %.0f B/voxel, state %.1f B/voxel, PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, "
+                   "%.2f dB (lit %.2f) after %d it", k ? "float16" : "float32", illum, (double)st.method_bytes / gvox,
+                   psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
+        hd_destroy(ctx);
+    }
+    g_precision = HD_PRECISION_FLOAT32;
+    for (j = 0; j < 2; ++j) {
+        /* the float32 image as the reference of the float16 one: tone-mapped MSE as compare() */
+        double mse = 0.0, d;
+        size_t i;
+        int c;
+        for (i = 0; i < npix; ++i)
+            for (c = 0; c < 3; ++c) {
+                d = (double)tonemap(img[1][j][4 * i + c]) - tonemap(img[0][j][4 * i + c]);
+                mse += d * d;
+            }
+        mse /= 3.0 * (double)npix;
+        fprintf(md, "%sfloat16 against float32 after %d it: %.2f dB%s", j ? "; " : "\n", j ? 4 * n : n, psnr(mse), j ? "\n" : "");
+        check_line("float16 vs float32 image after %d it: PSNR %.2f dB", j ? 4 * n : n, psnr(mse));
+    }
+    fclose(md);
+    for (k = 0; k < 2; ++k)
+        for (j = 0; j < 2; ++j) free(img[k][j]);
+}
+
 static const char *usage =
     "usage: hdeval [SCENE] [--paper] [--out DIR] [--cache DIR] [--work DIR] [--size N] [--table-size N]\n"
-    "              [--skip-table] [--downsample-study] [--rgb-study]\n"
+    "              [--skip-table] [--downsample-study] [--rgb-study] [--half-study]\n"
     "  SCENE           scene file (default examples/eval/head.scene): every setting\n"
     "  --paper         use the scene's paper.* settings (1024^2, paper-scale iterations/references)\n"
     "  --out DIR       tables, plots, figures (default docs/eval)\n"
@@ -873,13 +932,16 @@ static const char *usage =
     "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n"
     "  --rgb-study     only HD with grey and RGB scattering, each with the box and the surface\n"
     "                  boundary, against the 1-light PT_MS reference (OUT/rgb.md,\n"
-    "                  OUT/rgb_scattering.png), then stop\n";
+    "                  OUT/rgb_scattering.png), then stop\n"
+    "  --half-study    only HD with E and phi stored as float32 and as float16, against the\n"
+    "                  1-light PT_MS reference (OUT/half.md), then stop\n";
 
 int main(int argc, char **argv)
 {
     const char *scene_path = "examples/eval/head.scene", *out = "docs/eval", *cache = "out/eval-cache";
     const char *work = "out/eval-work";
     int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, rgb_study = 0, i, m, li, k;
+    int half_study = 0;
     char err[1024];
     static ref_img refs[HDE_METHODS][2];
     static curve cur[HDE_METHODS][2];
@@ -901,6 +963,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--skip-table")) skip_table = 1;
         else if (!strcmp(a, "--downsample-study")) downsample_study = 1;
         else if (!strcmp(a, "--rgb-study")) rgb_study = 1;
+        else if (!strcmp(a, "--half-study")) half_study = 1;
         else if (a[0] == '-') { fprintf(stderr, "hdeval: unknown option %s\n%s", a, usage); return 2; }
         else scene_path = a;
 #undef NEXT
@@ -932,7 +995,8 @@ int main(int argc, char **argv)
     if (r != HD_SUCCESS) die("%s: %s (make data fetches the head CT)", S.volume, hd_result_string(r));
     if (g_tf.data_domain) hdx_tf_set_domain(&g_tf, g_vol.value_min, g_vol.value_max);
 
-    g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : rgb_study ? "rgb-checks.txt" : "checks.txt", NULL);
+    g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : rgb_study ? "rgb-checks.txt" :
+                           half_study ? "half-checks.txt" : "checks.txt", NULL);
     check_line("hdeval: %s%s, %s %dx%dx%d, tf %s, backend %s, curves %dx%d, table %dx%d", scene_path,
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
                S.tf, hd_backend_name(), S.size, S.size, S.table_size, S.table_size);
@@ -942,6 +1006,12 @@ int main(int argc, char **argv)
                S.ref_paths[HDE_SS], S.ref_paths[HDE_MS], (double)S.extinction, (double)S.albedo,
                (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps);
 
+    if (half_study) {
+        ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
+        run_half_study(&refs[HDE_MS][0], out);
+        fclose(g_checks);
+        return 0;
+    }
     if (rgb_study) {
         ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
         run_rgb_study(&refs[HDE_MS][0], out);

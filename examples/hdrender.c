@@ -96,6 +96,8 @@ static const char *usage_text_method =
     "                          diffusion): the colour shift of deep light, +28 bytes/voxel\n"
     "  --grid-downsample N     store E and phi at the volume's resolution / N per axis (1..8,\n"
     "                          default 1): 8x less illumination memory and ~5x faster HD at 2\n"
+    "  --half                  store E and phi as float16 (float32 arithmetic): 2 bytes per\n"
+    "                          voxel and channel instead of 4 (CPU and OpenCL backends)\n"
     "\n"
     "output\n"
     "  -o, --out FILE.png      output image (default " DEFAULT_OUTPUT "; its directory is\n"
@@ -550,6 +552,9 @@ int main(int argc, char **argv)
             desc.params.frame_window = (int)parse_int(a, VAL(), 1, 1000000);
         } else if (IS("--rgb-scattering")) {
             desc.params.rgb_scattering = 1;
+        } else if (IS("--half")) {
+            FLAG();
+            desc.params.illumination_precision = HD_PRECISION_FLOAT16;
         } else if (IS("--grid-downsample")) {
             desc.params.illumination_downsample = (int)parse_int(a, VAL(), 1, 8);
         } else if (IS("-o") || IS("--out")) {

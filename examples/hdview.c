@@ -13,6 +13,8 @@
      A / shift+A  albedo +0.05 / -0.05             R   restart     S   screenshot (hdview-N.png)
      H         the default camera                  G   illumination grid 1/1 -> 1/2 -> 1/4 resolution
      C         grey / RGB multiple scattering         B   diffusion boundary: box / surface
+     F         float32 / float16 illumination storage (CPU and OpenCL only: the GL backend
+               refuses it, the log says so and the viewer stays at float32)
      Esc / Q   quit
    The title shows the method, iterations, iterations/s and the bytes the method holds.
 
@@ -266,6 +268,12 @@ static void key_char(viewer *v, int c)
     case 'g': case 'G': /* params.illumination_downsample: 8x less memory per step */
         v->params.illumination_downsample = v->params.illumination_downsample >= 4 ? 1 : v->params.illumination_downsample * 2;
         apply_params(v);
+        break;
+    case 'f': case 'F': /* params.illumination_precision; a backend without it keeps the old one */
+        v->params.illumination_precision = v->params.illumination_precision == HD_PRECISION_FLOAT16 ? HD_PRECISION_FLOAT32
+                                                                                                   : HD_PRECISION_FLOAT16;
+        if ((r = hd_set_params(v->ctx, &v->params)) == HD_ERROR_UNSUPPORTED) v->params.illumination_precision = HD_PRECISION_FLOAT32;
+        else if (r != HD_SUCCESS) die("hd_set_params", r);
         break;
     case 's': case 'S':
         snprintf(name, sizeof name, "hdview-%d.png", v->shots++);
