@@ -1,9 +1,10 @@
 /* hdbench - prints the figures the core's targets are measured by, in one run:
      - memory bandwidth (STREAM triad a = b + s c, all threads), the roofline for the stencil;
-     - the diffusion sweep's time and bytes/s as a share of the triad;
+     - the diffusion sweep's time and bytes/s as a share of the triad (box and surface boundary);
      - HD iterations/s and per-stage times on the head CT at 512^2 and 1024^2, 1 and 3 lights;
      - bytes per voxel of HD's state for 1, 3 and 16 lights.
-   Usage: hdbench [data/head.nrrd] [--quick]   (make data fetches the head CT)
+   Usage: hdbench [data/head.nrrd] [--quick] [--sweep]   (make data fetches the head CT;
+   --sweep: the triad and the sweeps only)
    Figures, not a test: nothing here passes or fails. */
 #define HYBRIDDIFF_IMPLEMENTATION
 #ifndef HYBRIDDIFF_BACKEND_OPENCL
@@ -93,12 +94,13 @@ static void fill_desc(hd_desc *d, const hd_volume_file *vf, int size, int lights
 int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd";
-    int quick = 0, i, sizes[2] = {512, 1024}, si, li, nthreads;
+    int quick = 0, sweep_only = 0, i, sizes[2] = {512, 1024}, si, li, nthreads;
     hd_volume_file vf;
     hd_result r;
     double triad, hd_rate[2][2] = {{0, 0}, {0, 0}};
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0) quick = 1;
+        else if (strcmp(argv[i], "--sweep") == 0) sweep_only = 1;
         else path = argv[i];
     }
     r = hd_volume_load_nrrd(path, &vf, NULL);
@@ -118,11 +120,13 @@ int main(int argc, char **argv)
         hd_desc d;
         hd_context ctx;
         hd_stats s0, s1;
-        int solver, sweeps = quick ? 20 : 100;
+        int solver, boundary, sweeps = quick ? 20 : 100;
+        for (boundary = HD_BOUNDARY_BOX; boundary <= HD_BOUNDARY_SURFACE; ++boundary)
         for (solver = HD_SOLVER_RED_BLACK; solver <= HD_SOLVER_JACOBI; ++solver) {
             double t, nvox, bytes;
             fill_desc(&d, &vf, 64, 1);
             d.params.solver = (hd_solver)solver;
+            d.params.diffusion_boundary = (hd_boundary)boundary;
             d.params.diffusion_sweeps = sweeps;
             if (hd_create(&d, &ctx) != HD_SUCCESS) return 1;
             hd_iterate(ctx, 1); /* warm-up: first touch of the pages */
@@ -134,12 +138,14 @@ int main(int argc, char **argv)
             /* red-black: each half-sweep streams sigma, E, phi in and phi out: 2 x 16 B/voxel;
                Jacobi: sigma, E, phi in and phi2 out: 16 B/voxel */
             bytes = nvox * (solver == HD_SOLVER_RED_BLACK ? 32.0 : 16.0);
-            printf("diffusion sweep (%s): %.2f ms = %.0f sweeps/s, %.2f GB/s = %.0f%% of the triad\n",
-                   solver == HD_SOLVER_RED_BLACK ? "red-black" : "Jacobi", t * 1e3, 1.0 / t, bytes / t * 1e-9,
+            printf("diffusion sweep (%s, %s boundary): %.2f ms = %.0f sweeps/s, %.2f GB/s = %.0f%% of the triad\n",
+                   solver == HD_SOLVER_RED_BLACK ? "red-black" : "Jacobi",
+                   boundary == HD_BOUNDARY_BOX ? "box" : "surface", t * 1e3, 1.0 / t, bytes / t * 1e-9,
                    100.0 * bytes / t / triad);
             hd_destroy(ctx);
         }
     }
+    if (sweep_only) { hd_volume_free(&vf); return 0; }
 
     /* HD iterations per second and per-stage times */
     printf("\n| image | lights | HD it/s | direct ms | diffusion ms | projection ms | bytes/voxel |\n");
