@@ -318,16 +318,16 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
         }                                                                                       \
     } while (0)
 /* The loop for the grid's flags: each combination a loop of its own, so none keeps a test. */
-#define HD__CPU_ROW_VARIANTS(xs, step, expr)                                                         \
+#define HD__CPU_ROW_VARIANTS(xs, step, expr)                                                        \
     switch (hd__cpu_row_variant(K)) {                                                           \
-    case 0: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 0, xs, step, expr); break;                          \
-    case 1: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 0, xs, step, expr); break;                          \
-    case 2: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 1, xs, step, expr); break;                          \
-    case 3: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 1, xs, step, expr); break;                          \
-    case 4: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 0, xs, step, expr); break;                      \
-    case 5: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 0, xs, step, expr); break;                      \
-    case 6: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 1, xs, step, expr); break;                      \
-    default: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 1, xs, step, expr); break;                     \
+    case 0: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 0, xs, step, expr); break;                    \
+    case 1: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 0, xs, step, expr); break;                    \
+    case 2: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 0, 1, xs, step, expr); break;                    \
+    case 3: HD__CPU_ROW_LOOP(hd_diffuse_terms_box, 1, 1, xs, step, expr); break;                    \
+    case 4: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 0, xs, step, expr); break;                \
+    case 5: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 0, xs, step, expr); break;                \
+    case 6: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 0, 1, xs, step, expr); break;                \
+    default: HD__CPU_ROW_LOOP(hd_diffuse_terms_surface, 1, 1, xs, step, expr); break;               \
     }
 
 /* A grid the diffusion passes work on. */
