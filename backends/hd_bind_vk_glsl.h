@@ -11,7 +11,9 @@
    Specialization constant 0, hd_sc_flags: in the diffusion module, the flags word (counts.z) as
    a constant fixed when hd_vulkan.h makes the pipeline, one per flags value, read by the kernel
    through HD_DIFFUSE_FLAGS: lavapipe runs both sides of every branch, so a flag tested at run
-   time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT). */
+   time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT).
+   Specialization constant 1, hd_sc_zk: voxels per diffusion invocation along z
+   (HD_DIFFUSE_ZK, hd_entry_glsl.h), fixed by hd_vulkan.h, which dispatches to match. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
@@ -25,8 +27,10 @@ layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 10, r32f) uniform image3D hd_i_lv2;
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
+layout(constant_id = 1) const int hd_sc_zk = 1;
 #if HD_STAGE == 3 /* HD_STAGE_DIFFUSE (hd_entry_glsl.h); the other stages read counts.z */
 #define HD_DIFFUSE_FLAGS hd_sc_flags
+#define HD_DIFFUSE_ZK hd_sc_zk
 #endif
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))

@@ -9,6 +9,9 @@
 #define HD_STAGE_CONVECT 5
 #define HD_STAGE_SUM_LIGHT 6
 #define HD_STAGE_PATH 7
+#ifndef HD_DIFFUSE_ZK
+#define HD_DIFFUSE_ZK 1 /* voxels per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
+#endif
 
 void main()
 {
@@ -19,17 +22,32 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIRECT
     if (x < g.x && y < g.y && z < g.z) hd_direct_voxel(x, y, z);
 #elif HD_STAGE == HD_STAGE_DIFFUSE
-    /* one voxel per invocation; z runs over channels * depth. Red-black: invocation x relaxes
-       voxel 2x + ((y + z + parity) & 1) of its row, hd_diffuse_row's voxels, in place;
-       Jacobi: voxel x, phi -> phi2. The same terms and division as hd_diffuse_row. */
-    int c = z / g.z, zz = z - c * g.z;
-    int jacobi = hd_pc.y;
-    int xv = jacobi != 0 ? x : 2 * x + ((y + zz + hd_pc.x) & 1);
-    if (xv < g.x && y < g.y && c < g.w) {
+    /* HD_DIFFUSE_ZK voxels per invocation, one per slice z * ZK + k (slices run over channels *
+       depth). Red-black: in each slice, invocation x relaxes voxel 2x + ((y + z + parity) & 1) of
+       its row, hd_diffuse_row's voxels, in place; Jacobi: voxel x, phi -> phi2. The same terms
+       and division as hd_diffuse_row. All the voxels' terms come before their stores: a red-black
+       half-sweep reads only the other colour's phi (Jacobi reads phi, writes phi2), so the order
+       changes no value, and with no store between them the loads of a texel two voxels share (the
+       black voxel between two red ones of the column) can be merged. Lanes past the grid compute
+       at a clamped voxel (every load in bounds) and store nothing. */
+    int jacobi = hd_pc.y, nz = g.z * g.w;
+    float v[HD_DIFFUSE_ZK];
+    for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
+        int zs = hd_mini(z * HD_DIFFUSE_ZK + k, nz - 1);
+        int c = (zs >= g.z ? 1 : 0) + (zs >= 2 * g.z ? 1 : 0), zz = zs - c * g.z; /* zs / g.z, <= 3 channels */
+        int xv = hd_mini(jacobi != 0 ? x : 2 * x + ((y + zz + hd_pc.x) & 1), g.x - 1);
         float den;
-        float num = hd_diffuse_terms(xv, y, zz, c, den);
-        if (jacobi != 0) HD_SET(phi2, 0, xv, y, z, num / den);
-        else HD_SET(phi, 0, xv, y, z, num / den);
+        v[k] = hd_diffuse_terms(xv, y, zz, c, den);
+        v[k] = v[k] / den;
+    }
+    for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
+        int zs = z * HD_DIFFUSE_ZK + k;
+        int c = (zs >= g.z ? 1 : 0) + (zs >= 2 * g.z ? 1 : 0), zz = zs - c * g.z;
+        int xv = jacobi != 0 ? x : 2 * x + ((y + zz + hd_pc.x) & 1);
+        if (xv < g.x && y < g.y && zs < nz) {
+            if (jacobi != 0) HD_SET(phi2, 0, xv, y, zs, v[k]);
+            else HD_SET(phi, 0, xv, y, zs, v[k]);
+        }
     }
 #elif HD_STAGE == HD_STAGE_PROJECT
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) hd_project_pixel(x, y);

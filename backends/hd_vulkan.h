@@ -90,6 +90,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 #define HD__VK_DIFFUSE_VARIANTS 32 /* diffusion pipelines per context, one per flags value (16 today) */
+#define HD__VK_DIFFUSE_ZK 4 /* voxels per diffusion invocation along z (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_BINDINGS 11
 
 typedef struct hd__vk_buffer {
@@ -105,6 +106,7 @@ typedef struct hd__vk_image {
     VkDeviceMemory memory;
     VkDeviceSize bytes;
     int extent[3];
+    int texel; /* bytes per texel: 4 (r32f), 8 (rg32f) */
 } hd__vk_image;
 
 struct hd__backend {
@@ -134,6 +136,7 @@ struct hd__backend {
     VkPipeline diffuse[HD__VK_DIFFUSE_VARIANTS];  /* the diffusion stage specialized for flags diffuse_flags[i] */
     int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS];
     int ndiffuse;
+    int32_t diffuse_zk;           /* HD__VK_DIFFUSE_ZK: what the pipelines are specialized for */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -462,8 +465,10 @@ static hd_result hd__vk_buffer_create(hd__ctx *ctx, hd__vk_buffer *b, VkDeviceSi
     return HD_SUCCESS;
 }
 
-/* An r32f storage image3D (layout GENERAL once the next command buffer has run). */
-static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+/* A storage image3D of format fmt (R32 or R32G32 SFLOAT), also usable as `usage` (e.g. sampled);
+   layout GENERAL once the next command buffer has run. */
+static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, VkFormat fmt,
+                                        VkImageUsageFlags usage, const char *what)
 {
     hd__backend *be = ctx->be;
     VkImageCreateInfo ici;
@@ -479,13 +484,13 @@ static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int 
     memset(&ici, 0, sizeof ici);
     ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
     ici.imageType = VK_IMAGE_TYPE_3D;
-    ici.format = VK_FORMAT_R32_SFLOAT;
+    ici.format = fmt;
     ici.extent.width = (uint32_t)w; ici.extent.height = (uint32_t)h; ici.extent.depth = (uint32_t)d;
     ici.mipLevels = 1;
     ici.arrayLayers = 1;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    ici.usage = usage | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     ici.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     HD__VK_TRY(ctx, be->fn.vkCreateImage(be->device, &ici, NULL, &im->image), "vkCreateImage");
@@ -497,13 +502,20 @@ static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int 
     vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
     vci.image = im->image;
     vci.viewType = VK_IMAGE_VIEW_TYPE_3D;
-    vci.format = VK_FORMAT_R32_SFLOAT;
+    vci.format = fmt;
     vci.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
     vci.subresourceRange.levelCount = 1;
     vci.subresourceRange.layerCount = 1;
     HD__VK_TRY(ctx, be->fn.vkCreateImageView(be->device, &vci, NULL, &im->view), "vkCreateImageView");
     im->extent[0] = w; im->extent[1] = h; im->extent[2] = d;
+    im->texel = fmt == VK_FORMAT_R32G32_SFLOAT ? 8 : 4;
     return HD_SUCCESS;
+}
+
+/* An r32f storage image3D, the grids' usual form. */
+static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+{
+    return hd__vk_image_create_as(ctx, im, w, h, d, VK_FORMAT_R32_SFLOAT, 0, what);
 }
 
 /* ---- command buffers -------------------------------------------------------------------------- */
@@ -665,7 +677,7 @@ static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
 static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float *src)
 {
     hd__backend *be = ctx->be;
-    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * sizeof(float);
+    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
     VkBufferImageCopy reg = hd__vk_region(im);
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
@@ -683,7 +695,7 @@ static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float
 static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst)
 {
     hd__backend *be = ctx->be;
-    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * sizeof(float);
+    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
     VkBufferImageCopy reg = hd__vk_region(im);
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
@@ -704,31 +716,37 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
    constant hd_sc_flags (constant_id 0, hd_bind_vk_glsl.h) is the flags word, so the kernels'
    branches on the flags (RGB scattering, boundary condition) fold away at pipeline creation.
    Lavapipe executes both sides of every branch, uniform ones included, so each flag left to a
-   run-time test makes every voxel pay for the paths it does not take. */
-static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, VkPipeline *out)
+   run-time test makes every voxel pay for the paths it does not take. Its constant 1 is
+   be->diffuse_zk, the voxels each invocation relaxes (one per z slice, hd_entry_glsl.h): lavapipe
+   pays a fixed cost per invocation (the store and its own set-up cost as much as 7 loads) and
+   merges the loads that neighbouring slices share. flags: constant 0's value, NULL for the other
+   stages (bench/hdbench_vulkan.c's --ab also calls this). */
+static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
-    static const uint32_t *const code[HD__VK_PIPELINE_COUNT] = {hd__spv_classify, hd__spv_direct, hd__spv_diffuse,
-        hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path};
-    static const size_t size[HD__VK_PIPELINE_COUNT] = {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse,
-        sizeof hd__spv_project, sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path};
-    VkSpecializationMapEntry sme;
+    VkSpecializationMapEntry sme[2];
     VkSpecializationInfo spec;
     VkShaderModuleCreateInfo smci;
     VkComputePipelineCreateInfo cpci;
     VkShaderModule sm;
     VkResult e;
-    sme.constantID = 0;
-    sme.offset = 0;
-    sme.size = sizeof flags;
-    spec.mapEntryCount = 1;
-    spec.pMapEntries = &sme;
-    spec.dataSize = sizeof flags;
-    spec.pData = &flags;
+    int32_t data[2];
+    data[0] = flags ? *flags : 0;
+    data[1] = be->diffuse_zk;
+    sme[0].constantID = 0;
+    sme[0].offset = 0;
+    sme[0].size = sizeof data[0];
+    sme[1].constantID = 1;
+    sme[1].offset = sizeof data[0];
+    sme[1].size = sizeof data[1];
+    spec.mapEntryCount = 2;
+    spec.pMapEntries = sme;
+    spec.dataSize = sizeof data;
+    spec.pData = data;
     memset(&smci, 0, sizeof smci);
     smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    smci.codeSize = size[p];
-    smci.pCode = code[p];
+    smci.codeSize = bytes;
+    smci.pCode = code;
     HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
     memset(&cpci, 0, sizeof cpci);
     cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
@@ -736,12 +754,21 @@ static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, VkPipeline 
     cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     cpci.stage.module = sm;
     cpci.stage.pName = "main";
-    cpci.stage.pSpecializationInfo = p == HD__VK_DIFFUSE ? &spec : NULL;
+    cpci.stage.pSpecializationInfo = flags ? &spec : NULL;
     cpci.layout = be->layout;
     e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, out);
     be->fn.vkDestroyShaderModule(be->device, sm, NULL);
     if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
     return HD_SUCCESS;
+}
+
+static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, VkPipeline *out)
+{
+    static const uint32_t *const code[HD__VK_PIPELINE_COUNT] = {hd__spv_classify, hd__spv_direct, hd__spv_diffuse,
+        hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path};
+    static const size_t size[HD__VK_PIPELINE_COUNT] = {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse,
+        sizeof hd__spv_project, sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path};
+    return hd__vk_pipeline_code(ctx, code[p], size[p], p == HD__VK_DIFFUSE ? &flags : NULL, out);
 }
 
 /* The diffusion pipeline for the current flags, made on first use and kept until hd_destroy
@@ -1003,6 +1030,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the backend");
     ctx->be = be;
     be->ctx = ctx;
+    be->diffuse_zk = HD__VK_DIFFUSE_ZK;
     if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
     if (lose && *lose) be->lose_at = strtoul(lose, NULL, 10);
     /* void* -> function pointer by memcpy: a cast is not ISO C */
@@ -1190,7 +1218,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    int nz = ctx->gdims[2] * ctx->channels;
+    int nz = (ctx->gdims[2] * ctx->channels + be->diffuse_zk - 1) / be->diffuse_zk; /* invocations along z */
     VkPipeline pipe;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_diffuse_pipeline(ctx, &pipe)) != HD_SUCCESS) return r;

@@ -9,7 +9,13 @@
        the best of `rounds` round-robin passes, so a burst of load elsewhere hits one pass only;
      - iterations/s of every method (HD, CD, PT_SS, PT_MS) with 1 and 3 lights, through hd_iterate
        (skipped with --sweeps).
-   Usage: hdbench_vulkan [file.nrrd] [seconds per figure, default 2] [--sweeps] [--rounds n] */
+     - with --variants instead: the plain image3D stencil beside bench/hdbench_sweep.comp's variants
+       of the sweep's memory access (what lavapipe's cost is made of);
+     - with --ab FILE.spv also: the library's sweeps with the diffusion module FILE (a candidate
+       build/spirv/diffuse.spv, specialized and dispatched for --ab-zk voxels per invocation,
+       default 1), interleaved with the library's own.
+   Usage: hdbench_vulkan [file.nrrd] [seconds per figure, default 2] [--sweeps] [--rounds n]
+                         [--variants[=name,name...]] [--ab FILE.spv [--ab-zk n]] */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
 #include "hybriddiff.h"
@@ -44,6 +50,73 @@ static void log_errors(void *user, hd_log_level level, hd_result code, const cha
 }
 
 static hd_result sweep_step(void *h) { return hd__test_diffuse(*(hd_context *)h, 1); }
+
+/* --ab FILE.spv: the library's sweep with its diffusion pipeline swapped for one made from FILE
+   (e.g. build/spirv/diffuse.spv of a candidate tree), interleaved with the library's own, so a
+   change to the diffusion module is measured against the committed one in one process. */
+static uint32_t *ab_code;
+static size_t ab_bytes;
+static int32_t ab_zk = 1; /* --ab-zk n: FILE's voxels per invocation (1 for a module without hd_sc_zk) */
+typedef struct ab_sweep {
+    hd_context h;
+    VkPipeline alt;
+    int live; /* ab_init ran */
+} ab_sweep;
+
+static hd_result ab_step(void *user)
+{
+    ab_sweep *a = (ab_sweep *)user;
+    hd__backend *be = hd__lookup(a->h, NULL)->be;
+    VkPipeline own = be->diffuse[0];
+    int32_t own_zk = be->diffuse_zk;
+    hd_result r;
+    be->diffuse[0] = a->alt;
+    be->diffuse_zk = ab_zk;
+    r = hd__test_diffuse(a->h, 1);
+    be->diffuse[0] = own;
+    be->diffuse_zk = own_zk;
+    return r;
+}
+
+/* After one sweep made the library's pipeline: the alternative with the same specialization. */
+static hd_result ab_init(ab_sweep *a, hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd_result r;
+    a->h = h;
+    a->alt = VK_NULL_HANDLE;
+    a->live = 1;
+    if ((r = hd__test_diffuse(h, 1)) != HD_SUCCESS) return r;
+    if (ctx->be->ndiffuse != 1) return HD_ERROR_BACKEND;
+    {
+        int32_t own_zk = ctx->be->diffuse_zk;
+        ctx->be->diffuse_zk = ab_zk;
+        r = hd__vk_pipeline_code(ctx, ab_code, ab_bytes, &ctx->be->diffuse_flags[0], &a->alt);
+        ctx->be->diffuse_zk = own_zk;
+        return r;
+    }
+}
+
+static void ab_free(ab_sweep *a)
+{
+    hd__backend *be = hd__lookup(a->h, NULL)->be;
+    be->fn.vkDeviceWaitIdle(be->device);
+    if (a->alt) be->fn.vkDestroyPipeline(be->device, a->alt, NULL);
+}
+
+static int ab_load(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    long n;
+    if (!f) return 0;
+    fseek(f, 0, SEEK_END);
+    n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    ab_code = n > 0 && n % 4 == 0 ? (uint32_t *)malloc((size_t)n) : NULL;
+    ab_bytes = ab_code && fread(ab_code, 1, (size_t)n, f) == (size_t)n ? (size_t)n : 0;
+    fclose(f);
+    return ab_bytes > 0;
+}
 static hd_result iterate_step(void *h) { return hd_iterate(*(hd_context *)h, 1); }
 
 /* ---- the plain stencil on the Vulkan device ------------------------------------------------- */
@@ -229,6 +302,203 @@ static hd_result stencil_step(void *user)
     return hd__vk_flush(s->ctx);
 }
 
+/* ---- variants of the sweep's memory access (bench/hdbench_sweep.comp, --variants) ------------- */
+#define NVAR ((int)(sizeof hd__sweep_variants / sizeof hd__sweep_variants[0]))
+#define VAR_BINDINGS 7
+typedef struct variants {
+    hd__ctx *ctx;
+    int g[3], cur;
+    hd__vk_image im[4]; /* st, E, phi (r32f), packed (st, phi) (rg32f) */
+    VkSampler sampler;
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkDescriptorPool pool;
+    VkDescriptorSet set;
+    VkPipeline pipe[NVAR];
+} variants;
+
+static void variants_free(variants *v)
+{
+    hd__backend *be = v->ctx->be;
+    int i;
+    be->fn.vkDeviceWaitIdle(be->device);
+    for (i = 0; i < 4; ++i) hd__vk_free_image(v->ctx, &v->im[i]);
+    for (i = 0; i < NVAR; ++i)
+        if (v->pipe[i]) be->fn.vkDestroyPipeline(be->device, v->pipe[i], NULL);
+    if (v->pool) be->fn.vkDestroyDescriptorPool(be->device, v->pool, NULL);
+    if (v->layout) be->fn.vkDestroyPipelineLayout(be->device, v->layout, NULL);
+    if (v->set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, v->set_layout, NULL);
+    if (v->sampler) {
+        PFN_vkDestroySampler destroy = (PFN_vkDestroySampler)be->fn.vkGetDeviceProcAddr(be->device, "vkDestroySampler");
+        destroy(be->device, v->sampler, NULL);
+    }
+}
+
+/* st: a CT-like mix of empty (0) and medium voxels; E: as the stencil's rhs; phi 0. */
+static hd_result variants_data(variants *v)
+{
+    size_t n = (size_t)v->g[0] * v->g[1] * v->g[2], i;
+    float *st = (float *)malloc(n * sizeof(float)), *e = (float *)malloc(n * sizeof(float));
+    float *pk = (float *)malloc(2 * n * sizeof(float));
+    hd_result r = HD_ERROR_OUT_OF_MEMORY;
+    if (st && e && pk) {
+        for (i = 0; i < n; ++i) {
+            st[i] = i % 89 < 20 ? 0.0f : 0.05f + (float)(i % 89) * 0.01f;
+            e[i] = (float)(i % 97) * 0.01f;
+            pk[2 * i] = st[i];
+            pk[2 * i + 1] = 0.0f;
+        }
+        r = hd__vk_upload_image(v->ctx, &v->im[0], st);
+        if (r == HD_SUCCESS) r = hd__vk_upload_image(v->ctx, &v->im[1], e);
+        if (r == HD_SUCCESS) r = hd__vk_upload_image(v->ctx, &v->im[3], pk);
+    }
+    free(st); free(e); free(pk);
+    return r;
+}
+
+static hd_result variants_set(variants *v)
+{
+    hd__backend *be = v->ctx->be;
+    VkDescriptorPoolSize ps[2];
+    VkDescriptorPoolCreateInfo dpci;
+    VkDescriptorSetAllocateInfo ai;
+    VkWriteDescriptorSet w[VAR_BINDINGS];
+    VkDescriptorImageInfo ii[VAR_BINDINGS];
+    int i;
+    ps[0].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[0].descriptorCount = 4;
+    ps[1].type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER; ps[1].descriptorCount = 3;
+    memset(&dpci, 0, sizeof dpci);
+    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    dpci.maxSets = 1;
+    dpci.poolSizeCount = 2;
+    dpci.pPoolSizes = ps;
+    HD__VK_TRY(v->ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &v->pool), "vkCreateDescriptorPool");
+    memset(&ai, 0, sizeof ai);
+    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    ai.descriptorPool = v->pool;
+    ai.descriptorSetCount = 1;
+    ai.pSetLayouts = &v->set_layout;
+    HD__VK_TRY(v->ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, &v->set), "vkAllocateDescriptorSets");
+    for (i = 0; i < VAR_BINDINGS; ++i) {
+        memset(&w[i], 0, sizeof w[i]);
+        w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        w[i].dstSet = v->set;
+        w[i].dstBinding = (uint32_t)i;
+        w[i].descriptorCount = 1;
+        w[i].descriptorType = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        ii[i].sampler = i < 4 ? VK_NULL_HANDLE : v->sampler;
+        ii[i].imageView = v->im[i < 4 ? i : i - 4].view;
+        ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+        w[i].pImageInfo = &ii[i];
+    }
+    be->fn.vkUpdateDescriptorSets(be->device, VAR_BINDINGS, w, 0, NULL);
+    return HD_SUCCESS;
+}
+
+static hd_result variants_pipelines(variants *v)
+{
+    hd__backend *be = v->ctx->be;
+    VkShaderModuleCreateInfo smci;
+    VkComputePipelineCreateInfo cpci;
+    VkShaderModule sm;
+    VkResult e;
+    int k;
+    for (k = 0; k < NVAR; ++k) {
+        memset(&smci, 0, sizeof smci);
+        smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+        smci.codeSize = hd__sweep_variants[k].bytes;
+        smci.pCode = hd__sweep_variants[k].code;
+        HD__VK_TRY(v->ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
+        memset(&cpci, 0, sizeof cpci);
+        cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+        cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+        cpci.stage.module = sm;
+        cpci.stage.pName = "main";
+        cpci.layout = v->layout;
+        e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, &v->pipe[k]);
+        be->fn.vkDestroyShaderModule(be->device, sm, NULL);
+        if (e < 0) { v->pipe[k] = VK_NULL_HANDLE; return hd__vk_fail(v->ctx, e, "vkCreateComputePipelines", __LINE__); }
+    }
+    return HD_SUCCESS;
+}
+
+static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
+{
+    hd__backend *be = ctx->be;
+    VkDescriptorSetLayoutBinding b[VAR_BINDINGS];
+    VkDescriptorSetLayoutCreateInfo lci;
+    VkSamplerCreateInfo sci;
+    PFN_vkCreateSampler create;
+    VkPushConstantRange pcr;
+    VkPipelineLayoutCreateInfo plci;
+    hd_result r;
+    int i;
+    memset(v, 0, sizeof *v);
+    v->ctx = ctx;
+    memcpy(v->g, g, sizeof v->g);
+    for (i = 0; i < 4 && (r = hd__vk_image_create_as(ctx, &v->im[i], g[0], g[1], g[2], i == 3 ? VK_FORMAT_R32G32_SFLOAT : VK_FORMAT_R32_SFLOAT,
+                                                     VK_IMAGE_USAGE_SAMPLED_BIT, "a variant image")) == HD_SUCCESS; ++i)
+        r = hd__vk_image_init(ctx, &v->im[i]);
+    if (r != HD_SUCCESS || (r = variants_data(v)) != HD_SUCCESS) return r;
+    memset(&sci, 0, sizeof sci);
+    sci.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+    sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
+    sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    create = (PFN_vkCreateSampler)be->fn.vkGetDeviceProcAddr(be->device, "vkCreateSampler"); /* the library needs none */
+    HD__VK_TRY(ctx, create(be->device, &sci, NULL, &v->sampler), "vkCreateSampler");
+    memset(b, 0, sizeof b);
+    for (i = 0; i < VAR_BINDINGS; ++i) {
+        b[i].binding = (uint32_t)i;
+        b[i].descriptorType = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    memset(&lci, 0, sizeof lci);
+    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    lci.bindingCount = VAR_BINDINGS;
+    lci.pBindings = b;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, &v->set_layout), "vkCreateDescriptorSetLayout");
+    memset(&pcr, 0, sizeof pcr);
+    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    pcr.size = 8 * sizeof(int32_t);
+    memset(&plci, 0, sizeof plci);
+    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &v->set_layout;
+    plci.pushConstantRangeCount = 1;
+    plci.pPushConstantRanges = &pcr;
+    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &v->layout), "vkCreatePipelineLayout");
+    if ((r = variants_pipelines(v)) != HD_SUCCESS) return r;
+    return variants_set(v);
+}
+
+/* One full red-black sweep of variant v->cur: two half-sweeps, submitted and waited for. */
+static hd_result variant_step(void *user)
+{
+    variants *v = (variants *)user;
+    hd__backend *be = v->ctx->be;
+    VkCommandBuffer cb;
+    uint32_t lx = (uint32_t)hd__sweep_variants[v->cur].lx, ly = (uint32_t)hd__sweep_variants[v->cur].ly;
+    uint32_t zk = (uint32_t)hd__sweep_variants[v->cur].zk;
+    int32_t pc[8];
+    hd_result r;
+    int parity;
+    if ((r = hd__vk_cmd(v->ctx, &cb)) != HD_SUCCESS) return r;
+    memset(pc, 0, sizeof pc);
+    pc[0] = v->g[0]; pc[1] = v->g[1]; pc[2] = v->g[2];
+    pc[5] = (int32_t)zk; /* ZRT variants read their count here */
+    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->pipe[v->cur]);
+    be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->layout, 0, 1, &v->set, 0, NULL);
+    for (parity = 0; parity < 2; ++parity) {
+        pc[4] = parity;
+        hd__vk_barrier(be, cb);
+        be->fn.vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
+        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx - 1) / lx, ((uint32_t)v->g[1] + ly - 1) / ly, ((uint32_t)v->g[2] + zk - 1) / zk);
+    }
+    return hd__vk_flush(v->ctx);
+}
+
 /* ---- the same stencil in plain C --------------------------------------------------------------- */
 typedef struct c_grid {
     int g[3];
@@ -260,7 +530,7 @@ static hd_result c_step(void *user)
 }
 
 /* ---- the figures ------------------------------------------------------------------------------- */
-enum { F_IMAGE, F_SSBO, F_C, F_RB, F_JACOBI, F_COUNT };
+enum { F_IMAGE, F_SSBO, F_C, F_RB, F_JACOBI, F_RB_AB, F_JACOBI_AB, F_COUNT };
 
 static void sweep_figures(const hd_desc *base, const int *g, int rounds)
 {
@@ -269,11 +539,15 @@ static void sweep_figures(const hd_desc *base, const int *g, int rounds)
         "plain 7-point stencil, Vulkan, storage buffer",
         "plain 7-point stencil, C, 1 thread",
         "library sweep, red-black (2 half-sweeps)",
-        "library sweep, Jacobi (+ copy back)"};
+        "library sweep, Jacobi (+ copy back)",
+        "--ab module, red-black",
+        "--ab module, Jacobi"};
     double best[F_COUNT], vox = (double)g[0] * g[1] * g[2];
     hd_desc d = *base;
     hd_context h[2];
+    ab_sweep ab[2];
     stencil st[2];
+    int nfig = ab_code ? F_COUNT : F_RB_AB;
     c_grid c;
     size_t n = (size_t)vox, i;
     int k, f, ok = 1;
@@ -285,19 +559,23 @@ static void sweep_figures(const hd_desc *base, const int *g, int rounds)
     printf("device: %s\n", hd__lookup(h[0], NULL)->be->device_name);
     for (k = 0; k < 2; ++k)
         if (stencil_init(&st[k], hd__lookup(h[0], NULL), g, k) != HD_SUCCESS) ok = 0;
+    memset(ab, 0, sizeof ab);
+    for (k = 0; ab_code && k < 2; ++k)
+        if (ab_init(&ab[k], h[k]) != HD_SUCCESS) ok = 0;
     c.g[0] = g[0]; c.g[1] = g[1]; c.g[2] = g[2];
     c.a = (float *)calloc(n, sizeof(float)); c.b = (float *)calloc(n, sizeof(float)); c.rhs = (float *)calloc(n, sizeof(float));
     if (!c.a || !c.b || !c.rhs) ok = 0;
     for (i = 0; ok && i < n; ++i) c.rhs[i] = (float)(i % 97) * 0.01f;
     for (k = 0; ok && k < rounds; ++k)
-        for (f = 0; f < F_COUNT; ++f) {
+        for (f = 0; f < nfig; ++f) {
             double v = f == F_IMAGE || f == F_SSBO ? rate(stencil_step, &st[f == F_SSBO])
-                     : f == F_C ? rate(c_step, &c) : rate(sweep_step, &h[f == F_JACOBI]);
+                     : f == F_C ? rate(c_step, &c)
+                     : f >= F_RB_AB ? rate(ab_step, &ab[f == F_JACOBI_AB]) : rate(sweep_step, &h[f == F_JACOBI]);
             if (v > best[f]) best[f] = v;
         }
     if (ok) {
         printf("%-48s %9s %8s %12s\n", "diffusion sweep figure (best of rounds)", "sweeps/s", "GB/s*", "/ image3D");
-        for (f = 0; f < F_COUNT; ++f)
+        for (f = 0; f < nfig; ++f)
             printf("%-48s %9.1f %8.2f %12.2f\n", names[f], best[f], best[f] * vox * (f <= F_C ? 12.0 : 16.0) / 1e9,
                    best[f] / best[F_IMAGE]);
         printf("* minimum traffic: 12 B/voxel for the stencil (a, rhs read, b written), 16 B/voxel for the\n"
@@ -306,9 +584,56 @@ static void sweep_figures(const hd_desc *base, const int *g, int rounds)
         printf("the stencil figures failed (see the log)\n");
     }
     for (k = 0; k < 2; ++k) stencil_free(&st[k]);
+    for (k = 0; k < 2; ++k)
+        if (ab[k].live) ab_free(&ab[k]);
     free(c.a); free(c.b); free(c.rhs);
     hd_destroy(h[0]);
     hd_destroy(h[1]);
+}
+
+/* The plain image3D stencil and every sweep variant, round-robin, best of rounds. */
+static const char *variant_list; /* --variants=a,b,c: only these (by name) */
+
+static int variant_wanted(int k)
+{
+    const char *p = variant_list, *name = hd__sweep_variants[k].name;
+    size_t n = strlen(name);
+    if (!p) return 1;
+    for (; (p = strstr(p, name)) != NULL; p += n)
+        if ((p == variant_list || p[-1] == ',') && (p[n] == ',' || p[n] == '\0')) return 1;
+    return 0;
+}
+
+static void variant_figures(const hd_desc *base, const int *g, int rounds)
+{
+    double best[NVAR + 1], v_;
+    hd_desc d = *base;
+    hd_context h;
+    stencil st;
+    variants v;
+    int k, f, ok;
+    memset(best, 0, sizeof best);
+    if (hd_create(&d, &h) != HD_SUCCESS) { printf("Vulkan unavailable\n"); return; }
+    ok = stencil_init(&st, hd__lookup(h, NULL), g, 0) == HD_SUCCESS;
+    ok = ok && variants_init(&v, hd__lookup(h, NULL), g) == HD_SUCCESS;
+    for (k = 0; ok && k < rounds; ++k)
+        for (f = 0; f <= NVAR; ++f) {
+            if (f < NVAR && !variant_wanted(f)) continue;
+            if (f < NVAR) v.cur = f;
+            v_ = f == NVAR ? rate(stencil_step, &st) : rate(variant_step, &v);
+            if (v_ > best[f]) best[f] = v_;
+        }
+    if (ok) {
+        printf("%-48s %9s %12s\n", "sweep variant (bench/hdbench_sweep.comp)", "sweeps/s", "/ image3D");
+        printf("%-48s %9.1f %12.2f\n", "plain 7-point stencil, storage image3D", best[NVAR], 1.0);
+        for (f = 0; f < NVAR; ++f)
+            if (variant_wanted(f)) printf("%-48s %9.1f %12.2f\n", hd__sweep_variants[f].name, best[f], best[f] / best[NVAR]);
+    } else {
+        printf("the variant figures failed (see the log)\n");
+    }
+    stencil_free(&st);
+    variants_free(&v);
+    hd_destroy(h);
 }
 
 static void method_figures(hd_desc d)
@@ -342,11 +667,19 @@ int main(int argc, char **argv)
     hd_desc d;
     hd_result r;
     hd_logger log;
-    int g[3], i, sweeps_only = 0, rounds = 2, nth = 0;
+    int g[3], i, sweeps_only = 0, rounds = 2, nth = 0, only_variants = 0;
     (void)hd__test_prepare; (void)hd__test_direct; (void)hd__test_project; /* hooks this bench does not use */
     (void)hd__test_write_illumination; (void)hd__test_finish;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--sweeps") == 0) sweeps_only = 1;
+        else if (strncmp(argv[i], "--variants", 10) == 0 && (argv[i][10] == '\0' || argv[i][10] == '=')) {
+            only_variants = 1;
+            variant_list = argv[i][10] == '=' ? argv[i] + 11 : NULL;
+        }
+        else if (strcmp(argv[i], "--ab-zk") == 0 && i + 1 < argc) ab_zk = atoi(argv[++i]) > 0 ? atoi(argv[i]) : 1;
+        else if (strcmp(argv[i], "--ab") == 0 && i + 1 < argc) {
+            if (!ab_load(argv[++i])) { fprintf(stderr, "hdbench_vulkan: cannot read %s\n", argv[i]); return 1; }
+        }
         else if (strcmp(argv[i], "--rounds") == 0 && i + 1 < argc) rounds = atoi(argv[++i]);
         else if (nth++ == 0) path = argv[i];
         else budget = atof(argv[i]);
@@ -365,8 +698,15 @@ int main(int argc, char **argv)
     g[0] = vol.desc.dims[0]; g[1] = vol.desc.dims[1]; g[2] = vol.desc.dims[2];
     printf("hdbench_vulkan: %s, %dx%dx%d voxels, image 256x256, %.1f s per figure, %d round%s\n", path, g[0], g[1], g[2],
            budget, rounds, rounds == 1 ? "" : "s");
+    if (only_variants) {
+        variant_figures(&d, g, rounds);
+        hd_volume_free(&vol);
+        free(ab_code);
+        return 0;
+    }
     sweep_figures(&d, g, rounds);
     if (!sweeps_only) method_figures(d);
     hd_volume_free(&vol);
+    free(ab_code);
     return 0;
 }

@@ -43,7 +43,7 @@ compile-vulkan-cxx: | $(B)
 	$(CXX) $(CPPFLAGS) $(VK_CXXWARN) -O1 -x c++ -c $(VK_CONF)/impl_vk.c -o $(B)/conf_impl_vk_cxx.o
 
 # the benchmark's own stencil shaders, compiled here (glslangValidator) rather than committed
-$(B)/hdbench_vulkan_spirv.h: bench/hdbench_stencil.comp scripts/build-spirv | $(B)
+$(B)/hdbench_vulkan_spirv.h: bench/hdbench_stencil.comp bench/hdbench_sweep.comp scripts/build-spirv | $(B)
 	scripts/build-spirv --bench $@
 
 $(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(B)/hdbench_vulkan_spirv.h $(LIB_SRC) | $(B)
