@@ -13,7 +13,8 @@
    through HD_DIFFUSE_FLAGS: lavapipe runs both sides of every branch, so a flag tested at run
    time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT).
    Specialization constant 1, hd_sc_zk: voxels per diffusion invocation along z
-   (HD_DIFFUSE_ZK, hd_entry_glsl.h), fixed by hd_vulkan.h, which dispatches to match. */
+   (HD_DIFFUSE_ZK, hd_entry_glsl.h), fixed by hd_vulkan.h, which dispatches to match; 2,
+   hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so only one of the two stores is compiled. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
@@ -28,9 +29,11 @@ layout(binding = 10, r32f) uniform image3D hd_i_lv2;
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;
+layout(constant_id = 2) const int hd_sc_jacobi = 0;
 #if HD_STAGE == 3 /* HD_STAGE_DIFFUSE (hd_entry_glsl.h); the other stages read counts.z */
 #define HD_DIFFUSE_FLAGS hd_sc_flags
 #define HD_DIFFUSE_ZK hd_sc_zk
+#define HD_DIFFUSE_JACOBI hd_sc_jacobi
 #endif
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))

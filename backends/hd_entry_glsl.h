@@ -12,6 +12,9 @@
 #ifndef HD_DIFFUSE_ZK
 #define HD_DIFFUSE_ZK 1 /* voxels per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
 #endif
+#ifndef HD_DIFFUSE_JACOBI
+#define HD_DIFFUSE_JACOBI hd_pc.y /* Jacobi (1) or red-black (0); Vulkan: a constant per pipeline */
+#endif
 
 void main()
 {
@@ -30,7 +33,7 @@ void main()
        changes no value, and with no store between them the loads of a texel two voxels share (the
        black voxel between two red ones of the column) can be merged. Lanes past the grid compute
        at a clamped voxel (every load in bounds) and store nothing. */
-    int jacobi = hd_pc.y, nz = g.z * g.w;
+    int jacobi = HD_DIFFUSE_JACOBI, nz = g.z * g.w;
     float v[HD_DIFFUSE_ZK];
     for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
         int zs = hd_mini(z * HD_DIFFUSE_ZK + k, nz - 1);

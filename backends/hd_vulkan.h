@@ -89,7 +89,7 @@ typedef struct hd__vk_fns {
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
-#define HD__VK_DIFFUSE_VARIANTS 32 /* diffusion pipelines per context, one per flags value (16 today) */
+#define HD__VK_DIFFUSE_VARIANTS 64 /* diffusion pipelines per context, one per flags value and solver (32 today) */
 #define HD__VK_DIFFUSE_ZK 4 /* voxels per diffusion invocation along z (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_BINDINGS 11
 
@@ -133,8 +133,8 @@ struct hd__backend {
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
     VkPipeline pipelines[HD__VK_PIPELINE_COUNT]; /* [HD__VK_DIFFUSE] unused: see diffuse */
-    VkPipeline diffuse[HD__VK_DIFFUSE_VARIANTS];  /* the diffusion stage specialized for flags diffuse_flags[i] */
-    int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS];
+    VkPipeline diffuse[HD__VK_DIFFUSE_VARIANTS];  /* the diffusion stage specialized for diffuse_flags[i], diffuse_jacobi[i] */
+    int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS], diffuse_jacobi[HD__VK_DIFFUSE_VARIANTS];
     int ndiffuse;
     int32_t diffuse_zk;           /* HD__VK_DIFFUSE_ZK: what the pipelines are specialized for */
     VkDescriptorPool dpool;
@@ -719,27 +719,30 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
    run-time test makes every voxel pay for the paths it does not take. Its constant 1 is
    be->diffuse_zk, the voxels each invocation relaxes (one per z slice, hd_entry_glsl.h): lavapipe
    pays a fixed cost per invocation (the store and its own set-up cost as much as 7 loads) and
-   merges the loads that neighbouring slices share. flags: constant 0's value, NULL for the other
-   stages (bench/hdbench_vulkan.c's --ab also calls this). */
-static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, VkPipeline *out)
+   merges the loads that neighbouring slices share. Constant 2 is the solver (jacobi), so the
+   store of the other one is not compiled (1.08x sweeps/s, docs/DESIGN-VULKAN.md). flags: constant
+   0's value, NULL for the other stages (bench/hdbench_vulkan.c's --ab also calls this). */
+static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
+                                      VkPipeline *out)
 {
     hd__backend *be = ctx->be;
-    VkSpecializationMapEntry sme[2];
+    VkSpecializationMapEntry sme[3];
     VkSpecializationInfo spec;
     VkShaderModuleCreateInfo smci;
     VkComputePipelineCreateInfo cpci;
     VkShaderModule sm;
     VkResult e;
-    int32_t data[2];
+    int32_t data[3];
+    int i;
     data[0] = flags ? *flags : 0;
     data[1] = be->diffuse_zk;
-    sme[0].constantID = 0;
-    sme[0].offset = 0;
-    sme[0].size = sizeof data[0];
-    sme[1].constantID = 1;
-    sme[1].offset = sizeof data[0];
-    sme[1].size = sizeof data[1];
-    spec.mapEntryCount = 2;
+    data[2] = jacobi;
+    for (i = 0; i < 3; ++i) {
+        sme[i].constantID = (uint32_t)i;
+        sme[i].offset = (uint32_t)(i * sizeof data[0]);
+        sme[i].size = sizeof data[0];
+    }
+    spec.mapEntryCount = 3;
     spec.pMapEntries = sme;
     spec.dataSize = sizeof data;
     spec.pData = data;
@@ -762,29 +765,31 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, VkPipeline *out)
+static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jacobi, VkPipeline *out)
 {
     static const uint32_t *const code[HD__VK_PIPELINE_COUNT] = {hd__spv_classify, hd__spv_direct, hd__spv_diffuse,
         hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path};
     static const size_t size[HD__VK_PIPELINE_COUNT] = {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse,
         sizeof hd__spv_project, sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path};
-    return hd__vk_pipeline_code(ctx, code[p], size[p], p == HD__VK_DIFFUSE ? &flags : NULL, out);
+    return hd__vk_pipeline_code(ctx, code[p], size[p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
 }
 
-/* The diffusion pipeline for the current flags, made on first use and kept until hd_destroy
-   (a command buffer recorded by hd_vulkan_record may still name an older one). */
-static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, VkPipeline *out)
+/* The diffusion pipeline for the current flags and solver, made on first use and kept until
+   hd_destroy (a command buffer recorded by hd_vulkan_record may still name an older one). */
+static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
     int32_t flags = ctx->kp.counts.z;
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
-        if (be->diffuse_flags[i] == flags) { *out = be->diffuse[i]; return HD_SUCCESS; }
+        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi) { *out = be->diffuse[i]; return HD_SUCCESS; }
     if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag combinations for the diffusion stage", HD__VK_DIFFUSE_VARIANTS);
-    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag and solver combinations for the diffusion stage",
+                       HD__VK_DIFFUSE_VARIANTS);
+    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
     be->diffuse_flags[be->ndiffuse] = flags;
+    be->diffuse_jacobi[be->ndiffuse] = jacobi;
     *out = be->diffuse[be->ndiffuse++];
     return HD_SUCCESS;
 }
@@ -828,7 +833,7 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
     plci.pPushConstantRanges = &pcr;
     HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &be->layout), "vkCreatePipelineLayout");
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
-        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
+        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
     ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 3 * HD_MAX_LIGHTS;
@@ -1221,7 +1226,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     int nz = (ctx->gdims[2] * ctx->channels + be->diffuse_zk - 1) / be->diffuse_zk; /* invocations along z */
     VkPipeline pipe;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_diffuse_pipeline(ctx, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
         if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
         hd__vk_copy_image(be, cb, &be->phi2, &be->phi);

@@ -91,7 +91,7 @@ static hd_result ab_init(ab_sweep *a, hd_context h)
     {
         int32_t own_zk = ctx->be->diffuse_zk;
         ctx->be->diffuse_zk = ab_zk;
-        r = hd__vk_pipeline_code(ctx, ab_code, ab_bytes, &ctx->be->diffuse_flags[0], &a->alt);
+        r = hd__vk_pipeline_code(ctx, ab_code, ab_bytes, &ctx->be->diffuse_flags[0], ctx->be->diffuse_jacobi[0], &a->alt);
         ctx->be->diffuse_zk = own_zk;
         return r;
     }
@@ -480,7 +480,7 @@ static hd_result variant_step(void *user)
     hd__backend *be = v->ctx->be;
     VkCommandBuffer cb;
     uint32_t lx = (uint32_t)hd__sweep_variants[v->cur].lx, ly = (uint32_t)hd__sweep_variants[v->cur].ly;
-    uint32_t zk = (uint32_t)hd__sweep_variants[v->cur].zk;
+    uint32_t zk = (uint32_t)hd__sweep_variants[v->cur].zk, yk = (uint32_t)hd__sweep_variants[v->cur].yk;
     int32_t pc[8];
     hd_result r;
     int parity;
@@ -494,7 +494,8 @@ static hd_result variant_step(void *user)
         pc[4] = parity;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx - 1) / lx, ((uint32_t)v->g[1] + ly - 1) / ly, ((uint32_t)v->g[2] + zk - 1) / zk);
+        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx - 1) / lx, ((uint32_t)v->g[1] + ly * yk - 1) / (ly * yk),
+                              ((uint32_t)v->g[2] + zk - 1) / zk);
     }
     return hd__vk_flush(v->ctx);
 }
