@@ -1,7 +1,8 @@
 /* hdbench_gl - the GL column: iterations/s of every method with 1 and 3 lights on the head CT
    (data/head.nrrd, make data), image 256x256, headless EGL (make bench-gl). Each figure is
    hd_iterate over at least 2 iterations and ~2 s after one warm-up iteration (shader compile,
-   uploads), with glFinish before the clock stops. Also one diffusion sweep (red-black) alone. */
+   uploads), with glFinish before the clock stops. Also one diffusion sweep (red-black) alone.
+   Usage: hdbench_gl [file.nrrd [N]]; N: also the sweep's A/B against N voxels per invocation. */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_GL
 #include "hybriddiff.h"
@@ -28,6 +29,29 @@ static double rate(hd_context c, int sweeps_only)
         ++n;
     } while (n < 2 || t - t0 < 2.0);
     return n / (t - t0);
+}
+
+/* hdbench_gl FILE N: the sweep with N voxels per diffusion invocation against the library's
+   HD__GL_DIFFUSE_ZK, alternated over 4 rounds in this process (the diffusion programs are
+   recompiled at each switch, in rate()'s warm-up), best of each. */
+static void sweep_ab(hd_context c, int zk)
+{
+    hd__ctx *ctx = hd__lookup(c, NULL);
+    hd__backend *be = ctx->be;
+    double best[2] = {0.0, 0.0};
+    int k, i, own = be->diffuse_zk;
+    for (k = 0; k < 8; ++k) {
+        double v;
+        if (hd__gl_enter(ctx) != HD_SUCCESS) return;
+        for (i = HD__GL_PROGRAM_COUNT; i < HD__GL_SLOTS; ++i)
+            if (be->programs[i]) { be->gl.DeleteProgram(be->programs[i]); be->programs[i] = 0; }
+        hd__gl_leave(ctx, HD_SUCCESS);
+        be->diffuse_zk = k & 1 ? zk : own;
+        v = rate(c, 1);
+        if (v > best[k & 1]) best[k & 1] = v;
+    }
+    printf("diffusion sweep, %d voxel(s) per invocation: %.2f sweeps/s; %d: %.2f sweeps/s (%.2fx)\n", own, best[0], zk, best[1],
+           best[0] / best[1]);
 }
 
 int main(int argc, char **argv)
@@ -65,6 +89,7 @@ int main(int argc, char **argv)
     printf("hdbench_gl: %s %dx%dx%d, image 256x256, backend %s\n", path, vol.desc.dims[0], vol.desc.dims[1], vol.desc.dims[2],
            hd_backend_name());
     printf("diffusion sweep (red-black, both half-sweeps): %.2f sweeps/s\n", rate(c, 1));
+    if (argc > 2) sweep_ab(c, atoi(argv[2]));
     printf("| method | 1 light it/s | 3 lights it/s |\n|---|---|---|\n");
     for (m = 0; m < 4; ++m) {
         double f[2];
