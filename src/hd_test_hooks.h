@@ -73,12 +73,28 @@ HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_i
     HD__GET_CTX(ctx, h);
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
 #if defined(HYBRIDDIFF_BACKEND_CPU)
+    if (ctx->params.illumination_precision == HD_PRECISION_FLOAT16) { /* stored as binary16 */
+        uint16_t *dst = which == HD_ILLUMINATION_DIRECT ? ctx->be->Eh : ctx->be->phih;
+        size_t i;
+        for (i = 0; i < ctx->be->illum_floats; ++i) dst[i] = hd_f2h(src[i]);
+        return HD_SUCCESS;
+    }
     memcpy(which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, src, ctx->be->illum_floats * sizeof(float));
     return HD_SUCCESS;
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, CL_TRUE, 0,
-                                         ctx->be->illum_floats * sizeof(float), src, 0, NULL, NULL),
-               "clEnqueueWriteBuffer(test illumination)");
+    {
+        int f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+        size_t i, n = ctx->be->illum_floats;
+        uint16_t *h = f16 ? (uint16_t *)hd__alloc(ctx, n * sizeof(uint16_t)) : NULL;
+        cl_int e;
+        if (f16 && !h) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "hd__test_write_illumination: no memory");
+        for (i = 0; f16 && i < n; ++i) h[i] = hd_f2h(src[i]);
+        e = clEnqueueWriteBuffer(ctx->be->queue, which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, CL_TRUE, 0,
+                                 n * (f16 ? sizeof(uint16_t) : sizeof(float)), f16 ? (const void *)h : (const void *)src,
+                                 0, NULL, NULL);
+        hd__free(ctx, h);
+        HD__CL_TRY(ctx, e, "clEnqueueWriteBuffer(test illumination)");
+    }
     return HD_SUCCESS;
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
     return hd__vk_write_illumination(ctx, which, src);
