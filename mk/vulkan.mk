@@ -9,7 +9,9 @@
 #   make compile-vulkan-cxx             the Vulkan implementation as C++17, warnings as errors
 #   make bench-vulkan                   build/hdbench_vulkan on the head CT (make data): the
 #                                       sweep against a plain stencil (image3D, SSBO, C), then
-#                                       it/s per method; BENCH_ARGS=--sweeps for the first part
+#                                       it/s per method; BENCH_ARGS=--sweeps for the first part,
+#                                       --variants for bench/hdbench_sweep.comp's cost breakdown,
+#                                       --ab FILE.spv [--ab-zk n] to A/B a diffusion module
 # Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 VK_LDLIBS := -lvulkan
 VK_CONF := tests/conformance
