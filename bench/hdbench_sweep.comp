@@ -21,7 +21,8 @@
      9 LOADS7  the same with the plain stencil's 7 loads (its red-black twin)
     10 STORE   no load: the store and the invocation's own cost
     11 LOADS1  one load and the store
-    12 LIBLS   LIB, YK x ZK voxels (rows x slices) per invocation, all loads before all stores
+    12 LIBLS   LIB, XK x YK x ZK voxels (same-colour voxels of a row x rows x slices) per
+               invocation, all loads before all stores
    Bindings: 0 st, 1 E, 2 phi (r32f storage), 3 packed (st, phi) (rg32f storage), 4 st, 5 E,
    6 phi (sampler3D over the images of bindings 0-2). */
 layout(local_size_x = LX, local_size_y = LY, local_size_z = 1) in;
@@ -181,19 +182,25 @@ void main()
 #ifndef YK
 #define YK 1
 #endif
+#ifndef XK
+#define XK 1
+#endif
 #if HD_SV == 12
     /* 12 LIBLS: the ZK voxels' loads and arithmetic first, then their stores, so that a texel two
        of them read (the black voxel between two red ones) may be loaded once */
     int x = int(gl_GlobalInvocationID.x), y0 = int(gl_GlobalInvocationID.y) * YK, z0 = int(gl_GlobalInvocationID.z) * ZK;
-    float v[YK * ZK];
-    for (int j = 0; j < YK; ++j)
-        for (int k = 0; k < ZK; ++k)
-            v[j * ZK + k] = lib_value(ivec3(2 * x + ((y0 + j + z0 + k + ctl.x) & 1), y0 + j, z0 + k));
-    for (int j = 0; j < YK; ++j)
-        for (int k = 0; k < ZK; ++k) {
-            ivec3 p = ivec3(2 * x + ((y0 + j + z0 + k + ctl.x) & 1), y0 + j, z0 + k);
-            if (p.x < dims.x && p.y < dims.y && p.z < dims.z) imageStore(phi_i, p, vec4(v[j * ZK + k], 0.0f, 0.0f, 0.0f));
-        }
+    float v[XK * YK * ZK];
+    for (int i = 0; i < XK; ++i)
+        for (int j = 0; j < YK; ++j)
+            for (int k = 0; k < ZK; ++k)
+                v[(i * YK + j) * ZK + k] = lib_value(ivec3(2 * (x * XK + i) + ((y0 + j + z0 + k + ctl.x) & 1), y0 + j, z0 + k));
+    for (int i = 0; i < XK; ++i)
+        for (int j = 0; j < YK; ++j)
+            for (int k = 0; k < ZK; ++k) {
+                ivec3 p = ivec3(2 * (x * XK + i) + ((y0 + j + z0 + k + ctl.x) & 1), y0 + j, z0 + k);
+                if (p.x < dims.x && p.y < dims.y && p.z < dims.z)
+                    imageStore(phi_i, p, vec4(v[(i * YK + j) * ZK + k], 0.0f, 0.0f, 0.0f));
+            }
     return;
 #endif
 {

@@ -481,6 +481,7 @@ static hd_result variant_step(void *user)
     VkCommandBuffer cb;
     uint32_t lx = (uint32_t)hd__sweep_variants[v->cur].lx, ly = (uint32_t)hd__sweep_variants[v->cur].ly;
     uint32_t zk = (uint32_t)hd__sweep_variants[v->cur].zk, yk = (uint32_t)hd__sweep_variants[v->cur].yk;
+    uint32_t xk = (uint32_t)hd__sweep_variants[v->cur].xk;
     int32_t pc[8];
     hd_result r;
     int parity;
@@ -494,7 +495,7 @@ static hd_result variant_step(void *user)
         pc[4] = parity;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx - 1) / lx, ((uint32_t)v->g[1] + ly * yk - 1) / (ly * yk),
+        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx * xk - 1) / (lx * xk), ((uint32_t)v->g[1] + ly * yk - 1) / (ly * yk),
                               ((uint32_t)v->g[2] + zk - 1) / zk);
     }
     return hd__vk_flush(v->ctx);
