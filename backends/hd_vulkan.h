@@ -39,7 +39,8 @@
    fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
    $HD_VK_LOSE_DEVICE=n makes the n-th queue submission since hd_create fail as
    VK_ERROR_DEVICE_LOST instead of being submitted (the other test knob: the error path of a lost
-   device cannot be provoked on lavapipe).
+   device cannot be provoked on lavapipe). $HD_VK_NO_HALF=1 plays a device without r16f storage
+   images (lavapipe has them): float16 illumination is then refused as it would be there.
    Errors: every VkResult below zero is logged with the failing call and becomes an hd_result
    (OUT_OF_DEVICE_MEMORY -> HD_ERROR_OUT_OF_DEVICE_MEMORY, DEVICE_LOST -> HD_ERROR_DEVICE_LOST,
    which sticks: later calls fail fast, hd_destroy still frees everything). */
@@ -1098,8 +1099,11 @@ static void hd__vk_check_half(hd__ctx *ctx)
     VkFormatProperties fp;
     be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
     be->fn.vkGetPhysicalDeviceFormatProperties(be->phys, VK_FORMAT_R16_SFLOAT, &fp);
+    const char *knob = getenv("HD_VK_NO_HALF");
     be->no_half = NULL;
-    if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
+    if (knob && *knob && strcmp(knob, "0") != 0)
+        be->no_half = "$HD_VK_NO_HALF is set (the test knob that plays a device without them)";
+    else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
         be->no_half = "VK_FORMAT_R16_SFLOAT has no VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT";
     else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_SRC_BIT) || !(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
         be->no_half = "VK_FORMAT_R16_SFLOAT images cannot be copied (no TRANSFER_SRC / TRANSFER_DST)";
