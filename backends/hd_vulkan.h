@@ -33,8 +33,9 @@
    arithmetic stays float32. r16f storage images need the format's STORAGE_IMAGE feature and
    shaderStorageImageExtendedFormats: the own device enables it where the physical device has
    it, a caller's device must have enabled it; without either, FLOAT16 is HD_ERROR_UNSUPPORTED
-   (logged) at hd_create and at the next render after hd_set_params. The grids as images are not bound by maxStorageBufferRange
-   (128 MiB on lavapipe), only by maxImageDimension3D per axis (channels stack along z).
+   (logged) at hd_create and at the next render after hd_set_params. The grids as images are not
+   bound by maxStorageBufferRange (128 MiB on lavapipe), only by maxImageDimension3D per axis
+   (channels stack along z).
    $HD_VK_MEMORY_LIMIT=bytes caps the device memory the backend allocates; an allocation above it
    fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
    $HD_VK_LOSE_DEVICE=n makes the n-th queue submission since hd_create fail as
@@ -1097,15 +1098,16 @@ static void hd__vk_check_half(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     VkPhysicalDeviceFeatures f;
     VkFormatProperties fp;
+    const char *knob = getenv("HD_VK_NO_HALF");
     be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
     be->fn.vkGetPhysicalDeviceFormatProperties(be->phys, VK_FORMAT_R16_SFLOAT, &fp);
-    const char *knob = getenv("HD_VK_NO_HALF");
     be->no_half = NULL;
     if (knob && *knob && strcmp(knob, "0") != 0)
         be->no_half = "$HD_VK_NO_HALF is set (the test knob that plays a device without them)";
     else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
         be->no_half = "VK_FORMAT_R16_SFLOAT has no VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT";
-    else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_SRC_BIT) || !(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
+    else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_SRC_BIT) ||
+             !(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
         be->no_half = "VK_FORMAT_R16_SFLOAT images cannot be copied (no TRANSFER_SRC / TRANSFER_DST)";
     else if (!f.shaderStorageImageExtendedFormats)
         be->no_half = "the device lacks shaderStorageImageExtendedFormats (r16f storage images)";
