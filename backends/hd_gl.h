@@ -842,10 +842,21 @@ static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, f
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
+/* A GL_R16F grid gets the floats rounded to nearest even on the host (hd_f2h, the CPU backend's
+   halves): the GL's own conversion may truncate, as llvmpipe's image stores do. */
 static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float *src)
 {
+    size_t n = (size_t)t->extent[0] * t->extent[1] * t->extent[2], i;
+    uint16_t *h = NULL;
+    if (t->format == GL_R16F) {
+        if (!(h = (uint16_t *)hd__calloc(ctx, n, sizeof(uint16_t))))
+            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to convert an illumination grid");
+        for (i = 0; i < n; ++i) h[i] = hd_f2h(src[i]);
+    }
     ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED, GL_FLOAT, src);
+    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED,
+                              h ? GL_HALF_FLOAT : GL_FLOAT, h ? (const void *)h : (const void *)src);
+    if (h) hd__free(ctx, h);
     return hd__gl_check(ctx, "writing an illumination grid", __LINE__);
 }
 HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
