@@ -9,20 +9,34 @@
    0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written; storage
    buffers 0 TF, 1 majorants, 2 image accumulation. GL has no push
    constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
-   uniform at location 0. */
+   uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision
+   FLOAT16): E, phi and phi2 are r16f (GL_R16F textures, core in GL 4.3), converted by imageLoad /
+   imageStore, the arithmetic float32. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
+#ifdef HD_ILLUM_R16F
+#define HD_ILLUM_FMT r16f
+#define HD_ILLUM_ROUND(v) hd_f16_round(v) /* the store rounds to nearest even (hd_prelude_glsl.h) */
+#else
+#define HD_ILLUM_FMT r32f
+#define HD_ILLUM_ROUND(v) (v)
+#endif
 layout(binding = 0, r32f) uniform readonly image3D hd_i_vol;
 layout(std430, binding = 0) readonly buffer hd_b_tf { float tf[]; };
 layout(std430, binding = 1) readonly buffer hd_b_maj { float maj[]; };
 layout(binding = 1, r32f) uniform image3D hd_i_sig;
-layout(binding = 2, r32f) uniform image3D hd_i_E;
-layout(binding = 3, r32f) uniform image3D hd_i_phi;
-layout(binding = 4, r32f) uniform image3D hd_i_phi2;
+layout(binding = 2, HD_ILLUM_FMT) uniform image3D hd_i_E;
+layout(binding = 3, HD_ILLUM_FMT) uniform image3D hd_i_phi;
+layout(binding = 4, HD_ILLUM_FMT) uniform image3D hd_i_phi2;
 layout(std430, binding = 2) buffer hd_b_img { float img[]; };
 layout(binding = 5, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 6, r32f) uniform image3D hd_i_lv2;
 layout(location = 0) uniform ivec4 hd_pc;
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
-#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))
+#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4(HD_STV_##buf(v), 0.0f, 0.0f, 0.0f))
+#define HD_STV_sig(v) (v)
+#define HD_STV_lv2(v) (v)
+#define HD_STV_E(v) HD_ILLUM_ROUND(v)
+#define HD_STV_phi(v) HD_ILLUM_ROUND(v)
+#define HD_STV_phi2(v) HD_ILLUM_ROUND(v)
 #define HD_GET1(buf, i) buf[(i)]
 #define HD_SET1(buf, i, v) buf[(i)] = (v)

@@ -14,15 +14,25 @@
    time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT).
    Specialization constant 1, hd_sc_zk: voxels per diffusion invocation along z
    (HD_DIFFUSE_ZK, hd_entry_glsl.h), fixed by hd_vulkan.h, which dispatches to match; 2,
-   hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so only one of the two stores is compiled. */
+   hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so only one of the two stores is compiled.
+   HD_ILLUM_R16F (scripts/build-spirv's _half modules of the stages that touch E / phi): E, phi
+   and phi2 are r16f (VK_FORMAT_R16_SFLOAT, params.illumination_precision FLOAT16), converted by
+   imageLoad / imageStore, the arithmetic float32; r16f needs shaderStorageImageExtendedFormats. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
+#ifdef HD_ILLUM_R16F
+#define HD_ILLUM_FMT r16f
+#define HD_ILLUM_ROUND(v) hd_f16_round(v) /* the store rounds to nearest even (hd_prelude_glsl.h) */
+#else
+#define HD_ILLUM_FMT r32f
+#define HD_ILLUM_ROUND(v) (v)
+#endif
 layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
 layout(std430, binding = 3) readonly buffer hd_b_maj { float maj[]; };
 layout(binding = 4, r32f) uniform image3D hd_i_sig;
-layout(binding = 5, r32f) uniform image3D hd_i_E;
-layout(binding = 6, r32f) uniform image3D hd_i_phi;
-layout(binding = 7, r32f) uniform image3D hd_i_phi2;
+layout(binding = 5, HD_ILLUM_FMT) uniform image3D hd_i_E;
+layout(binding = 6, HD_ILLUM_FMT) uniform image3D hd_i_phi;
+layout(binding = 7, HD_ILLUM_FMT) uniform image3D hd_i_phi2;
 layout(std430, binding = 8) buffer hd_b_img { float img[]; };
 layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 10, r32f) uniform image3D hd_i_lv2;
@@ -36,6 +46,11 @@ layout(constant_id = 2) const int hd_sc_jacobi = 0;
 #define HD_DIFFUSE_JACOBI hd_sc_jacobi
 #endif
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
-#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4((v), 0.0f, 0.0f, 0.0f))
+#define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4(HD_STV_##buf(v), 0.0f, 0.0f, 0.0f))
+#define HD_STV_sig(v) (v)
+#define HD_STV_lv2(v) (v)
+#define HD_STV_E(v) HD_ILLUM_ROUND(v)
+#define HD_STV_phi(v) HD_ILLUM_ROUND(v)
+#define HD_STV_phi2(v) HD_ILLUM_ROUND(v)
 #define HD_GET1(buf, i) buf[(i)]
 #define HD_SET1(buf, i, v) buf[(i)] = (v)

@@ -21,6 +21,9 @@
 
    Resources (docs/DESIGN-GL.md has the measurements): the grids (volume, sigma_t, E, phi, phi2,
    CD's light volumes) are GL_R32F 3D textures used as r32f images (channels stacked along z);
+   with params.illumination_precision FLOAT16, E, phi and phi2 are GL_R16F textures used as r16f
+   images (core GL 4.3, so never refused here) by a second program of each stage that touches
+   them, compiled with `#define HD_ILLUM_R16F` (hd_bind_gl_glsl.h);
    the TF, majorant grid and image accumulation are storage buffers; the parameter block a
    uniform buffer rewritten when it changes; hd_pc a plain uniform. Jacobi's phi2 and CD's spare
    swap names with phi / the light's volume, as the CPU backend swaps pointers.
@@ -42,6 +45,7 @@
 
 #define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
 #define HD__BE_HAS_PT 1 /* hd__be_path */
+#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: GL_R16F E / phi / phi2 */
 
 /* ---- function table: every GL function through the loader ------------------------------- */
 #define HD__GL_FNS(X) \
@@ -80,7 +84,14 @@ static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
    (Vulkan measured 1.4-1.6x from the same specialization). Program slots past
    HD__GL_PROGRAM_COUNT hold these variants. */
 #define HD__GL_DIFFUSE_VARIANTS 4
-#define HD__GL_SLOTS (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)
+#define HD__GL_SLOTS_F32 (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)
+/* Then the same slots again for float16 illumination storage (HD_ILLUM_R16F): only those of the
+   stages that touch E / phi / phi2 are ever compiled (hd__gl_touches_illum). */
+#define HD__GL_SLOTS (2 * HD__GL_SLOTS_F32)
+static int hd__gl_touches_illum(int stage)
+{
+    return stage == HD__GL_DIRECT || stage == HD__GL_DIFFUSE || stage == HD__GL_PROJECT || stage == HD__GL_SUM_LIGHT;
+}
 static int hd__gl_diffuse_flags(int variant)
 {
     return ((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0);
@@ -100,6 +111,7 @@ static int hd__gl_diffuse_slot(int counts_z)
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
+    GLenum format; /* GL_R32F, or GL_R16F (E / phi / phi2 at float16) */
 } hd__gl_tex;
 
 /* The host state a call may touch (saved on entry, restored on exit). */
@@ -126,12 +138,13 @@ struct hd__backend {
     int version;                /* major * 10 + minor */
     int depth;                  /* nesting of hd__gl_enter */
     hd__gl_state saved;
-    GLuint programs[HD__GL_SLOTS]; /* by stage, then the diffusion variants */
+    GLuint programs[HD__GL_SLOTS]; /* by stage, then the diffusion variants; twice (float32, float16) */
     GLuint params;              /* uniform buffer of hd__kparams */
     hd__kparams params_kp;      /* what it holds */
     int params_valid;
     GLuint tf, maj, img, dummy_buffer;
-    hd__gl_tex vol, sig, E, phi, phi2, dummy;
+    hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
+    int f16;                    /* E, phi, phi2 are GL_R16F (params.illumination_precision) */
     hd__gl_tex *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
@@ -334,7 +347,8 @@ static const char *const hd__gl_to_texture_src =
 /* Compiles and links the program of slot p (a stage, or a diffusion variant) on its first use. */
 static hd_result hd__gl_program(hd__ctx *ctx, int p)
 {
-    int stage = p < HD__GL_PROGRAM_COUNT ? p : HD__GL_DIFFUSE;
+    int half = p >= HD__GL_SLOTS_F32, q = p % HD__GL_SLOTS_F32;
+    int stage = q < HD__GL_PROGRAM_COUNT ? q : HD__GL_DIFFUSE;
     hd__backend *be = ctx->be;
     const char *src[1 + HD__GL_SOURCE_LINES];
     char prefix[256], log[4096];
@@ -349,11 +363,11 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
     } else {
         int len = snprintf(prefix, sizeof prefix,
                            "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
-                           "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                           HD_MAX_LIGHTS, stage + 1, HD__GL_LOCAL_X);
-        if (p >= HD__GL_PROGRAM_COUNT)
+                           "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n%s",
+                           HD_MAX_LIGHTS, stage + 1, HD__GL_LOCAL_X, half ? "#define HD_ILLUM_R16F 1\n" : "");
+        if (q >= HD__GL_PROGRAM_COUNT)
             snprintf(prefix + len, sizeof prefix - (size_t)len, "#define HD_DIFFUSE_FLAGS %d\n#define HD_DIFFUSE_ZK %d\n",
-                     hd__gl_diffuse_flags(p - HD__GL_PROGRAM_COUNT), be->diffuse_zk);
+                     hd__gl_diffuse_flags(q - HD__GL_PROGRAM_COUNT), be->diffuse_zk);
         src[0] = prefix;
         for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
         n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
@@ -399,8 +413,10 @@ static void hd__gl_free_buffer(hd__backend *be, GLuint *b)
     *b = 0;
 }
 
-/* A w x h x d GL_R32F 3D texture, zeroed (or filled from src). */
-static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, const float *src, const char *what)
+/* A w x h x d 3D texture of format fmt (GL_R32F or GL_R16F), zeroed (or filled from src, which
+   the GL converts to fmt). */
+static hd_result hd__gl_tex_new_as(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, GLenum fmt, const float *src,
+                                   const char *what)
 {
     hd__backend *be = ctx->be;
     hd_result r;
@@ -410,8 +426,9 @@ static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d
                        what, w, h, d, be->max_3d);
     be->gl.GenTextures(1, &t->name);
     be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    be->gl.TexStorage3D(GL_TEXTURE_3D, 1, GL_R32F, w, h, d);
+    be->gl.TexStorage3D(GL_TEXTURE_3D, 1, fmt, w, h, d);
     t->extent[0] = w; t->extent[1] = h; t->extent[2] = d;
+    t->format = fmt;
     if ((r = hd__gl_check(ctx, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
     if (src) be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, src);
     else if (be->gl.ClearTexImage && be->version >= 44) be->gl.ClearTexImage(t->name, 0, GL_RED, GL_FLOAT, NULL);
@@ -425,10 +442,23 @@ static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d
     return HD_SUCCESS;
 }
 
+/* A GL_R32F 3D texture, the grids' usual form. */
+static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, const float *src, const char *what)
+{
+    return hd__gl_tex_new_as(ctx, t, w, h, d, GL_R32F, src, what);
+}
+
+/* E, phi, phi2: GL_R16F at float16 storage, else GL_R32F. */
+static hd_result hd__gl_illum_new(hd__ctx *ctx, hd__gl_tex *t, const char *what)
+{
+    return hd__gl_tex_new_as(ctx, t, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels,
+                             ctx->be->f16 ? GL_R16F : GL_R32F, NULL, what);
+}
+
 static hd_result hd__gl_tex_zero(hd__ctx *ctx, hd__gl_tex *t)
 {
     if (!t->name) return HD_SUCCESS;
-    return hd__gl_tex_new(ctx, t, t->extent[0], t->extent[1], t->extent[2], NULL, "clearing an illumination grid");
+    return hd__gl_tex_new_as(ctx, t, t->extent[0], t->extent[1], t->extent[2], t->format, NULL, "clearing an illumination grid");
 }
 
 static hd_result hd__gl_buffer_data(hd__ctx *ctx, GLuint *b, size_t bytes, const void *src, GLenum usage, const char *what)
@@ -440,11 +470,12 @@ static hd_result hd__gl_buffer_data(hd__ctx *ctx, GLuint *b, size_t bytes, const
     return hd__gl_check(ctx, what, __LINE__);
 }
 
-/* Binds every resource to its unit (placeholders for the absent ones) and the program. */
-static void hd__gl_bind_image(hd__backend *be, GLuint unit, const hd__gl_tex *t, GLenum access)
+/* Binds every resource to its unit (placeholders for the absent ones) and the program. An image
+   unit's format is its texture's: a float16 program's absent phi2 gets the GL_R16F placeholder. */
+static void hd__gl_bind_image(hd__backend *be, GLuint unit, const hd__gl_tex *t, GLenum access, int half)
 {
-    const hd__gl_tex *u = t && t->name ? t : &be->dummy;
-    be->gl.BindImageTexture(unit, u->name, 0, GL_TRUE, 0, access, GL_R32F);
+    const hd__gl_tex *u = t && t->name ? t : half ? &be->dummy16 : &be->dummy;
+    be->gl.BindImageTexture(unit, u->name, 0, GL_TRUE, 0, access, u->format);
 }
 
 static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
@@ -454,7 +485,8 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     hd_result r;
     const hd__gl_tex *lv = be->lv && light < be->nlv ? &be->lv[light] : NULL;
     const hd__gl_tex *lv2 = be->lv ? &be->lv[be->nlv] : NULL;
-    int slot = p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p;
+    int half = be->f16 && hd__gl_touches_illum(p);
+    int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
     if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
     if (!be->params_valid || memcmp(&be->params_kp, &ctx->kp, sizeof ctx->kp) != 0) {
         be->gl.BindBuffer(GL_UNIFORM_BUFFER, be->params);
@@ -468,13 +500,13 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->tf ? be->tf : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->maj ? be->maj : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
-    hd__gl_bind_image(be, 0, &be->vol, GL_READ_ONLY);
-    hd__gl_bind_image(be, 1, &be->sig, GL_READ_WRITE);
-    hd__gl_bind_image(be, 2, &be->E, GL_READ_WRITE);
-    hd__gl_bind_image(be, 3, &be->phi, GL_READ_WRITE);
-    hd__gl_bind_image(be, 4, &be->phi2, GL_READ_WRITE);
-    hd__gl_bind_image(be, 5, lv, GL_READ_ONLY);
-    hd__gl_bind_image(be, 6, lv2, GL_READ_WRITE);
+    hd__gl_bind_image(be, 0, &be->vol, GL_READ_ONLY, 0);
+    hd__gl_bind_image(be, 1, &be->sig, GL_READ_WRITE, 0);
+    hd__gl_bind_image(be, 2, &be->E, GL_READ_WRITE, half);
+    hd__gl_bind_image(be, 3, &be->phi, GL_READ_WRITE, half);
+    hd__gl_bind_image(be, 4, &be->phi2, GL_READ_WRITE, half);
+    hd__gl_bind_image(be, 5, lv, GL_READ_ONLY, 0);
+    hd__gl_bind_image(be, 6, lv2, GL_READ_WRITE, 0);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
     be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
     return hd__gl_check(ctx, hd__gl_stage_names[p], __LINE__);
@@ -594,6 +626,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
         hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2); hd__gl_free_tex(be, &be->dummy);
+        hd__gl_free_tex(be, &be->dummy16);
         hd__gl_free_lights(be);
         hd__gl_leave(ctx, HD_SUCCESS);
     }
@@ -638,6 +671,7 @@ static hd_result hd__gl_setup(hd__ctx *ctx)
     be->gl.GenBuffers(1, &be->params);
     if ((r = hd__gl_buffer_data(ctx, &be->dummy_buffer, 16, NULL, GL_STATIC_DRAW, "a placeholder buffer")) != HD_SUCCESS) return r;
     if ((r = hd__gl_tex_new(ctx, &be->dummy, 1, 1, 1, NULL, "a placeholder image")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new_as(ctx, &be->dummy16, 1, 1, 1, GL_R16F, NULL, "a float16 placeholder image")) != HD_SUCCESS) return r;
     return hd__gl_tex_new(ctx, &be->vol, ctx->dims[0], ctx->dims[1], ctx->dims[2], ctx->vol, "the volume");
 }
 
@@ -693,10 +727,11 @@ static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
     hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
     be->illum_floats = 0;
+    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     if (illum_floats == 0) return HD_SUCCESS;
     if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, NULL, "sigma_t")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_tex_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, NULL, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_tex_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, NULL, "phi")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
     return HD_SUCCESS;
 }
@@ -710,7 +745,7 @@ static hd_result hd__gl_alloc_jacobi(hd__ctx *ctx, int enable)
     hd__backend *be = ctx->be;
     hd__gl_free_tex(be, &be->phi2);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    return hd__gl_tex_new(ctx, &be->phi2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, NULL, "Jacobi's buffer");
+    return hd__gl_illum_new(ctx, &be->phi2, "Jacobi's buffer");
 }
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gl_alloc_jacobi(ctx, enable)); }
 
@@ -794,6 +829,7 @@ static hd_result hd__gl_read_image(hd__ctx *ctx, float *dst)
 }
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst) { HD__GL_STAGE(ctx, hd__gl_read_image(ctx, dst)); }
 
+/* GL_R16F grids come back widened to float by the GL, exactly (every half is a float). */
 static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, float *dst)
 {
     ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
@@ -806,10 +842,21 @@ static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, f
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
+/* A GL_R16F grid gets the floats rounded to nearest even on the host (hd_f2h, the CPU backend's
+   halves): the GL's own conversion may truncate, as llvmpipe's image stores do. */
 static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float *src)
 {
+    size_t n = (size_t)t->extent[0] * t->extent[1] * t->extent[2], i;
+    uint16_t *h = NULL;
+    if (t->format == GL_R16F) {
+        if (!(h = (uint16_t *)hd__calloc(ctx, n, sizeof(uint16_t))))
+            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to convert an illumination grid");
+        for (i = 0; i < n; ++i) h[i] = hd_f2h(src[i]);
+    }
     ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED, GL_FLOAT, src);
+    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED,
+                              h ? GL_HALF_FLOAT : GL_FLOAT, h ? (const void *)h : (const void *)src);
+    if (h) hd__free(ctx, h);
     return hd__gl_check(ctx, "writing an illumination grid", __LINE__);
 }
 HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)

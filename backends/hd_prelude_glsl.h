@@ -44,6 +44,23 @@ int hd_maxi(int a, int b) { return a > b ? a : b; }
 float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
+/* v rounded to the nearest binary16, ties to even, as a float: what hd_f2h (hd_prelude_c.h) and
+   OpenCL's vstore_half_rte store. Float16 illumination (HD_ILLUM_R16F) stores this, so the r16f
+   image's own float -> half conversion has nothing left to round: lavapipe and llvmpipe convert
+   by truncation (toward zero), measured on every stored voxel of a direct pass (docs/DESIGN-
+   VULKAN.md), a bias that E's and phi's iterations accumulate. Normal halves: the 13 dropped
+   mantissa bits rounded in integer arithmetic (a carry into the exponent is right); subnormal
+   halves (|v| < 2^-14): to a multiple of 2^-24 by roundEven, the scalings exact; |v| >= 65520:
+   inf, as hd_f2h; NaN as it is. */
+float hd_f16_round(float v)
+{
+    uint u = floatBitsToUint(v), s = u & 0x80000000u, a = u & 0x7fffffffu;
+    float nrm = uintBitsToFloat(s | ((a + 0x0fffu + ((a >> 13) & 1u)) & 0xffffe000u));
+    float sub = uintBitsToFloat(s | floatBitsToUint(roundEven(uintBitsToFloat(a) * 16777216.0f) * 5.9604644775390625e-8f));
+    float big = uintBitsToFloat(s | 0x7f800000u);
+    return a > 0x7f800000u ? v : (a >= 0x477ff000u ? big : (a >= 0x38800000u ? nrm : sub));
+}
+
 #define HD_STRUCT(name) struct name {
 #define HD_STRUCT_END(name) };
 

@@ -27,13 +27,21 @@
    iterations each see their own parameters). No sub-allocator: there are at most a dozen
    resources plus one per CD light (<= 66 + 10), each large, far below maxMemoryAllocationCount
    (4096 guaranteed), so every resource has its own vkAllocateMemory; a sub-allocator would add
-   code and save nothing measurable. The grids as images are not bound by maxStorageBufferRange
-   (128 MiB on lavapipe), only by maxImageDimension3D per axis (channels stack along z).
+   code and save nothing measurable. With params.illumination_precision FLOAT16, E, phi and phi2
+   are r16f (VK_FORMAT_R16_SFLOAT) images, read and written by the _half SPIR-V of the stages
+   that touch them (direct, diffuse, project, sum_light); imageLoad / imageStore convert, the
+   arithmetic stays float32. r16f storage images need the format's STORAGE_IMAGE feature and
+   shaderStorageImageExtendedFormats: the own device enables it where the physical device has
+   it, a caller's device must have enabled it; without either, FLOAT16 is HD_ERROR_UNSUPPORTED
+   (logged) at hd_create and at the next render after hd_set_params. The grids as images are not
+   bound by maxStorageBufferRange (128 MiB on lavapipe), only by maxImageDimension3D per axis
+   (channels stack along z).
    $HD_VK_MEMORY_LIMIT=bytes caps the device memory the backend allocates; an allocation above it
    fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
    $HD_VK_LOSE_DEVICE=n makes the n-th queue submission since hd_create fail as
    VK_ERROR_DEVICE_LOST instead of being submitted (the other test knob: the error path of a lost
-   device cannot be provoked on lavapipe).
+   device cannot be provoked on lavapipe). $HD_VK_NO_HALF=1 plays a device without r16f storage
+   images (lavapipe has them): float16 illumination is then refused as it would be there.
    Errors: every VkResult below zero is logged with the failing call and becomes an hd_result
    (OUT_OF_DEVICE_MEMORY -> HD_ERROR_OUT_OF_DEVICE_MEMORY, DEVICE_LOST -> HD_ERROR_DEVICE_LOST,
    which sticks: later calls fail fast, hd_destroy still frees everything). */
@@ -55,13 +63,15 @@ VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instan
 
 #define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
 #define HD__BE_HAS_PT 1 /* hd__be_path */
+#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: r16f E / phi / phi2 where the device has them */
 
 /* ---- function table: everything is loaded through vkGetInstanceProcAddr ------------------ */
 #define HD__VK_GLOBAL_FNS(X) X(vkCreateInstance) X(vkEnumerateInstanceLayerProperties) \
     X(vkEnumerateInstanceExtensionProperties)
 #define HD__VK_INSTANCE_FNS(X) X(vkDestroyInstance) X(vkEnumeratePhysicalDevices) \
     X(vkGetPhysicalDeviceProperties) X(vkGetPhysicalDeviceQueueFamilyProperties) \
-    X(vkGetPhysicalDeviceMemoryProperties) X(vkCreateDevice) X(vkGetDeviceProcAddr)
+    X(vkGetPhysicalDeviceMemoryProperties) X(vkCreateDevice) X(vkGetDeviceProcAddr) \
+    X(vkGetPhysicalDeviceFeatures) X(vkGetPhysicalDeviceFormatProperties)
 #define HD__VK_DEVICE_FNS(X) X(vkDestroyDevice) X(vkGetDeviceQueue) X(vkDeviceWaitIdle) \
     X(vkQueueSubmit) X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences) \
     X(vkCreateCommandPool) X(vkDestroyCommandPool) X(vkAllocateCommandBuffers) \
@@ -89,7 +99,7 @@ typedef struct hd__vk_fns {
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
-#define HD__VK_DIFFUSE_VARIANTS 64 /* diffusion pipelines per context, one per flags value and solver (32 today) */
+#define HD__VK_DIFFUSE_VARIANTS 128 /* diffusion pipelines per context, one per flags value, solver and precision (64 today) */
 #define HD__VK_DIFFUSE_ZK 4 /* voxels per diffusion invocation along z (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_BINDINGS 11
 
@@ -106,7 +116,7 @@ typedef struct hd__vk_image {
     VkDeviceMemory memory;
     VkDeviceSize bytes;
     int extent[3];
-    int texel; /* bytes per texel: 4 (r32f), 8 (rg32f) */
+    int texel; /* bytes per texel: 2 (r16f), 4 (r32f), 8 (rg32f) */
 } hd__vk_image;
 
 struct hd__backend {
@@ -133,8 +143,10 @@ struct hd__backend {
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
     VkPipeline pipelines[HD__VK_PIPELINE_COUNT]; /* [HD__VK_DIFFUSE] unused: see diffuse */
+    VkPipeline pipelines_half[HD__VK_PIPELINE_COUNT]; /* the r16f E / phi variants, made on first use */
     VkPipeline diffuse[HD__VK_DIFFUSE_VARIANTS];  /* the diffusion stage specialized for diffuse_flags[i], diffuse_jacobi[i] */
     int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS], diffuse_jacobi[HD__VK_DIFFUSE_VARIANTS];
+    int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk;           /* HD__VK_DIFFUSE_ZK: what the pipelines are specialized for */
     VkDescriptorPool dpool;
@@ -149,7 +161,9 @@ struct hd__backend {
     hd__kparams slot_kp;          /* what the current slot holds */
     /* resources */
     hd__vk_buffer tf, maj, img, staging, dummy_buffer;
-    hd__vk_image vol, sig, E, phi, phi2, dummy;
+    hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
+    int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
+    const char *no_half;          /* why r16f storage images are missing, or NULL */
     hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
@@ -363,7 +377,11 @@ static hd_result hd__vk_create_device(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     VkDeviceQueueCreateInfo qci;
     VkDeviceCreateInfo dci;
+    VkPhysicalDeviceFeatures have, want;
     float prio = 1.0f;
+    be->fn.vkGetPhysicalDeviceFeatures(be->phys, &have);
+    memset(&want, 0, sizeof want);
+    want.shaderStorageImageExtendedFormats = have.shaderStorageImageExtendedFormats; /* r16f: float16 illumination */
     memset(&qci, 0, sizeof qci);
     qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
     qci.queueFamilyIndex = be->queue_family;
@@ -373,6 +391,7 @@ static hd_result hd__vk_create_device(hd__ctx *ctx)
     dci.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
+    dci.pEnabledFeatures = &want;
     HD__VK_TRY(ctx, be->fn.vkCreateDevice(be->phys, &dci, NULL, &be->device), "vkCreateDevice");
     return HD_SUCCESS;
 }
@@ -465,7 +484,7 @@ static hd_result hd__vk_buffer_create(hd__ctx *ctx, hd__vk_buffer *b, VkDeviceSi
     return HD_SUCCESS;
 }
 
-/* A storage image3D of format fmt (R32 or R32G32 SFLOAT), also usable as `usage` (e.g. sampled);
+/* A storage image3D of format fmt (R16, R32 or R32G32 SFLOAT), also usable as `usage` (e.g. sampled);
    layout GENERAL once the next command buffer has run. */
 static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, VkFormat fmt,
                                         VkImageUsageFlags usage, const char *what)
@@ -508,7 +527,7 @@ static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, i
     vci.subresourceRange.layerCount = 1;
     HD__VK_TRY(ctx, be->fn.vkCreateImageView(be->device, &vci, NULL, &im->view), "vkCreateImageView");
     im->extent[0] = w; im->extent[1] = h; im->extent[2] = d;
-    im->texel = fmt == VK_FORMAT_R32G32_SFLOAT ? 8 : 4;
+    im->texel = fmt == VK_FORMAT_R32G32_SFLOAT ? 8 : fmt == VK_FORMAT_R16_SFLOAT ? 2 : 4;
     return HD_SUCCESS;
 }
 
@@ -645,11 +664,23 @@ static hd_result hd__vk_image_init(hd__ctx *ctx, hd__vk_image *im)
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_image_new(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+static hd_result hd__vk_image_new_as(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, VkFormat fmt, const char *what)
 {
     hd_result r;
-    if ((r = hd__vk_image_create(ctx, im, w, h, d, what)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_create_as(ctx, im, w, h, d, fmt, 0, what)) != HD_SUCCESS) return r;
     return hd__vk_image_init(ctx, im);
+}
+
+static hd_result hd__vk_image_new(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+{
+    return hd__vk_image_new_as(ctx, im, w, h, d, VK_FORMAT_R32_SFLOAT, what);
+}
+
+/* E, phi, phi2: r16f at float16 storage, else r32f. */
+static hd_result hd__vk_illum_new(hd__ctx *ctx, hd__vk_image *im, const char *what)
+{
+    return hd__vk_image_new_as(ctx, im, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels,
+                               ctx->be->f16 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT, what);
 }
 
 static hd_result hd__vk_staging(hd__ctx *ctx, VkDeviceSize bytes)
@@ -673,7 +704,8 @@ static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
     return reg;
 }
 
-/* Whole image <- host floats (x fastest), submitted and waited for. */
+/* Whole image <- host floats (x fastest), submitted and waited for; an r16f image gets them
+   rounded to nearest even (hd_f2h, the CPU backend's rounding). */
 static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float *src)
 {
     hd__backend *be = ctx->be;
@@ -683,7 +715,12 @@ static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float
     hd_result r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r; /* the staging buffer is free */
     if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
-    memcpy(be->staging.map, src, bytes);
+    if (im->texel == 2) {
+        size_t i;
+        for (i = 0; i < bytes / 2; ++i) ((uint16_t *)be->staging.map)[i] = hd_f2h(src[i]);
+    } else {
+        memcpy(be->staging.map, src, bytes);
+    }
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
     hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
     be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
@@ -691,7 +728,8 @@ static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float
     return hd__vk_flush(ctx);
 }
 
-/* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar). */
+/* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar); an
+   r16f image's halves are widened exactly (hd_h2f). */
 static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst)
 {
     hd__backend *be = ctx->be;
@@ -707,7 +745,12 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
     hd__vk_layout(be, cb, im->image, HD__VK_SRC, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
     hd__vk_barrier(be, cb);
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    memcpy(dst, be->staging.map, bytes);
+    if (im->texel == 2) {
+        size_t i;
+        for (i = 0; i < bytes / 2; ++i) dst[i] = hd_h2f(((const uint16_t *)be->staging.map)[i]);
+    } else {
+        memcpy(dst, be->staging.map, bytes);
+    }
     return HD_SUCCESS;
 }
 
@@ -765,13 +808,33 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jacobi, VkPipeline *out)
+/* Stage p's pipeline; half: from its r16f SPIR-V (only the stages that touch E / phi have one). */
+static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jacobi, int half, VkPipeline *out)
 {
-    static const uint32_t *const code[HD__VK_PIPELINE_COUNT] = {hd__spv_classify, hd__spv_direct, hd__spv_diffuse,
-        hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path};
-    static const size_t size[HD__VK_PIPELINE_COUNT] = {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse,
-        sizeof hd__spv_project, sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path};
-    return hd__vk_pipeline_code(ctx, code[p], size[p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
+    static const uint32_t *const code[2][HD__VK_PIPELINE_COUNT] = {
+        {hd__spv_classify, hd__spv_direct, hd__spv_diffuse, hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path},
+        {NULL, hd__spv_direct_half, hd__spv_diffuse_half, hd__spv_project_half, NULL, hd__spv_sum_light_half, NULL}};
+    static const size_t size[2][HD__VK_PIPELINE_COUNT] = {
+        {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse, sizeof hd__spv_project,
+         sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path},
+        {0, sizeof hd__spv_direct_half, sizeof hd__spv_diffuse_half, sizeof hd__spv_project_half, 0, sizeof hd__spv_sum_light_half, 0}};
+    half = half && code[1][p] != NULL;
+    return hd__vk_pipeline_code(ctx, code[half][p], size[half][p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
+}
+
+/* The pipeline of stage p (not the diffusion stage) for the current precision: a float16 one
+   made on first use, kept until hd_destroy. */
+static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    if (!be->f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT)) {
+        *out = be->pipelines[p];
+        return HD_SUCCESS;
+    }
+    if (!be->pipelines_half[p] && (r = hd__vk_pipeline(ctx, p, 0, 0, 1, &be->pipelines_half[p])) != HD_SUCCESS) return r;
+    *out = be->pipelines_half[p];
+    return HD_SUCCESS;
 }
 
 /* The diffusion pipeline for the current flags and solver, made on first use and kept until
@@ -783,13 +846,17 @@ static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipelin
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
-        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi) { *out = be->diffuse[i]; return HD_SUCCESS; }
+        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi && be->diffuse_half[i] == be->f16) {
+            *out = be->diffuse[i];
+            return HD_SUCCESS;
+        }
     if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag and solver combinations for the diffusion stage",
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag, solver and precision combinations for the diffusion stage",
                        HD__VK_DIFFUSE_VARIANTS);
-    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
     be->diffuse_flags[be->ndiffuse] = flags;
     be->diffuse_jacobi[be->ndiffuse] = jacobi;
+    be->diffuse_half[be->ndiffuse] = be->f16;
     *out = be->diffuse[be->ndiffuse++];
     return HD_SUCCESS;
 }
@@ -833,7 +900,7 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
     plci.pPushConstantRanges = &pcr;
     HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &be->layout), "vkCreatePipelineLayout");
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
-        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
+        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
     ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 3 * HD_MAX_LIGHTS;
@@ -847,7 +914,8 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
 }
 
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
-   spare) at bindings 9 and 10; set 0 serves every other stage. Absent resources bind dummies.
+   spare) at bindings 9 and 10; set 0 serves every other stage. Absent resources bind dummies
+   (at float16 storage an r16f one for E / phi / phi2: a view's format must match the shader's).
    Nothing may be in flight (the backend waits after each stage; hd_vulkan_record's contract). */
 static hd_result hd__vk_sets(hd__ctx *ctx)
 {
@@ -890,7 +958,7 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
                 w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
                 w[i].pBufferInfo = &bi[i];
             } else {
-                const hd__vk_image *x = im[i]->image ? im[i] : &be->dummy;
+                const hd__vk_image *x = im[i]->image ? im[i] : be->f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
                 ii[i].sampler = VK_NULL_HANDLE;
                 ii[i].imageView = x->view;
                 ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
@@ -1000,10 +1068,13 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__vk_free_lights(ctx);
         hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
         hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2); hd__vk_free_image(ctx, &be->dummy);
+        hd__vk_free_image(ctx, &be->dummy16);
         hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
+        for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
+            if (be->pipelines_half[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines_half[i], NULL);
         for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
@@ -1018,6 +1089,36 @@ static void hd__be_destroy(hd__ctx *ctx)
     }
     hd__free(ctx, be);
     ctx->be = NULL;
+}
+
+/* Whether the device has r16f storage images (float16 illumination): be->no_half says why not.
+   A caller's device: the physical device's feature is checked; enabling it was the caller's job. */
+static void hd__vk_check_half(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkPhysicalDeviceFeatures f;
+    VkFormatProperties fp;
+    const char *knob = getenv("HD_VK_NO_HALF");
+    be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
+    be->fn.vkGetPhysicalDeviceFormatProperties(be->phys, VK_FORMAT_R16_SFLOAT, &fp);
+    be->no_half = NULL;
+    if (knob && *knob && strcmp(knob, "0") != 0)
+        be->no_half = "$HD_VK_NO_HALF is set (the test knob that plays a device without them)";
+    else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
+        be->no_half = "VK_FORMAT_R16_SFLOAT has no VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT";
+    else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_SRC_BIT) ||
+             !(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_DST_BIT))
+        be->no_half = "VK_FORMAT_R16_SFLOAT images cannot be copied (no TRANSFER_SRC / TRANSFER_DST)";
+    else if (!f.shaderStorageImageExtendedFormats)
+        be->no_half = "the device lacks shaderStorageImageExtendedFormats (r16f storage images)";
+}
+
+/* HD_ERROR_UNSUPPORTED, logged, when float16 illumination is asked for and the device lacks it. */
+static hd_result hd__vk_half_ok(hd__ctx *ctx)
+{
+    if (ctx->params.illumination_precision != HD_PRECISION_FLOAT16 || !ctx->be->no_half) return HD_SUCCESS;
+    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: illumination_precision FLOAT16 is not available on %s: %s",
+                   ctx->be->device_name, ctx->be->no_half);
 }
 
 static hd_result hd__be_create(hd__ctx *ctx)
@@ -1090,6 +1191,10 @@ static hd_result hd__be_create(hd__ctx *ctx)
     HD__VK_TRY(ctx, be->fn.vkCreateFence(be->device, &fci, NULL, &be->fence), "vkCreateFence");
     if ((r = hd__vk_pipelines(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_ring(ctx, 16)) != HD_SUCCESS) return r;
+    hd__vk_check_half(ctx);
+    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r;
+    if (!be->no_half && (r = hd__vk_image_new_as(ctx, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
+        return r;
     if ((r = hd__vk_buffer_create(ctx, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
     if ((r = hd__vk_image_new(ctx, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
     if ((r = hd__vk_buffer_create(ctx, &be->maj, (VkDeviceSize)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float),
@@ -1137,10 +1242,13 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
     hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
     be->illum_floats = 0;
+    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r; /* after hd_set_params */
+    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    be->sets_valid = 0; /* the placeholders bound for absent E / phi / phi2 follow the precision */
     if (illum_floats == 0) return HD_SUCCESS;
     if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_new(ctx, &be->E, g[0], g[1], g[2] * ctx->channels, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_new(ctx, &be->phi, g[0], g[1], g[2] * ctx->channels, "phi")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
     return hd__vk_flush(ctx);
 }
@@ -1153,8 +1261,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
     hd__vk_free_image(ctx, &be->phi2);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__vk_image_new(ctx, &be->phi2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, "Jacobi's buffer")) != HD_SUCCESS)
-        return r;
+    if ((r = hd__vk_illum_new(ctx, &be->phi2, "Jacobi's buffer")) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1210,8 +1317,10 @@ static hd_result hd__be_direct(hd__ctx *ctx)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
+    VkPipeline pipe;
+    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_DIRECT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_DIRECT], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1243,8 +1352,10 @@ static hd_result hd__be_project(hd__ctx *ctx)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
+    VkPipeline pipe;
+    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_PROJECT], 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1326,9 +1437,11 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     int l;
+    VkPipeline pipe;
+    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     for (l = 0; l < ctx->be->nlv; ++l)
-        if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_SUM_LIGHT], l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+        if ((r = hd__vk_dispatch(ctx, cb, pipe, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return hd__vk_flush(ctx);
 }

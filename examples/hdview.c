@@ -13,8 +13,8 @@
      A / shift+A  albedo +0.05 / -0.05             R   restart     S   screenshot (hdview-N.png)
      H         the default camera                  G   illumination grid 1/1 -> 1/2 -> 1/4 resolution
      C         grey / RGB multiple scattering         B   diffusion boundary: box / surface
-     F         float32 / float16 illumination storage (CPU and OpenCL only: the GL backend
-               refuses it, the log says so and the viewer stays at float32)
+     F         float32 / float16 illumination storage (GL_R16F images on the GL backend; a
+               backend that refuses it logs why and the viewer stays at float32)
      Esc / Q   quit
    The title shows the method, iterations, iterations/s and the bytes the method holds.
 

@@ -167,7 +167,7 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
 #endif
 #ifndef HD__BE_HAS_HALF
     if (p->illumination_precision == HD_PRECISION_FLOAT16)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 is not available on the %s backend (CPU and OpenCL only)",
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 is not available on the %s backend",
                        hd__be_name());
 #endif
     /* the multigrid levels (hd_cpu_multigrid.h) restrict and prolong float32 fine grids */

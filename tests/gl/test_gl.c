@@ -11,6 +11,11 @@
    3. a texture of the wrong size or format is refused with HD_ERROR_INVALID_PARAMETER, and the
       other backends' hd_gl_render_to_texture is HD_ERROR_UNSUPPORTED (tests/test_core.c side:
       the CPU build of this call is compiled in every other test program).
+   4. float16 illumination stores: hd_f16_round (hd_prelude_glsl.h, the embedded GLSL) and an
+      r16f imageStore give hd_f2h's bits (the CPU's round to nearest even) for every finite half,
+      both signs, the midpoint above it (a tie) and the floats either side of that midpoint,
+      and for overflow (>= 65520: inf) and inf; the same store without hd_f16_round is counted
+      and printed (llvmpipe truncates), not checked: a driver may round.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -232,6 +237,102 @@ static void run_calls(int use_current, const char *what)
     glDeleteTextures(1, &wrong);
 }
 
+/* The prelude's text (source string 2 of hd_glsl_embedded.h) between #version and a main()
+   that stores hd_f16_round(src[i]) (or src[i] itself, raw != 0) into an r16f 512x512 image. */
+static GLuint round_program(int raw)
+{
+    static const char *head = "#version 430 core\n#define HD_GLSL_CUSTOM_BUFFERS 1\n";
+    static const char *tail =
+        "layout(local_size_x = 64) in;\n"
+        "layout(std430, binding = 0) readonly buffer hd_t_in { float src[]; };\n"
+        "layout(binding = 0, r16f) uniform writeonly image2D hd_t_out;\n"
+        "void main() {\n"
+        "    int i = int(gl_GlobalInvocationID.x);\n"
+        "    imageStore(hd_t_out, ivec2(i % 512, i / 512), vec4(HD_T_ROUND(src[i]), 0.0, 0.0, 0.0));\n"
+        "}\n";
+    const char *src[3 + HD__GL_SOURCE_LINES];
+    GLsizei n = 0;
+    size_t i;
+    int in = 0;
+    GLint ok = 0;
+    GLuint sh = glCreateShader(GL_COMPUTE_SHADER), prog = glCreateProgram();
+    src[n++] = head;
+    src[n++] = raw ? "#define HD_T_ROUND(v) (v)\n" : "#define HD_T_ROUND(v) hd_f16_round(v)\n";
+    for (i = 0; i < HD__GL_SOURCE_LINES; ++i) {
+        if (strncmp(hd__gl_source[i], "#line 1 ", 8) == 0) in = strcmp(hd__gl_source[i], "#line 1 2\n") == 0;
+        else if (in) src[n++] = hd__gl_source[i];
+    }
+    src[n++] = tail;
+    glShaderSource(sh, n, src, NULL);
+    glCompileShader(sh);
+    glGetShaderiv(sh, GL_COMPILE_STATUS, &ok);
+    CHECK(ok, "the rounding shader does not compile");
+    glAttachShader(prog, sh);
+    glLinkProgram(prog);
+    glDeleteShader(sh);
+    return prog;
+}
+
+/* Check 4: returns how many of the stores differ from hd_f2h. */
+static int round_mismatches(const float *in, int count, int raw)
+{
+    static uint16_t out[512 * 512];
+    GLuint prog = round_program(raw), buf, tex;
+    int i, bad = 0;
+    glGenBuffers(1, &buf);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(512 * 512 * sizeof(float)), NULL, GL_STATIC_DRAW);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(count * sizeof(float)), in);
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_R16F, 512, 512);
+    glUseProgram(prog);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buf);
+    glBindImageTexture(0, tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R16F);
+    glDispatchCompute((GLuint)(count + 63) / 64, 1, 1);
+    glMemoryBarrier(GL_ALL_BARRIER_BITS);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_HALF_FLOAT, out);
+    for (i = 0; i < count; ++i) {
+        uint16_t want = hd_f2h(in[i]);
+        if (out[i] != want) {
+            if (!raw && bad < 5) printf("  hd_f16_round: %.9g (0x%08x) stored 0x%04x, hd_f2h 0x%04x\n", in[i], (unsigned)hd_f2u(in[i]), out[i], want);
+            ++bad;
+        }
+    }
+    glUseProgram(0);
+    glDeleteProgram(prog);
+    glDeleteBuffers(1, &buf);
+    glDeleteTextures(1, &tex);
+    return bad;
+}
+
+static void check_f16_round(void)
+{
+    static float in[512 * 512];
+    int n = 0, s, bad, raw;
+    uint32_t h;
+    for (s = 0; s < 2; ++s) {
+        uint16_t sign = (uint16_t)(s << 15);
+        for (h = 0; h < 0x7c00u; ++h) {
+            /* the midpoint of two neighbouring halves has 12 significant bits: exact in float;
+               above the largest half (65504) the midpoint is 65520, where inf begins */
+            float v = hd_h2f((uint16_t)(sign | h)), mid = h < 0x7bffu ? 0.5f * (v + hd_h2f((uint16_t)(sign | (h + 1)))) : (s ? -65520.0f : 65520.0f);
+            in[n++] = v;
+            in[n++] = mid;
+            in[n++] = hd_u2f(hd_f2u(mid) - 1u);
+            in[n++] = hd_u2f(hd_f2u(mid) + 1u);
+        }
+        in[n++] = s ? -1e30f : 1e30f;
+        in[n++] = hd_u2f(hd_f2u(1.0f / 0.0f) | ((uint32_t)s << 31));
+    }
+    bad = round_mismatches(in, n, 0);
+    raw = round_mismatches(in, n, 1);
+    CHECK(bad == 0, "hd_f16_round + r16f imageStore: %d of %d values differ from hd_f2h", bad, n);
+    printf("float16 stores: hd_f16_round + r16f imageStore equal hd_f2h for %d of %d values; the raw store for %d (the driver's own conversion)\n",
+           n - bad, n, n - raw);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -250,6 +351,7 @@ int main(void)
         return getenv("HD_CONFORMANCE_REQUIRE") && getenv("HD_CONFORMANCE_REQUIRE")[0] == '1' ? 1 : 0;
     }
     printf("host context: %s\n", (const char *)glGetString(GL_RENDERER));
+    check_f16_round();
     run_calls(1, "caller's context");
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
