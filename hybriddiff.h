@@ -271,9 +271,10 @@ typedef struct hd_params {
                                HD_PRECISION_FLOAT16 stores them as IEEE binary16, rounded to
                                nearest even, while every operation stays float32: 2 bytes per
                                voxel and channel instead of 4 (see docs/EVALUATION.md for the
-                               PSNR cost). CPU and OpenCL; the other backends and the multigrid
-                               solver return HD_ERROR_UNSUPPORTED. hd_read_illumination still
-                               returns floats. */
+                               PSNR cost). Every backend (Vulkan/GL: r16f images, where the
+                               device lacks them HD_ERROR_UNSUPPORTED at the next render); the
+                               multigrid solver returns HD_ERROR_UNSUPPORTED. hd_read_illumination
+                               still returns floats. */
 } hd_params;
 
 typedef struct hd_desc {
