@@ -861,6 +861,46 @@ static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipelin
     return HD_SUCCESS;
 }
 
+/* A compute descriptor-set layout of n bindings (binding i of types[i], one descriptor each)
+   and the pipeline layout of that one set with push_bytes of push constants (the library's
+   layouts and the benchmarks' share this). */
+#define HD__VK_MAX_SET_BINDINGS 16
+static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uint32_t n, uint32_t push_bytes,
+                                VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
+{
+    hd__backend *be = ctx->be;
+    VkDescriptorSetLayoutBinding b[HD__VK_MAX_SET_BINDINGS];
+    VkDescriptorSetLayoutCreateInfo lci;
+    VkPushConstantRange pcr;
+    VkPipelineLayoutCreateInfo plci;
+    uint32_t i;
+    if (n > HD__VK_MAX_SET_BINDINGS)
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: %u bindings in one set, at most %d", n, HD__VK_MAX_SET_BINDINGS);
+    memset(b, 0, sizeof b);
+    for (i = 0; i < n; ++i) {
+        b[i].binding = i;
+        b[i].descriptorType = types[i];
+        b[i].descriptorCount = 1;
+        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    }
+    memset(&lci, 0, sizeof lci);
+    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+    lci.bindingCount = n;
+    lci.pBindings = b;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, set_layout), "vkCreateDescriptorSetLayout");
+    memset(&pcr, 0, sizeof pcr);
+    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+    pcr.size = push_bytes;
+    memset(&plci, 0, sizeof plci);
+    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = set_layout;
+    plci.pushConstantRangeCount = 1;
+    plci.pPushConstantRanges = &pcr;
+    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, layout), "vkCreatePipelineLayout");
+    return HD_SUCCESS;
+}
+
 static hd_result hd__vk_pipelines(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -869,36 +909,12 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
-    VkDescriptorSetLayoutBinding b[HD__VK_BINDINGS];
-    VkDescriptorSetLayoutCreateInfo lci;
-    VkPushConstantRange pcr;
-    VkPipelineLayoutCreateInfo plci;
     VkDescriptorPoolSize ps[3];
     VkDescriptorPoolCreateInfo dpci;
     hd_result r;
     int i;
-    memset(b, 0, sizeof b);
-    for (i = 0; i < HD__VK_BINDINGS; ++i) {
-        b[i].binding = (uint32_t)i;
-        b[i].descriptorType = types[i];
-        b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    memset(&lci, 0, sizeof lci);
-    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    lci.bindingCount = HD__VK_BINDINGS;
-    lci.pBindings = b;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, &be->set_layout), "vkCreateDescriptorSetLayout");
-    memset(&pcr, 0, sizeof pcr);
-    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    pcr.size = 4 * sizeof(int32_t);
-    memset(&plci, 0, sizeof plci);
-    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &be->set_layout;
-    plci.pushConstantRangeCount = 1;
-    plci.pPushConstantRanges = &pcr;
-    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &be->layout), "vkCreatePipelineLayout");
+    if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
+        return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
         if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;

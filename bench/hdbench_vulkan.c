@@ -228,10 +228,7 @@ static hd_result stencil_sets(stencil *s)
 static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
 {
     hd__backend *be = ctx->be;
-    VkDescriptorSetLayoutBinding b[3];
-    VkDescriptorSetLayoutCreateInfo lci;
-    VkPushConstantRange pcr;
-    VkPipelineLayoutCreateInfo plci;
+    VkDescriptorType types[3];
     VkShaderModuleCreateInfo smci;
     VkComputePipelineCreateInfo cpci;
     VkShaderModule sm;
@@ -242,28 +239,8 @@ static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
     s->ctx = ctx;
     s->ssbo = ssbo;
     memcpy(s->g, g, sizeof s->g);
-    memset(b, 0, sizeof b);
-    for (i = 0; i < 3; ++i) {
-        b[i].binding = (uint32_t)i;
-        b[i].descriptorType = ssbo ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-        b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    memset(&lci, 0, sizeof lci);
-    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    lci.bindingCount = 3;
-    lci.pBindings = b;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, &s->set_layout), "vkCreateDescriptorSetLayout");
-    memset(&pcr, 0, sizeof pcr);
-    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    pcr.size = 4 * sizeof(int32_t);
-    memset(&plci, 0, sizeof plci);
-    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &s->set_layout;
-    plci.pushConstantRangeCount = 1;
-    plci.pPushConstantRanges = &pcr;
-    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &s->layout), "vkCreatePipelineLayout");
+    for (i = 0; i < 3; ++i) types[i] = ssbo ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    if ((r = hd__vk_layouts(ctx, types, 3, 4 * sizeof(int32_t), &s->set_layout, &s->layout)) != HD_SUCCESS) return r;
     memset(&smci, 0, sizeof smci);
     smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
     smci.codeSize = ssbo ? sizeof hd__spv_stencil_ssbo : sizeof hd__spv_stencil_image;
@@ -426,12 +403,9 @@ static hd_result variants_pipelines(variants *v)
 static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
 {
     hd__backend *be = ctx->be;
-    VkDescriptorSetLayoutBinding b[VAR_BINDINGS];
-    VkDescriptorSetLayoutCreateInfo lci;
+    VkDescriptorType types[VAR_BINDINGS];
     VkSamplerCreateInfo sci;
     PFN_vkCreateSampler create;
-    VkPushConstantRange pcr;
-    VkPipelineLayoutCreateInfo plci;
     hd_result r;
     int i;
     memset(v, 0, sizeof *v);
@@ -447,28 +421,10 @@ static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
     sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     create = (PFN_vkCreateSampler)be->fn.vkGetDeviceProcAddr(be->device, "vkCreateSampler"); /* the library needs none */
     HD__VK_TRY(ctx, create(be->device, &sci, NULL, &v->sampler), "vkCreateSampler");
-    memset(b, 0, sizeof b);
-    for (i = 0; i < VAR_BINDINGS; ++i) {
-        b[i].binding = (uint32_t)i;
-        b[i].descriptorType = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        b[i].descriptorCount = 1;
-        b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    }
-    memset(&lci, 0, sizeof lci);
-    lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    lci.bindingCount = VAR_BINDINGS;
-    lci.pBindings = b;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, &v->set_layout), "vkCreateDescriptorSetLayout");
-    memset(&pcr, 0, sizeof pcr);
-    pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    pcr.size = 8 * sizeof(int32_t);
-    memset(&plci, 0, sizeof plci);
-    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &v->set_layout;
-    plci.pushConstantRangeCount = 1;
-    plci.pPushConstantRanges = &pcr;
-    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, &v->layout), "vkCreatePipelineLayout");
+    for (i = 0; i < VAR_BINDINGS; ++i)
+        types[i] = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    if ((r = hd__vk_layouts(ctx, types, VAR_BINDINGS, 8 * sizeof(int32_t), &v->set_layout, &v->layout)) != HD_SUCCESS)
+        return r;
     if ((r = variants_pipelines(v)) != HD_SUCCESS) return r;
     return variants_set(v);
 }
