@@ -755,6 +755,35 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
 }
 
 /* ---- pipelines -------------------------------------------------------------------------------- */
+/* A compute pipeline of SPIR-V `code` (entry "main") with layout and the specialization spec
+   (NULL for none); the shader module lives only while the pipeline is made. */
+static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, size_t bytes, const VkSpecializationInfo *spec,
+                                         VkPipelineLayout layout, VkPipeline *out)
+{
+    hd__backend *be = ctx->be;
+    VkShaderModuleCreateInfo smci;
+    VkComputePipelineCreateInfo cpci;
+    VkShaderModule sm;
+    VkResult e;
+    memset(&smci, 0, sizeof smci);
+    smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+    smci.codeSize = bytes;
+    smci.pCode = code;
+    HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+    cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpci.stage.module = sm;
+    cpci.stage.pName = "main";
+    cpci.stage.pSpecializationInfo = spec;
+    cpci.layout = layout;
+    e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, out);
+    be->fn.vkDestroyShaderModule(be->device, sm, NULL);
+    if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
+    return HD_SUCCESS;
+}
+
 /* Pipeline of stage p from its SPIR-V. The diffusion stage's is specialized: its specialization
    constant hd_sc_flags (constant_id 0, hd_bind_vk_glsl.h) is the flags word, so the kernels'
    branches on the flags (RGB scattering, boundary condition) fold away at pipeline creation.
@@ -771,10 +800,6 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
     hd__backend *be = ctx->be;
     VkSpecializationMapEntry sme[3];
     VkSpecializationInfo spec;
-    VkShaderModuleCreateInfo smci;
-    VkComputePipelineCreateInfo cpci;
-    VkShaderModule sm;
-    VkResult e;
     int32_t data[3];
     int i;
     data[0] = flags ? *flags : 0;
@@ -789,23 +814,7 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
     spec.pMapEntries = sme;
     spec.dataSize = sizeof data;
     spec.pData = data;
-    memset(&smci, 0, sizeof smci);
-    smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    smci.codeSize = bytes;
-    smci.pCode = code;
-    HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
-    memset(&cpci, 0, sizeof cpci);
-    cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    cpci.stage.module = sm;
-    cpci.stage.pName = "main";
-    cpci.stage.pSpecializationInfo = flags ? &spec : NULL;
-    cpci.layout = be->layout;
-    e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, out);
-    be->fn.vkDestroyShaderModule(be->device, sm, NULL);
-    if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
-    return HD_SUCCESS;
+    return hd__vk_compute_pipeline(ctx, code, bytes, flags ? &spec : NULL, be->layout, out);
 }
 
 /* Stage p's pipeline; half: from its r16f SPIR-V (only the stages that touch E / phi have one). */

@@ -227,12 +227,7 @@ static hd_result stencil_sets(stencil *s)
 
 static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
 {
-    hd__backend *be = ctx->be;
     VkDescriptorType types[3];
-    VkShaderModuleCreateInfo smci;
-    VkComputePipelineCreateInfo cpci;
-    VkShaderModule sm;
-    VkResult e;
     hd_result r;
     int i;
     memset(s, 0, sizeof *s);
@@ -241,21 +236,9 @@ static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
     memcpy(s->g, g, sizeof s->g);
     for (i = 0; i < 3; ++i) types[i] = ssbo ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     if ((r = hd__vk_layouts(ctx, types, 3, 4 * sizeof(int32_t), &s->set_layout, &s->layout)) != HD_SUCCESS) return r;
-    memset(&smci, 0, sizeof smci);
-    smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    smci.codeSize = ssbo ? sizeof hd__spv_stencil_ssbo : sizeof hd__spv_stencil_image;
-    smci.pCode = ssbo ? hd__spv_stencil_ssbo : hd__spv_stencil_image;
-    HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
-    memset(&cpci, 0, sizeof cpci);
-    cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    cpci.stage.module = sm;
-    cpci.stage.pName = "main";
-    cpci.layout = s->layout;
-    e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, &s->pipeline);
-    be->fn.vkDestroyShaderModule(be->device, sm, NULL);
-    if (e < 0) { s->pipeline = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
+    r = ssbo ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo, sizeof hd__spv_stencil_ssbo, NULL, s->layout, &s->pipeline)
+             : hd__vk_compute_pipeline(ctx, hd__spv_stencil_image, sizeof hd__spv_stencil_image, NULL, s->layout, &s->pipeline);
+    if (r != HD_SUCCESS) return r;
     if ((r = stencil_resources(s)) != HD_SUCCESS) return r;
     return stencil_sets(s);
 }
@@ -374,29 +357,12 @@ static hd_result variants_set(variants *v)
 
 static hd_result variants_pipelines(variants *v)
 {
-    hd__backend *be = v->ctx->be;
-    VkShaderModuleCreateInfo smci;
-    VkComputePipelineCreateInfo cpci;
-    VkShaderModule sm;
-    VkResult e;
+    hd_result r;
     int k;
-    for (k = 0; k < NVAR; ++k) {
-        memset(&smci, 0, sizeof smci);
-        smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-        smci.codeSize = hd__sweep_variants[k].bytes;
-        smci.pCode = hd__sweep_variants[k].code;
-        HD__VK_TRY(v->ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
-        memset(&cpci, 0, sizeof cpci);
-        cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-        cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-        cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-        cpci.stage.module = sm;
-        cpci.stage.pName = "main";
-        cpci.layout = v->layout;
-        e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, &v->pipe[k]);
-        be->fn.vkDestroyShaderModule(be->device, sm, NULL);
-        if (e < 0) { v->pipe[k] = VK_NULL_HANDLE; return hd__vk_fail(v->ctx, e, "vkCreateComputePipelines", __LINE__); }
-    }
+    for (k = 0; k < NVAR; ++k)
+        if ((r = hd__vk_compute_pipeline(v->ctx, hd__sweep_variants[k].code, hd__sweep_variants[k].bytes, NULL, v->layout,
+                                         &v->pipe[k])) != HD_SUCCESS)
+            return r;
     return HD_SUCCESS;
 }
 
