@@ -38,7 +38,7 @@ $(B)/hdtest: $(TEST_OBJ)
 $(B)/hdrender: examples/hdrender.c examples/*.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
-$(B)/hdbench: bench/hdbench.c $(LIB_SRC) | $(B)
+$(B)/hdbench: bench/hdbench.c bench/hdbench_triad.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 $(B):

@@ -12,48 +12,7 @@
 #endif
 #include "hybriddiff.h"
 
-#define BENCH_TRIAD_N (32u << 20) /* 3 arrays of 128 MiB: far beyond the caches */
-
-typedef struct triad_job { float *a, *b, *c; size_t lo, hi; int reps; } triad_job;
-
-static void *triad_worker(void *arg)
-{
-    triad_job *j = (triad_job *)arg;
-    int r;
-    size_t i;
-    for (r = 0; r < j->reps; ++r)
-        for (i = j->lo; i < j->hi; ++i) j->a[i] = j->b[i] + 3.0f * j->c[i];
-    return NULL;
-}
-
-/* Best-of-5 triad bandwidth in bytes/s over nthreads threads (24 bytes per element, the STREAM
-   convention: write-allocate traffic not counted). */
-static double triad_bandwidth(int nthreads)
-{
-    float *a = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
-    float *b = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
-    float *c = (float *)malloc(BENCH_TRIAD_N * sizeof(float));
-    pthread_t th[64];
-    triad_job jobs[64];
-    double best = 0.0;
-    int rep, t;
-    size_t i;
-    for (i = 0; i < BENCH_TRIAD_N; ++i) { a[i] = 0.0f; b[i] = 1.0f; c[i] = 2.0f; }
-    for (rep = 0; rep < 5; ++rep) {
-        double t0 = hd__now(), dt;
-        for (t = 0; t < nthreads; ++t) {
-            jobs[t].a = a; jobs[t].b = b; jobs[t].c = c; jobs[t].reps = 1;
-            jobs[t].lo = BENCH_TRIAD_N / nthreads * t;
-            jobs[t].hi = t == nthreads - 1 ? BENCH_TRIAD_N : BENCH_TRIAD_N / nthreads * (t + 1);
-            pthread_create(&th[t], NULL, triad_worker, &jobs[t]);
-        }
-        for (t = 0; t < nthreads; ++t) pthread_join(th[t], NULL);
-        dt = hd__now() - t0;
-        if (24.0 * BENCH_TRIAD_N / dt > best) best = 24.0 * BENCH_TRIAD_N / dt;
-    }
-    free(a); free(b); free(c);
-    return best;
-}
+#include "hdbench_triad.h"
 
 /* The plain constant-coefficient 7-point Jacobi stencil the issue's 70 % target was set with:
    b = (sum of a's 6 neighbours) / 7 over the grid's interior, zero boundary, z-slabs per
@@ -161,7 +120,7 @@ int main(int argc, char **argv)
     nthreads = (int)sysconf(_SC_NPROCESSORS_ONLN);
     printf("hdbench: backend %s, %d threads, volume %s %dx%dx%d\n", hd_backend_name(), nthreads, path,
            vf.desc.dims[0], vf.desc.dims[1], vf.desc.dims[2]);
-    triad = triad_bandwidth(nthreads);
+    triad = hdbench_triad_bandwidth(nthreads);
     printf("STREAM triad: %.2f GB/s\n", triad * 1e-9);
 
     /* the plain stencil on the head's grid, for scale */

@@ -18,40 +18,7 @@
 
 HD_API_TABLE(hd_api_backend);
 
-/* 24 bytes per element (STREAM convention), best of 5, 2 threads of the pthreads pool. */
-typedef struct bt_job { float *a, *b, *c; size_t lo, hi; } bt_job;
-static void *bt_worker(void *arg)
-{
-    bt_job *j = (bt_job *)arg;
-    size_t i;
-    for (i = j->lo; i < j->hi; ++i) j->a[i] = j->b[i] + 3.0f * j->c[i];
-    return NULL;
-}
-static double triad_bandwidth(int nthreads)
-{
-    size_t n = (size_t)32 << 20, i;
-    float *a = (float *)malloc(n * 4), *b = (float *)malloc(n * 4), *c = (float *)malloc(n * 4);
-    pthread_t th[64];
-    bt_job jobs[64];
-    double best = 0.0;
-    int rep, t;
-    if (nthreads > 64) nthreads = 64;
-    for (i = 0; i < n; ++i) { a[i] = 0.0f; b[i] = 1.0f; c[i] = 2.0f; }
-    for (rep = 0; rep < 5; ++rep) {
-        double t0 = hd__now(), dt;
-        for (t = 0; t < nthreads; ++t) {
-            jobs[t].a = a; jobs[t].b = b; jobs[t].c = c;
-            jobs[t].lo = n / (size_t)nthreads * (size_t)t;
-            jobs[t].hi = t == nthreads - 1 ? n : n / (size_t)nthreads * (size_t)(t + 1);
-            pthread_create(&th[t], NULL, bt_worker, &jobs[t]);
-        }
-        for (t = 0; t < nthreads; ++t) pthread_join(th[t], NULL);
-        dt = hd__now() - t0;
-        if (24.0 * (double)n / dt > best) best = 24.0 * (double)n / dt;
-    }
-    free(a); free(b); free(c);
-    return best;
-}
+#include "hdbench_triad.h"
 
 static const float bench_tf[] = {
     0.0f, 0.0f, 0.0f, 0.0f,     0.0f, 0.0f, 0.0f, 0.0f,       0.93f, 0.73f, 0.62f, 0.02f,
@@ -310,7 +277,7 @@ int main(int argc, char **argv)
     bench_lights[1].direction[0] = 1.0f; bench_lights[1].direction[1] = -0.3f; bench_lights[1].direction[2] = 0.2f;
     bench_lights[2].direction[0] = 0.2f; bench_lights[2].direction[1] = 0.8f; bench_lights[2].direction[2] = -1.0f;
     nvox = (double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2];
-    triad = triad_bandwidth(nthreads);
+    triad = hdbench_triad_bandwidth(nthreads);
     printf("hdbench_opencl: volume %s %dx%dx%d, %d cores, STREAM triad %.2f GB/s\n", path, vf.desc.dims[0],
            vf.desc.dims[1], vf.desc.dims[2], nthreads, triad * 1e-9);
 

@@ -34,7 +34,7 @@ check-generated:
 	scripts/check-generated
 
 # The bench is its own OpenCL implementation unit (its experiments reach the backend's buffers).
-$(B)/hdbench_opencl: bench/hdbench_opencl.c $(B)/conf_impl_cpu.o $(CONF_DEPS) | $(B)
+$(B)/hdbench_opencl: bench/hdbench_opencl.c bench/hdbench_triad.h $(B)/conf_impl_cpu.o $(CONF_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -I$(CONF_DIR) $(WARN) $(CFLAGS) bench/hdbench_opencl.c $(B)/conf_impl_cpu.o -o $@ $(LDLIBS) $(CL_LDLIBS)
 
 # Memcheck on the quick subset; PoCL's and LLVM's own leaks are suppressed (see the .supp).
