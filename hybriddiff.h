@@ -152,10 +152,11 @@ typedef enum hd_solver {
     HD_SOLVER_DEFAULT = 0,   /* = RED_BLACK */
     HD_SOLVER_RED_BLACK,     /* red-black Gauss-Seidel, in place: two half-sweeps per sweep */
     HD_SOLVER_JACOBI,        /* Jacobi with a ping-pong buffer (+4 bytes per voxel) */
-    HD_SOLVER_MULTIGRID,     /* geometric multigrid V-cycles (red-black smoothing on every
-                                level); diffusion_sweeps counts V-cycles, each about 6 sweeps of
-                                work; +about 6 bytes per voxel. CPU backend only for now: the
-                                GPU backends return HD_ERROR_UNSUPPORTED */
+    HD_SOLVER_MULTIGRID,     /* conjugate gradients preconditioned by a geometric multigrid
+                                V-cycle (red-black smoothing on every level); diffusion_sweeps
+                                counts CG steps (one V-cycle and two residual passes each);
+                                +about 22 bytes per voxel and channel. CPU backend only for now:
+                                the GPU backends return HD_ERROR_UNSUPPORTED */
     HD_SOLVER_COUNT
 } hd_solver;
 
@@ -242,7 +243,7 @@ typedef struct hd_params {
                                to sigma_s (1 - g); used by PT_MS as its phase; default 0 */
     float majorant;         /* 0 -> a coarse grid of local majorants (empty space is skipped);
                                > 0 -> this global majorant (must be >= max sigma_t) */
-    int diffusion_sweeps;   /* solver sweeps per iteration, 0 -> 4 (multigrid: V-cycles, 0 -> 1) */
+    int diffusion_sweeps;   /* solver sweeps per iteration, 0 -> 4 (multigrid: CG steps, 0 -> 1) */
     int disable_diffusion;  /* 1: phi stays 0 (direct light only, the PT_SS equivalent) */
     hd_solver solver;
     hd_tracking tracking;

@@ -1,12 +1,16 @@
 /* hdbench_multigrid - the multigrid target of issue 9, in one run: on the head CT (256x256x108,
    full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
-   source), the time single-level red-black sweeps and multigrid V-cycles take to bring the
+   source), the time single-level red-black sweeps and HD_SOLVER_MULTIGRID's steps (conjugate
+   gradients preconditioned by a V-cycle, backends/hd_cpu_multigrid.h) take to bring the
    diffusion's relative residual |f - A phi| / |f| from phi = 0 below 1e-4, for the box and the
    surface boundary. Times: wall clock of the solver calls only (residual checks excluded) and
    process CPU seconds / threads (robust to other load on the machine). Red-black stops at
    --cap seconds (default 300) if it has not converged: its ratio is then a lower bound.
    --f64 evaluates the residual in double (bench/hd_residual_f64.c): float32's rounding floors
-   the float residual near 1e-3 in soft tissue.
+   the float residual near 1e-3 in soft tissue. With --f64 each printed line also gives the
+   residual with the kernel's own float coefficients summed in double (the solver's residual),
+   and at the end the residual of phi moved by one float32 ulp per voxel: the floor float32
+   storage of phi sets (rounding to nearest is about 0.29 ulp rms).
    Usage: hdbench_multigrid [data/head.nrrd] [--cap SECONDS] [--tol T] [--downsample N]
                             [--print-every STEPS] [--surface-only] [--f64]
    Figures, not a test: nothing here passes or fails. */
@@ -38,6 +42,41 @@ static double residual_f64(hd_context h)
     return hdb_residual_f64(&ctx->kp, ctx->be->sig, gvox * (size_t)ctx->sig_channels, ctx->be->E, ctx->be->phi);
 }
 
+/* The relative residual of the equation the library solves, with the kernel's own float
+   coefficients (source, sigma_a, face weights), the sums in double (hd__cpu_mg_residual_f64_into,
+   the multigrid solver's residual): residual_f64 recomputes the coefficients themselves in
+   double, a different operator by float32 rounding. iterate: of the multigrid solver's own
+   iterate phi + lo instead of phi. -1 when it cannot be computed. */
+static double residual_kernel_f64(hd_context h, int iterate)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__cpu_grid g;
+    int rows, r, x, gx;
+    float *row;
+    double r2 = 0.0, b2 = 0.0;
+    if (!ctx || !ctx->be->phi) return -1.0;
+    gx = ctx->gdims[0];
+    rows = ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
+    if (!(row = (float *)malloc((size_t)gx * sizeof(float)))) return -1.0;
+    if (iterate && !ctx->be->mg) { free(row); return -1.0; }
+    g.k = &ctx->be->k;
+    g.res = NULL;
+    ctx->be->grid = iterate ? &ctx->be->mg->fineg : &g; /* the fine grid's residual reads phi + lo */
+    for (r = 0; r < rows; ++r) {
+        int y = r % ctx->gdims[1], z = (r / ctx->gdims[1]) % ctx->gdims[2], c = r / (ctx->gdims[1] * ctx->gdims[2]);
+        hd__cpu_mg_residual_f64_into(ctx->be, r, row);
+        for (x = 0; x < gx; ++x) {
+            float rhs;
+            (void)hd_diffuse_residual(&ctx->be->k, x, y, z, c, &rhs);
+            r2 += (double)row[x] * row[x];
+            b2 += (double)rhs * rhs;
+        }
+    }
+    ctx->be->grid = NULL;
+    free(row);
+    return b2 > 0.0 ? sqrt(r2 / b2) : 0.0;
+}
+
 /* Runs the context's solver `batch` steps at a time until the residual is below tol or cap
    wall seconds have passed; prints the residual every `print_every` steps. */
 static int f64; /* --f64: the residual evaluated in double (residual_f64) */
@@ -55,12 +94,42 @@ static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threa
         r.steps += batch;
         hd__test_residual(ctx, &res);
         if (f64) res = residual_f64(ctx);
-        if (r.steps % (batch * print_every) == 0 || res < tol)
-            printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, residual %.3e\n", name, r.steps, r.wall, r.cpu, res);
+        if (r.steps % (batch * print_every) == 0 || res < tol) {
+            hd__ctx *c = hd__lookup(ctx, NULL);
+            printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, residual %.3e (kernel coefficients %.3e", name,
+                   r.steps, r.wall, r.cpu, res, f64 ? residual_kernel_f64(ctx, 0) : res);
+            if (f64 && c && c->be->mg && c->params.solver == HD_SOLVER_MULTIGRID)
+                printf("; the solver's iterate phi + lo %.3e", residual_kernel_f64(ctx, 1));
+            printf(")\n");
+        }
         fflush(stdout);
     }
     r.res = res;
     return r;
+}
+
+/* The double residual of phi with every voxel moved by one float32 ulp, up or down by a fixed
+   hash of its index (then restored): the floor float32 storage of phi puts under any solver
+   (rounding to nearest moves a voxel by up to half an ulp, about 0.29 ulp rms; this is 1 ulp). */
+static double residual_ulp_f64(hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    size_t n, i;
+    float *phi, *keep;
+    double res;
+    if (!ctx || !ctx->be->phi) return -1.0;
+    n = ctx->be->illum_floats;
+    phi = ctx->be->phi;
+    if (!(keep = (float *)malloc(n * sizeof(float)))) return -1.0;
+    memcpy(keep, phi, n * sizeof(float));
+    for (i = 0; i < n; ++i) {
+        uint32_t k = (uint32_t)i * 2654435761u;
+        phi[i] = nextafterf(phi[i], (k >> 16) & 1 ? HUGE_VALF : -HUGE_VALF);
+    }
+    res = residual_f64(h);
+    memcpy(phi, keep, n * sizeof(float));
+    free(keep);
+    return res;
 }
 
 int main(int argc, char **argv)
@@ -104,21 +173,33 @@ int main(int argc, char **argv)
         if (hd_create(&d, &mg) != HD_SUCCESS) return 1;
         if (hd__test_direct(rb, 4) != HD_SUCCESS || hd__test_direct(mg, 4) != HD_SUCCESS) return 1;
         printf("\nboundary %s:\n", boundary == HD_BOUNDARY_BOX ? "box" : "surface");
-        b = solve(mg, 1, tol, cap, threads, print_every, "multigrid V-cycles");
+        b = solve(mg, 1, tol, cap, threads, print_every, "multigrid PCG steps");
         /* the double residual costs about a sweep's time x 20: checked every 250 sweeps */
         a = solve(rb, f64 ? 250 : 25, tol, cap, threads, print_every, "red-black sweeps  ");
+        if (f64)
+            printf("phi moved by 1 ulp per voxel: residual (double) red-black %.2e, multigrid %.2e\n", residual_ulp_f64(rb),
+                   residual_ulp_f64(mg));
         hd_get_stats(rb, &s_rb);
         hd_get_stats(mg, &s_mg);
         printf("| boundary | solver | steps | wall s | cpu s / thread | residual |\n|---|---|---|---|---|---|\n");
         printf("| %s | red-black | %d sweeps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", a.steps, a.wall, a.cpu, a.res);
-        printf("| %s | multigrid | %d V-cycles | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
+        printf("| %s | multigrid | %d PCG steps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
+        {
+            hd__ctx *m = hd__lookup(mg, NULL);
+            double vc = m && m->be->mg ? m->be->mg->vcycle_seconds : 0.0;
+            printf("per step (wall): red-black sweep %.2f ms, PCG step %.2f ms, of which its V-cycle %.2f ms\n",
+                   1e3 * a.wall / a.steps, 1e3 * b.wall / b.steps, 1e3 * vc / b.steps);
+        }
         if (b.res < tol)
             printf("multigrid is %s%.1fx faster in wall time, %s%.1fx in CPU time (target >= 10x)\n",
                    a.res >= tol ? ">= " : "", a.wall / b.wall, a.res >= tol ? ">= " : "", a.cpu / b.cpu);
         else
             printf("neither reached %.0e within %.0f s: at equal time multigrid's residual is %.0fx lower\n", tol, cap,
                    a.res / b.res);
-        printf("the levels add %.2f bytes per voxel\n",
+        if (f64) /* the solver's own iterate, phi + lo (hd_cpu_multigrid.h): no float32 storage floor */
+            printf("the multigrid solver's own iterate phi + lo (about 48 bits; phi is its float32 rounding): "
+                   "residual %.2e\n", residual_kernel_f64(mg, 1));
+        printf("the solver's vectors and levels add %.2f bytes per data voxel\n",
                ((double)s_mg.method_bytes - (double)s_rb.method_bytes) / ((double)vf.desc.dims[0] * vf.desc.dims[1] * vf.desc.dims[2]));
         hd_destroy(rb);
         hd_destroy(mg);

@@ -70,6 +70,96 @@ static void test_multigrid_matches(void)
     }
 }
 
+/* Multigrid-preconditioned CG reaches a bound in a few steps: on the blob (box, surface, RGB),
+   one HD iteration with k solver steps from phi = 0, against red-black after 3000 sweeps (the
+   same seed, so the same E). A CG whose direction, step length or preconditioner were wrong
+   (e.g. a nonsymmetric V-cycle, a beta of the wrong sign) would stall far above it; k = 0..12
+   are printed. Measured (max |phi_k - phi_ref| / max phi_ref): surface 1.6e-6 after 6 steps
+   (red-black's own distance from the solution, about 1.5e-6, after that); box 2.1e-1 after 4
+   steps and 9.1e-3 after 12, RGB 2.3e-1 and 1.4e-2: air's floored D (a conductance jump of
+   about 1e4 at every tissue surface) is what the coarse grids represent worst. Bounds: surface
+   1e-5 after 6 steps; box and RGB 5e-2 after 12 steps and 10x below the error after 4. */
+static void test_multigrid_pcg_bound(void)
+{
+    static const float tf[12] = {1, 0.5f, 0.25f, 0, 1, 0.5f, 0.25f, 0.3f, 1, 0.5f, 0.25f, 1};
+    int variant, k;
+    for (variant = 0; variant < 3; ++variant) {
+        hd_desc d;
+        hd_context ref;
+        hd_stats st;
+        size_t n = (size_t)SN * SN * SN * 3, i, nread;
+        float *a = (float *)malloc(n * 4), *b = (float *)malloc(n * 4);
+        double maxv = 0, err[13];
+        solver_desc(&d);
+        d.transfer_function.rgba = tf;
+        d.params.diffusion_boundary = variant == 1 ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+        d.params.rgb_scattering = variant == 2;
+        d.params.diffusion_sweeps = 3000;
+        CHECK(hd_create(&d, &ref) == HD_SUCCESS);
+        CHECK(hd_iterate(ref, 1) == HD_SUCCESS && hd_get_stats(ref, &st) == HD_SUCCESS);
+        nread = (size_t)SN * SN * SN * (size_t)st.illumination_channels;
+        CHECK(hd_read_illumination(ref, HD_ILLUMINATION_SCATTERED, a, nread) == HD_SUCCESS);
+        for (i = 0; i < nread; ++i)
+            if (a[i] > maxv) maxv = a[i];
+        hd_destroy(ref);
+        d.params.solver = HD_SOLVER_MULTIGRID;
+        printf("  multigrid PCG (%s%s), max |phi_k - phi_ref| / max phi_ref:", variant == 1 ? "surface" : "box",
+               variant == 2 ? ", rgb" : "");
+        for (k = 0; k <= 12; ++k) {
+            hd_context mg;
+            double e = 0;
+            d.params.diffusion_sweeps = k;
+            d.params.disable_diffusion = k == 0; /* 0 sweeps means the default: no solve instead */
+            CHECK(hd_create(&d, &mg) == HD_SUCCESS);
+            CHECK(hd_iterate(mg, 1) == HD_SUCCESS);
+            CHECK(hd_read_illumination(mg, HD_ILLUMINATION_SCATTERED, b, nread) == HD_SUCCESS);
+            for (i = 0; i < nread; ++i)
+                if (fabs((double)a[i] - b[i]) > e) e = fabs((double)a[i] - b[i]);
+            err[k] = e / maxv;
+            printf(" %.1e", err[k]);
+            hd_destroy(mg);
+        }
+        printf("\n");
+        CHECK(maxv > 0 && err[0] > 0.5);
+        if (variant == 1) CHECK_MSG(err[6] <= 1e-5, "surface: after 6 steps %.2e of max phi", err[6]);
+        else CHECK_MSG(err[12] <= 5e-2 && err[12] * 10 <= err[4], "box: after 4 and 12 steps %.2e, %.2e", err[4], err[12]);
+        free(a); free(b);
+    }
+}
+
+/* The multigrid solver's result is the same bits for 1, 2 and 3 threads (its dot products are
+   summed per row, then in row order): 17 rows (a block's remainder), box, surface and RGB, two
+   iterations of 5 steps (the second warm-started, with the CG restarted on its new E). */
+static void test_multigrid_threads(void)
+{
+    static const float tf[12] = {1, 0.5f, 0.25f, 0, 1, 0.5f, 0.25f, 0.3f, 1, 0.5f, 0.25f, 1};
+    int variant, t;
+    for (variant = 0; variant < 3; ++variant) {
+        size_t n = (size_t)SN * 17 * SN * 3;
+        float *a = (float *)malloc(n * 4), *b = (float *)malloc(n * 4);
+        for (t = 1; t <= 3; ++t) {
+            hd_desc d;
+            hd_context ctx;
+            solver_desc(&d);
+            d.transfer_function.rgba = tf;
+            d.volume.dims[1] = 17;
+            d.params.diffusion_boundary = variant == 1 ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+            d.params.rgb_scattering = variant == 2;
+            d.params.solver = HD_SOLVER_MULTIGRID;
+            d.params.diffusion_sweeps = 5;
+            d.threads = t;
+            CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+            CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
+            memset(t == 1 ? a : b, 0, n * 4);
+            CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_SCATTERED, t == 1 ? a : b,
+                                       (size_t)SN * 17 * SN * (variant == 2 ? 3 : 1)) == HD_SUCCESS);
+            if (t > 1) CHECK_MSG(memcmp(a, b, n * 4) == 0, "variant %d: 1 and %d threads differ", variant, t);
+            hd_destroy(ctx);
+        }
+        free(a); free(b);
+    }
+}
+
 /* The CPU's block schedule (16-row blocks, a last-row pass) for row counts around a block's
    size, 16 * k + 1 included (its remainder joins the previous block): red-black and Jacobi give
    the same bits on 1 and 2 threads; under `make tsan` this also shows no thread reads a row
@@ -111,5 +201,7 @@ static void test_block_schedule(void)
 const hd_test_case hd_tests_solvers[] = {
     {"solvers_multigrid_matches_red_black", test_multigrid_matches},
     {"solvers_block_schedule_threads", test_block_schedule},
+    {"solvers_multigrid_pcg_bound", test_multigrid_pcg_bound},
+    {"solvers_multigrid_threads_bitwise", test_multigrid_threads},
 };
 const int hd_tests_solvers_count = (int)(sizeof hd_tests_solvers / sizeof hd_tests_solvers[0]);
