@@ -547,7 +547,8 @@ static hd_result hd__prepare(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* One sweep of the selected solver (multigrid: one V-cycle). */
+/* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a
+   V-cycle: about 15 red-black sweeps of work on the head CT). */
 static hd_result hd__diffuse_once(hd__ctx *ctx)
 {
 #ifdef HD__BE_HAS_MULTIGRID

@@ -26,7 +26,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
     return HD_SUCCESS;
 }
 
-/* n diffusion sweeps of the selected solver (multigrid: V-cycles) on the current E and phi. */
+/* n diffusion sweeps of the selected solver (multigrid: CG steps) on the current E and phi. */
 HD__MAYBE_UNUSED static hd_result hd__test_diffuse(hd_context h, int n)
 {
     hd_result r;
