@@ -165,6 +165,8 @@ static int g_downsample = 1; /* params.illumination_downsample of HD and CD cont
 static int g_rgb = 0;        /* params.rgb_scattering of HD and CD contexts */
 static hd_boundary g_boundary = HD_BOUNDARY_BOX; /* params.diffusion_boundary of HD and CD contexts */
 static hd_precision g_precision = HD_PRECISION_FLOAT32; /* params.illumination_precision of HD and CD */
+static hd_solver g_solver = HD_SOLVER_DEFAULT; /* params.solver of HD and CD contexts */
+static int g_sweeps = 0;     /* params.diffusion_sweeps of HD and CD contexts; 0: the scene's */
 
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
 {
@@ -196,7 +198,8 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.extinction = S.extinction;
     d.params.albedo = S.albedo;
     d.params.anisotropy = S.anisotropy;
-    d.params.diffusion_sweeps = S.diffusion_sweeps;
+    d.params.diffusion_sweeps = g_sweeps ? g_sweeps : S.diffusion_sweeps;
+    d.params.solver = g_solver;
     d.params.seed = seed;
     d.params.step = S.step;
     d.params.frame_window = S.frame_window;
@@ -755,7 +758,7 @@ static void run_downsample_study(const ref_img *ref, const char *out)
     float *img = (float *)xmalloc(npix * 4 * sizeof(float));
     double nvox = (double)g_vol.desc.dims[0] * g_vol.desc.dims[1] * g_vol.desc.dims[2];
     double budget = 0.0, rate1 = 0.0;
-    int k, n = S.iterations[HDE_HD];
+    int k, n = S.iterations[HDE_HD], saved = g_downsample;
     FILE *md = open_w(out, "downsample.md", NULL);
     fprintf(md, "| factor | illumination grid | state bytes per data voxel | HD it/s | speed-up | PSNR vs PT_MS after %d it | lit part | PSNR at equal time | lit part |\n"
                 "|---|---|---|---|---|---|---|---|---|\n", n);
@@ -797,7 +800,7 @@ static void run_downsample_study(const ref_img *ref, const char *out)
                    (double)st.method_bytes / nvox, rate, rate / rate1, psnr(e.mse), psnr(e.mse_lit), n);
         hd_destroy(ctx);
     }
-    g_downsample = 1;
+    g_downsample = saved;
     fclose(md);
     free(img);
 }
@@ -917,9 +920,279 @@ static void run_half_study(const ref_img *ref, const char *out)
         for (j = 0; j < 2; ++j) free(img[k][j]);
 }
 
+/* Beyond the paper: what the multigrid-preconditioned CG solver (HD_SOLVER_MULTIGRID) buys HD's
+   image in the first seconds. HD with 1 light against the 1-light PT_MS reference, as curves over
+   time: every iteration is timed alone (wall clock and CPU time / cores around hd_iterate; the
+   read-back and the comparison are not timed) and followed by a comparison, so the PSNR at time t
+   is that of the image on screen at t: the last one finished by then. Four solver settings (the
+   scene's red-black sweeps per iteration, 8x as many, CG with 1 and with 2 multigrid-
+   preconditioned steps per iteration), each with the surface and the box boundary, each run for
+   --study-seconds on both clocks. OUT/multigrid.md, multigrid.csv (PSNR at fixed times),
+   multigrid-curves.csv (every iteration), multigrid_psnr_time.png (gnuplot), multigrid_1s.png
+   (surface boundary: each setting's image at 1 s wall, then PT_MS) and multigrid-checks.txt. */
+enum { MG_CONFIGS = 4, MG_BOUNDARIES = 2, MG_TIMES = 7 };
+static const double k_mg_times[MG_TIMES] = {0.5, 1, 2, 5, 10, 20, 40};
+static const char *const k_mg_color[MG_CONFIGS] = {"#7f7f7f", "#1f77b4", "#d62728", "#2ca02c"};
+
+typedef struct mg_run {
+    hd_solver solver;
+    int steps;     /* params.diffusion_sweeps: red-black sweeps or CG steps per HD iteration */
+    hd_boundary boundary;
+    curve c;       /* p[].e[1]: against PT_MS (e[0] unused) */
+    hd_stats st;   /* at the end: the library's stage timers (wall) and the grid */
+    double mean;   /* mean radiance of the last image / PT_MS's */
+} mg_run;
+
+static const char *mg_label(const mg_run *r, char *buf, size_t n)
+{
+    snprintf(buf, n, "%s, %d %s/it", r->solver == HD_SOLVER_MULTIGRID ? "multigrid CG" : "red-black", r->steps,
+             r->solver == HD_SOLVER_MULTIGRID ? (r->steps == 1 ? "step" : "steps") : "sweeps");
+    return buf;
+}
+
+/* The load average from /proc/loadavg (the machine is shared: the wall clock carries the load). */
+static void load_average(char *buf, size_t n)
+{
+    FILE *f = fopen("/proc/loadavg", "r");
+    double a = 0, b = 0, c = 0;
+    if (f && fscanf(f, "%lf %lf %lf", &a, &b, &c) == 3) snprintf(buf, n, "%.2f %.2f %.2f", a, b, c);
+    else snprintf(buf, n, "n/a");
+    if (f) fclose(f);
+}
+
+/* One configuration: iterations one at a time until both clocks pass `seconds`; snap (if not
+   NULL) gets the last image finished within 1 s of wall time (left untouched if none was). */
+static void mg_run_curve(mg_run *run, const ref_img *ref, double seconds, float *snap)
+{
+    size_t npix = (size_t)S.size * S.size;
+    float *img = (float *)xmalloc(npix * 4 * sizeof(float));
+    hd_context ctx;
+    int cap = 64;
+    double wall = 0.0, cpu = 0.0;
+    curve *c = &run->c;
+    g_solver = run->solver;
+    g_sweeps = run->steps;
+    g_boundary = run->boundary;
+    ctx = make_ctx(HDE_HD, 1, S.size, 1u);
+    memset(c, 0, sizeof *c);
+    c->p = (point *)xmalloc((size_t)cap * sizeof(point));
+    while (wall < seconds || cpu < seconds) {
+        double a = now(), ca = cpu_now();
+        iterate(ctx, 1);
+        cpu += cpu_now() - ca;
+        wall += now() - a;
+        read_image(ctx, img, S.size);
+        if (c->n == cap) c->p = (point *)realloc(c->p, (size_t)(cap *= 2) * sizeof(point));
+        if (!c->p) die("out of memory");
+        memset(&c->p[c->n], 0, sizeof(point));
+        c->p[c->n].it = c->n + 1;
+        c->p[c->n].sec = cpu;
+        c->p[c->n].wall = wall;
+        c->p[c->n].e[1] = compare(img, ref, npix);
+        ++c->n;
+        if (snap && wall <= 1.0) memcpy(snap, img, npix * 4 * sizeof(float));
+    }
+    if (hd_get_stats(ctx, &run->st) != HD_SUCCESS) die("hd_get_stats");
+    run->mean = mean_radiance(img, npix) / mean_radiance(ref->lin, npix);
+    hd_destroy(ctx);
+    free(img);
+    g_solver = HD_SOLVER_DEFAULT;
+    g_sweeps = 0;
+    g_boundary = HD_BOUNDARY_BOX;
+}
+
+/* PSNR against PT_MS of the image on screen at time t (wall or CPU clock): the last iteration
+   finished by t; -1 before the first one. *it gets its iteration (0 if none). */
+static double mg_psnr_at(const curve *c, double t, int wall, int lit, int *it)
+{
+    int i, last = -1;
+    for (i = 0; i < c->n; ++i)
+        if ((wall ? c->p[i].wall : c->p[i].sec) <= t) last = i;
+    if (it) *it = last < 0 ? 0 : c->p[last].it;
+    if (last < 0) return -1.0;
+    return psnr(lit ? c->p[last].e[1].mse_lit : c->p[last].e[1].mse);
+}
+
+static void mg_write_md_table(FILE *md, mg_run runs[MG_BOUNDARIES][MG_CONFIGS], int wall, int ntimes)
+{
+    int b, k, j;
+    char lab[64];
+    fprintf(md, "| boundary | solver | it/s | diffusion s/it |");
+    for (j = 0; j < ntimes; ++j) fprintf(md, " %g s |", k_mg_times[j]);
+    fprintf(md, "\n|---|---|---|---|");
+    for (j = 0; j < ntimes; ++j) fprintf(md, "---|");
+    fputc('\n', md);
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k) {
+            const mg_run *r = &runs[b][k];
+            const point *last = &r->c.p[r->c.n - 1];
+            fprintf(md, "| %s | %s | %.2f | %.3f |", b ? "box" : "surface", mg_label(r, lab, sizeof lab),
+                    r->c.n / (wall ? last->wall : last->sec), r->st.seconds_diffusion / r->c.n);
+            for (j = 0; j < ntimes; ++j) {
+                int it;
+                double v = mg_psnr_at(&r->c, k_mg_times[j], wall, 0, &it);
+                if (v < 0) fprintf(md, " no image |");
+                else fprintf(md, " %.2f (%d) |", v, it);
+            }
+            fputc('\n', md);
+        }
+}
+
+static void mg_plot(const char *work, const char *out, mg_run runs[MG_BOUNDARIES][MG_CONFIGS], double seconds)
+{
+    char path[1024], cmd[1200], lab[64];
+    FILE *gp;
+    int b, k, clk, i;
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k) {
+            char name[64];
+            FILE *f;
+            snprintf(name, sizeof name, "mg_%d_%d.dat", b, k);
+            f = open_w(work, name, NULL);
+            fprintf(f, "# it wall_s cpu_s psnr_ms psnr_lit_ms\n");
+            for (i = 0; i < runs[b][k].c.n; ++i) {
+                const point *p = &runs[b][k].c.p[i];
+                fprintf(f, "%d %.5f %.5f %.4f %.4f\n", p->it, p->wall, p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+            }
+            fclose(f);
+        }
+    gp = open_w(work, "multigrid.gp", path);
+    fprintf(gp, "if (strstrt(GPVAL_TERMINALS, 'pngcairo') > 0) {\n"
+                "  set terminal pngcairo size 1100,900 font 'Sans,10'\n"
+                "} else {\n  set terminal png size 1100,900 small\n}\n"
+                "set output '%s/multigrid_psnr_time.png'\nset grid\nset logscale x\nset xrange [0.1:%g]\n"
+                "set key at screen 0.5,0.955 center top horizontal maxrows 2 samplen 2\n"
+                "set ylabel 'PSNR against PT\\_MS (dB)'\n"
+                "set arrow 1 from 1, graph 0 to 1, graph 1 nohead dt 3 lc rgb '#000000'\n"
+                "set multiplot layout 2,2 margins 0.07,0.98,0.06,0.88 spacing 0.08,0.1 title 'HD, 1 light, %dx%d, "
+                "illumination grid %dx%dx%d: PSNR over time (a point per iteration; dotted: 1 s)'\n",
+            out, seconds, S.size, S.size, runs[0][0].st.illumination_dims[0], runs[0][0].st.illumination_dims[1],
+            runs[0][0].st.illumination_dims[2]);
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (clk = 0; clk < 2; ++clk) {
+            fprintf(gp, "set title '%s boundary, %s'\nset xlabel '%s'\nplot ", b ? "box" : "surface",
+                    clk ? "CPU time" : "wall clock",
+                    clk ? "time (s): process CPU seconds / worker threads" : "time (s): wall clock of hd\\_iterate");
+            for (k = 0; k < MG_CONFIGS; ++k)
+                fprintf(gp, "%s'%s/mg_%d_%d.dat' using %d:4 with linespoints lw 2 pt 7 ps 0.4 lc rgb '%s' title '%s'",
+                        k ? ", " : "", work, b, k, clk ? 3 : 2, k_mg_color[k], mg_label(&runs[b][k], lab, sizeof lab));
+            fprintf(gp, "\nunset key\n"); /* one key, above the panels, for all four */
+        }
+    fprintf(gp, "unset multiplot\n");
+    fclose(gp);
+    snprintf(cmd, sizeof cmd, "gnuplot '%s'", path);
+    if (system(cmd) != 0) fprintf(stderr, "hdeval: warning: gnuplot failed (%s)\n", cmd);
+}
+
+static void run_multigrid_study(const ref_img *ref, const char *out, const char *work, double seconds)
+{
+    size_t npix = (size_t)S.size * S.size;
+    static mg_run runs[MG_BOUNDARIES][MG_CONFIGS];
+    const float *tiles[MG_CONFIGS + 1];
+    float *snap[MG_CONFIGS];
+    int b, k, j, ntimes = 0;
+    char lab[64], load0[64], load1[64], path[1024];
+    FILE *f, *md;
+    load_average(load0, sizeof load0);
+    while (ntimes < MG_TIMES && k_mg_times[ntimes] <= seconds) ++ntimes;
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k) {
+            mg_run *r = &runs[b][k];
+            r->boundary = b ? HD_BOUNDARY_BOX : HD_BOUNDARY_SURFACE;
+            r->solver = k < 2 ? HD_SOLVER_RED_BLACK : HD_SOLVER_MULTIGRID;
+            r->steps = k == 0 ? S.diffusion_sweeps : k == 1 ? 8 * S.diffusion_sweeps : k - 1;
+            if (b == 0) {
+                snap[k] = (float *)xmalloc(npix * 4 * sizeof(float));
+                memset(snap[k], 0, npix * 4 * sizeof(float));
+            }
+            mg_run_curve(r, ref, seconds, b == 0 ? snap[k] : NULL);
+            {
+                const point *last = &r->c.p[r->c.n - 1];
+                check_line("multigrid study: %s boundary, %s: %d it in %.2f s wall (%.2f it/s), %.2f s CPU/%d "
+                           "(%.2f it/s); per it: direct %.3f s, diffusion %.3f s, projection %.3f s (wall); "
+                           "PSNR vs PT_MS at 1 s wall %.2f dB, at the end %.2f dB (lit %.2f); mean radiance %.3f x PT_MS",
+                           b ? "box" : "surface", mg_label(r, lab, sizeof lab), r->c.n, last->wall, r->c.n / last->wall,
+                           last->sec, g_cores, r->c.n / last->sec, r->st.seconds_direct / r->c.n,
+                           r->st.seconds_diffusion / r->c.n, r->st.seconds_projection / r->c.n,
+                           mg_psnr_at(&r->c, 1.0, 1, 0, NULL), psnr(last->e[1].mse), psnr(last->e[1].mse_lit), r->mean);
+            }
+        }
+    load_average(load1, sizeof load1);
+    check_line("multigrid study: load average %s at the start, %s at the end", load0, load1);
+
+    f = open_w(out, "multigrid.csv", NULL);
+    fprintf(f, "boundary,solver,steps_per_iteration,clock,seconds,iterations,psnr_vs_pt_ms,psnr_lit_vs_pt_ms,"
+               "iterations_per_s,s_direct_per_it,s_diffusion_per_it,s_projection_per_it\n");
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k) {
+            const mg_run *r = &runs[b][k];
+            const point *last = &r->c.p[r->c.n - 1];
+            int clk;
+            for (clk = 0; clk < 2; ++clk)
+                for (j = 0; j < ntimes; ++j) {
+                    int it;
+                    double v = mg_psnr_at(&r->c, k_mg_times[j], !clk, 0, &it);
+                    double vl = mg_psnr_at(&r->c, k_mg_times[j], !clk, 1, NULL);
+                    fprintf(f, "%s,%s,%d,%s,%g,%d,", b ? "box" : "surface",
+                            r->solver == HD_SOLVER_MULTIGRID ? "multigrid" : "red_black", r->steps,
+                            clk ? "cpu" : "wall", k_mg_times[j], it);
+                    if (v < 0) fprintf(f, ",");
+                    else fprintf(f, "%.3f,%.3f", v, vl);
+                    fprintf(f, ",%.4f,%.5f,%.5f,%.5f\n", r->c.n / (clk ? last->sec : last->wall),
+                            r->st.seconds_direct / r->c.n, r->st.seconds_diffusion / r->c.n,
+                            r->st.seconds_projection / r->c.n);
+                }
+        }
+    fclose(f);
+
+    f = open_w(out, "multigrid-curves.csv", NULL);
+    fprintf(f, "boundary,solver,steps_per_iteration,iteration,wall_seconds,cpu_seconds,psnr_vs_pt_ms,psnr_lit_vs_pt_ms\n");
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k)
+            for (j = 0; j < runs[b][k].c.n; ++j) {
+                const point *p = &runs[b][k].c.p[j];
+                fprintf(f, "%s,%s,%d,%d,%.4f,%.4f,%.3f,%.3f\n", b ? "box" : "surface",
+                        runs[b][k].solver == HD_SOLVER_MULTIGRID ? "multigrid" : "red_black", runs[b][k].steps, p->it,
+                        p->wall, p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+            }
+    fclose(f);
+
+    md = open_w(out, "multigrid.md", path);
+    fprintf(md, "HD, 1 light, %dx%d image, illumination grid %dx%dx%d (data %dx%dx%d), CPU backend, %d threads; "
+                "PSNR (dB, all pixels) against the 1-light PT_MS reference (%d paths/pixel, its own noise %.1f dB) "
+                "of the image on screen at each time, i.e. after the last iteration finished by then (that "
+                "iteration in brackets; \"no image\": none finished yet). Load average %s at the start, %s at "
+                "the end.\n\n",
+            S.size, S.size, runs[0][0].st.illumination_dims[0], runs[0][0].st.illumination_dims[1],
+            runs[0][0].st.illumination_dims[2], g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2], g_cores,
+            ref->paths, psnr(ref->noise_mse), load0, load1);
+    fprintf(md, "Wall clock of hd_iterate (it/s by the wall clock; diffusion s/it from the library's stage timer):\n\n");
+    mg_write_md_table(md, runs, 1, ntimes);
+    fprintf(md, "\nCPU time of hd_iterate / %d threads (what the same work takes on %d otherwise idle cores; "
+                "it/s by this clock):\n\n", g_cores, g_cores);
+    mg_write_md_table(md, runs, 0, ntimes);
+    fprintf(md, "\nMean radiance of the last image / PT_MS's (the diffusion's energy balance):");
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k)
+            fprintf(md, "%s %s, %s: %.3f", b || k ? ";" : "", b ? "box" : "surface", mg_label(&runs[b][k], lab, sizeof lab),
+                    runs[b][k].mean);
+    fprintf(md, "\n");
+    fclose(md);
+    say("wrote %s", path);
+
+    mg_plot(work, out, runs, seconds);
+    for (k = 0; k < MG_CONFIGS; ++k) tiles[k] = snap[k];
+    tiles[MG_CONFIGS] = ref->lin;
+    write_grid(out, "multigrid_1s.png", tiles, MG_CONFIGS + 1, 1);
+    for (k = 0; k < MG_CONFIGS; ++k) free(snap[k]);
+    for (b = 0; b < MG_BOUNDARIES; ++b)
+        for (k = 0; k < MG_CONFIGS; ++k) free(runs[b][k].c.p);
+}
+
 static const char *usage =
     "usage: hdeval [SCENE] [--paper] [--out DIR] [--cache DIR] [--work DIR] [--size N] [--table-size N]\n"
-    "              [--skip-table] [--downsample-study] [--rgb-study] [--half-study]\n"
+    "              [--skip-table] [--downsample N] [--downsample-study] [--rgb-study] [--half-study]\n"
+    "              [--multigrid-study] [--study-seconds S]\n"
     "  SCENE           scene file (default examples/eval/head.scene): every setting\n"
     "  --paper         use the scene's paper.* settings (1024^2, paper-scale iterations/references)\n"
     "  --out DIR       tables, plots, figures (default docs/eval)\n"
@@ -928,20 +1201,29 @@ static const char *usage =
     "  --size N        override the scene's image size of the curves and figures\n"
     "  --table-size N  override the scene's image size of Table 1 (default 1024, like the paper)\n"
     "  --skip-table    no Table 1 (quality only)\n"
+    "  --downsample N  params.illumination_downsample of HD and CD (default 1; the downsample study\n"
+    "                  sets its own)\n"
     "  --downsample-study  only HD with its illumination at 1/1, 1/2, 1/4 resolution against the\n"
     "                  1-light PT_MS reference (docs/eval/downsample.md), then stop\n"
     "  --rgb-study     only HD with grey and RGB scattering, each with the box and the surface\n"
     "                  boundary, against the 1-light PT_MS reference (OUT/rgb.md,\n"
     "                  OUT/rgb_scattering.png), then stop\n"
     "  --half-study    only HD with E and phi stored as float32 and as float16, against the\n"
-    "                  1-light PT_MS reference (OUT/half.md), then stop\n";
+    "                  1-light PT_MS reference (OUT/half.md), then stop\n"
+    "  --multigrid-study  only HD with red-black (the scene's sweeps and 8x) and multigrid CG (1 and 2\n"
+    "                  steps per iteration), surface and box boundary, as curves of PSNR against the\n"
+    "                  1-light PT_MS reference over wall and CPU time (OUT/multigrid.md, .csv,\n"
+    "                  multigrid_psnr_time.png), then stop; with --downsample 2 the first second\n"
+    "                  holds several iterations\n"
+    "  --study-seconds S  how long each multigrid-study run lasts on both clocks (default 20)\n";
 
 int main(int argc, char **argv)
 {
     const char *scene_path = "examples/eval/head.scene", *out = "docs/eval", *cache = "out/eval-cache";
     const char *work = "out/eval-work";
     int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, rgb_study = 0, i, m, li, k;
-    int half_study = 0;
+    int half_study = 0, multigrid_study = 0;
+    double study_seconds = 20.0;
     char err[1024];
     static ref_img refs[HDE_METHODS][2];
     static curve cur[HDE_METHODS][2];
@@ -964,6 +1246,9 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--downsample-study")) downsample_study = 1;
         else if (!strcmp(a, "--rgb-study")) rgb_study = 1;
         else if (!strcmp(a, "--half-study")) half_study = 1;
+        else if (!strcmp(a, "--multigrid-study")) multigrid_study = 1;
+        else if (!strcmp(a, "--study-seconds")) study_seconds = atof(NEXT());
+        else if (!strcmp(a, "--downsample")) g_downsample = atoi(NEXT());
         else if (a[0] == '-') { fprintf(stderr, "hdeval: unknown option %s\n%s", a, usage); return 2; }
         else scene_path = a;
 #undef NEXT
@@ -975,6 +1260,8 @@ int main(int argc, char **argv)
     if (size) S.size = size;
     if (table_size) S.table_size = table_size;
     if (S.size < 8 || S.size > 16384 || S.table_size < 8 || S.table_size > 16384) die("bad image size");
+    if (g_downsample < 1 || g_downsample > 8) die("--downsample: 1..8");
+    if (!(study_seconds > 0.0 && study_seconds <= 3600.0)) die("--study-seconds: (0, 3600]");
     g_cores = S.threads > 0 ? S.threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
     if (g_cores < 1) g_cores = 1;
     mkdirs(out);
@@ -996,16 +1283,23 @@ int main(int argc, char **argv)
     if (g_tf.data_domain) hdx_tf_set_domain(&g_tf, g_vol.value_min, g_vol.value_max);
 
     g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : rgb_study ? "rgb-checks.txt" :
-                           half_study ? "half-checks.txt" : "checks.txt", NULL);
+                           half_study ? "half-checks.txt" : multigrid_study ? "multigrid-checks.txt" : "checks.txt",
+                     NULL);
     check_line("hdeval: %s%s, %s %dx%dx%d, tf %s, backend %s, curves %dx%d, table %dx%d", scene_path,
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
                S.tf, hd_backend_name(), S.size, S.size, S.table_size, S.table_size);
     check_line("settings: iterations HD %d, CD %d, PT_SS %d, PT_MS %d; references PT_SS %d, PT_MS %d paths/pixel; "
-               "extinction %g, albedo %g, g %g, exposure %g, frame_window %d, sweeps %d",
+               "extinction %g, albedo %g, g %g, exposure %g, frame_window %d, sweeps %d, illumination downsample %d",
                S.iterations[HDE_HD], S.iterations[HDE_CD], S.iterations[HDE_SS], S.iterations[HDE_MS],
                S.ref_paths[HDE_SS], S.ref_paths[HDE_MS], (double)S.extinction, (double)S.albedo,
-               (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps);
+               (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps, g_downsample);
 
+    if (multigrid_study) {
+        ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
+        run_multigrid_study(&refs[HDE_MS][0], out, work, study_seconds);
+        fclose(g_checks);
+        return 0;
+    }
     if (half_study) {
         ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
         run_half_study(&refs[HDE_MS][0], out);

@@ -3,7 +3,10 @@
 #   make eval           the reduced evaluation (examples/eval/head.scene, 256^2; ~15 min on 2 cores)
 #                       -> docs/eval/*; reference images are cached in out/eval-cache
 #   make eval-paper     the paper-scale settings (--paper: 1024^2, 1.3M-path references) -> out/eval-paper
-.PHONY: eval eval-paper
+#   make eval-multigrid the multigrid study: HD's PSNR against PT_MS over time, red-black and
+#                       multigrid CG (head-tissue, 128^2, illumination grid /2; ~6 min on 2 cores)
+#                       -> docs/eval/multigrid/
+.PHONY: eval eval-paper eval-multigrid
 
 $(B)/hdeval: examples/hdeval.c $(wildcard examples/*.h) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
@@ -15,3 +18,8 @@ eval: $(B)/hdeval
 eval-paper: $(B)/hdeval
 	@test -f data/head.nrrd || scripts/fetch-data
 	$(B)/hdeval examples/eval/head.scene --paper --out out/eval-paper --cache out/eval-cache
+
+eval-multigrid: $(B)/hdeval
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdeval examples/eval/head-tissue.scene --multigrid-study --size 128 --downsample 2 --study-seconds 20 \
+	    --out docs/eval/multigrid --cache out/eval-cache --work out/eval-work-mg
