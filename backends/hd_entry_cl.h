@@ -9,7 +9,8 @@
     __global float *restrict img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; k.dx = 0; \
+    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
+    k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0; \
     k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
 /* One work-item per voxel: global size = illumination grid (x, y, z). */
@@ -32,45 +33,43 @@ __kernel void hd_k_classify(HD__CL_BUFFERS)
 HD__CL_DIRECT(hd_k_direct, 0)
 HD__CL_DIRECT(hd_k_direct_half, 1)
 
-/* Diffusion: one work-item per voxel, global size (gx, gy, gz * channels), one x-row per
-   work-group (hd_opencl.h), so PoCL runs each row as one loop and vectorises it along x; the
-   previous kernel (one work-item per row, the shared hd_diffuse_row) ran scalar, 3x slower
-   (docs/DESIGN-OPENCL.md). What keeps the loop vectorisable:
+/* Diffusion: one work-item per voxel of the colour being updated, global size ((gx + 1) / 2,
+   gy, gz * channels), one x-row per work-group (hd_opencl.h), so PoCL runs each row as one loop
+   and vectorises it. The grids are stored colour by colour (the prelude's HD_GET): the
+   work-item with packed index id updates x = 2 id + cp, cp = (y + z + parity) & 1 the row's
+   first x of the colour, and every neighbour it reads is of the other colour at packed index
+   id - 1 + cp, id + cp (x -+ 1) or id (y -+ 1, z -+ 1): contiguous loads. Red-black: half-sweep
+   `parity` updates the voxels with (x + y + z) & 1 == parity in place, as the CPU does (so the
+   sweeps stay bit-identical); Jacobi: the same two passes, reading phi and writing phi2. What
+   keeps the loop vectorisable:
    - the solver, the RGB flag and the boundary are literals (eight kernels: the flags through
      the HD_DIFFUSE_FLAGS hook, K->flags), so the update's only selects are on the in-grid
      tests; the prelude forces inlining;
-   - every work-item stores: red-black computes both colours and a work-item of the other
-     colour writes its voxel's own value back, bit for bit (a conditional store made LLVM sink
-     the update under the condition and give up). No voxel changes value while it is read:
-     the updated colour reads only the other one, whose rewrites store the bits already there;
-   - K->dx = x makes the neighbour addresses affine (the prelude's HD_GET);
+   - every work-item stores, unconditionally (a conditional store made LLVM sink the update
+     under the condition and give up): with odd gx the last work-item of a row whose colour
+     starts at x = 1 has x = gx, outside the grid, and writes its (finite, unused) result into
+     that row's padding slot, which no voxel reads (its x + 1 neighbour test is false);
+   - cx = x and cid = id make the addresses affine in the work-item index;
    - the buffer arguments are restrict, so the parameter block's loads leave the loop.
-   Binary16 storage (f16): the other colour's work-items write back the half they read, the
-   same bits (a half converts to float and back exactly). */
+   Before this layout the kernel computed both colours of a whole row and kept one (stride-2
+   stores and loads gathered): twice the arithmetic of a compute-bound update. */
 #define HD__CL_DIFFUSE(name, bits, jacobi, is16) \
     __kernel void name(HD__CL_BUFFERS, int parity) \
     { \
         HD__CL_KCTX; \
-        int gx = p->gdims.x, gy = p->gdims.y, gz = p->gdims.z; \
-        int x = (int)get_global_id(0), y = (int)get_global_id(1); \
+        const hd__kctx *K = &k; \
+        int gz = p->gdims.z, y = (int)get_global_id(1); \
         int z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz; \
-        size_t i = (size_t)(((c * gz + z) * gy + y) * gx) + get_global_id(0); \
-        float den, num, v; \
+        int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp; \
+        float den, num; \
         k.flags = (k.flags & ~(HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY)) | (bits); \
-        k.dx = get_global_id(0); \
+        k.cx = x; \
+        k.cp = cp; \
+        k.cid = get_global_id(0); \
         k.f16 = (is16); \
         num = hd_diffuse_terms(&k, x, y, z, c, &den); \
-        v = num / den; \
-        if (jacobi) { \
-            if (is16) vstore_half_rte(v, i, k.phi2h); \
-            else phi2[i] = v; \
-        } else { \
-            uint mine = 0u - (uint)(((x + y + z + parity) & 1) == 0); \
-            float old = (is16) ? vload_half(i, k.phih) : phi[i]; \
-            v = as_float((as_uint(v) & mine) | (as_uint(old) & ~mine)); \
-            if (is16) vstore_half_rte(v, i, k.phih); \
-            else phi[i] = v; \
-        } \
+        if (jacobi) HD_SET(phi2, 0, x, y, z + c * gz, num / den); \
+        else HD_SET(phi, 0, x, y, z + c * gz, num / den); \
     }
 #define HD__CL_DIFFUSE_SET(suffix, is16) \
     HD__CL_DIFFUSE(hd_k_diffuse##suffix, 0, 0, is16) \

@@ -10,7 +10,11 @@
    GPU, else the first device of any type.
    Memory: the volume, TF, majorant grid, sigma_t, E, phi (+ Jacobi's phi2) and the image are
    plain buffers; volume reads use the shared software trilinear filter (docs/DESIGN-OPENCL.md
-   has the measurement against 3D images with a linear sampler).
+   has the measurement against 3D images with a linear sampler). sigma_t, E, phi and phi2 are
+   stored colour by colour (red-black), the layout hd_prelude_cl.h describes: each z-slice of
+   each channel is its colour-0 voxels then its colour-1 voxels, (gx + 1) / 2 per row, so a
+   half-sweep reads and writes contiguous runs. hd__be_read_illumination and the test hook's
+   hd__cl_write_illumination convert from and to the API's x-fastest layout.
    Errors: every CL call is checked; the failing call and its CL error name are logged and the
    code becomes an hd_result (allocation -> HD_ERROR_OUT_OF_DEVICE_MEMORY, lost device ->
    HD_ERROR_DEVICE_LOST, which then sticks: later calls fail fast). */
@@ -55,6 +59,7 @@ struct hd__backend {
     cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
     int nlv;
     size_t tf_bytes, illum_floats, img_floats;
+    size_t illum_slots;      /* elements of E, phi, phi2 in the colour layout (>= illum_floats) */
     int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
@@ -359,6 +364,20 @@ static size_t hd__cl_illum_bytes(const hd__backend *be, size_t n)
     return be->f16 ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float);
 }
 
+/* Elements of a colour-layout grid of `slices` z-slices (gz per channel): each row of gx voxels
+   takes 2 * ((gx + 1) / 2) slots, one of them padding when gx is odd. */
+static size_t hd__cl_slots(const hd__ctx *ctx, size_t slices)
+{
+    return slices * (size_t)ctx->gdims[1] * 2 * (((size_t)ctx->gdims[0] + 1) / 2);
+}
+
+/* The slot of voxel (x, y, zz) in the colour layout: hd_prelude_cl.h's HD__CL_AT, host side. */
+static size_t hd__cl_slot(const hd__ctx *ctx, int x, int y, int zz)
+{
+    size_t hx = ((size_t)ctx->gdims[0] + 1) / 2;
+    return (((size_t)zz * 2 + (size_t)((x + y + zz) & 1)) * (size_t)ctx->gdims[1] + (size_t)y) * hx + (size_t)(x >> 1);
+}
+
 /* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
 static int hd__cl_k(const hd__ctx *ctx, int k)
 {
@@ -373,17 +392,21 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
-    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], bytes;
+    size_t slots = illum_floats ? hd__cl_slots(ctx, (size_t)ctx->gdims[2] * (size_t)ctx->channels) : 0, bytes;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
     be->illum_floats = 0;
+    be->illum_slots = 0;
     be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    bytes = hd__cl_illum_bytes(be, illum_floats);
-    if ((r = hd__cl_buffer(ctx, &be->sig, gvox * (size_t)ctx->sig_channels * sizeof(float), NULL, "sigma_t")) != HD_SUCCESS) return r;
+    bytes = hd__cl_illum_bytes(be, slots);
+    if ((r = hd__cl_buffer(ctx, &be->sig, hd__cl_slots(ctx, (size_t)ctx->gdims[2] * (size_t)ctx->sig_channels) * sizeof(float),
+                           NULL, "sigma_t")) != HD_SUCCESS)
+        return r;
     if ((r = hd__cl_buffer(ctx, &be->E, bytes, NULL, "E")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->phi, bytes, NULL, "phi")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
+    be->illum_slots = slots;
     return HD_SUCCESS;
 }
 
@@ -393,7 +416,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->phi2);
     if (!enable) return HD_SUCCESS;
-    return hd__cl_buffer(ctx, &be->phi2, hd__cl_illum_bytes(be, be->illum_floats), NULL, "Jacobi's buffer");
+    return hd__cl_buffer(ctx, &be->phi2, hd__cl_illum_bytes(be, be->illum_slots), NULL, "Jacobi's buffer");
 }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
@@ -412,7 +435,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r = HD_SUCCESS;
-    size_t n = hd__cl_illum_bytes(be, be->illum_floats) / sizeof(float); /* in floats' worth of bytes */
+    size_t n = hd__cl_illum_bytes(be, be->illum_slots) / sizeof(float); /* in floats' worth of bytes */
     HD__CL_LOST_CHECK(ctx);
     if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, n)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, n)) != HD_SUCCESS) return r;
@@ -476,26 +499,27 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. Work-groups are
-   one x-row each (gx work-items): PoCL vectorises a work-group along x, and its own choice of
-   local size can cut a row into pieces as small as one item (it did for a prime row length).
-   A row longer than the kernel's largest work-group leaves the choice to the runtime. */
+/* One full sweep: two half-sweeps (red, black), or Jacobi's two colour passes and a swap. A
+   pass has one work-item per voxel of its colour, (gx + 1) / 2 per row (hd_entry_cl.h), and a
+   work-group is one x-row: PoCL vectorises a work-group along x, and its own choice of local
+   size can cut a row into pieces as small as one item (it did for a prime row length). A row
+   longer than the kernel's largest work-group leaves the choice to the runtime. */
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0) + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) +
                           ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0));
-    size_t gx = (size_t)ctx->gdims[0], local[3], wg = 0;
+    size_t hx = ((size_t)ctx->gdims[0] + 1) / 2, local[3], wg = 0;
     hd_result r;
     cl_int parity;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
     HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
                "clGetKernelWorkGroupInfo");
-    local[0] = gx; local[1] = 1; local[2] = 1;
-    for (parity = 0; parity < (jacobi ? 1 : 2); ++parity) {
+    local[0] = hx; local[1] = 1; local[2] = 1;
+    for (parity = 0; parity < 2; ++parity) {
         HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], 9, sizeof parity, &parity), "clSetKernelArg(parity)");
-        if ((r = hd__cl_run_local(ctx, k, 3, gx, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels,
-                                  gx <= wg ? local : NULL)) != HD_SUCCESS)
+        if ((r = hd__cl_run_local(ctx, k, 3, hx, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels,
+                                  hx <= wg ? local : NULL)) != HD_SUCCESS)
             return r;
     }
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
@@ -523,26 +547,73 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     return HD_SUCCESS;
 }
 
-/* Binary16 storage is read into the second half of dst (2 bytes per element fit in the 4
-   each float takes) and widened in place from the front, with the CPU's exact hd_h2f: float i
-   ends at byte 4i + 4, at or before half i + 1 starts (byte 2n + 2i at least, n odd). The halves
-   are read with memcpy, which the compiler must order against the float stores. */
+/* Maps E or phi (which) for reading or writing; *out is NULL on failure (logged). */
+static hd_result hd__cl_map_illumination(hd__ctx *ctx, hd_illumination which, cl_map_flags flags, void **out)
+{
+    hd__backend *be = ctx->be;
+    cl_int e;
+    *out = clEnqueueMapBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, flags, 0,
+                              be->illum_slots * (be->f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
+    return HD_SUCCESS;
+}
+
+static hd_result hd__cl_unmap_illumination(hd__ctx *ctx, hd_illumination which, void *mapped)
+{
+    hd__backend *be = ctx->be;
+    HD__CL_TRY(ctx, clEnqueueUnmapMemObject(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, mapped, 0, NULL, NULL),
+               "clEnqueueUnmapMemObject(illumination)");
+    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* The colour layout, mapped, into dst in the API's x-fastest channel-planar order; binary16
+   widened with the CPU's exact hd_h2f. */
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
     hd__backend *be = ctx->be;
-    size_t n = be->illum_floats, i;
-    unsigned char *h = (unsigned char *)(dst + n / 2);
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
+    void *m;
+    hd_result r;
     HD__CL_LOST_CHECK(ctx);
-    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, 0,
-                                        n * (be->f16 ? 2 : sizeof(float)), be->f16 ? (void *)h : (void *)dst, 0, NULL, NULL),
-               "clEnqueueReadBuffer(illumination)");
-    if (be->f16)
-        for (i = 0; i < n; ++i) {
-            uint16_t v;
-            memcpy(&v, h + 2 * i, 2);
-            dst[i] = hd_h2f(v);
-        }
-    return HD_SUCCESS;
+    if ((r = hd__cl_map_illumination(ctx, which, CL_MAP_READ, &m)) != HD_SUCCESS) return r;
+    for (zz = 0; zz < nz; ++zz)
+        for (y = 0; y < gy; ++y)
+            for (x = 0; x < gx; ++x) {
+                size_t s = hd__cl_slot(ctx, x, y, zz);
+                if (be->f16) {
+                    uint16_t v;
+                    memcpy(&v, (const unsigned char *)m + 2 * s, 2);
+                    *dst++ = hd_h2f(v);
+                } else {
+                    *dst++ = ((const float *)m)[s];
+                }
+            }
+    return hd__cl_unmap_illumination(ctx, which, m);
+}
+
+/* The inverse, for the test hooks (src/hd_test_hooks.h): src in the API's layout into E or phi,
+   rounded with the CPU's hd_f2h for binary16 storage. */
+HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+{
+    hd__backend *be = ctx->be;
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
+    void *m;
+    hd_result r;
+    HD__CL_LOST_CHECK(ctx);
+    if ((r = hd__cl_map_illumination(ctx, which, CL_MAP_WRITE, &m)) != HD_SUCCESS) return r;
+    for (zz = 0; zz < nz; ++zz)
+        for (y = 0; y < gy; ++y)
+            for (x = 0; x < gx; ++x) {
+                size_t s = hd__cl_slot(ctx, x, y, zz);
+                if (be->f16) {
+                    uint16_t v = hd_f2h(*src++);
+                    memcpy((unsigned char *)m + 2 * s, &v, 2);
+                } else {
+                    ((float *)m)[s] = *src++;
+                }
+            }
+    return hd__cl_unmap_illumination(ctx, which, m);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */

@@ -107,7 +107,12 @@ typedef struct hd__kctx {
     __global const float *lv;   /* CD: the light volume being read */
     __global float *lv2;        /* CD: the light volume being written */
     int flags;                  /* what the diffusion reads as HD_DIFFUSE_FLAGS */
-    size_t dx;                  /* 0, or the diffusion work-item's x: see HD_GET */
+    /* The colour-separated layout of sig, E, phi, phi2 (see HD_GET): hx = (gx + 1) / 2, the
+       length of a packed half-row; gy the grid's rows. In the diffusion, cx is the work-item's
+       x, cp = cx & 1 and cid = cx >> 1 its packed index (so addresses are affine in it); in every
+       other kernel all three are 0 and the same formula gives any voxel's place. */
+    int hx, gy, cx, cp;
+    size_t cid;
 } hd__kctx;
 
 /* The diffusion's flags come from K, so a kernel can make them literals (hd_entry_cl.h). */
@@ -116,30 +121,44 @@ typedef struct hd__kctx {
 #define HD_KARGS const hd__kctx *K,
 #define HD_KPASS K,
 #define HD_PRM(name) (K->p->name)
-/* Grid reads and writes at (i) = (z * gy + y) * gx + x. K->dx is 0 except in the diffusion
-   kernels, where it is the work-item's x (as a 64-bit value): element i is then addressed as
-   (buf + dx)[i - x], the same element, but after the compiler cancels x from i the address is
-   affine in the work-item index and PoCL loads neighbours as vectors; through the shared 32-bit
-   index it gathered them one by one. */
-#define HD_GET(buf, i, x, y, z) HD__LD_##buf(i)
-#define HD_SET(buf, i, x, y, z, v) HD__ST_##buf((i), (v))
-#define HD__LD_PLAIN(buf, i) ((K->buf + K->dx)[(i) - (int)K->dx])
-#define HD__LD_vol(i) HD__LD_PLAIN(vol, i)
-#define HD__LD_sig(i) HD__LD_PLAIN(sig, i)
-#define HD__LD_lv(i) HD__LD_PLAIN(lv, i)
-#define HD__LD_lv2(i) HD__LD_PLAIN(lv2, i)
-#define HD__ST_sig(i, v) (HD__LD_PLAIN(sig, i) = (v))
-#define HD__ST_lv2(i, v) (HD__LD_PLAIN(lv2, i) = (v))
+/* Grid reads and writes. The volume (vol) and CD's light volumes (lv, lv2) are x-fastest,
+   element i = (z * gy + y) * gx + x. The buffers the diffusion reads (sig with its RGB channels,
+   E, phi, phi2) are stored colour by colour instead: voxel (x, y, zz), zz = z + c * gz for
+   channel c, has colour k = (x + y + zz) & 1 and lives at
+       ((zz * 2 + k) * gy + y) * hx + (x >> 1),   hx = (gx + 1) / 2,
+   i.e. each z-slice (of each channel) is its colour-0 voxels, row by row, then its colour-1
+   voxels; a row of odd gx has one padding slot in one colour. The shared kernels pass every
+   voxel's coordinates, so the index i is not used for these buffers. Why: a red-black half-sweep
+   updates one colour, and the work-item with packed index id updates x = 2 id + cp; its
+   neighbours x - 1, x + 1 (the other colour) sit at id - 1 + cp and id + cp, and y +- 1, z +- 1
+   at id, the same offsets for every work-item of the row: contiguous, vectorisable loads, where
+   stride-2 accesses in the x-fastest layout became gathers (docs/DESIGN-OPENCL.md). Written with
+   d = x - cx, which the compiler folds to the constant -1, 0 or +1 after inlining, the address
+   is (buf + cid)[uniform]: affine in the work-item index. Outside the diffusion cx = cp = cid
+   = 0 and the same expression is the plain formula above. */
+#define HD_GET(buf, i, x, y, z) HD__LD_##buf((i), (x), (y), (z))
+#define HD_SET(buf, i, x, y, z, v) HD__ST_##buf((i), (x), (y), (z), (v))
+#define HD__CL_D(x) ((x) - K->cx)
+#define HD__CL_AT(x, y, zz) \
+    ((((zz) * 2 + ((K->cp + HD__CL_D(x) + (y) + (zz)) & 1)) * K->gy + (y)) * K->hx + ((HD__CL_D(x) + K->cp) >> 1))
+#define HD__CL_COL(buf, x, y, zz) ((K->buf + K->cid)[HD__CL_AT(x, y, zz)])
+#define HD__LD_vol(i, x, y, z) (K->vol[(i)])
+#define HD__LD_lv(i, x, y, z) (K->lv[(i)])
+#define HD__LD_lv2(i, x, y, z) (K->lv2[(i)])
+#define HD__ST_lv2(i, x, y, z, v) (K->lv2[(i)] = (v))
+#define HD__LD_sig(i, x, y, z) HD__CL_COL(sig, x, y, z)
+#define HD__ST_sig(i, x, y, z, v) (HD__CL_COL(sig, x, y, z) = (v))
 /* The illumination buffers: float, or binary16 rounded to nearest even (as the C prelude's
    hd_f2h, so both backends store the same bits for the same float). */
-#define HD__LD_HALF(buf, i) (K->f16 != 0 ? vload_half((size_t)((i) - (int)K->dx), K->buf##h + K->dx) : HD__LD_PLAIN(buf, i))
-#define HD__ST_HALF(buf, i, v) \
-    (K->f16 != 0 ? vstore_half_rte((v), (size_t)((i) - (int)K->dx), K->buf##h + K->dx) : (void)(HD__LD_PLAIN(buf, i) = (v)))
-#define HD__LD_E(i) HD__LD_HALF(E, i)
-#define HD__LD_phi(i) HD__LD_HALF(phi, i)
-#define HD__LD_phi2(i) HD__LD_HALF(phi2, i)
-#define HD__ST_E(i, v) HD__ST_HALF(E, i, v)
-#define HD__ST_phi(i, v) HD__ST_HALF(phi, i, v)
-#define HD__ST_phi2(i, v) HD__ST_HALF(phi2, i, v)
+#define HD__LD_HALF(buf, x, y, z) \
+    (K->f16 != 0 ? vload_half((size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) : HD__CL_COL(buf, x, y, z))
+#define HD__ST_HALF(buf, x, y, z, v) \
+    (K->f16 != 0 ? vstore_half_rte((v), (size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) : (void)(HD__CL_COL(buf, x, y, z) = (v)))
+#define HD__LD_E(i, x, y, z) HD__LD_HALF(E, x, y, z)
+#define HD__LD_phi(i, x, y, z) HD__LD_HALF(phi, x, y, z)
+#define HD__LD_phi2(i, x, y, z) HD__LD_HALF(phi2, x, y, z)
+#define HD__ST_E(i, x, y, z, v) HD__ST_HALF(E, x, y, z, v)
+#define HD__ST_phi(i, x, y, z, v) HD__ST_HALF(phi, x, y, z, v)
+#define HD__ST_phi2(i, x, y, z, v) HD__ST_HALF(phi2, x, y, z, v)
 #define HD_GET1(buf, i) (K->buf[(i)])
 #define HD_SET1(buf, i, v) (K->buf[(i)] = (v))
