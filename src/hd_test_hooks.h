@@ -82,20 +82,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_i
     memcpy(which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, src, ctx->be->illum_floats * sizeof(float));
     return HD_SUCCESS;
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
-    {
-        int f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-        size_t i, n = ctx->be->illum_floats;
-        uint16_t *h = f16 ? (uint16_t *)hd__alloc(ctx, n * sizeof(uint16_t)) : NULL;
-        cl_int e;
-        if (f16 && !h) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "hd__test_write_illumination: no memory");
-        for (i = 0; f16 && i < n; ++i) h[i] = hd_f2h(src[i]);
-        e = clEnqueueWriteBuffer(ctx->be->queue, which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, CL_TRUE, 0,
-                                 n * (f16 ? sizeof(uint16_t) : sizeof(float)), f16 ? (const void *)h : (const void *)src,
-                                 0, NULL, NULL);
-        hd__free(ctx, h);
-        HD__CL_TRY(ctx, e, "clEnqueueWriteBuffer(test illumination)");
-    }
-    return HD_SUCCESS;
+    return hd__cl_write_illumination(ctx, which, src);
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
     return hd__vk_write_illumination(ctx, which, src);
 #elif defined(HYBRIDDIFF_BACKEND_GL)
