@@ -35,6 +35,8 @@
    the in-grid flags drop them) and store nothing. Blocks do not straddle channels: invocation z
    is channel c's block z - c * hd_pc.z (hd_pc.z: blocks per channel, from the backend). */
 #define HD_DB (HD_DIFFUSE_YK * HD_DIFFUSE_ZK)
+/* HD_UNROLL: [[unroll]] on the block's loops where the front end takes it (hd_bind_vk_glsl.h):
+   lavapipe left 4 x 4 and 8 x 2 blocks' arrays in memory without it (0.48 of the stencil) */
 #ifndef HD_UNROLL
 #define HD_UNROLL
 #endif
@@ -53,6 +55,7 @@ void hd_diffuse_texel(int x, int y, int z, int c, int rgb, out float s, out floa
     p = HD_GET(phi, 0, xc, y, z + c * HD_PRM(gdims).z);
 }
 
+/* Relaxes the block of invocation (bx, by, bz): loads, then the updates, then the stores. */
 void hd_diffuse_block(int bx, int by, int bz)
 {
     ivec4 g = HD_PRM(gdims);
