@@ -103,6 +103,34 @@ HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, 
                              HD_GET(E, i + c * nvox, x, y, z + c * gz), rhs, sp, dn);
 }
 
+/* One face of the box boundary's update: adds the face's weight toward a neighbour with sigma' s
+   and phi p to *dn and its term to *num (inside == 0: the box's outside, phi = 0, s ignored). */
+HD_FN void hd_diffuse_box_add(float scale, float sp, float s, float p, int inside, float fl, HD_INOUT(float) num,
+                              HD_INOUT(float) dn)
+{
+    float w = hd_diffuse_face(scale, sp, inside != 0 ? s : sp, fl);
+    if (inside != 0) HD_DEREF(num) += w * p;
+    HD_DEREF(dn) += w;
+}
+
+/* The same under the surface boundary: empty neighbours and the outside add to *dn only. */
+HD_FN void hd_diffuse_surface_add(float scale, float h, float sp, float s, float p, int inside, float fl,
+                                  HD_INOUT(float) num, HD_INOUT(float) dn)
+{
+    float open, w = hd_diffuse_surface_face(scale, h, sp, inside != 0 ? s : 0.0f, inside, fl, HD_REF(open));
+    if (inside != 0) HD_DEREF(num) += open * w * p;
+    HD_DEREF(dn) += w;
+}
+
+/* The surface boundary's end of the update: an empty voxel (sigma' sp below half the floor) gets
+   num 0 and den 1 (phi = 0). */
+HD_FN float hd_diffuse_surface_end(float sp, float fl, float num, float dn, HD_INOUT(float) den)
+{
+    float self = sp + sp < fl ? 0.0f : 1.0f;
+    HD_DEREF(den) = self * dn + (1.0f - self);
+    return self * num;
+}
+
 /* The box boundary's update from loaded values: num and dn the voxel's own part
    (hd_diffuse_own_of), sp its sigma'; s_* the 6 neighbours' sigma' and p_* their phi (x-, x+,
    y-, y+, z-, z+), in_* whether each lies inside the grid (the values of one that does not are
@@ -112,25 +140,13 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
                               float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
                               int in_zp, HD_INOUT(float) den)
 {
-    float fl = HD_PRM(grid).w, w;
-    w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xm != 0 ? s_xm : sp, fl);
-    if (in_xm != 0) num += w * p_xm;
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xp != 0 ? s_xp : sp, fl);
-    if (in_xp != 0) num += w * p_xp;
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).y, sp, in_ym != 0 ? s_ym : sp, fl);
-    if (in_ym != 0) num += w * p_ym;
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).y, sp, in_yp != 0 ? s_yp : sp, fl);
-    if (in_yp != 0) num += w * p_yp;
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).z, sp, in_zm != 0 ? s_zm : sp, fl);
-    if (in_zm != 0) num += w * p_zm;
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).z, sp, in_zp != 0 ? s_zp : sp, fl);
-    if (in_zp != 0) num += w * p_zp;
-    dn += w;
+    float fl = HD_PRM(grid).w;
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
     HD_DEREF(den) = dn;
     return num;
 }
@@ -144,27 +160,14 @@ HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float 
                                   float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
                                   int in_zp, HD_INOUT(float) den)
 {
-    float fl = HD_PRM(grid).w, w, open, self = sp + sp < fl ? 0.0f : 1.0f;
-    w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xm != 0 ? s_xm : 0.0f, in_xm, fl, HD_REF(open));
-    if (in_xm != 0) num += open * w * p_xm;
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xp != 0 ? s_xp : 0.0f, in_xp, fl, HD_REF(open));
-    if (in_xp != 0) num += open * w * p_xp;
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).y, HD_PRM(gridh).y, sp, in_ym != 0 ? s_ym : 0.0f, in_ym, fl, HD_REF(open));
-    if (in_ym != 0) num += open * w * p_ym;
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).y, HD_PRM(gridh).y, sp, in_yp != 0 ? s_yp : 0.0f, in_yp, fl, HD_REF(open));
-    if (in_yp != 0) num += open * w * p_yp;
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).z, HD_PRM(gridh).z, sp, in_zm != 0 ? s_zm : 0.0f, in_zm, fl, HD_REF(open));
-    if (in_zm != 0) num += open * w * p_zm;
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).z, HD_PRM(gridh).z, sp, in_zp != 0 ? s_zp : 0.0f, in_zp, fl, HD_REF(open));
-    if (in_zp != 0) num += open * w * p_zp;
-    dn += w;
-    HD_DEREF(den) = self * dn + (1.0f - self);
-    return self * num;
+    float fl = HD_PRM(grid).w;
+    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
+    return hd_diffuse_surface_end(sp, fl, num, dn, den);
 }
 
 /* The update from loaded values under the configured boundary (HD_DIFFUSE_FLAGS). */
@@ -198,33 +201,46 @@ HD_FN float hd_diffuse_nb_phi(HD_KARGS int inside, int j, int x, int y, int z, i
    backend passes literals for interior voxels so the compiler drops the tests (see hd_cpu.h).
    With rgb = 0 and a white TF the RGB path computes the same bits as the grey one. rhs
    (HD_FLAG_DIFFUSE_RHS): E holds the whole right-hand side (multigrid's coarse levels solve for
-   a correction), not the direct light. Loads the voxel's own values and its in-grid neighbours',
-   then the arithmetic above. */
+   a correction), not the direct light. Loads each face's values right before its term (the same
+   hd_diffuse_*_add calls, in the same face order, as hd_diffuse_box_of / _surface_of): loading
+   all 12 first tripled the CPU row loops' vector spills (365 -> 1113 zmm moves to the stack). */
 HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp, int in_ym,
                                     int in_yp, int in_zm, int in_zp, int rgb, int rhs, int surface,
                                     HD_INOUT(float) den)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, sxy = gx * gy;
     int i = (z * gy + y) * gx + x;
-    float sp, dn;
+    float sp, dn, fl = HD_PRM(grid).w;
     float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(dn));
-    float s_xm = hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb);
-    float s_xp = hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb);
-    float s_ym = hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb);
-    float s_yp = hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb);
-    float s_zm = hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb);
-    float s_zp = hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb);
-    float p_xm = hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c);
-    float p_xp = hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c);
-    float p_ym = hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c);
-    float p_yp = hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c);
-    float p_zm = hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c);
-    float p_zp = hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c);
-    if (surface != 0)
-        return hd_diffuse_surface_of(HD_KPASS num, dn, sp, s_xm, s_xp, s_ym, s_yp, s_zm, s_zp, p_xm, p_xp, p_ym, p_yp,
-                                     p_zm, p_zp, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, den);
-    return hd_diffuse_box_of(HD_KPASS num, dn, sp, s_xm, s_xp, s_ym, s_yp, s_zm, s_zp, p_xm, p_xp, p_ym, p_yp, p_zm,
-                             p_zp, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, den);
+    if (surface != 0) {
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb),
+                               hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+        return hd_diffuse_surface_end(sp, fl, num, dn, den);
+    }
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb),
+                       hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+    HD_DEREF(den) = dn;
+    return num;
 }
 
 /* hd_diffuse_terms_loaded under the box boundary (the CPU's row loops name one boundary each). */
