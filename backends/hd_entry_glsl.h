@@ -48,10 +48,10 @@ int hd_diffuse_bx(int bx, int o0, int j, int k, int jacobi)
 }
 
 /* sigma' and phi of texel (x, y, z) of channel c, x clamped into the grid (y, z already are). */
-void hd_diffuse_texel(int x, int y, int z, int c, int rgb, out float s, out float p)
+void hd_diffuse_texel(int x, int y, int z, int c, int rgb, float ag, out float s, out float p)
 {
     int xc = hd_clampi(x, 0, HD_PRM(gdims).x - 1);
-    s = hd_diffuse_sigp(0, xc, y, z, c, rgb);
+    s = hd_diffuse_sigp(0, xc, y, z, c, rgb, ag);
     p = HD_GET(phi, 0, xc, y, z + c * HD_PRM(gdims).z);
 }
 
@@ -70,14 +70,14 @@ void hd_diffuse_block(int bx, int by, int bz)
     /* the faces: rows y0 - 1 and y0 + YK per slice, slices z0 - 1 and z0 + ZK per row */
     float sym[HD_DIFFUSE_ZK], pym[HD_DIFFUSE_ZK], syp[HD_DIFFUSE_ZK], pyp[HD_DIFFUSE_ZK];
     float szm[HD_DIFFUSE_YK], pzm[HD_DIFFUSE_YK], szp[HD_DIFFUSE_YK], pzp[HD_DIFFUSE_YK];
-    float v[HD_DB];
+    float v[HD_DB], ag = hd_diffuse_ag(HD_PRM(medium).y), agr; /* 1 - albedo g (grey; RGB per texel) */
     HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
         HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
             int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi);
             int y = hd_mini(y0 + j, g.y - 1), z = hd_mini(z0 + k, g.z - 1), xc = hd_mini(x, g.x - 1);
-            src[r] = hd_diffuse_own(0, xc, y, z, c, rgb, rhs, sp[r], dn[r]);
-            hd_diffuse_texel(x - 1, y, z, c, rgb, sl[r], pl[r]);
-            hd_diffuse_texel(x + 1, y, z, c, rgb, sr[r], pr[r]);
+            src[r] = hd_diffuse_own(0, xc, y, z, c, rgb, rhs, sp[r], agr, dn[r]);
+            hd_diffuse_texel(x - 1, y, z, c, rgb, ag, sl[r], pl[r]);
+            hd_diffuse_texel(x + 1, y, z, c, rgb, ag, sr[r], pr[r]);
             if (jacobi != 0) {
                 sc[r] = sp[r];
                 pc[r] = HD_GET(phi, 0, xc, y, z + c * g.z);
@@ -89,15 +89,15 @@ void hd_diffuse_block(int bx, int by, int bz)
         }
     HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
         int z = hd_mini(z0 + k, g.z - 1);
-        hd_diffuse_texel(hd_diffuse_bx(bx, o0, 0, k, jacobi), hd_maxi(y0 - 1, 0), z, c, rgb, sym[k], pym[k]);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, 0, k, jacobi), hd_maxi(y0 - 1, 0), z, c, rgb, ag, sym[k], pym[k]);
         hd_diffuse_texel(hd_diffuse_bx(bx, o0, HD_DIFFUSE_YK - 1, k, jacobi), hd_mini(y0 + HD_DIFFUSE_YK, g.y - 1), z, c,
-                         rgb, syp[k], pyp[k]);
+                         rgb, ag, syp[k], pyp[k]);
     }
     HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
         int y = hd_mini(y0 + j, g.y - 1);
-        hd_diffuse_texel(hd_diffuse_bx(bx, o0, j, 0, jacobi), y, hd_maxi(z0 - 1, 0), c, rgb, szm[j], pzm[j]);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, j, 0, jacobi), y, hd_maxi(z0 - 1, 0), c, rgb, ag, szm[j], pzm[j]);
         hd_diffuse_texel(hd_diffuse_bx(bx, o0, j, HD_DIFFUSE_ZK - 1, jacobi), y, hd_mini(z0 + HD_DIFFUSE_ZK, g.z - 1), c,
-                         rgb, szp[j], pzp[j]);
+                         rgb, ag, szp[j], pzp[j]);
     }
     HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
         HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {

@@ -36,10 +36,16 @@ HD_FN float hd_diffuse_albedo_of(HD_KARGS float sc, int rgb)
     return rgb != 0 ? HD_PRM(medium).y * sc : HD_PRM(medium).y;
 }
 
+/* 1 - albedo g for albedo a. */
+HD_FN float hd_diffuse_ag(HD_KARGS float a)
+{
+    return 1.0f - a * HD_PRM(medium).z;
+}
+
 /* sigma' = sigma_t (1 - albedo g) of a texel with sigma_t st and albedo a. */
 HD_FN float hd_diffuse_sigp_of(HD_KARGS float st, float a)
 {
-    return st * (1.0f - a * HD_PRM(medium).z);
+    return st * hd_diffuse_ag(HD_KPASS a);
 }
 
 /* The albedo of grid voxel j (image coordinates x, y, z) in channel c: loads channel 1 + c of the
@@ -50,10 +56,12 @@ HD_FN float hd_diffuse_albedo(HD_KARGS int j, int x, int y, int z, int c, int rg
     return hd_diffuse_albedo_of(HD_KPASS rgb != 0 ? HD_GET(sig, j + (1 + c) * nvox, x, y, z + (1 + c) * gz) : 0.0f, rgb);
 }
 
-/* sigma' of grid voxel j (image coordinates x, y, z) in channel c, loaded. */
-HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb)
+/* sigma' of grid voxel j (image coordinates x, y, z) in channel c, loaded; ag: 1 - albedo g
+   without RGB scattering (the same for every voxel: hd_diffuse_own gives it). */
+HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb, float ag)
 {
-    return hd_diffuse_sigp_of(HD_KPASS HD_GET(sig, j, x, y, z), hd_diffuse_albedo(HD_KPASS j, x, y, z, c, rgb));
+    float st = HD_GET(sig, j, x, y, z);
+    return rgb != 0 ? hd_diffuse_sigp_of(HD_KPASS st, hd_diffuse_albedo(HD_KPASS j, x, y, z, c, rgb)) : ag * st;
 }
 
 /* The weight w = D_ij / h^2 of the face between two voxels with sigma' spi and spj: the harmonic
@@ -94,13 +102,15 @@ HD_FN float hd_diffuse_own_of(HD_KARGS float st, float a, float e, int rhs, HD_I
     return rhs != 0 ? e : a * st * e;
 }
 
-/* The same, loaded at grid voxel i (image coordinates x, y, z) in channel c. */
+/* The same, loaded at grid voxel i (image coordinates x, y, z) in channel c; also gives its
+   1 - albedo g in *ag. */
 HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, int rhs, HD_INOUT(float) sp,
-                           HD_INOUT(float) dn)
+                           HD_INOUT(float) ag, HD_INOUT(float) dn)
 {
     int nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * HD_PRM(gdims).z, gz = HD_PRM(gdims).z;
-    return hd_diffuse_own_of(HD_KPASS HD_GET(sig, i, x, y, z), hd_diffuse_albedo(HD_KPASS i, x, y, z, c, rgb),
-                             HD_GET(E, i + c * nvox, x, y, z + c * gz), rhs, sp, dn);
+    float a = hd_diffuse_albedo(HD_KPASS i, x, y, z, c, rgb);
+    HD_DEREF(ag) = hd_diffuse_ag(HD_KPASS a);
+    return hd_diffuse_own_of(HD_KPASS HD_GET(sig, i, x, y, z), a, HD_GET(E, i + c * nvox, x, y, z + c * gz), rhs, sp, dn);
 }
 
 /* One face of the box boundary's update: adds the face's weight toward a neighbour with sigma' s
@@ -185,9 +195,9 @@ HD_FN float hd_diffuse_update_of(HD_KARGS float num, float dn, float sp, float s
 
 /* A neighbour's sigma' and phi, loaded only when it lies inside the grid (inside != 0): grid voxel
    j at image coordinates (x, y, z), phi's channel c at z + c * gz. */
-HD_FN float hd_diffuse_nb_sigp(HD_KARGS int inside, int j, int x, int y, int z, int c, int rgb)
+HD_FN float hd_diffuse_nb_sigp(HD_KARGS int inside, int j, int x, int y, int z, int c, int rgb, float ag)
 {
-    return inside != 0 ? hd_diffuse_sigp(HD_KPASS j, x, y, z, c, rgb) : 0.0f;
+    return inside != 0 ? hd_diffuse_sigp(HD_KPASS j, x, y, z, c, rgb, ag) : 0.0f;
 }
 HD_FN float hd_diffuse_nb_phi(HD_KARGS int inside, int j, int x, int y, int z, int c)
 {
@@ -210,34 +220,34 @@ HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, sxy = gx * gy;
     int i = (z * gy + y) * gx + x;
-    float sp, dn, fl = HD_PRM(grid).w;
-    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(dn));
+    float sp, ag, dn, fl = HD_PRM(grid).w;
+    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     if (surface != 0) {
-        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb),
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
                                hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
         return hd_diffuse_surface_end(sp, fl, num, dn, den);
     }
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb),
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
                        hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
     HD_DEREF(den) = dn;
     return num;
