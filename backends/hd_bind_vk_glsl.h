@@ -12,13 +12,16 @@
    a constant fixed when hd_vulkan.h makes the pipeline, one per flags value, read by the kernel
    through HD_DIFFUSE_FLAGS: lavapipe runs both sides of every branch, so a flag tested at run
    time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT).
-   Specialization constant 1, hd_sc_zk: voxels per diffusion invocation along z
-   (HD_DIFFUSE_ZK, hd_entry_glsl.h), fixed by hd_vulkan.h, which dispatches to match; 2,
-   hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so only one of the two stores is compiled.
+   Specialization constants 1, hd_sc_zk, and 3, hd_sc_yk: the slices and rows of the block each
+   diffusion invocation relaxes (HD_DIFFUSE_ZK, HD_DIFFUSE_YK, hd_entry_glsl.h), fixed by
+   hd_vulkan.h, which dispatches to match; 2, hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so
+   only one of the two stores is compiled.
    HD_ILLUM_R16F (scripts/build-spirv's _half modules of the stages that touch E / phi): E, phi
    and phi2 are r16f (VK_FORMAT_R16_SFLOAT, params.illumination_precision FLOAT16), converted by
    imageLoad / imageStore, the arithmetic float32; r16f needs shaderStorageImageExtendedFormats. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
+#extension GL_EXT_control_flow_attributes : require
+#define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
 #ifdef HD_ILLUM_R16F
 #define HD_ILLUM_FMT r16f
 #define HD_ILLUM_ROUND(v) hd_f16_round(v) /* the store rounds to nearest even (hd_prelude_glsl.h) */
@@ -40,9 +43,11 @@ layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;
 layout(constant_id = 2) const int hd_sc_jacobi = 0;
+layout(constant_id = 3) const int hd_sc_yk = 1;
 #if HD_STAGE == 3 /* HD_STAGE_DIFFUSE (hd_entry_glsl.h); the other stages read counts.z */
 #define HD_DIFFUSE_FLAGS hd_sc_flags
 #define HD_DIFFUSE_ZK hd_sc_zk
+#define HD_DIFFUSE_YK hd_sc_yk
 #define HD_DIFFUSE_JACOBI hd_sc_jacobi
 #endif
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r

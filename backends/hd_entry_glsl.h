@@ -10,10 +10,119 @@
 #define HD_STAGE_SUM_LIGHT 6
 #define HD_STAGE_PATH 7
 #ifndef HD_DIFFUSE_ZK
-#define HD_DIFFUSE_ZK 1 /* voxels per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
+#define HD_DIFFUSE_ZK 1 /* slices per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
+#endif
+#ifndef HD_DIFFUSE_YK
+#define HD_DIFFUSE_YK 1 /* rows per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
 #endif
 #ifndef HD_DIFFUSE_JACOBI
 #define HD_DIFFUSE_JACOBI hd_pc.y /* Jacobi (1) or red-black (0); Vulkan: a constant per pipeline */
+#endif
+
+#if HD_STAGE == HD_STAGE_DIFFUSE
+/* The diffusion stage relaxes a block of HD_DIFFUSE_YK rows x HD_DIFFUSE_ZK slices per
+   invocation, one voxel per row: red-black, in row (y, z) invocation bx relaxes voxel
+   2 bx + ((y + z + parity) & 1), hd_diffuse_row's voxels, in place; Jacobi voxel bx, phi -> phi2.
+   Lavapipe pays per static imageLoad (docs/DESIGN-VULKAN.md), so the block loads each texel once
+   and hands it to every voxel that needs it: a row's two x-neighbours are loaded with the row;
+   the y- and z-neighbours of a voxel are, inside the block, the texel at its x in the adjacent
+   rows, already loaded there (red-black: one of that row's x-neighbours, the rows' colours
+   alternate; Jacobi: that row's own voxel), so only the block's faces load extra texels. Grey
+   loads per voxel: 6 + 4 (YK + ZK) / (YK ZK) against 14 (8 at 4 x 4). The values go through
+   the shared hd_diffuse_update_of, as hd_diffuse_terms does after its own loads: the same
+   bits. A half-sweep reads only the other colour's phi (Jacobi writes phi2), so all loads come
+   before the stores. Out-of-grid coordinates are clamped for the loads (their values are unused:
+   the in-grid flags drop them) and store nothing. Blocks do not straddle channels: invocation z
+   is channel c's block z - c * hd_pc.z (hd_pc.z: blocks per channel, from the backend). */
+#define HD_DB (HD_DIFFUSE_YK * HD_DIFFUSE_ZK)
+/* HD_UNROLL: [[unroll]] on the block's loops where the front end takes it (hd_bind_vk_glsl.h):
+   lavapipe left 4 x 4 and 8 x 2 blocks' arrays in memory without it (0.48 of the stencil) */
+#ifndef HD_UNROLL
+#define HD_UNROLL
+#endif
+
+/* The voxel's x in block row (j, k): red-black's colour alternates between adjacent rows. */
+int hd_diffuse_bx(int bx, int o0, int j, int k, int jacobi)
+{
+    return jacobi != 0 ? bx : 2 * bx + (o0 ^ ((j + k) & 1));
+}
+
+/* sigma' and phi of texel (x, y, z) of channel c, x clamped into the grid (y, z already are). */
+void hd_diffuse_texel(int x, int y, int z, int c, int rgb, float ag, out float s, out float p)
+{
+    int xc = hd_clampi(x, 0, HD_PRM(gdims).x - 1);
+    s = hd_diffuse_sigp(0, xc, y, z, c, rgb, ag);
+    p = HD_GET(phi, 0, xc, y, z + c * HD_PRM(gdims).z);
+}
+
+/* Relaxes the block of invocation (bx, by, bz): loads, then the updates, then the stores. */
+void hd_diffuse_block(int bx, int by, int bz)
+{
+    ivec4 g = HD_PRM(gdims);
+    int jacobi = HD_DIFFUSE_JACOBI;
+    int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
+    int rhs = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? 1 : 0;
+    int nzb = hd_pc.z, c = (bz >= nzb ? 1 : 0) + (bz >= 2 * nzb ? 1 : 0); /* bz / nzb, <= 3 channels */
+    int y0 = by * HD_DIFFUSE_YK, z0 = (bz - c * nzb) * HD_DIFFUSE_ZK, o0 = (y0 + z0 + hd_pc.x) & 1;
+    /* per block row r = k * YK + j: own source, absorption and sigma'; x-neighbours' sigma' and
+       phi; the texel at the adjacent rows' voxel x (C) */
+    float src[HD_DB], dn[HD_DB], sp[HD_DB], sl[HD_DB], pl[HD_DB], sr[HD_DB], pr[HD_DB], sc[HD_DB], pc[HD_DB];
+    /* the faces: rows y0 - 1 and y0 + YK per slice, slices z0 - 1 and z0 + ZK per row */
+    float sym[HD_DIFFUSE_ZK], pym[HD_DIFFUSE_ZK], syp[HD_DIFFUSE_ZK], pyp[HD_DIFFUSE_ZK];
+    float szm[HD_DIFFUSE_YK], pzm[HD_DIFFUSE_YK], szp[HD_DIFFUSE_YK], pzp[HD_DIFFUSE_YK];
+    float v[HD_DB], ag = hd_diffuse_ag(HD_PRM(medium).y), agr; /* 1 - albedo g (grey; RGB per texel) */
+    HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
+        HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
+            int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi);
+            int y = hd_mini(y0 + j, g.y - 1), z = hd_mini(z0 + k, g.z - 1), xc = hd_mini(x, g.x - 1);
+            src[r] = hd_diffuse_own(0, xc, y, z, c, rgb, rhs, sp[r], agr, dn[r]);
+            hd_diffuse_texel(x - 1, y, z, c, rgb, ag, sl[r], pl[r]);
+            hd_diffuse_texel(x + 1, y, z, c, rgb, ag, sr[r], pr[r]);
+            if (jacobi != 0) {
+                sc[r] = sp[r];
+                pc[r] = HD_GET(phi, 0, xc, y, z + c * g.z);
+            } else {
+                int o = x & 1; /* red-black: the adjacent rows' voxel is x - 1 (o = 1) or x + 1 */
+                sc[r] = o != 0 ? sl[r] : sr[r];
+                pc[r] = o != 0 ? pl[r] : pr[r];
+            }
+        }
+    HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
+        int z = hd_mini(z0 + k, g.z - 1);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, 0, k, jacobi), hd_maxi(y0 - 1, 0), z, c, rgb, ag, sym[k], pym[k]);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, HD_DIFFUSE_YK - 1, k, jacobi), hd_mini(y0 + HD_DIFFUSE_YK, g.y - 1), z, c,
+                         rgb, ag, syp[k], pyp[k]);
+    }
+    HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
+        int y = hd_mini(y0 + j, g.y - 1);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, j, 0, jacobi), y, hd_maxi(z0 - 1, 0), c, rgb, ag, szm[j], pzm[j]);
+        hd_diffuse_texel(hd_diffuse_bx(bx, o0, j, HD_DIFFUSE_ZK - 1, jacobi), y, hd_mini(z0 + HD_DIFFUSE_ZK, g.z - 1), c,
+                         rgb, ag, szp[j], pzp[j]);
+    }
+    HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
+        HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
+            int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi), y = y0 + j, z = z0 + k;
+            int rym = hd_maxi(r - 1, 0), ryp = hd_mini(r + 1, HD_DB - 1);
+            int rzm = hd_maxi(r - HD_DIFFUSE_YK, 0), rzp = hd_mini(r + HD_DIFFUSE_YK, HD_DB - 1);
+            float den;
+            v[r] = hd_diffuse_update_of(src[r], dn[r], sp[r], sl[r], sr[r], j > 0 ? sc[rym] : sym[k],
+                                        j < HD_DIFFUSE_YK - 1 ? sc[ryp] : syp[k], k > 0 ? sc[rzm] : szm[j],
+                                        k < HD_DIFFUSE_ZK - 1 ? sc[rzp] : szp[j], pl[r], pr[r],
+                                        j > 0 ? pc[rym] : pym[k], j < HD_DIFFUSE_YK - 1 ? pc[ryp] : pyp[k],
+                                        k > 0 ? pc[rzm] : pzm[j], k < HD_DIFFUSE_ZK - 1 ? pc[rzp] : pzp[j],
+                                        x > 0 ? 1 : 0, x < g.x - 1 ? 1 : 0, y > 0 ? 1 : 0, y < g.y - 1 ? 1 : 0,
+                                        z > 0 ? 1 : 0, z < g.z - 1 ? 1 : 0, den);
+            v[r] = v[r] / den;
+        }
+    HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
+        HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
+            int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi), y = y0 + j, z = z0 + k;
+            if (x < g.x && y < g.y && z < g.z) {
+                if (jacobi != 0) HD_SET(phi2, 0, x, y, z + c * g.z, v[r]);
+                else HD_SET(phi, 0, x, y, z + c * g.z, v[r]);
+            }
+        }
+}
 #endif
 
 void main()
@@ -25,33 +134,7 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIRECT
     if (x < g.x && y < g.y && z < g.z) hd_direct_voxel(x, y, z);
 #elif HD_STAGE == HD_STAGE_DIFFUSE
-    /* HD_DIFFUSE_ZK voxels per invocation, one per slice z * ZK + k (slices run over channels *
-       depth). Red-black: in each slice, invocation x relaxes voxel 2x + ((y + z + parity) & 1) of
-       its row, hd_diffuse_row's voxels, in place; Jacobi: voxel x, phi -> phi2. The same terms
-       and division as hd_diffuse_row. All the voxels' terms come before their stores: a red-black
-       half-sweep reads only the other colour's phi (Jacobi reads phi, writes phi2), so the order
-       changes no value, and with no store between them the loads of a texel two voxels share (the
-       black voxel between two red ones of the column) can be merged. Lanes past the grid compute
-       at a clamped voxel (every load in bounds) and store nothing. */
-    int jacobi = HD_DIFFUSE_JACOBI, nz = g.z * g.w;
-    float v[HD_DIFFUSE_ZK];
-    for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
-        int zs = hd_mini(z * HD_DIFFUSE_ZK + k, nz - 1);
-        int c = (zs >= g.z ? 1 : 0) + (zs >= 2 * g.z ? 1 : 0), zz = zs - c * g.z; /* zs / g.z, <= 3 channels */
-        int xv = hd_mini(jacobi != 0 ? x : 2 * x + ((y + zz + hd_pc.x) & 1), g.x - 1);
-        float den;
-        v[k] = hd_diffuse_terms(xv, y, zz, c, den);
-        v[k] = v[k] / den;
-    }
-    for (int k = 0; k < HD_DIFFUSE_ZK; ++k) {
-        int zs = z * HD_DIFFUSE_ZK + k;
-        int c = (zs >= g.z ? 1 : 0) + (zs >= 2 * g.z ? 1 : 0), zz = zs - c * g.z;
-        int xv = jacobi != 0 ? x : 2 * x + ((y + zz + hd_pc.x) & 1);
-        if (xv < g.x && y < g.y && zs < nz) {
-            if (jacobi != 0) HD_SET(phi2, 0, xv, y, zs, v[k]);
-            else HD_SET(phi, 0, xv, y, zs, v[k]);
-        }
-    }
+    hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) hd_project_pixel(x, y);
 #elif HD_STAGE == HD_STAGE_CONVECT

@@ -102,9 +102,11 @@ static int hd__gl_diffuse_slot(int counts_z)
            ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
 }
 #define HD__GL_LOCAL_X 64 /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
-/* Voxels per diffusion invocation along z (HD_DIFFUSE_ZK in hd_entry_glsl.h): llvmpipe pays a
-   fixed cost per invocation and merges loads that neighbouring slices share (docs/DESIGN-GL.md). */
+/* The block of slices x rows each diffusion invocation relaxes (HD_DIFFUSE_ZK, HD_DIFFUSE_YK in
+   hd_entry_glsl.h): llvmpipe pays a fixed cost per invocation and per static image load, and the
+   block loads the texels its voxels share once (docs/DESIGN-GL.md). */
 #define HD__GL_DIFFUSE_ZK 4
+#define HD__GL_DIFFUSE_YK 2
 #define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
 #define HD__GL_SSBOS 3       /* storage buffers 0..2 */
 
@@ -149,7 +151,7 @@ struct hd__backend {
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
-    int diffuse_zk;             /* HD__GL_DIFFUSE_ZK: what the diffusion programs are compiled for */
+    int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -366,8 +368,8 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
                            "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n%s",
                            HD_MAX_LIGHTS, stage + 1, HD__GL_LOCAL_X, half ? "#define HD_ILLUM_R16F 1\n" : "");
         if (q >= HD__GL_PROGRAM_COUNT)
-            snprintf(prefix + len, sizeof prefix - (size_t)len, "#define HD_DIFFUSE_FLAGS %d\n#define HD_DIFFUSE_ZK %d\n",
-                     hd__gl_diffuse_flags(q - HD__GL_PROGRAM_COUNT), be->diffuse_zk);
+            snprintf(prefix + len, sizeof prefix - (size_t)len, "#define HD_DIFFUSE_FLAGS %d\n#define HD_DIFFUSE_ZK %d\n#define HD_DIFFUSE_YK %d\n",
+                     hd__gl_diffuse_flags(q - HD__GL_PROGRAM_COUNT), be->diffuse_zk, be->diffuse_yk);
         src[0] = prefix;
         for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
         n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
@@ -684,6 +686,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     ctx->be = be;
     be->ctx = ctx;
     be->diffuse_zk = HD__GL_DIFFUSE_ZK;
+    be->diffuse_yk = HD__GL_DIFFUSE_YK;
     be->gpa = ctx->desc.gl.get_proc_address;
     be->own = !ctx->desc.gl.use_current_context;
     if (be->own) {
@@ -800,15 +803,18 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    int nz = (ctx->gdims[2] * ctx->channels + be->diffuse_zk - 1) / be->diffuse_zk, parity; /* invocations along z */
+    /* invocations along y and z: blocks of diffuse_yk rows and diffuse_zk slices, nzb per channel
+       (uniform hd_pc.z, hd_entry_glsl.h) */
+    int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int nz = nzb * ctx->channels, parity;
     if (jacobi) {
         hd__gl_tex t;
-        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
+        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
         return HD_SUCCESS;
     }
     for (parity = 0; parity < 2; ++parity)
-        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
+        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
             return r;
     return HD_SUCCESS;
 }

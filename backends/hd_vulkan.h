@@ -100,7 +100,8 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 #define HD__VK_DIFFUSE_VARIANTS 128 /* diffusion pipelines per context, one per flags value, solver and precision (64 today) */
-#define HD__VK_DIFFUSE_ZK 4 /* voxels per diffusion invocation along z (hd_sc_zk; docs/DESIGN-VULKAN.md) */
+#define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
+#define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 11
 
 typedef struct hd__vk_buffer {
@@ -148,7 +149,7 @@ struct hd__backend {
     int32_t diffuse_flags[HD__VK_DIFFUSE_VARIANTS], diffuse_jacobi[HD__VK_DIFFUSE_VARIANTS];
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
-    int32_t diffuse_zk;           /* HD__VK_DIFFUSE_ZK: what the pipelines are specialized for */
+    int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -789,28 +790,30 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
    branches on the flags (RGB scattering, boundary condition) fold away at pipeline creation.
    Lavapipe executes both sides of every branch, uniform ones included, so each flag left to a
    run-time test makes every voxel pay for the paths it does not take. Its constant 1 is
-   be->diffuse_zk, the voxels each invocation relaxes (one per z slice, hd_entry_glsl.h): lavapipe
-   pays a fixed cost per invocation (the store and its own set-up cost as much as 7 loads) and
-   merges the loads that neighbouring slices share. Constant 2 is the solver (jacobi), so the
+   be->diffuse_zk and constant 3 be->diffuse_yk, the slices and rows of the block each invocation
+   relaxes (one voxel per row, hd_entry_glsl.h): lavapipe pays a fixed cost per invocation (the
+   store and its own set-up cost as much as 7 loads) and per static load, and the block loads each
+   texel its voxels share once. Constant 2 is the solver (jacobi), so the
    store of the other one is not compiled (1.08x sweeps/s, docs/DESIGN-VULKAN.md). flags: constant
    0's value, NULL for the other stages (bench/hdbench_vulkan.c's --ab also calls this). */
 static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
                                       VkPipeline *out)
 {
     hd__backend *be = ctx->be;
-    VkSpecializationMapEntry sme[3];
+    VkSpecializationMapEntry sme[4];
     VkSpecializationInfo spec;
-    int32_t data[3];
+    int32_t data[4];
     int i;
     data[0] = flags ? *flags : 0;
     data[1] = be->diffuse_zk;
     data[2] = jacobi;
-    for (i = 0; i < 3; ++i) {
+    data[3] = be->diffuse_yk;
+    for (i = 0; i < 4; ++i) {
         sme[i].constantID = (uint32_t)i;
         sme[i].offset = (uint32_t)(i * sizeof data[0]);
         sme[i].size = sizeof data[0];
     }
-    spec.mapEntryCount = 3;
+    spec.mapEntryCount = 4;
     spec.pMapEntries = sme;
     spec.dataSize = sizeof data;
     spec.pData = data;
@@ -1162,6 +1165,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     ctx->be = be;
     be->ctx = ctx;
     be->diffuse_zk = HD__VK_DIFFUSE_ZK;
+    be->diffuse_yk = HD__VK_DIFFUSE_YK;
     if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
     if (lose && *lose) be->lose_at = strtoul(lose, NULL, 10);
     /* void* -> function pointer by memcpy: a cast is not ISO C */
@@ -1357,17 +1361,20 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    int nz = (ctx->gdims[2] * ctx->channels + be->diffuse_zk - 1) / be->diffuse_zk; /* invocations along z */
+    /* invocations along y and z: blocks of diffuse_yk rows and diffuse_zk slices, nzb per channel
+       (push constant z, hd_entry_glsl.h) */
+    int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int nz = nzb * ctx->channels;
     VkPipeline pipe;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
-        if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ctx->gdims[1], nz, 0, 1, 0, 0)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
         hd__vk_copy_image(be, cb, &be->phi2, &be->phi);
     } else {
         int parity;
         for (parity = 0; parity < 2; ++parity)
-            if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, (ctx->gdims[0] + 1) / 2, ctx->gdims[1], nz, parity, 0, 0, 0)) != HD_SUCCESS)
+            if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, (ctx->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     }
     return hd__vk_flush(ctx);

@@ -12,10 +12,10 @@
      - with --variants instead: the plain image3D stencil beside bench/hdbench_sweep.comp's variants
        of the sweep's memory access (what lavapipe's cost is made of);
      - with --ab FILE.spv also: the library's sweeps with the diffusion module FILE (a candidate
-       build/spirv/diffuse.spv, specialized and dispatched for --ab-zk voxels per invocation,
-       default 1), interleaved with the library's own.
+       build/spirv/diffuse.spv, specialized and dispatched for blocks of --ab-zk slices x --ab-yk
+       rows per invocation, default 1 x 1), interleaved with the library's own.
    Usage: hdbench_vulkan [file.nrrd] [seconds per figure, default 2] [--sweeps] [--rounds n]
-                         [--variants[=name,name...]] [--ab FILE.spv [--ab-zk n]] */
+                         [--variants[=name,name...]] [--ab FILE.spv [--ab-zk n] [--ab-yk n]] */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
 #include "hybriddiff.h"
@@ -56,7 +56,8 @@ static hd_result sweep_step(void *h) { return hd__test_diffuse(*(hd_context *)h,
    change to the diffusion module is measured against the committed one in one process. */
 static uint32_t *ab_code;
 static size_t ab_bytes;
-static int32_t ab_zk = 1; /* --ab-zk n: FILE's voxels per invocation (1 for a module without hd_sc_zk) */
+static int32_t ab_zk = 1; /* --ab-zk n: FILE's slices per invocation (1 for a module without hd_sc_zk) */
+static int32_t ab_yk = 1; /* --ab-yk n: FILE's rows per invocation (1 for a module without hd_sc_yk) */
 typedef struct ab_sweep {
     hd_context h;
     VkPipeline alt;
@@ -68,13 +69,15 @@ static hd_result ab_step(void *user)
     ab_sweep *a = (ab_sweep *)user;
     hd__backend *be = hd__lookup(a->h, NULL)->be;
     VkPipeline own = be->diffuse[0];
-    int32_t own_zk = be->diffuse_zk;
+    int32_t own_zk = be->diffuse_zk, own_yk = be->diffuse_yk;
     hd_result r;
     be->diffuse[0] = a->alt;
     be->diffuse_zk = ab_zk;
+    be->diffuse_yk = ab_yk;
     r = hd__test_diffuse(a->h, 1);
     be->diffuse[0] = own;
     be->diffuse_zk = own_zk;
+    be->diffuse_yk = own_yk;
     return r;
 }
 
@@ -89,10 +92,12 @@ static hd_result ab_init(ab_sweep *a, hd_context h)
     if ((r = hd__test_diffuse(h, 1)) != HD_SUCCESS) return r;
     if (ctx->be->ndiffuse != 1) return HD_ERROR_BACKEND;
     {
-        int32_t own_zk = ctx->be->diffuse_zk;
+        int32_t own_zk = ctx->be->diffuse_zk, own_yk = ctx->be->diffuse_yk;
         ctx->be->diffuse_zk = ab_zk;
+        ctx->be->diffuse_yk = ab_yk;
         r = hd__vk_pipeline_code(ctx, ab_code, ab_bytes, &ctx->be->diffuse_flags[0], ctx->be->diffuse_jacobi[0], &a->alt);
         ctx->be->diffuse_zk = own_zk;
+        ctx->be->diffuse_yk = own_yk;
         return r;
     }
 }
@@ -601,6 +606,7 @@ int main(int argc, char **argv)
             variant_list = argv[i][10] == '=' ? argv[i] + 11 : NULL;
         }
         else if (strcmp(argv[i], "--ab-zk") == 0 && i + 1 < argc) ab_zk = atoi(argv[++i]) > 0 ? atoi(argv[i]) : 1;
+        else if (strcmp(argv[i], "--ab-yk") == 0 && i + 1 < argc) ab_yk = atoi(argv[++i]) > 0 ? atoi(argv[i]) : 1;
         else if (strcmp(argv[i], "--ab") == 0 && i + 1 < argc) {
             if (!ab_load(argv[++i])) { fprintf(stderr, "hdbench_vulkan: cannot read %s\n", argv[i]); return 1; }
         }

@@ -21,18 +21,47 @@
 #define HD_DIFFUSE_FLAGS HD_PRM(counts).z
 #endif
 
-/* sigma' = sigma_t (1 - albedo g) of grid voxel j (image coordinates x, y, z) in channel c.
-   With RGB scattering the albedo of channel c is albedo * TF colour_c(j), read from the sigma_t
-   grid's channel 1 + c; otherwise ag = 1 - albedo g, the same for every voxel. */
+/* The update is written twice over: as pure arithmetic on values already loaded (the *_of
+   functions below: no grid access), and as the loading wrappers every backend's row or voxel loop
+   calls (hd_diffuse_terms_box / _surface), which load a voxel's 14 values and pass them on. A
+   backend whose loads are dear (lavapipe: each imageLoad a full gather, docs/DESIGN-VULKAN.md)
+   loads a block of texels once and passes the values its voxels share to each of them
+   (hd_entry_glsl.h); the formulae stay in this file only, and the same operations on the same
+   values give the same bits either way. */
+
+/* The albedo of a texel in channel c: albedo * TF colour_c from the sigma_t grid's channel 1 + c
+   (sc, loaded by the caller) with RGB scattering, else the constant albedo. */
+HD_FN float hd_diffuse_albedo_of(HD_KARGS float sc, int rgb)
+{
+    return rgb != 0 ? HD_PRM(medium).y * sc : HD_PRM(medium).y;
+}
+
+/* 1 - albedo g for albedo a. */
+HD_FN float hd_diffuse_ag(HD_KARGS float a)
+{
+    return 1.0f - a * HD_PRM(medium).z;
+}
+
+/* sigma' = sigma_t (1 - albedo g) of a texel with sigma_t st and albedo a. */
+HD_FN float hd_diffuse_sigp_of(HD_KARGS float st, float a)
+{
+    return st * hd_diffuse_ag(HD_KPASS a);
+}
+
+/* The albedo of grid voxel j (image coordinates x, y, z) in channel c: loads channel 1 + c of the
+   sigma_t grid only with RGB scattering. */
+HD_FN float hd_diffuse_albedo(HD_KARGS int j, int x, int y, int z, int c, int rgb)
+{
+    int gz = HD_PRM(gdims).z, nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * gz;
+    return hd_diffuse_albedo_of(HD_KPASS rgb != 0 ? HD_GET(sig, j + (1 + c) * nvox, x, y, z + (1 + c) * gz) : 0.0f, rgb);
+}
+
+/* sigma' of grid voxel j (image coordinates x, y, z) in channel c, loaded; ag: 1 - albedo g
+   without RGB scattering (the same for every voxel: hd_diffuse_own gives it). */
 HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb, float ag)
 {
     float st = HD_GET(sig, j, x, y, z);
-    if (rgb != 0) {
-        int gz = HD_PRM(gdims).z, nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * gz;
-        float aj = HD_PRM(medium).y * HD_GET(sig, j + (1 + c) * nvox, x, y, z + (1 + c) * gz);
-        return st * (1.0f - aj * HD_PRM(medium).z);
-    }
-    return ag * st;
+    return rgb != 0 ? hd_diffuse_sigp_of(HD_KPASS st, hd_diffuse_albedo(HD_KPASS j, x, y, z, c, rgb)) : ag * st;
 }
 
 /* The weight w = D_ij / h^2 of the face between two voxels with sigma' spi and spj: the harmonic
@@ -63,92 +92,179 @@ HD_FN float hd_diffuse_surface_face(float scale, float h, float spi, float spj, 
     return empty != 0.0f ? hd_diffuse_vacuum_face(h, spi) : hd_diffuse_face(scale, spi, spj, fl);
 }
 
-/* The voxel's own part of its update: returns the source term (sigma_s E, or with rhs the
-   right-hand side E holds) and gives its absorption sigma_a in *dn, its sigma' in *sp and
-   1 - albedo g in *ag (with RGB scattering the albedo of channel c). */
+/* The voxel's own part of its update from its sigma_t st, albedo a and E e: returns the source
+   term (sigma_s E, or with rhs the right-hand side E holds) and gives its absorption sigma_a in
+   *dn and its sigma' in *sp. */
+HD_FN float hd_diffuse_own_of(HD_KARGS float st, float a, float e, int rhs, HD_INOUT(float) sp, HD_INOUT(float) dn)
+{
+    HD_DEREF(sp) = hd_diffuse_sigp_of(HD_KPASS st, a);
+    HD_DEREF(dn) = (1.0f - a) * st;
+    return rhs != 0 ? e : a * st * e;
+}
+
+/* The same, loaded at grid voxel i (image coordinates x, y, z) in channel c; also gives its
+   1 - albedo g in *ag. */
 HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, int rhs, HD_INOUT(float) sp,
                            HD_INOUT(float) ag, HD_INOUT(float) dn)
 {
     int nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * HD_PRM(gdims).z, gz = HD_PRM(gdims).z;
-    int ic = i + c * nvox, zc = z + c * gz;
-    float a = rgb != 0 ? HD_PRM(medium).y * HD_GET(sig, i + (1 + c) * nvox, x, y, z + (1 + c) * gz) : HD_PRM(medium).y;
-    float st = HD_GET(sig, i, x, y, z);
-    HD_DEREF(ag) = 1.0f - a * HD_PRM(medium).z;
-    HD_DEREF(sp) = st * HD_DEREF(ag);
-    HD_DEREF(dn) = (1.0f - a) * st;
-    return rhs != 0 ? HD_GET(E, ic, x, y, zc) : a * st * HD_GET(E, ic, x, y, zc);
+    float a = hd_diffuse_albedo(HD_KPASS i, x, y, z, c, rgb);
+    HD_DEREF(ag) = hd_diffuse_ag(HD_KPASS a);
+    return hd_diffuse_own_of(HD_KPASS HD_GET(sig, i, x, y, z), a, HD_GET(E, i + c * nvox, x, y, z + c * gz), rhs, sp, dn);
 }
 
-/* The numerator of voxel (x,y,z)'s update in channel c under the box boundary; its denominator
-   goes to *den. in_xm ... in_zp say whether the neighbour on each side lies inside the grid, rgb
-   whether the albedo is per channel (HD_FLAG_RGB_SCATTERING): the CPU backend passes literals for
-   interior voxels so the compiler drops the tests (see hd_cpu.h). With rgb = 0 and a white TF the
-   RGB path computes the same bits as the grey one. rhs (HD_FLAG_DIFFUSE_RHS): E holds the whole
-   right-hand side (multigrid's coarse levels solve for a correction), not the direct light. */
-HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
-                                 int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
+/* One face of the box boundary's update: adds the face's weight toward a neighbour with sigma' s
+   and phi p to *dn and its term to *num (inside == 0: the box's outside, phi = 0, s ignored). */
+HD_FN void hd_diffuse_box_add(float scale, float sp, float s, float p, int inside, float fl, HD_INOUT(float) num,
+                              HD_INOUT(float) dn)
 {
-    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
-    int i = (z * gy + y) * gx + x;
-    int ic = i + c * gx * gy * gz, zc = z + c * gz, sxy = gx * gy;
-    float fl = HD_PRM(grid).w, sp, ag, dn;
-    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
-    float w;
-    w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : sp, fl);
-    if (in_xm != 0) num += w * HD_GET(phi, ic - 1, x - 1, y, zc);
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).x, sp, in_xp != 0 ? hd_diffuse_sigp(HD_KPASS i + 1, x + 1, y, z, c, rgb, ag) : sp, fl);
-    if (in_xp != 0) num += w * HD_GET(phi, ic + 1, x + 1, y, zc);
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).y, sp, in_ym != 0 ? hd_diffuse_sigp(HD_KPASS i - gx, x, y - 1, z, c, rgb, ag) : sp, fl);
-    if (in_ym != 0) num += w * HD_GET(phi, ic - gx, x, y - 1, zc);
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).y, sp, in_yp != 0 ? hd_diffuse_sigp(HD_KPASS i + gx, x, y + 1, z, c, rgb, ag) : sp, fl);
-    if (in_yp != 0) num += w * HD_GET(phi, ic + gx, x, y + 1, zc);
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).z, sp, in_zm != 0 ? hd_diffuse_sigp(HD_KPASS i - sxy, x, y, z - 1, c, rgb, ag) : sp, fl);
-    if (in_zm != 0) num += w * HD_GET(phi, ic - sxy, x, y, zc - 1);
-    dn += w;
-    w = hd_diffuse_face(HD_PRM(grid).z, sp, in_zp != 0 ? hd_diffuse_sigp(HD_KPASS i + sxy, x, y, z + 1, c, rgb, ag) : sp, fl);
-    if (in_zp != 0) num += w * HD_GET(phi, ic + sxy, x, y, zc + 1);
-    dn += w;
+    float w = hd_diffuse_face(scale, sp, inside != 0 ? s : sp, fl);
+    if (inside != 0) HD_DEREF(num) += w * p;
+    HD_DEREF(dn) += w;
+}
+
+/* The same under the surface boundary: empty neighbours and the outside add to *dn only. */
+HD_FN void hd_diffuse_surface_add(float scale, float h, float sp, float s, float p, int inside, float fl,
+                                  HD_INOUT(float) num, HD_INOUT(float) dn)
+{
+    float open, w = hd_diffuse_surface_face(scale, h, sp, inside != 0 ? s : 0.0f, inside, fl, HD_REF(open));
+    if (inside != 0) HD_DEREF(num) += open * w * p;
+    HD_DEREF(dn) += w;
+}
+
+/* The surface boundary's end of the update: an empty voxel (sigma' sp below half the floor) gets
+   num 0 and den 1 (phi = 0). */
+HD_FN float hd_diffuse_surface_end(float sp, float fl, float num, float dn, HD_INOUT(float) den)
+{
+    float self = sp + sp < fl ? 0.0f : 1.0f;
+    HD_DEREF(den) = self * dn + (1.0f - self);
+    return self * num;
+}
+
+/* The box boundary's update from loaded values: num and dn the voxel's own part
+   (hd_diffuse_own_of), sp its sigma'; s_* the 6 neighbours' sigma' and p_* their phi (x-, x+,
+   y-, y+, z-, z+), in_* whether each lies inside the grid (the values of one that does not are
+   ignored). Returns the numerator, the denominator goes to *den. */
+HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
+                              float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
+                              float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
+                              int in_zp, HD_INOUT(float) den)
+{
+    float fl = HD_PRM(grid).w;
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
     HD_DEREF(den) = dn;
     return num;
 }
 
-/* The same under the surface boundary (HD_FLAG_SURFACE_BOUNDARY): an empty voxel gets num 0 and
-   den 1 (phi = 0); a medium voxel's faces toward empty neighbours or the box's outside carry the
-   Marshak weight and no neighbour term. Every select is arithmetic, so the CPU's row loop stays
-   branch-free. */
+/* The surface boundary's update from loaded values, the arguments as hd_diffuse_box_of's: an
+   empty voxel gets num 0 and den 1 (phi = 0); a medium voxel's faces toward empty neighbours or
+   the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
+   so the CPU's row loop stays branch-free. */
+HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
+                                  float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
+                                  float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
+                                  int in_zp, HD_INOUT(float) den)
+{
+    float fl = HD_PRM(grid).w;
+    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
+    return hd_diffuse_surface_end(sp, fl, num, dn, den);
+}
+
+/* The update from loaded values under the configured boundary (HD_DIFFUSE_FLAGS). */
+HD_FN float hd_diffuse_update_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
+                                 float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
+                                 float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
+                                 int in_zp, HD_INOUT(float) den)
+{
+    if ((HD_DIFFUSE_FLAGS & HD_FLAG_SURFACE_BOUNDARY) != 0)
+        return hd_diffuse_surface_of(HD_KPASS num, dn, sp, s_xm, s_xp, s_ym, s_yp, s_zm, s_zp, p_xm, p_xp, p_ym, p_yp,
+                                     p_zm, p_zp, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, den);
+    return hd_diffuse_box_of(HD_KPASS num, dn, sp, s_xm, s_xp, s_ym, s_yp, s_zm, s_zp, p_xm, p_xp, p_ym, p_yp, p_zm,
+                             p_zp, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, den);
+}
+
+/* A neighbour's sigma' and phi, loaded only when it lies inside the grid (inside != 0): grid voxel
+   j at image coordinates (x, y, z), phi's channel c at z + c * gz. */
+HD_FN float hd_diffuse_nb_sigp(HD_KARGS int inside, int j, int x, int y, int z, int c, int rgb, float ag)
+{
+    return inside != 0 ? hd_diffuse_sigp(HD_KPASS j, x, y, z, c, rgb, ag) : 0.0f;
+}
+HD_FN float hd_diffuse_nb_phi(HD_KARGS int inside, int j, int x, int y, int z, int c)
+{
+    int gz = HD_PRM(gdims).z, nvox = HD_PRM(gdims).x * HD_PRM(gdims).y * gz;
+    return inside != 0 ? HD_GET(phi, j + c * nvox, x, y, z + c * gz) : 0.0f;
+}
+
+/* The numerator of voxel (x,y,z)'s update in channel c; its denominator goes to *den. surface:
+   the boundary (HD_FLAG_SURFACE_BOUNDARY). in_xm ... in_zp say whether the neighbour on each side
+   lies inside the grid, rgb whether the albedo is per channel (HD_FLAG_RGB_SCATTERING): the CPU
+   backend passes literals for interior voxels so the compiler drops the tests (see hd_cpu.h).
+   With rgb = 0 and a white TF the RGB path computes the same bits as the grey one. rhs
+   (HD_FLAG_DIFFUSE_RHS): E holds the whole right-hand side (multigrid's coarse levels solve for
+   a correction), not the direct light. Loads each face's values right before its term (the same
+   hd_diffuse_*_add calls, in the same face order, as hd_diffuse_box_of / _surface_of): loading
+   all 12 first tripled the CPU row loops' vector spills (365 -> 1113 zmm moves to the stack). */
+HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp, int in_ym,
+                                    int in_yp, int in_zm, int in_zp, int rgb, int rhs, int surface,
+                                    HD_INOUT(float) den)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, sxy = gx * gy;
+    int i = (z * gy + y) * gx + x;
+    float sp, ag, dn, fl = HD_PRM(grid).w;
+    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
+    if (surface != 0) {
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
+                               hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+        return hd_diffuse_surface_end(sp, fl, num, dn, den);
+    }
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
+                       hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+    HD_DEREF(den) = dn;
+    return num;
+}
+
+/* hd_diffuse_terms_loaded under the box boundary (the CPU's row loops name one boundary each). */
+HD_FN float hd_diffuse_terms_box(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
+                                 int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
+{
+    return hd_diffuse_terms_loaded(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, rhs, 0, den);
+}
+
+/* The same under the surface boundary. */
 HD_FN float hd_diffuse_terms_surface(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp,
                                      int in_ym, int in_yp, int in_zm, int in_zp, int rgb, int rhs, HD_INOUT(float) den)
 {
-    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
-    int i = (z * gy + y) * gx + x;
-    int ic = i + c * gx * gy * gz, zc = z + c * gz, sxy = gx * gy;
-    float fl = HD_PRM(grid).w, sp, ag, dn;
-    float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
-    float w, open, self = sp + sp < fl ? 0.0f : 1.0f;
-    w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xm != 0 ? hd_diffuse_sigp(HD_KPASS i - 1, x - 1, y, z, c, rgb, ag) : 0.0f, in_xm, fl, HD_REF(open));
-    if (in_xm != 0) num += open * w * HD_GET(phi, ic - 1, x - 1, y, zc);
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).x, HD_PRM(gridh).x, sp, in_xp != 0 ? hd_diffuse_sigp(HD_KPASS i + 1, x + 1, y, z, c, rgb, ag) : 0.0f, in_xp, fl, HD_REF(open));
-    if (in_xp != 0) num += open * w * HD_GET(phi, ic + 1, x + 1, y, zc);
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).y, HD_PRM(gridh).y, sp, in_ym != 0 ? hd_diffuse_sigp(HD_KPASS i - gx, x, y - 1, z, c, rgb, ag) : 0.0f, in_ym, fl, HD_REF(open));
-    if (in_ym != 0) num += open * w * HD_GET(phi, ic - gx, x, y - 1, zc);
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).y, HD_PRM(gridh).y, sp, in_yp != 0 ? hd_diffuse_sigp(HD_KPASS i + gx, x, y + 1, z, c, rgb, ag) : 0.0f, in_yp, fl, HD_REF(open));
-    if (in_yp != 0) num += open * w * HD_GET(phi, ic + gx, x, y + 1, zc);
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).z, HD_PRM(gridh).z, sp, in_zm != 0 ? hd_diffuse_sigp(HD_KPASS i - sxy, x, y, z - 1, c, rgb, ag) : 0.0f, in_zm, fl, HD_REF(open));
-    if (in_zm != 0) num += open * w * HD_GET(phi, ic - sxy, x, y, zc - 1);
-    dn += w;
-    w = hd_diffuse_surface_face(HD_PRM(grid).z, HD_PRM(gridh).z, sp, in_zp != 0 ? hd_diffuse_sigp(HD_KPASS i + sxy, x, y, z + 1, c, rgb, ag) : 0.0f, in_zp, fl, HD_REF(open));
-    if (in_zp != 0) num += open * w * HD_GET(phi, ic + sxy, x, y, zc + 1);
-    dn += w;
-    HD_DEREF(den) = self * dn + (1.0f - self);
-    return self * num;
+    return hd_diffuse_terms_loaded(HD_KPASS x, y, z, c, in_xm, in_xp, in_ym, in_yp, in_zm, in_zp, rgb, rhs, 1, den);
 }
 
 /* The update's numerator and denominator at (x, y, z) under the configured boundary. */
