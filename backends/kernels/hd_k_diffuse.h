@@ -304,7 +304,9 @@ HD_FN float hd_diffuse_residual(HD_KARGS int x, int y, int z, int c, HD_INOUT(fl
     int i = (z * gy + y) * gx + x, ic = i + c * gx * gy * gz;
     float den;
     float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
+    int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
+    /* sigma_s E with the channel's albedo (per channel with RGB scattering, as the update uses) */
     HD_DEREF(rhs) = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? HD_GET(E, ic, x, y, z + c * gz)
-                  : HD_PRM(medium).y * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
+                  : hd_diffuse_albedo(HD_KPASS i, x, y, z, c, rgb) * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
     return num - den * HD_GET(phi, ic, x, y, z + c * gz);
 }
