@@ -395,13 +395,14 @@ HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, in
     }
     /* Jacobi: every voxel of the row; red-black: its colour (x0, x0 + 2, ...), into row[] */
     x0 = be->jacobi ? 0 : ((y + z + be->parity) & 1);
-    dst = (be->jacobi ? K->phi2 : K->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
+    /* float32 destination (float16 grids have no float view: K->phi is NULL there) */
+    dst = K->f16 ? NULL : (be->jacobi ? K->phi2 : K->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
     /* red-black float32: row[] starts as the row itself, so after the colour is relaxed into it
        the whole row goes back with one memcpy instead of a scalar stride-2 copy (gcc does not
        vectorise that store; it took about 8 % of a red-black sweep). The other colour goes back
        unchanged, and no other thread touches this row during the pass (the block schedule:
        a pass never writes a row a neighbour block reads), so rewriting it races with nothing. */
-    if (!be->jacobi && !K->f16) memcpy(row, dst, (size_t)gx * sizeof(float));
+    if (!be->jacobi && dst != NULL) memcpy(row, dst, (size_t)gx * sizeof(float));
     if (be->jacobi) HD__CPU_ROW_VARIANTS(1, 1, num_ / den_)
     else HD__CPU_ROW_VARIANTS(2 - x0, 2, num_ / den_)
     /* the ends of the kept colour only: the whole row goes back */
