@@ -317,18 +317,18 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
             row[x] = (expr);                                                                    \
         }                                                                                       \
     } while (0)
-/* The row's end voxels x = 0 (if xs) and x = gx - 1 (if step) through `terms` with literal
+/* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) through `terms` with literal
    in-grid flags, so they take no branch either (through hd_diffuse_terms' run-time flags they
    cost about 5 % of a red-black sweep on the head CT). */
-#define HD__CPU_ROW_ENDS(terms, rgb, rhs, xs, step, expr)                                        \
+#define HD__CPU_ROW_ENDS(terms, rgb, rhs, first, last, expr)                                     \
     do {                                                                                        \
         float den_, num_;                                                                       \
-        if (xs) {                                                                               \
+        if (first) {                                                                            \
             x = 0;                                                                              \
             num_ = terms(K, x, y, z, c, 0, 1, 1, 1, 1, 1, rgb, rhs, &den_);                      \
             row[x] = (expr);                                                                    \
         }                                                                                       \
-        if (step) {                                                                             \
+        if (last) {                                                                             \
             x = gx - 1;                                                                         \
             num_ = terms(K, x, y, z, c, 1, 0, 1, 1, 1, 1, rgb, rhs, &den_);                      \
             row[x] = (expr);                                                                    \
