@@ -67,8 +67,10 @@ HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb,
 /* The weight w = D_ij / h^2 of the face between two voxels with sigma' spi and spj: the harmonic
    mean of their D = 1 / (3 sigma'), 2 / (3 (spi + spj)), floored at fl so empty space stays finite,
    times the axis' 1 / h^2 (scale). A face on the box boundary passes spj = spi: phi = 0 outside
-   with the voxel's own D. Both voxels of a face get the same bits (a + b == b + a in IEEE
-   arithmetic). */
+   with the voxel's own D. One division per face, and both voxels of a face get the same bits
+   (a + b == b + a in IEEE arithmetic): the operator the CPU's conjugate gradients applies
+   (hd_cpu_multigrid.h) is exactly symmetric. The sweep computes the same weights as a / d, an
+   axis' two faces over one division (hd_diffuse_box_axis below), within a few ulps of these. */
 HD_FN float hd_diffuse_face(float scale, float spi, float spj, float fl)
 {
     return scale * (0.6666667f / hd_maxf(spi + spj, fl));
@@ -83,7 +85,8 @@ HD_FN float hd_diffuse_vacuum_face(float h, float spi)
 
 /* One face of the surface boundary's update: the weight toward a neighbour with sigma' spj that
    lies in the grid (inside != 0), else toward the box's outside; empty neighbours and the outside
-   are vacuum, whose phi is 0, so they add to the denominator only. */
+   are vacuum, whose phi is 0, so they add to the denominator only. (Exact per-face form, as
+   hd_diffuse_face: the sweep's is hd_diffuse_surface_den.) */
 HD_FN float hd_diffuse_surface_face(float scale, float h, float spi, float spj, int inside, float fl,
                                     HD_INOUT(float) open)
 {
@@ -113,23 +116,72 @@ HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, 
     return hd_diffuse_own_of(HD_KPASS HD_GET(sig, i, x, y, z), a, HD_GET(E, i + c * nvox, x, y, z + c * gz), rhs, sp, dn);
 }
 
-/* One face of the box boundary's update: adds the face's weight toward a neighbour with sigma' s
-   and phi p to *dn and its term to *num (inside == 0: the box's outside, phi = 0, s ignored). */
-HD_FN void hd_diffuse_box_add(float scale, float sp, float s, float p, int inside, float fl, HD_INOUT(float) num,
-                              HD_INOUT(float) dn)
+/* ---- the sweep's faces: an axis' two weights over one division -------------------------------
+   Divisions are the dearest arithmetic of the update on every backend (lavapipe: a per-lane
+   vdivps; docs/DESIGN-VULKAN.md "Shared loads"): the update made 7 per voxel under the box
+   boundary (one per face weight, and num / den), 13 under the surface boundary (its selects
+   compute both the vacuum and the medium weight). Each weight is written w = a / d (box face:
+   a = 0.6666667 / h^2 of the axis, d = max(sp + spj, fl); vacuum face: a = 1 / h,
+   d = 1.5 sp h + 2, the same 1 / (1.5 sp h^2 + 2 h)) and an axis' two faces (-, +) go over one
+   division: w_- p_- + w_+ p_+ = (a_- d_+ p_- + a_+ d_- p_+) / (d_- d_+), and the same for
+   w_- + w_+. 4 divisions per voxel under either boundary, one multiplication more per axis (box).
+   Range, for every valid input (no float overflow, underflow or denormal, so GPUs that flush
+   denormals compute the same): sigma_t <= extinction <= 1e6 (hd_validate.h), 1 - albedo g < 2, so
+   sp < 2e6 and a box face's d in [fl, 4e6] = [1e-3, 4e6]; a vacuum face's d in [2, 3e6 + 2]
+   (h <= 1: the box's longest side is 1). So d_- d_+ in [1e-6, 1.6e13] and a / (d_- d_+) at most
+   1e6 a; the terms a d p are at most 4e6 a |phi| where the per-face form's w p reached 667 a
+   |phi| (and the sum they form is the same), so the update overflows for no input the per-face
+   form did not (|phi| near 1e31 at h = 1/256). The sums are symmetric in the two faces (a
+   mirrored grid gives the same bits), but a face's effective weight depends on the voxel's
+   opposite face, so the two voxels of a face may see it differ in the last bits:
+   hd_diffuse_face / _surface_face above stay the exact per-face forms, for the operator CPU
+   conjugate gradients applies (hd_cpu_multigrid.h), which must be exactly symmetric. */
+
+/* The denominator d of a box face toward a neighbour with sigma' s (inside == 0: the box's
+   outside, the voxel's own D). */
+HD_FN float hd_diffuse_box_den(float sp, float s, int inside, float fl)
 {
-    float w = hd_diffuse_face(scale, sp, inside != 0 ? s : sp, fl);
-    if (inside != 0) HD_DEREF(num) += w * p;
-    HD_DEREF(dn) += w;
+    return hd_maxf(sp + (inside != 0 ? s : sp), fl);
 }
 
-/* The same under the surface boundary: empty neighbours and the outside add to *dn only. */
-HD_FN void hd_diffuse_surface_add(float scale, float h, float sp, float s, float p, int inside, float fl,
-                                  HD_INOUT(float) num, HD_INOUT(float) dn)
+/* The denominator d of a surface boundary face (scale: the axis' 1 / h^2, h its spacing), its
+   numerator in *a and in *open whether its neighbour's phi enters the update (empty neighbours
+   and the box's outside are vacuum: Marshak weight, phi 0). */
+HD_FN float hd_diffuse_surface_den(float scale, float h, float sp, float s, int inside, float fl, HD_INOUT(float) a,
+                                   HD_INOUT(float) open)
 {
-    float open, w = hd_diffuse_surface_face(scale, h, sp, inside != 0 ? s : 0.0f, inside, fl, HD_REF(open));
-    if (inside != 0) HD_DEREF(num) += open * w * p;
-    HD_DEREF(dn) += w;
+    float spj = inside != 0 ? s : 0.0f;
+    float empty = inside != 0 ? (spj + spj < fl ? 1.0f : 0.0f) : 1.0f;
+    HD_DEREF(open) = 1.0f - empty;
+    HD_DEREF(a) = empty != 0.0f ? h * scale : 0.6666667f * scale;
+    return empty != 0.0f ? 1.5f * sp * h + 2.0f : hd_maxf(sp + spj, fl);
+}
+
+/* An axis' two faces of the box boundary's update, toward neighbours with sigma' s0, s1 and phi
+   p0, p1 (in0, in1: whether each lies in the grid; the box's outside has phi = 0): adds
+   w0 p0 + w1 p1 to *num and w0 + w1 to *dn. a = 0.6666667 / h^2 of the axis, the same for both. */
+HD_FN void hd_diffuse_box_axis(float a, float sp, float s0, float s1, float p0, float p1, int in0, int in1, float fl,
+                               HD_INOUT(float) num, HD_INOUT(float) dn)
+{
+    float d0 = hd_diffuse_box_den(sp, s0, in0, fl), d1 = hd_diffuse_box_den(sp, s1, in1, fl);
+    float t = a / (d0 * d1);
+    float q0 = in0 != 0 ? p0 * d1 : 0.0f, q1 = in1 != 0 ? p1 * d0 : 0.0f;
+    HD_DEREF(num) += t * (q0 + q1);
+    HD_DEREF(dn) += t * (d0 + d1);
+}
+
+/* The same under the surface boundary (scale: the axis' 1 / h^2, h its spacing): vacuum faces add
+   their weight to *dn only. */
+HD_FN void hd_diffuse_surface_axis(float scale, float h, float sp, float s0, float s1, float p0, float p1, int in0,
+                                   int in1, float fl, HD_INOUT(float) num, HD_INOUT(float) dn)
+{
+    float a0, a1, o0, o1;
+    float d0 = hd_diffuse_surface_den(scale, h, sp, s0, in0, fl, HD_REF(a0), HD_REF(o0));
+    float d1 = hd_diffuse_surface_den(scale, h, sp, s1, in1, fl, HD_REF(a1), HD_REF(o1));
+    float r = 1.0f / (d0 * d1), u0 = a0 * d1, u1 = a1 * d0;
+    float q0 = in0 != 0 ? o0 * u0 * p0 : 0.0f, q1 = in1 != 0 ? o1 * u1 * p1 : 0.0f;
+    HD_DEREF(num) += r * (q0 + q1);
+    HD_DEREF(dn) += r * (u0 + u1);
 }
 
 /* The surface boundary's end of the update: an empty voxel (sigma' sp below half the floor) gets
@@ -151,12 +203,12 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
                               int in_zp, HD_INOUT(float) den)
 {
     float fl = HD_PRM(grid).w;
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).x, sp, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl, HD_REF(num),
+                        HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).y, sp, s_ym, s_yp, p_ym, p_yp, in_ym, in_yp, fl, HD_REF(num),
+                        HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).z, sp, s_zm, s_zp, p_zm, p_zp, in_zm, in_zp, fl, HD_REF(num),
+                        HD_REF(dn));
     HD_DEREF(den) = dn;
     return num;
 }
@@ -171,12 +223,12 @@ HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float 
                                   int in_zp, HD_INOUT(float) den)
 {
     float fl = HD_PRM(grid).w;
-    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xm, p_xm, in_xm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xp, p_xp, in_xp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_ym, p_ym, in_ym, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_yp, p_yp, in_yp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zm, p_zm, in_zm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zp, p_zp, in_zp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl, HD_REF(num),
+                            HD_REF(dn));
+    hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_ym, s_yp, p_ym, p_yp, in_ym, in_yp, fl, HD_REF(num),
+                            HD_REF(dn));
+    hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zm, s_zp, p_zm, p_zp, in_zm, in_zp, fl, HD_REF(num),
+                            HD_REF(dn));
     return hd_diffuse_surface_end(sp, fl, num, dn, den);
 }
 
@@ -211,9 +263,10 @@ HD_FN float hd_diffuse_nb_phi(HD_KARGS int inside, int j, int x, int y, int z, i
    backend passes literals for interior voxels so the compiler drops the tests (see hd_cpu.h).
    With rgb = 0 and a white TF the RGB path computes the same bits as the grey one. rhs
    (HD_FLAG_DIFFUSE_RHS): E holds the whole right-hand side (multigrid's coarse levels solve for
-   a correction), not the direct light. Loads each face's values right before its term (the same
-   hd_diffuse_*_add calls, in the same face order, as hd_diffuse_box_of / _surface_of): loading
-   all 12 first tripled the CPU row loops' vector spills (365 -> 1113 zmm moves to the stack). */
+   a correction), not the direct light. The same hd_diffuse_*_axis calls, in the same axis order,
+   as hd_diffuse_box_of / _surface_of, so the same bits; each axis' values are loaded right before
+   its terms: loading all 12 first tripled the CPU row loops' vector spills (365 -> 1113 zmm
+   moves to the stack). */
 HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_xm, int in_xp, int in_ym,
                                     int in_yp, int in_zm, int in_zp, int rgb, int rhs, int surface,
                                     HD_INOUT(float) den)
@@ -223,32 +276,41 @@ HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_
     float sp, ag, dn, fl = HD_PRM(grid).w;
     float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     if (surface != 0) {
-        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).x, HD_PRM(gridh).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).y, HD_PRM(gridh).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_add(HD_PRM(grid).z, HD_PRM(gridh).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
-                               hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp,
+                                hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
+                                hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
+                                hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c),
+                                hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xm, in_xp, fl,
+                                HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp,
+                                hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
+                                hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
+                                hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c),
+                                hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_ym, in_yp, fl,
+                                HD_REF(num), HD_REF(dn));
+        hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp,
+                                hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
+                                hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
+                                hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c),
+                                hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zm, in_zp, fl,
+                                HD_REF(num), HD_REF(dn));
         return hd_diffuse_surface_end(sp, fl, num, dn, den);
     }
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c), in_xm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c), in_ym, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_yp, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c), in_zm, fl, HD_REF(num), HD_REF(dn));
-    hd_diffuse_box_add(HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
-                       hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zp, fl, HD_REF(num), HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
+                        hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
+                        hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c),
+                        hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xm, in_xp, fl, HD_REF(num),
+                        HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).y, sp, hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
+                        hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
+                        hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c),
+                        hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_ym, in_yp, fl, HD_REF(num),
+                        HD_REF(dn));
+    hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).z, sp, hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
+                        hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
+                        hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c),
+                        hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zm, in_zp, fl, HD_REF(num),
+                        HD_REF(dn));
     HD_DEREF(den) = dn;
     return num;
 }
