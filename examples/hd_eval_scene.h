@@ -27,6 +27,9 @@ typedef struct hde_scene {
     char tf[512];
     float extinction, albedo, anisotropy, step, exposure, fov, lit_opacity;
     int max_bounces, diffusion_sweeps, frame_window;
+    int solver; /* HD and CD's diffusion solver: 0 = the library's default (red-black),
+                   1 = red-black, 2 = multigrid CG (HD_SOLVER_RED_BLACK / _MULTIGRID; the CPU
+                   backend only); diffusion_sweeps counts CG steps with multigrid */
     float eye[3], target[3], up[3];
     int light_count;
     float light_dir[HDE_MAX_LIGHTS][3], light_intensity[HDE_MAX_LIGHTS];
@@ -104,6 +107,12 @@ static int hde__apply(hde_scene *s, const char *key, const char *val, char *err,
         if (s->light_count == HDE_MAX_LIGHTS) { snprintf(err, errn, "more than %d lights", HDE_MAX_LIGHTS); return 0; }
         for (m = 0; m < 3; ++m) s->light_dir[s->light_count][m] = (float)v[m];
         s->light_intensity[s->light_count++] = (float)v[3];
+        return 1;
+    }
+    if (strcmp(key, "solver") == 0) {
+        if (strcmp(val, "red-black") == 0) s->solver = 1;
+        else if (strcmp(val, "multigrid") == 0) s->solver = 2;
+        else { snprintf(err, errn, "solver wants red-black or multigrid"); return 0; }
         return 1;
     }
     if (strcmp(key, "psnr_levels") == 0) {

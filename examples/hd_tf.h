@@ -11,6 +11,9 @@
      ct-skin    CT, domain -1024..3071 HU: the skin surface opaque and skin-coloured, bone bright
      ct-bone    CT: bone only (from ~200 HU), ivory
      ct-tissue  CT: the skin faint and pale, muscle and soft tissue red, bone white
+     ct-flesh   CT: all soft tissue (skin, fat, muscle, brain) one flesh colour (0.95, 0.50, 0.35)
+                at ct-skin's opacities, bone hidden: light seen has scattered many times in
+                strongly coloured tissue (the RGB-scattering study)
      ramp       any data: a white ramp over the data's own range (minimum to maximum), the
                 lowest 5% transparent
 
@@ -110,6 +113,25 @@ static const float hdx__tf_ct_tissue[][5] = {
     {800, 1.00f, 1.00f, 1.00f, 1.00f},
     {3071, 1.00f, 1.00f, 1.00f, 1.00f},
 };
+/* Soft tissue as one optically thick, strongly coloured scatterer, for testing coloured multiple
+   scattering (hdeval --rgb-study, examples/eval/head-flesh.scene). Colour: blood-perfused tissue
+   scatters red almost without loss, while haemoglobin absorbs green (Q bands, 540-580 nm) and
+   blue (Soret band, ~415 nm) strongly; a per-channel albedo of about (0.95, 0.5, 0.35) is that
+   of muscle-like "flesh" (before the scene's global albedo multiplies it). Opacity is ct-skin's
+   (0.6 for fat and skin, 0.7 for muscle and brain, so the head is tens of mean free paths
+   across and its look is multiply scattered light), and bone fades out from 150 to 250 HU and
+   stays transparent: white bone (colour 1, where grey and RGB diffusion are identical) would
+   otherwise dominate the image, as it does with ct-tissue. */
+static const float hdx__tf_ct_flesh[][5] = {
+    {-1024, 0.00f, 0.00f, 0.00f, 0.00f},
+    {-500, 0.95f, 0.50f, 0.35f, 0.00f},
+    {-250, 0.95f, 0.50f, 0.35f, 0.00f}, /* below fat: air, foam, the head holder */
+    {-100, 0.95f, 0.50f, 0.35f, 0.60f}, /* fat, skin */
+    {100, 0.95f, 0.50f, 0.35f, 0.70f},  /* muscle, brain */
+    {150, 0.95f, 0.50f, 0.35f, 0.70f},
+    {250, 0.95f, 0.50f, 0.35f, 0.00f},  /* bone and above: hidden */
+    {3071, 0.95f, 0.50f, 0.35f, 0.00f},
+};
 static const float hdx__tf_ramp[][5] = {
     {0.00f, 1.0f, 1.0f, 1.0f, 0.0f},
     {0.05f, 1.0f, 1.0f, 1.0f, 0.0f},
@@ -131,6 +153,8 @@ static const struct hdx__tf_preset {
     {"ct-tissue", hdx__tf_ct_tissue,
      (int)(sizeof hdx__tf_ct_tissue / sizeof hdx__tf_ct_tissue[0]), {-1024.0f, 3071.0f}, 1,
      "CT: faint skin, red muscle, white bone"},
+    {"ct-flesh", hdx__tf_ct_flesh, (int)(sizeof hdx__tf_ct_flesh / sizeof hdx__tf_ct_flesh[0]),
+     {-1024.0f, 3071.0f}, 1, "CT: soft tissue flesh-coloured, bone hidden"},
     {"ramp", hdx__tf_ramp, (int)(sizeof hdx__tf_ramp / sizeof hdx__tf_ramp[0]), {0.0f, 1.0f}, 0,
      "any data: white ramp over the data's range"},
 };

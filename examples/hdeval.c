@@ -165,7 +165,7 @@ static int g_downsample = 1; /* params.illumination_downsample of HD and CD cont
 static int g_rgb = 0;        /* params.rgb_scattering of HD and CD contexts */
 static hd_boundary g_boundary = HD_BOUNDARY_BOX; /* params.diffusion_boundary of HD and CD contexts */
 static hd_precision g_precision = HD_PRECISION_FLOAT32; /* params.illumination_precision of HD and CD */
-static hd_solver g_solver = HD_SOLVER_DEFAULT; /* params.solver of HD and CD contexts */
+static hd_solver g_solver = HD_SOLVER_DEFAULT; /* params.solver of HD and CD contexts; DEFAULT: the scene's */
 static int g_sweeps = 0;     /* params.diffusion_sweeps of HD and CD contexts; 0: the scene's */
 
 static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
@@ -199,7 +199,8 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.albedo = S.albedo;
     d.params.anisotropy = S.anisotropy;
     d.params.diffusion_sweeps = g_sweeps ? g_sweeps : S.diffusion_sweeps;
-    d.params.solver = g_solver;
+    d.params.solver = g_solver != HD_SOLVER_DEFAULT ? g_solver
+                      : S.solver == 2 ? HD_SOLVER_MULTIGRID : S.solver == 1 ? HD_SOLVER_RED_BLACK : HD_SOLVER_DEFAULT;
     d.params.seed = seed;
     d.params.step = S.step;
     d.params.frame_window = S.frame_window;
@@ -809,30 +810,75 @@ static void run_downsample_study(const ref_img *ref, const char *out)
    iteration count and at 4x it: grey (the paper) and RGB scattering, each with the box boundary
    (METHOD.md) and the surface (Marshak) boundary. rgb.md, rgb-checks lines, the mean radiance of
    each image against the reference's (the diffusion's energy balance), and the side-by-side
-   figure rgb_scattering.png (the four variants, then PT_MS). */
+   figure rgb_scattering.png (the four variants, then PT_MS).
+   Colour, apart from brightness: PT_MS multiplies a path by the TF colour at every scattering
+   vertex, so grey diffusion (colour applied once) over-lights the weak channels of coloured
+   tissue, and that excess is the colour error. rgb.md's second table separates it: each
+   channel's mean over PT_MS's (where the light is missing or in excess), the G/R and B/R ratios
+   of the means over PT_MS's (the mean hue; 1 = PT_MS's), and the PSNR after scaling the whole
+   image by one number to PT_MS's mean luminance (what is left when brightness is matched). */
+static void channel_means(const float *img, size_t npix, double m[3])
+{
+    size_t i;
+    int c;
+    m[0] = m[1] = m[2] = 0.0;
+    for (i = 0; i < npix; ++i)
+        for (c = 0; c < 3; ++c) m[c] += (double)img[4 * i + c];
+    for (c = 0; c < 3; ++c) m[c] /= (double)npix;
+}
+
 static double mean_radiance(const float *img, size_t npix)
 {
-    double s = 0.0;
-    size_t i;
-    for (i = 0; i < npix; ++i) s += (double)img[4 * i] + img[4 * i + 1] + img[4 * i + 2];
-    return s / (3.0 * (double)npix);
+    double m[3];
+    channel_means(img, npix, m);
+    return (m[0] + m[1] + m[2]) / 3.0;
 }
+
+/* Rec. 709 luminance of linear RGB. */
+static double luminance(const double m[3]) { return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2]; }
+
+/* Error of img scaled by one factor so that its mean luminance is the reference's: brightness
+   taken out, hue and spatial distribution left. *scale gets the factor. */
+static err2 compare_luminance_matched(const float *img, const ref_img *ref, size_t npix, double *scale)
+{
+    double mi[3], mr[3];
+    float *tmp = (float *)xmalloc(npix * 4 * sizeof(float));
+    size_t i;
+    err2 e;
+    channel_means(img, npix, mi);
+    channel_means(ref->lin, npix, mr);
+    *scale = luminance(mi) > 0.0 ? luminance(mr) / luminance(mi) : 1.0;
+    for (i = 0; i < npix * 4; ++i) tmp[i] = (float)(*scale * img[i]);
+    e = compare(tmp, ref, npix);
+    free(tmp);
+    return e;
+}
+
+typedef struct rgb_row {
+    double mean, ch[3];      /* after 4n it: mean radiance and R, G, B means over PT_MS's */
+    double gr, br;           /* (G/R) and (B/R) of the means over PT_MS's */
+    double scale;            /* after 4n it: the luminance-matching factor */
+    err2 lm1, lm4;           /* luminance-matched error after n and 4n it */
+} rgb_row;
 
 static void run_rgb_study(const ref_img *ref, const char *out)
 {
     size_t npix = (size_t)S.size * S.size;
     float *img[4];
     const float *tiles[5];
-    int k, n = S.iterations[HDE_HD];
-    double ref_mean = mean_radiance(ref->lin, npix);
+    rgb_row rows[4];
+    int k, c, n = S.iterations[HDE_HD];
+    double ref_mean = mean_radiance(ref->lin, npix), ref_ch[3];
     FILE *md = open_w(out, "rgb.md", NULL);
+    channel_means(ref->lin, npix, ref_ch);
     fprintf(md, "| diffusion | boundary | state bytes per voxel | mean radiance / PT_MS's | PSNR vs PT_MS after %d it | lit part | after %d it | lit part |\n"
                 "|---|---|---|---|---|---|---|---|\n", n, 4 * n);
     for (k = 0; k < 4; ++k) {
         hd_context ctx;
         hd_stats st;
         err2 e1, e4;
-        double mean;
+        double mean, ch[3], scale1;
+        rgb_row *r = &rows[k];
         img[k] = (float *)xmalloc(npix * 4 * sizeof(float));
         g_rgb = k & 1;
         g_boundary = k >= 2 ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
@@ -840,19 +886,42 @@ static void run_rgb_study(const ref_img *ref, const char *out)
         iterate(ctx, n);
         read_image(ctx, img[k], S.size);
         e1 = compare(img[k], ref, npix);
+        r->lm1 = compare_luminance_matched(img[k], ref, npix, &scale1);
         iterate(ctx, 3 * n);
         read_image(ctx, img[k], S.size);
         e4 = compare(img[k], ref, npix);
+        r->lm4 = compare_luminance_matched(img[k], ref, npix, &r->scale);
         mean = mean_radiance(img[k], npix) / ref_mean;
+        channel_means(img[k], npix, ch);
+        r->mean = mean;
+        for (c = 0; c < 3; ++c) r->ch[c] = ch[c] / ref_ch[c];
+        r->gr = r->ch[1] / r->ch[0];
+        r->br = r->ch[2] / r->ch[0];
         if (hd_get_stats(ctx, &st) != HD_SUCCESS) die("hd_get_stats");
         fprintf(md, "| %s | %s | %.1f | %.3f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", g_rgb ? "RGB" : "grey",
                 k >= 2 ? "surface" : "box",
                 (double)st.method_bytes / ((double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2]),
                 mean, psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
         check_line("rgb_scattering %d, boundary %s: mean radiance %.3f x PT_MS, PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, "
-                   "%.2f dB (lit %.2f) after %d it", g_rgb, k >= 2 ? "surface" : "box", mean, psnr(e1.mse),
-                   psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
+                   "%.2f dB (lit %.2f) after %d it; R G B means %.3f %.3f %.3f x PT_MS, G/R %.3f and B/R %.3f x PT_MS's; "
+                   "luminance-matched (x%.3f) PSNR %.2f dB (lit %.2f) after %d it, %.2f dB (lit %.2f) after %d it",
+                   g_rgb, k >= 2 ? "surface" : "box", mean, psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse),
+                   psnr(e4.mse_lit), 4 * n, r->ch[0], r->ch[1], r->ch[2], r->gr, r->br, r->scale, psnr(r->lm1.mse),
+                   psnr(r->lm1.mse_lit), n, psnr(r->lm4.mse), psnr(r->lm4.mse_lit), 4 * n);
         hd_destroy(ctx);
+    }
+    fprintf(md, "\nColour apart from brightness, after %d it (PT_MS's R G B means %.4g %.4g %.4g, G/R %.3f, B/R %.3f). "
+                "Luminance-matched: the image scaled by one factor to PT_MS's mean luminance (Rec. 709), then "
+                "compared as above.\n\n"
+                "| diffusion | boundary | R mean / PT_MS's | G | B | G/R / PT_MS's | B/R / PT_MS's | luminance factor | "
+                "luminance-matched PSNR after %d it | lit part | after %d it | lit part |\n"
+                "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+            4 * n, ref_ch[0], ref_ch[1], ref_ch[2], ref_ch[1] / ref_ch[0], ref_ch[2] / ref_ch[0], n, 4 * n);
+    for (k = 0; k < 4; ++k) {
+        const rgb_row *r = &rows[k];
+        fprintf(md, "| %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n",
+                k & 1 ? "RGB" : "grey", k >= 2 ? "surface" : "box", r->ch[0], r->ch[1], r->ch[2], r->gr, r->br,
+                r->scale, psnr(r->lm1.mse), psnr(r->lm1.mse_lit), psnr(r->lm4.mse), psnr(r->lm4.mse_lit));
     }
     g_rgb = 0;
     g_boundary = HD_BOUNDARY_BOX;
@@ -1289,10 +1358,11 @@ int main(int argc, char **argv)
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
                S.tf, hd_backend_name(), S.size, S.size, S.table_size, S.table_size);
     check_line("settings: iterations HD %d, CD %d, PT_SS %d, PT_MS %d; references PT_SS %d, PT_MS %d paths/pixel; "
-               "extinction %g, albedo %g, g %g, exposure %g, frame_window %d, sweeps %d, illumination downsample %d",
+               "extinction %g, albedo %g, g %g, exposure %g, frame_window %d, sweeps %d%s, illumination downsample %d",
                S.iterations[HDE_HD], S.iterations[HDE_CD], S.iterations[HDE_SS], S.iterations[HDE_MS],
                S.ref_paths[HDE_SS], S.ref_paths[HDE_MS], (double)S.extinction, (double)S.albedo,
-               (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps, g_downsample);
+               (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps,
+               S.solver == 2 ? " (multigrid CG steps)" : "", g_downsample);
 
     if (multigrid_study) {
         ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);

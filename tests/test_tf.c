@@ -42,6 +42,13 @@ static void tf_presets(void)
     CHECK(tf_a.rgba[4 * 1 + 3] == 0.0f);
     CHECK(hdx_tf_preset("ct-bone", &tf_a));
     CHECK(tf_a.rgba[4 * (int)((0.0f + 1024.0f) / 4095.0f * 255.0f) + 3] == 0.0f); /* no tissue */
+    /* ct-flesh: soft tissue (40 HU) flesh-coloured and dense, bone (1000 HU) hidden */
+    CHECK(hdx_tf_preset("ct-flesh", &tf_a));
+    {
+        const float *t = &tf_a.rgba[4 * (int)((40.0f + 1024.0f) / 4095.0f * 255.0f)];
+        CHECK(tf_near(t[0], 0.95f) && tf_near(t[1], 0.50f) && tf_near(t[2], 0.35f) && t[3] > 0.6f);
+        CHECK(tf_a.rgba[4 * (int)((1000.0f + 1024.0f) / 4095.0f * 255.0f) + 3] == 0.0f);
+    }
     CHECK(!hdx_tf_preset("ct-nothing", &tf_a));
     /* the ramp follows the data's range */
     CHECK(hdx_tf_preset("ramp", &tf_a));
