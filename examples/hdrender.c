@@ -50,7 +50,7 @@ static const char *usage_text =
     "  --spacing X,Y,Z         voxel size, overrides the file's (default: file or 1,1,1)\n"
     "\n"
     "transfer function\n"
-    "  --tf PRESET|FILE        ct-skin, ct-bone, ct-tissue, ramp, or a TF file\n"
+    "  --tf PRESET|FILE        ct-skin, ct-bone, ct-tissue, ct-flesh, ramp, or a TF file\n"
     "                          (docs/TF_FORMAT.md). Default: ct-skin for CT data (values\n"
     "                          below -500), else ramp. CT presets map -1024..3071 HU.\n"
     "  --print-tf              print the chosen TF in the file format and exit\n"
@@ -593,7 +593,7 @@ int main(int argc, char **argv)
     if (tf_arg) {
         if (!hdx_tf_preset(tf_arg, &tf)) {
             FILE *f = fopen(tf_arg, "rb");
-            if (!f) fail(2, "--tf: '%s' is neither a preset (ct-skin, ct-bone, ct-tissue, ramp) "
+            if (!f) fail(2, "--tf: '%s' is neither a preset (ct-skin, ct-bone, ct-tissue, ct-flesh, ramp) "
                             "nor a readable file", tf_arg);
             fclose(f);
             if (!hdx_tf_load(tf_arg, &tf, err, sizeof err)) fail(2, "--tf: %s", err);
