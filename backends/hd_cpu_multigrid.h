@@ -417,9 +417,11 @@ static void hd__cpu_mg_cycle(hd__backend *be, int l)
 }
 
 /* ---- the fine residual in double ------------------------------------------------------------------ */
-/* f - A phi at one voxel of the fine grid with the shared kernel's own coefficients (the same
-   float source term, sigma_a and face weights as hd_diffuse_terms_box / _surface compute, so the
-   same A and f), summed in double with every neighbour's term written as a difference
+/* f - A phi at one voxel of the fine grid with the shared kernel's own coefficients: the same
+   float source term and sigma_a as hd_diffuse_terms_box / _surface, and each face's exact weight
+   hd_diffuse_face / hd_diffuse_surface_face (one division per face, bit-identical from both
+   voxels, so this A is exactly symmetric, as CG needs; the sweep puts an axis' two faces over one
+   division, hd_diffuse_box_axis, and so relaxes the same A to within a few ulps), summed in double with every neighbour's term written as a difference
    w (phi_i - phi_j). Why: the kernel's float residual num - den phi cancels two terms of about
    den phi (den ~ 2e4 in soft tissue at h = 1/128), so it carries rounding of about 1e-4 of the
    source there, and CG driven by it stalled at a relative residual of 1.2e-4 on the head CT at
