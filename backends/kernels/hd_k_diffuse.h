@@ -83,16 +83,24 @@ HD_FN float hd_diffuse_vacuum_face(float h, float spi)
     return 1.0f / (1.5f * spi * h * h + 2.0f * h);
 }
 
+/* Under the surface boundary, 1 if a neighbour with sigma' spj that lies in the grid
+   (inside != 0) is medium, its phi entering the update; 0 if it is vacuum: empty (sigma' below
+   half the floor) or the box's outside, whose phi is 0. */
+HD_FN float hd_diffuse_open_of(float spj, int inside, float fl)
+{
+    return inside != 0 ? (spj + spj < fl ? 0.0f : 1.0f) : 0.0f;
+}
+
 /* One face of the surface boundary's update: the weight toward a neighbour with sigma' spj that
-   lies in the grid (inside != 0), else toward the box's outside; empty neighbours and the outside
-   are vacuum, whose phi is 0, so they add to the denominator only. (Exact per-face form, as
-   hd_diffuse_face: the sweep's is hd_diffuse_surface_den.) */
+   lies in the grid (inside != 0), else toward the box's outside; vacuum neighbours add to the
+   denominator only (*open = 0). (Exact per-face form, as hd_diffuse_face: the sweep's is
+   hd_diffuse_surface_den.) */
 HD_FN float hd_diffuse_surface_face(float scale, float h, float spi, float spj, int inside, float fl,
                                     HD_INOUT(float) open)
 {
-    float empty = inside != 0 ? (spj + spj < fl ? 1.0f : 0.0f) : 1.0f;
-    HD_DEREF(open) = 1.0f - empty;
-    return empty != 0.0f ? hd_diffuse_vacuum_face(h, spi) : hd_diffuse_face(scale, spi, spj, fl);
+    float o = hd_diffuse_open_of(spj, inside, fl);
+    HD_DEREF(open) = o;
+    return o == 0.0f ? hd_diffuse_vacuum_face(h, spi) : hd_diffuse_face(scale, spi, spj, fl);
 }
 
 /* The voxel's own part of its update from its sigma_t st, albedo a and E e: returns the source
@@ -150,11 +158,10 @@ HD_FN float hd_diffuse_box_den(float sp, float s, int inside, float fl)
 HD_FN float hd_diffuse_surface_den(float scale, float h, float sp, float s, int inside, float fl, HD_INOUT(float) a,
                                    HD_INOUT(float) open)
 {
-    float spj = inside != 0 ? s : 0.0f;
-    float empty = inside != 0 ? (spj + spj < fl ? 1.0f : 0.0f) : 1.0f;
-    HD_DEREF(open) = 1.0f - empty;
-    HD_DEREF(a) = empty != 0.0f ? h * scale : 0.6666667f * scale;
-    return empty != 0.0f ? 1.5f * sp * h + 2.0f : hd_maxf(sp + spj, fl);
+    float spj = inside != 0 ? s : 0.0f, o = hd_diffuse_open_of(spj, inside, fl);
+    HD_DEREF(open) = o;
+    HD_DEREF(a) = o == 0.0f ? h * scale : 0.6666667f * scale;
+    return o == 0.0f ? 1.5f * sp * h + 2.0f : hd_maxf(sp + spj, fl);
 }
 
 /* An axis' two faces of the box boundary's update, toward neighbours with sigma' s0, s1 and phi
@@ -188,7 +195,7 @@ HD_FN void hd_diffuse_surface_axis(float scale, float h, float sp, float s0, flo
    num 0 and den 1 (phi = 0). */
 HD_FN float hd_diffuse_surface_end(float sp, float fl, float num, float dn, HD_INOUT(float) den)
 {
-    float self = sp + sp < fl ? 0.0f : 1.0f;
+    float self = hd_diffuse_open_of(sp, 1, fl); /* 0: the voxel itself is empty */
     HD_DEREF(den) = self * dn + (1.0f - self);
     return self * num;
 }
