@@ -567,53 +567,44 @@ static hd_result hd__cl_unmap_illumination(hd__ctx *ctx, hd_illumination which, 
     return HD_SUCCESS;
 }
 
-/* The colour layout, mapped, into dst in the API's x-fastest channel-planar order; binary16
-   widened with the CPU's exact hd_h2f. */
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+/* Copies E or phi between the colour layout, mapped, and the API's x-fastest channel-planar
+   order, one direction per call: into dst (src NULL; binary16 widened with the CPU's exact
+   hd_h2f) or from src (dst NULL; rounded with the CPU's hd_f2h). */
+static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst)
 {
     hd__backend *be = ctx->be;
     int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
-    void *m;
+    unsigned char *m;
+    void *mv;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
-    if ((r = hd__cl_map_illumination(ctx, which, CL_MAP_READ, &m)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_map_illumination(ctx, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
+    m = (unsigned char *)mv;
     for (zz = 0; zz < nz; ++zz)
         for (y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__cl_slot(ctx, x, y, zz);
                 if (be->f16) {
                     uint16_t v;
-                    memcpy(&v, (const unsigned char *)m + 2 * s, 2);
-                    *dst++ = hd_h2f(v);
+                    if (src != NULL) { v = hd_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
+                    else { memcpy(&v, m + 2 * s, 2); *dst++ = hd_h2f(v); }
                 } else {
-                    *dst++ = ((const float *)m)[s];
+                    if (src != NULL) memcpy(m + 4 * s, src++, 4);
+                    else memcpy(dst++, m + 4 * s, 4);
                 }
             }
-    return hd__cl_unmap_illumination(ctx, which, m);
+    return hd__cl_unmap_illumination(ctx, which, mv);
 }
 
-/* The inverse, for the test hooks (src/hd_test_hooks.h): src in the API's layout into E or phi,
-   rounded with the CPU's hd_f2h for binary16 storage. */
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    return hd__cl_copy_illumination(ctx, which, NULL, dst);
+}
+
+/* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
-    void *m;
-    hd_result r;
-    HD__CL_LOST_CHECK(ctx);
-    if ((r = hd__cl_map_illumination(ctx, which, CL_MAP_WRITE, &m)) != HD_SUCCESS) return r;
-    for (zz = 0; zz < nz; ++zz)
-        for (y = 0; y < gy; ++y)
-            for (x = 0; x < gx; ++x) {
-                size_t s = hd__cl_slot(ctx, x, y, zz);
-                if (be->f16) {
-                    uint16_t v = hd_f2h(*src++);
-                    memcpy((unsigned char *)m + 2 * s, &v, 2);
-                } else {
-                    ((float *)m)[s] = *src++;
-                }
-            }
-    return hd__cl_unmap_illumination(ctx, which, m);
+    return hd__cl_copy_illumination(ctx, which, src, NULL);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
