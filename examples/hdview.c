@@ -15,6 +15,8 @@
      C         grey / RGB multiple scattering         B   diffusion boundary: box / surface
      F         float32 / float16 illumination storage (GL_R16F images on the GL backend; a
                backend that refuses it logs why and the viewer stays at float32)
+     M         diffusion solver: red-black sweeps / multigrid (a backend without multigrid logs
+               why and the viewer stays at red-black)
      Esc / Q   quit
    The title shows the method, iterations, iterations/s and the bytes the method holds.
 
@@ -273,6 +275,11 @@ static void key_char(viewer *v, int c)
         v->params.illumination_precision = v->params.illumination_precision == HD_PRECISION_FLOAT16 ? HD_PRECISION_FLOAT32
                                                                                                    : HD_PRECISION_FLOAT16;
         if ((r = hd_set_params(v->ctx, &v->params)) == HD_ERROR_UNSUPPORTED) v->params.illumination_precision = HD_PRECISION_FLOAT32;
+        else if (r != HD_SUCCESS) die("hd_set_params", r);
+        break;
+    case 'm': case 'M': /* params.solver; a backend without multigrid keeps red-black */
+        v->params.solver = v->params.solver == HD_SOLVER_MULTIGRID ? HD_SOLVER_RED_BLACK : HD_SOLVER_MULTIGRID;
+        if ((r = hd_set_params(v->ctx, &v->params)) == HD_ERROR_UNSUPPORTED) v->params.solver = HD_SOLVER_RED_BLACK;
         else if (r != HD_SUCCESS) die("hd_set_params", r);
         break;
     case 's': case 'S':
