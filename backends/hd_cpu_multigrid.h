@@ -13,7 +13,7 @@
    One solver step (diffusion_sweeps counts them; default 1 per HD iteration):
    1. r = f - A (phi + lo), recomputed from the iterate and E at every step (so a new E is used
       at once and rounding in the updates never accumulates into r), with the kernel's own float
-      coefficients but summed in double as differences (hd__mg_res_f64): the float kernel's
+      coefficients but summed in double as differences (hd_mg_res_f64): the float kernel's
       residual cancels two terms of about den phi and floored the residual near 1e-4;
    2. z = M r: one symmetric V-cycle (below) from z = 0;
    3. beta = <r, z> / <r, z>_previous (0 at a restart), p = z + beta p;
@@ -45,7 +45,7 @@
    - a coarse grid has half its fine grid's voxels per axis, rounded DOWN: with an odd size the
      last fine voxel has no parent (rounding up put the last coarse voxel's centre on the fine
      box's vacuum boundary, and the plain cycle diverged on odd sizes with air);
-   - coarse sigma_t: the harmonic mean of the 8 children (hd__mg_child_harmonic), rebuilt when
+   - coarse sigma_t: the harmonic mean of the 8 children (hd_mg_coarse_sig), rebuilt when
      sigma_t changes; RGB colour channels: the mean.
    The fixed point is the fine grid's discrete solution (tested: phi matches red-black's).
    Memory: r, z, p, lo and the fine residual (which doubles as q) are 20 bytes per voxel and
@@ -209,145 +209,60 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
 }
 
 /* ---- transfers, one coarse row (or fine row) per item ------------------------------------------- */
-/* Mean of the existing children of coarse voxel (X, Y, Z) in the fine channel-planar field f
-   (dims fd, nch channels of fd's size), channel ch. */
-static float hd__mg_child_mean(const float *f, const int *fd, int X, int Y, int Z, int ch)
-{
-    size_t plane = hd__mg_vox(fd) * (size_t)ch;
-    float s = 0.0f;
-    int n = 0, i, j, k;
-    for (k = 2 * Z; k <= 2 * Z + 1 && k < fd[2]; ++k)
-        for (j = 2 * Y; j <= 2 * Y + 1 && j < fd[1]; ++j)
-            for (i = 2 * X; i <= 2 * X + 1 && i < fd[0]; ++i) {
-                s += f[plane + ((size_t)k * fd[1] + j) * fd[0] + i];
-                ++n;
-            }
-    return s / (float)n;
-}
+/* The per-voxel math is the shared kernel's (backends/kernels/hd_k_multigrid.h, with the OpenCL
+   backend); these rows run it on a copy of a level's kernel context whose f16 is a literal 0 (the
+   levels are float32: no per-load precision test, hd_prelude_c.h's HD_GET) and whose phi is the
+   grid the function reads. */
 
-/* sigma_t of a coarse voxel from its 8 children: the harmonic mean, i.e. the mean of their D, so
-   a coarse voxel conducts like its most conductive part (the arithmetic mean of sigma_t made
-   voxels of soft tissue and bone, or of air and tissue, insulators, and the cycle diverged on a
-   sphere in air). Box boundary: every child counts, air floored at 1e-4 per world unit (air
-   conducts). Surface boundary: empty children are vacuum, not medium: the mean is over the
-   medium children, and a coarse voxel with fewer than 4 of them is empty. */
-static float hd__mg_child_harmonic(const float *f, const int *fd, int X, int Y, int Z, int surface, float empty_below)
-{
-    float s = 0.0f;
-    int n = 0, i, j, k;
-    for (k = 2 * Z; k <= 2 * Z + 1; ++k)
-        for (j = 2 * Y; j <= 2 * Y + 1; ++j)
-            for (i = 2 * X; i <= 2 * X + 1; ++i) {
-                float v = f[((size_t)k * fd[1] + j) * fd[0] + i];
-                if (surface && v < empty_below) continue;
-                s += 1.0f / (v > 1e-4f ? v : 1e-4f);
-                ++n;
-            }
-    return surface && n < 4 ? 0.0f : (float)n / s;
-}
-
-/* sigma_t (all its channels) of level mg->cur from the level above. */
-static void hd__cpu_mg_sig_row(hd__backend *be, int r)
+/* sigma_t (all its channels) of level mg->cur from the level above (hd_mg_coarse_sig). */
+static HD__CPU_FLATTEN void hd__cpu_mg_sig_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
-    hd__cpu_level *C = &mg->lv[mg->cur], *F = &mg->lv[mg->cur - 1];
-    const float *fs = mg->cur == 1 ? be->sig : F->sig;
+    hd__cpu_level *C = &mg->lv[mg->cur];
+    hd__kctx k = mg->lv[mg->cur - 1].k;
     int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X;
     float *dst = C->sig + hd__mg_vox(C->dims) * (size_t)ch + ((size_t)Z * C->dims[1] + Y) * C->dims[0];
-    int surface = (be->k.p->counts.z & HD_FLAG_SURFACE_BOUNDARY) != 0;
-    /* empty under the surface boundary: sigma' = sigma_t (1 - albedo g) below half the floor */
-    float empty_below = 0.5f * be->k.p->grid.w / (1.0f - be->k.p->medium.y * be->k.p->medium.z);
-    for (X = 0; X < C->dims[0]; ++X)
-        dst[X] = ch == 0 ? hd__mg_child_harmonic(fs, F->dims, X, Y, Z, surface, empty_below)
-                         : hd__mg_child_mean(fs, F->dims, X, Y, Z, ch);
+    k.f16 = 0;
+    for (X = 0; X < C->dims[0]; ++X) dst[X] = hd_mg_coarse_sig(&k, X, Y, Z, ch);
 }
 
-/* Full-weighting weight of fine index 2 C - 1 + t (t = 0..3) for coarse index C: P^T / 8 per
-   axis, the transpose of hd__mg_prolong_into's 3/4, 1/4 (halved: the 8 children's volume). */
-static const float hd__mg_fw[4] = {0.125f, 0.375f, 0.375f, 0.125f};
-
-/* The right-hand side of level mg->cur: R = P^T / 8 of the residual of the level above, the 16
-   fine rows around coarse row r first summed into one fine-length line, then weighted along x;
-   its phi (the correction) starts at 0. */
-static void hd__cpu_mg_restrict_row(hd__backend *be, int r)
+/* The right-hand side of level mg->cur: R = P^T / 8 of the residual of the level above
+   (hd_mg_restrict), each fine column's share of the row computed once (hd_mg_restrict_line, a
+   vector loop) and four of them combined per coarse voxel (hd_mg_restrict_x); its phi (the
+   correction) starts at 0. */
+static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
     hd__cpu_level *C = &mg->lv[mg->cur], *F = &mg->lv[mg->cur - 1];
-    const int *fd = F->dims;
-    int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X, x, a, b;
+    int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X, x, t;
     size_t off = hd__mg_vox(C->dims) * (size_t)ch + ((size_t)Z * C->dims[1] + Y) * C->dims[0];
-    const float *fr = F->res + hd__mg_vox(fd) * (size_t)ch;
+    hd__kctx k = F->k;
     float line[HD__CPU_ROW_MAX];
-    for (x = 0; x < fd[0]; ++x) line[x] = 0.0f;
-    for (a = 0; a < 4; ++a) {
-        int z = 2 * Z - 1 + a;
-        if (z < 0 || z >= fd[2]) continue;
-        for (b = 0; b < 4; ++b) {
-            int y = 2 * Y - 1 + b;
-            const float *src;
-            float w = hd__mg_fw[a] * hd__mg_fw[b];
-            if (y < 0 || y >= fd[1]) continue;
-            src = fr + ((size_t)z * fd[1] + y) * fd[0];
-            for (x = 0; x < fd[0]; ++x) line[x] += w * src[x];
-        }
-    }
+    k.f16 = 0;
+    k.phi = F->res;
+    for (x = 0; x < F->dims[0]; ++x) line[x] = hd_mg_restrict_line(&k, x, Y, Z, ch);
     for (X = 0; X < C->dims[0]; ++X) {
         float s = 0.0f;
-        for (a = 0; a < 4; ++a) {
-            x = 2 * X - 1 + a;
-            if (x >= 0 && x < fd[0]) s += hd__mg_fw[a] * line[x];
+        for (t = 0; t < 4; ++t) {
+            x = 2 * X - 1 + t;
+            if (x >= 0 && x < F->dims[0]) s = hd_mg_restrict_x(s, t, line[x]);
         }
         C->rhs[off + X] = s;
         C->phi[off + X] = 0.0f;
     }
 }
 
-/* Coarse index and weight of the nearer coarse neighbour along one axis for fine index i:
-   the fine centre lies 1/4 coarse voxel from coarse voxel i / 2, toward its far neighbour. */
-static void hd__mg_axis(int i, int *near, int *far)
-{
-    *near = i >> 1;
-    *far = (i & 1) ? *near + 1 : *near - 1;
-}
-
-/* The trilinear interpolation of level mg->cur's correction at the voxel centres of row r of
-   the level above, into e[]. */
-static void hd__mg_prolong_into(const hd__backend *be, int r, float *e)
-{
-    const struct hd__cpu_mg *mg = be->mg;
-    const hd__cpu_level *C = &mg->lv[mg->cur], *F = &mg->lv[mg->cur - 1];
-    int y = r % F->dims[1], z = (r / F->dims[1]) % F->dims[2], ch = r / (F->dims[1] * F->dims[2]), x, a, b;
-    int yn, yf, zn, zf;
-    const int *cd = C->dims;
-    const float *cp = C->phi + hd__mg_vox(cd) * (size_t)ch;
-    hd__mg_axis(y, &yn, &yf);
-    hd__mg_axis(z, &zn, &zf);
-    for (x = 0; x < F->dims[0]; ++x) {
-        int xn, xf, ys[2], zs[2], xs[2];
-        float w[2] = {0.75f, 0.25f}, v = 0.0f;
-        hd__mg_axis(x, &xn, &xf);
-        xs[0] = xn; xs[1] = xf; ys[0] = yn; ys[1] = yf; zs[0] = zn; zs[1] = zf;
-        for (a = 0; a < 2; ++a)
-            for (b = 0; b < 2; ++b) {
-                int c2;
-                if (zs[a] < 0 || zs[a] >= cd[2] || ys[b] < 0 || ys[b] >= cd[1]) continue;
-                for (c2 = 0; c2 < 2; ++c2)
-                    if (xs[c2] >= 0 && xs[c2] < cd[0])
-                        v += w[a] * w[b] * w[c2] * cp[((size_t)zs[a] * cd[1] + ys[b]) * cd[0] + xs[c2]];
-            }
-        e[x] = v;
-    }
-}
-
-/* Adds the prolonged correction of level mg->cur to row r of the level above. */
-static void hd__cpu_mg_prolong_row(hd__backend *be, int r)
+/* Adds the prolonged correction of level mg->cur (hd_mg_prolong) to row r of the level above. */
+static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
     const hd__cpu_level *F = &mg->lv[mg->cur - 1];
-    int x, gx = F->dims[0];
+    hd__kctx k = mg->lv[mg->cur].k;
+    int gx = F->dims[0], y = r % F->dims[1], z = (r / F->dims[1]) % F->dims[2], c = r / (F->dims[1] * F->dims[2]), x;
     float e[HD__CPU_ROW_MAX];
     float *phi = F->phi + (size_t)r * gx;
-    hd__mg_prolong_into(be, r, e);
+    k.f16 = 0;
+    for (x = 0; x < gx; ++x) e[x] = hd_mg_prolong(&k, x, y, z, c);
     for (x = 0; x < gx; ++x) phi[x] += e[x];
 }
 
@@ -417,67 +332,35 @@ static void hd__cpu_mg_cycle(hd__backend *be, int l)
 }
 
 /* ---- the fine residual in double ------------------------------------------------------------------ */
-/* f - A phi at one voxel of the fine grid with the shared kernel's own coefficients: the same
-   float source term and sigma_a as hd_diffuse_terms_box / _surface, and each face's exact weight
-   hd_diffuse_face / hd_diffuse_surface_face (one division per face, bit-identical from both
-   voxels, so this A is exactly symmetric, as CG needs; the sweep puts an axis' two faces over one
-   division, hd_diffuse_box_axis, and so relaxes the same A to within a few ulps), summed in double with every neighbour's term written as a difference
-   w (phi_i - phi_j). Why: the kernel's float residual num - den phi cancels two terms of about
-   den phi (den ~ 2e4 in soft tissue at h = 1/128), so it carries rounding of about 1e-4 of the
-   source there, and CG driven by it stalled at a relative residual of 1.2e-4 on the head CT at
-   half resolution (double-evaluated); the difference form in double is exact to the last bit of
-   its float inputs. in_* say whether the neighbour on each side lies in the grid (literals for
-   interior voxels, as in hd_cpu.h's row loops). */
-HD__CPU_INLINE double hd__mg_res_f64(const hd__kctx *K, const float *lo, int x, int y, int z, int c, int surface, int rgb,
-                                    int in_xm, int in_xp, int in_ym, int in_yp, int in_zm, int in_zp)
-{
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, f;
-    int i = (z * gy + y) * gx + x, ic = i + c * gx * gy * gz, sxy = gx * gy;
-    int rhs = (K->p->counts.z & HD_FLAG_DIFFUSE_RHS) != 0;
-    float fl = K->p->grid.w, sp, ag, dn;
-    float src = hd_diffuse_own(K, i, x, y, z, c, rgb, rhs, &sp, &ag, &dn);
-    double pi = (double)K->phi[ic] + (lo ? lo[ic] : 0.0f), r = (double)src - (double)dn * pi;
-    const int inside[6] = {in_xm, in_xp, in_ym, in_yp, in_zm, in_zp};
-    const int off[6] = {-1, 1, -gx, gx, -sxy, sxy};
-    const int nx[6] = {x - 1, x + 1, x, x, x, x}, ny[6] = {y, y, y - 1, y + 1, y, y}, nz[6] = {z, z, z, z, z - 1, z + 1};
-    const float scale[3] = {K->p->grid.x, K->p->grid.y, K->p->grid.z}, h[3] = {K->p->gridh.x, K->p->gridh.y, K->p->gridh.z};
-    if (surface && sp + sp < fl) return -pi; /* an empty voxel's row: phi = 0 */
-    for (f = 0; f < 6; ++f) {
-        float w, open = 1.0f;
-        if (surface) {
-            float spj = inside[f] ? hd_diffuse_sigp(K, i + off[f], nx[f], ny[f], nz[f], c, rgb, ag) : 0.0f;
-            w = hd_diffuse_surface_face(scale[f >> 1], h[f >> 1], sp, spj, inside[f], fl, &open);
-        } else {
-            float spj = inside[f] ? hd_diffuse_sigp(K, i + off[f], nx[f], ny[f], nz[f], c, rgb, ag) : sp;
-            w = hd_diffuse_face(scale[f >> 1], sp, spj, fl);
-            open = inside[f] ? 1.0f : 0.0f;
-        }
-        if (open != 0.0f) r -= (double)w * (pi - ((double)K->phi[ic + off[f]] + (lo ? lo[ic + off[f]] : 0.0f)));
-        else r -= (double)w * pi;
-    }
-    return r;
-}
-
-/* The residual of row r (= (c * gz + z) * gy + y) of be->grid into out[], evaluated in double
-   (hd__mg_res_f64), stored as float; on the fine grid of the iterate phi + lo (mg->fineg). */
+/* f - A (phi + lo) of row r (= (c * gz + z) * gy + y) of be->grid into out[], evaluated in double
+   by the shared hd_mg_res_f64 (hd_k_multigrid.h says why), stored as float; lo (the iterate's low
+   part) only on the fine grid of the iterate (mg->fineg). Literal in-grid flags, boundary and RGB
+   for the interior voxels, so each variant's loop has no test. */
 static HD__CPU_FLATTEN void hd__cpu_mg_residual_f64_into(const hd__backend *be, int r, float *out)
 {
-    const hd__kctx *K = be->grid->k;
-    const float *lo = be->mg && be->grid == &be->mg->fineg ? be->mg->lo : NULL;
+    hd__kctx k = *be->grid->k;
+    const hd__kctx *K = &k;
+    int lo = be->mg && be->grid == &be->mg->fineg;
     int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
     int surface = (K->p->counts.z & HD_FLAG_SURFACE_BOUNDARY) != 0, rgb = (K->p->counts.z & HD_FLAG_RGB_SCATTERING) != 0;
     int edge = gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1;
+    k.f16 = 0;
+    k.phi2 = lo ? be->mg->lo : NULL;
     for (x = 0; x < gx; ++x) {
         int ix = x > 0 && x < gx - 1;
         if (edge || !ix)
-            out[x] = (float)hd__mg_res_f64(K, lo, x, y, z, c, surface, rgb, x > 0, x < gx - 1, y > 0, y < gy - 1, z > 0, z < gz - 1);
-        else if (surface)
-            out[x] = (float)(rgb ? hd__mg_res_f64(K, lo, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, 1)
-                                 : hd__mg_res_f64(K, lo, x, y, z, c, 1, 0, 1, 1, 1, 1, 1, 1));
+            out[x] = (float)hd_mg_res_f64(K, x, y, z, c, surface, rgb, lo, x > 0, x < gx - 1, y > 0, y < gy - 1, z > 0, z < gz - 1);
+        else if (lo)
+            out[x] = (float)(surface ? (rgb ? hd_mg_res_f64(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, 1, 1)
+                                            : hd_mg_res_f64(K, x, y, z, c, 1, 0, 1, 1, 1, 1, 1, 1, 1))
+                                     : (rgb ? hd_mg_res_f64(K, x, y, z, c, 0, 1, 1, 1, 1, 1, 1, 1, 1)
+                                            : hd_mg_res_f64(K, x, y, z, c, 0, 0, 1, 1, 1, 1, 1, 1, 1)));
         else
-            out[x] = (float)(rgb ? hd__mg_res_f64(K, lo, x, y, z, c, 0, 1, 1, 1, 1, 1, 1, 1)
-                                 : hd__mg_res_f64(K, lo, x, y, z, c, 0, 0, 1, 1, 1, 1, 1, 1));
+            out[x] = (float)(surface ? (rgb ? hd_mg_res_f64(K, x, y, z, c, 1, 1, 0, 1, 1, 1, 1, 1, 1)
+                                            : hd_mg_res_f64(K, x, y, z, c, 1, 0, 0, 1, 1, 1, 1, 1, 1))
+                                     : (rgb ? hd_mg_res_f64(K, x, y, z, c, 0, 1, 0, 1, 1, 1, 1, 1, 1)
+                                            : hd_mg_res_f64(K, x, y, z, c, 0, 0, 0, 1, 1, 1, 1, 1, 1)));
     }
 }
 
@@ -488,15 +371,22 @@ static void hd__cpu_mg_residual_f64_row(hd__backend *be, int r)
 }
 
 /* ---- conjugate gradients' passes over the fine rows --------------------------------------------- */
+/* <a, b> of row r of level 0 (hd_mg_dot_row: in double, x in order). */
+static double hd__cpu_mg_dot(const hd__backend *be, int r, float *a, float *b)
+{
+    const struct hd__cpu_mg *mg = be->mg;
+    hd__kctx k = mg->lv[0].k;
+    k.f16 = 0;
+    k.E = a;
+    k.phi = b;
+    return hd_mg_dot_row(&k, r % mg->lv[0].dims[1], r / mg->lv[0].dims[1]);
+}
+
 /* dot_a[r] = <r, z> of row r. */
 static void hd__cpu_mg_rz_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
-    int x, gx = mg->lv[0].dims[0];
-    const float *rr = mg->lv[0].rhs + (size_t)r * gx, *z = mg->lv[0].phi + (size_t)r * gx;
-    double d = 0.0;
-    for (x = 0; x < gx; ++x) d += (double)rr[x] * z[x];
-    mg->dot_a[r] = d;
+    mg->dot_a[r] = hd__cpu_mg_dot(be, r, mg->lv[0].rhs, mg->lv[0].phi);
 }
 
 /* p = z + beta p, then z = 0 (the next V-cycle's start, and A p's zero right-hand side). */
@@ -506,7 +396,7 @@ static void hd__cpu_mg_dir_row(hd__backend *be, int r)
     int x, gx = mg->lv[0].dims[0];
     float *z = mg->lv[0].phi + (size_t)r * gx, *p = mg->p + (size_t)r * gx, beta = mg->beta;
     for (x = 0; x < gx; ++x) {
-        p[x] = z[x] + beta * p[x];
+        p[x] = hd_mg_dir_of(z[x], p[x], beta);
         z[x] = 0.0f;
     }
 }
@@ -520,22 +410,13 @@ static void hd__cpu_mg_op_row(hd__backend *be, int r)
     struct hd__cpu_mg *mg = be->mg;
     int x, gx = mg->lv[0].dims[0];
     float *q = mg->lv[0].res + (size_t)r * gx;
-    const float *p = mg->p + (size_t)r * gx, *rr = mg->lv[0].rhs + (size_t)r * gx;
-    double pq = 0.0, rp = 0.0;
     hd__cpu_mg_residual_f64_into(be, r, q);
-    for (x = 0; x < gx; ++x) {
-        q[x] = -q[x];
-        pq += (double)p[x] * q[x];
-        rp += (double)rr[x] * p[x];
-    }
-    mg->dot_a[r] = pq;
-    mg->dot_b[r] = rp;
+    for (x = 0; x < gx; ++x) q[x] = -q[x];
+    mg->dot_a[r] = hd__cpu_mg_dot(be, r, mg->p, mg->lv[0].res);
+    mg->dot_b[r] = hd__cpu_mg_dot(be, r, mg->lv[0].rhs, mg->p);
 }
 
-/* phi + lo += alpha p in double; phi is the sum rounded to float (what the projection reads),
-   lo the rest. Why: with phi alone, every step's rounding (up to half an ulp per voxel) added a
-   fresh rough error that one line search cannot remove, and the relative residual on the head
-   CT (half resolution) climbed from 4.7e-5 back to 1.1e-4 over 24 further steps. */
+/* phi + lo += alpha p in double (hd_mg_update_of): phi is the sum rounded to float, lo the rest. */
 static void hd__cpu_mg_update_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
@@ -543,11 +424,7 @@ static void hd__cpu_mg_update_row(hd__backend *be, int r)
     float *phi = be->phi + (size_t)r * gx, *lo = mg->lo + (size_t)r * gx;
     double alpha = mg->alpha;
     const float *p = mg->p + (size_t)r * gx;
-    for (x = 0; x < gx; ++x) {
-        double t = (double)phi[x] + lo[x] + alpha * p[x];
-        phi[x] = (float)t;
-        lo[x] = (float)(t - phi[x]);
-    }
+    for (x = 0; x < gx; ++x) phi[x] = hd_mg_update_of(phi[x], &lo[x], p[x], alpha);
 }
 
 /* The sum of the first `rows` entries of d in row order (the same bits for any thread count). */

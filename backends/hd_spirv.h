@@ -13,6 +13,7 @@
        backends/kernels/hd_k_classify.h
        backends/kernels/hd_k_direct.h
        backends/kernels/hd_k_diffuse.h
+       backends/kernels/hd_k_multigrid.h
        backends/kernels/hd_k_project.h
        backends/kernels/hd_k_convect.h
        backends/kernels/hd_k_path.h

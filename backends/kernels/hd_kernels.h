@@ -4,6 +4,7 @@
 #include "hd_k_classify.h"
 #include "hd_k_direct.h"
 #include "hd_k_diffuse.h"
+#include "hd_k_multigrid.h"
 #include "hd_k_project.h"
 #include "hd_k_convect.h"
 #include "hd_k_path.h"
