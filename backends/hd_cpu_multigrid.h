@@ -1,5 +1,7 @@
 /* hd_cpu_multigrid.h - the CPU backend's multigrid-preconditioned conjugate gradients for the
-   diffusion solve (params.solver = HD_SOLVER_MULTIGRID), included by hd_cpu.h.
+   diffusion solve (params.solver = HD_SOLVER_MULTIGRID), included by hd_cpu.h. This file is the
+   design; the per-voxel math is the shared backends/kernels/hd_k_multigrid.h, and the OpenCL
+   backend (hd_opencl.h's hd__be_multigrid) runs the same passes in the same order.
 
    Why: one relaxation sweep moves information one voxel, so single-level sweeps need O(n^2) of
    them to carry light across an n-voxel volume. A V-cycle reduces every scale of the error at

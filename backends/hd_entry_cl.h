@@ -122,3 +122,158 @@ __kernel void hd_k_path(HD__CL_BUFFERS)
     HD__CL_KCTX;
     hd_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
+
+/* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_multigrid ---------------
+   The math is hd_k_multigrid.h's; the V-cycle's smoothing is the diffusion kernels above, run on a
+   level's own parameter block (its dims, 1 / h^2, h and HD_FLAG_DIFFUSE_RHS) and buffers. Every
+   grid of the solver (each level's sigma_t, right-hand side, correction and residual, conjugate
+   gradients' vectors) is stored in the colour layout of its own dims, the layout those kernels
+   read; the kernels here reach a grid through a context made from its parameter block
+   (hd__cl_mg_ctx: cx = cp = cid = 0, so HD_GET / HD_SET give any voxel's slot), one work-item
+   per voxel of the grid they write (global size (gx, gy, gz * channels)), or per row for the dot
+   products (global size (gy, gz * channels)). */
+HD_FN hd__kctx hd__cl_mg_ctx(__constant hd__kparams *p)
+{
+    hd__kctx k;
+    k.p = p; k.vol = 0; k.tf = 0; k.maj = 0; k.sig = 0; k.E = 0; k.phi = 0; k.phi2 = 0; k.img = 0; k.lv = 0;
+    k.lv2 = 0; k.Eh = 0; k.phih = 0; k.phi2h = 0; k.f16 = 0; k.flags = p->counts.z;
+    k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0;
+    return k;
+}
+/* Stores into voxel (x, y, zz) of one of K's grids (HD_SET names its context K). */
+HD_FN void hd__cl_mg_set_sig(const hd__kctx *K, int x, int y, int zz, float v) { HD_SET(sig, 0, x, y, zz, v); }
+HD_FN void hd__cl_mg_set_E(const hd__kctx *K, int x, int y, int zz, float v) { HD_SET(E, 0, x, y, zz, v); }
+HD_FN void hd__cl_mg_set_phi(const hd__kctx *K, int x, int y, int zz, float v) { HD_SET(phi, 0, x, y, zz, v); }
+HD_FN void hd__cl_mg_set_phi2(const hd__kctx *K, int x, int y, int zz, float v) { HD_SET(phi2, 0, x, y, zz, v); }
+HD_FN float hd__cl_mg_get_E(const hd__kctx *K, int x, int y, int zz) { return HD_GET(E, 0, x, y, zz); }
+HD_FN float hd__cl_mg_get_phi(const hd__kctx *K, int x, int y, int zz) { return HD_GET(phi, 0, x, y, zz); }
+HD_FN float hd__cl_mg_get_phi2(const hd__kctx *K, int x, int y, int zz) { return HD_GET(phi2, 0, x, y, zz); }
+
+/* A coarse level's sigma_t (all its channels: global z = gz * sigma_t channels) from the level
+   above (pf, fsig). */
+__kernel void hd_k_mg_sig(__constant hd__kparams *pf, __constant hd__kparams *pc, __global float *fsig,
+                          __global float *csig)
+{
+    hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
+    int X = (int)get_global_id(0), Y = (int)get_global_id(1), zz = (int)get_global_id(2), gz = pc->gdims.z;
+    kf.sig = fsig;
+    kc.sig = csig;
+    hd__cl_mg_set_sig(&kc, X, Y, zz, hd_mg_coarse_sig(&kf, X, Y, zz % gz, zz / gz));
+}
+
+/* A level's float residual f - A phi into phi2 (the level's residual buffer; sig, E = the
+   right-hand side, phi = the correction: the smoothing's bindings): the diffusion kernels' own
+   work-item mapping, colour `parity` per pass (so loads are contiguous and the loop vectorises),
+   and hd_diffuse_terms' num - den phi, hd_diffuse_residual's and the CPU's hd__cpu_residual_row's
+   expression. Padding slots get a finite, unused value, as in the sweep. */
+#define HD__CL_MG_RESIDUAL(name, bits) \
+    __kernel void name(HD__CL_BUFFERS, int parity) \
+    { \
+        HD__CL_KCTX; \
+        const hd__kctx *K = &k; \
+        int gz = p->gdims.z, y = (int)get_global_id(1); \
+        int z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz; \
+        int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp; \
+        float den, num; \
+        k.flags = (k.flags & ~(HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY)) | (bits); \
+        k.cx = x; \
+        k.cp = cp; \
+        k.cid = get_global_id(0); \
+        num = hd_diffuse_terms(&k, x, y, z, c, &den); \
+        HD_SET(phi2, 0, x, y, z + c * gz, num - den * HD_GET(phi, 0, x, y, z + c * gz)); \
+    }
+HD__CL_MG_RESIDUAL(hd_k_mg_residual, 0)
+HD__CL_MG_RESIDUAL(hd_k_mg_residual_rgb, HD_FLAG_RGB_SCATTERING)
+HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface, HD_FLAG_SURFACE_BOUNDARY)
+HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING)
+
+/* A coarse level's right-hand side, the restriction of the fine residual fres; its correction
+   cphi starts at 0. */
+__kernel void hd_k_mg_restrict(__constant hd__kparams *pf, __constant hd__kparams *pc, __global float *fres,
+                               __global float *crhs, __global float *cphi)
+{
+    hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
+    int X = (int)get_global_id(0), Y = (int)get_global_id(1), zz = (int)get_global_id(2), gz = pc->gdims.z;
+    kf.phi = fres;
+    kc.E = crhs; kc.phi = cphi;
+    hd__cl_mg_set_E(&kc, X, Y, zz, hd_mg_restrict(&kf, X, Y, zz % gz, zz / gz));
+    hd__cl_mg_set_phi(&kc, X, Y, zz, 0.0f);
+}
+
+/* Adds the coarse correction cphi, interpolated, to the fine correction fphi: the diffusion's
+   work-item mapping over the fine grid, colour `parity` per pass, so the fine grid's load and
+   store are contiguous (the coarse loads are gathers in any mapping: a coarse row's colours
+   alternate with x). */
+__kernel void hd_k_mg_prolong(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
+                              __global float *restrict cphi, __global float *restrict fphi, int parity)
+{
+    hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
+    int gz = pf->gdims.z, y = (int)get_global_id(1), z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz;
+    int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp;
+    kc.phi = cphi;
+    kf.phi = fphi;
+    kf.cx = x; kf.cp = cp; kf.cid = get_global_id(0);
+    hd__cl_mg_set_phi(&kf, x, y, z + c * gz,
+                      hd__cl_mg_get_phi(&kf, x, y, z + c * gz) + hd_mg_prolong(&kc, hd_mini(x, pf->gdims.x - 1), y, z, c));
+}
+
+/* p = z + beta p, then z = 0. */
+__kernel void hd_k_mg_dir(__constant hd__kparams *p, __global float *z, __global float *dir, float beta)
+{
+    hd__kctx k = hd__cl_mg_ctx(p);
+    int x = (int)get_global_id(0), y = (int)get_global_id(1), zz = (int)get_global_id(2);
+    k.E = z; k.phi = dir;
+    hd__cl_mg_set_phi(&k, x, y, zz, hd_mg_dir_of(hd__cl_mg_get_E(&k, x, y, zz), hd__cl_mg_get_phi(&k, x, y, zz), beta));
+    hd__cl_mg_set_E(&k, x, y, zz, 0.0f);
+}
+
+#ifdef HD_MG_F64
+/* The fine grid's residual in double (hd_mg_res_f64): f - A (phi + lo) with use_lo, into out
+   (negate: -(f - A phi), conjugate gradients' q = A p with E = 0). The diffusion's work-item
+   mapping (colour `parity` per pass) and literal boundary and RGB flags, as the residual above. */
+#define HD__CL_MG_RES_F64(name, surface, rgb) \
+    __kernel void name(__constant hd__kparams *restrict p, __global float *restrict sig, __global float *restrict E, \
+                       __global float *restrict phi, __global float *restrict lo, __global float *restrict out, \
+                       int parity, int use_lo, int negate) \
+    { \
+        hd__kctx k = hd__cl_mg_ctx(p), ko; \
+        int gx = p->gdims.x, gy = p->gdims.y, gz = p->gdims.z, y = (int)get_global_id(1); \
+        int z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz; \
+        int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp; \
+        float v; \
+        k.sig = sig; k.E = E; k.phi = phi; k.phi2 = lo; \
+        k.cx = x; k.cp = cp; k.cid = get_global_id(0); \
+        ko = k; \
+        ko.phi = out; \
+        v = (float)hd_mg_res_f64(&k, x, y, z, c, surface, rgb, use_lo, x > 0 ? 1 : 0, x < gx - 1 ? 1 : 0, y > 0 ? 1 : 0, \
+                                 y < gy - 1 ? 1 : 0, z > 0 ? 1 : 0, z < gz - 1 ? 1 : 0); \
+        hd__cl_mg_set_phi(&ko, x, y, z + c * gz, negate != 0 ? -v : v); \
+    }
+HD__CL_MG_RES_F64(hd_k_mg_res_f64, 0, 0)
+HD__CL_MG_RES_F64(hd_k_mg_res_f64_rgb, 0, 1)
+HD__CL_MG_RES_F64(hd_k_mg_res_f64_surface, 1, 0)
+HD__CL_MG_RES_F64(hd_k_mg_res_f64_surface_rgb, 1, 1)
+
+/* dot[r] = <a, b> of row r = zz * gy + y (hd_mg_dot_row); the host sums the rows in order. */
+__kernel void hd_k_mg_dot(__constant hd__kparams *p, __global float *a, __global float *b, __global double *dot)
+{
+    hd__kctx k = hd__cl_mg_ctx(p);
+    int y = (int)get_global_id(0), zz = (int)get_global_id(1);
+    k.E = a; k.phi = b;
+    dot[(size_t)zz * p->gdims.y + y] = hd_mg_dot_row(&k, y, zz);
+}
+
+/* phi + lo += alpha p in double (hd_mg_update_of). */
+__kernel void hd_k_mg_update(__constant hd__kparams *p, __global float *phi, __global float *lo, __global float *dir,
+                             double alpha)
+{
+    hd__kctx k = hd__cl_mg_ctx(p);
+    int x = (int)get_global_id(0), y = (int)get_global_id(1), zz = (int)get_global_id(2);
+    float l, f;
+    k.phi = phi; k.phi2 = lo; k.E = dir;
+    l = hd__cl_mg_get_phi2(&k, x, y, zz);
+    f = hd_mg_update_of(hd__cl_mg_get_phi(&k, x, y, zz), &l, hd__cl_mg_get_E(&k, x, y, zz), alpha);
+    hd__cl_mg_set_phi(&k, x, y, zz, f);
+    hd__cl_mg_set_phi2(&k, x, y, zz, l);
+}
+#endif

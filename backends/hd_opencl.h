@@ -37,7 +37,12 @@
    (hd__cl_k picks them), the diffusion's in the same order */
 enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_DIFFUSE + 8, HD__CL_CONVECT,
        HD__CL_SUM_LIGHT, HD__CL_PATH, HD__CL_DIRECT_HALF, HD__CL_DIFFUSE_HALF,
-       HD__CL_PROJECT_HALF = HD__CL_DIFFUSE_HALF + 8, HD__CL_SUM_LIGHT_HALF, HD__CL_KERNEL_COUNT };
+       HD__CL_PROJECT_HALF = HD__CL_DIFFUSE_HALF + 8, HD__CL_SUM_LIGHT_HALF,
+       /* HD_SOLVER_MULTIGRID's passes (hd_entry_cl.h); the residuals in four variants each, indexed
+          by 2 * surface boundary + RGB scattering; those from HD__CL_MG_RES_F64 on compute in
+          double and exist only on a device with cl_khr_fp64 */
+       HD__CL_MG_SIG, HD__CL_MG_RESIDUAL, HD__CL_MG_RESTRICT = HD__CL_MG_RESIDUAL + 4, HD__CL_MG_PROLONG, HD__CL_MG_DIR,
+       HD__CL_MG_RES_F64, HD__CL_MG_DOT = HD__CL_MG_RES_F64 + 4, HD__CL_MG_UPDATE, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
     "hd_k_diffuse_surface_rgb", "hd_k_diffuse_jacobi", "hd_k_diffuse_jacobi_rgb", "hd_k_diffuse_jacobi_surface",
@@ -45,7 +50,12 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_direct_half", "hd_k_diffuse_half", "hd_k_diffuse_rgb_half", "hd_k_diffuse_surface_half",
     "hd_k_diffuse_surface_rgb_half", "hd_k_diffuse_jacobi_half", "hd_k_diffuse_jacobi_rgb_half",
     "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
-    "hd_k_sum_light_half"};
+    "hd_k_sum_light_half", "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
+    "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
+    "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update"};
+
+struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (hd__be_multigrid, at the end) */
+static void hd__cl_mg_free(hd__ctx *ctx);
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -65,6 +75,9 @@ struct hd__backend {
     hd__kparams params_sent; /* what the params buffer holds */
     int params_valid;
     int lost;                /* a call reported a lost device: every later call fails fast */
+    int fp64;                /* the device has cl_khr_fp64 (multigrid's double passes) */
+    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    struct hd__cl_mg *mg;    /* multigrid levels, NULL until first used */
 };
 
 static const char *hd__be_name(void) { return "opencl"; }
@@ -232,6 +245,7 @@ static hd_result hd__cl_build(hd__ctx *ctx)
         return r;
     }
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
+        if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_UPDATE) continue; /* not compiled (HD_MG_F64) */
         be->kernels[k] = clCreateKernel(be->program, hd__cl_kernel_names[k], &e);
         if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(ctx, e, hd__cl_kernel_names[k], 0, __LINE__); }
     }
@@ -292,6 +306,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     if (!be) return;
     if (be->queue) clFinish(be->queue);
     hd__cl_free_lights(ctx);
+    hd__cl_mg_free(ctx);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf);
     hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
     hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
@@ -323,7 +338,11 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if (const_size < sizeof(hd__kparams))
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: %s holds %llu bytes of __constant memory, the parameters need %zu",
                        name, (unsigned long long)const_size, sizeof(hd__kparams));
-    HD__INFO(&ctx->log, "opencl: device %s (%s)", name, version);
+    {
+        cl_device_fp_config fp64 = 0; /* 0 without double support (OpenCL 1.2: cl_khr_fp64) */
+        if (clGetDeviceInfo(be->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) == CL_SUCCESS) be->fp64 = fp64 != 0;
+    }
+    HD__INFO(&ctx->log, "opencl: device %s (%s)%s", name, version, be->fp64 ? "" : ", no double precision (no multigrid solver)");
     if ((r = hd__cl_build(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->params, sizeof(hd__kparams), NULL, "the parameter block")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->vol, ctx->nvox * sizeof(float), ctx->vol, "the volume")) != HD_SUCCESS) return r;
@@ -395,6 +414,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     size_t slots = illum_floats ? hd__cl_slots(ctx, (size_t)ctx->gdims[2] * (size_t)ctx->channels) : 0, bytes;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
+    hd__cl_mg_free(ctx); /* its fine grid is this one */
     hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
     be->illum_floats = 0;
     be->illum_slots = 0;
@@ -445,19 +465,29 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 }
 
 /* ---- dispatch ------------------------------------------------------------------------------ */
-/* Sends ctx->kp when it changed since the last dispatch (blocking: the host copy changes every
-   iteration), and binds the buffers to kernel k's first nine arguments. */
-static hd_result hd__cl_bind(hd__ctx *ctx, int k)
+/* Sends ctx->kp to the params buffer when it changed since the last send (blocking: the host
+   copy changes every iteration). */
+static hd_result hd__cl_send_params(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    cl_mem args[9];
-    cl_uint i;
     HD__CL_LOST_CHECK(ctx);
     if (!be->params_valid || memcmp(&be->params_sent, &ctx->kp, sizeof ctx->kp) != 0) {
         HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof ctx->kp, &ctx->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
         be->params_sent = ctx->kp;
         be->params_valid = 1;
     }
+    return HD_SUCCESS;
+}
+
+/* Sends ctx->kp if it changed (hd__cl_send_params) and binds the buffers to kernel k's first
+   nine arguments. */
+static hd_result hd__cl_bind(hd__ctx *ctx, int k)
+{
+    hd__backend *be = ctx->be;
+    cl_mem args[9];
+    cl_uint i;
+    hd_result r;
+    if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
     args[0] = be->params; args[1] = be->vol; args[2] = be->tf; args[3] = be->maj; args[4] = be->sig;
     args[5] = be->E; args[6] = be->phi; args[7] = be->phi2; args[8] = be->img;
     for (i = 0; i < 9; ++i)
@@ -483,6 +513,7 @@ static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
     hd_result r;
+    ++ctx->be->sig_gen;
     if ((r = hd__cl_bind(ctx, HD__CL_CLASSIFY)) != HD_SUCCESS) return r;
     return hd__cl_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
 }
@@ -677,5 +708,379 @@ static hd_result hd__be_path(hd__ctx *ctx)
     if ((r = hd__cl_bind(ctx, HD__CL_PATH)) != HD_SUCCESS) return r;
     if ((r = hd__cl_run(ctx, HD__CL_PATH, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
+   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
+   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design and its
+   measurements), on the device: the per-voxel math is the shared hd_k_multigrid.h, the V-cycle's
+   smoothing the diffusion kernels on each level's own parameter block. Every grid (levels and CG
+   vectors) is in the colour layout of its own dims, so those kernels smooth a level unchanged;
+   level 0's sigma_t is the backend's. Where the CPU sums in double, so does the device
+   (cl_khr_fp64; without it the solver is unsupported, logged); the dot products are summed per
+   row on the device (x in order) and the rows in order on the host, as the CPU does: the same
+   operations in the same order, so the result has the CPU's bits wherever the kernels do (the
+   conformance suite measures it). */
+#define HD__BE_HAS_MULTIGRID 1
+#define HD__CL_MG_MAX_LEVELS 12
+#define HD__CL_MG_PRE 2
+#define HD__CL_MG_POST 2
+#define HD__CL_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
+
+typedef struct hd__cl_level {
+    int dims[3];
+    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    int kp_sent;             /* params holds kp */
+    cl_mem params;
+    cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
+    cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
+} hd__cl_level;
+
+struct hd__cl_mg {
+    hd__cl_level lv[HD__CL_MG_MAX_LEVELS];
+    int levels, channels, sig_channels, fine[3];
+    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
+    int sig_surface;         /* ... and the boundary they were restricted for */
+    cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
+    cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
+    double *host_dot;        /* their host copy, one row sum per fine row */
+    double rz;               /* <r, z> of the previous step */
+    float beta;
+    int have_dir;
+    uint64_t iteration;
+    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
+};
+
+static size_t hd__cl_mg_slots(const int *d, int channels)
+{
+    return (size_t)channels * d[2] * (size_t)d[1] * 2 * (((size_t)d[0] + 1) / 2);
+}
+static size_t hd__cl_mg_rows(const struct hd__cl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
+
+static void hd__cl_mg_free(hd__ctx *ctx)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    int l;
+    if (!mg) return;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__cl_level *L = &mg->lv[l];
+        hd__cl_release(&L->params); hd__cl_release(&L->sig); hd__cl_release(&L->rhs);
+        hd__cl_release(&L->phi); hd__cl_release(&L->res);
+    }
+    hd__cl_release(&mg->p); hd__cl_release(&mg->lo); hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b);
+    hd__free(ctx, mg->host_dot);
+    hd__free(ctx, mg);
+    ctx->be->mg = NULL;
+}
+
+/* Bytes the solver holds on the device (as the CPU's hd__be_solver_bytes: counted in
+   method_bytes); 0 without it. */
+static size_t hd__be_solver_bytes(const hd__ctx *ctx)
+{
+    const struct hd__cl_mg *mg = ctx->be->mg;
+    size_t b;
+    int l;
+    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    b = 2 * sizeof(double) * hd__cl_mg_rows(mg) + 2 * sizeof(float) * hd__cl_mg_slots(mg->fine, mg->channels);
+    for (l = 0; l < mg->levels; ++l) {
+        b += 3 * sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->channels);
+        if (l > 0) b += sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->sig_channels);
+    }
+    return b;
+}
+#define HD__BE_HAS_SOLVER_BYTES 1
+
+/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
+   one: hd_cpu_multigrid.h's rule) and CG's vectors, zeroed. */
+static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg;
+    int l, i, d[3];
+    hd_result r;
+    size_t rows;
+    be->mg = mg = (struct hd__cl_mg *)hd__calloc(ctx, 1, sizeof *mg);
+    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the multigrid levels");
+    mg->channels = ctx->channels;
+    mg->sig_channels = ctx->sig_channels;
+    mg->sig_gen = be->sig_gen - 1u; /* restrict sigma_t on first use */
+    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
+    rows = hd__cl_mg_rows(mg);
+    mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
+    if (!mg->host_dot) { hd__cl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows"); }
+    if ((r = hd__cl_buffer(ctx, &mg->p, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's p")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(ctx, &mg->lo, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's lo")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(ctx, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS) {
+        hd__cl_mg_free(ctx);
+        return r;
+    }
+    for (l = 0; l < HD__CL_MG_MAX_LEVELS; ++l) {
+        hd__cl_level *L = &mg->lv[l];
+        size_t bytes = hd__cl_mg_slots(d, mg->channels) * sizeof(float);
+        memcpy(L->dims, d, sizeof d);
+        mg->levels = l + 1;
+        if ((r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters")) != HD_SUCCESS ||
+            (r = hd__cl_buffer(ctx, &L->rhs, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__cl_buffer(ctx, &L->phi, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__cl_buffer(ctx, &L->res, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
+            (l > 0 && (r = hd__cl_buffer(ctx, &L->sig, hd__cl_mg_slots(d, mg->sig_channels) * sizeof(float), NULL,
+                                         "a multigrid level's sigma_t")) != HD_SUCCESS)) {
+            hd__cl_mg_free(ctx);
+            return r;
+        }
+        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
+        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+    }
+    return HD_SUCCESS;
+}
+
+/* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
+static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
+{
+    hd__cl_level *L = &ctx->be->mg->lv[l];
+    hd__kparams kp = ctx->kp;
+    float s = (float)(1 << l);
+    kp.gdims.x = L->dims[0]; kp.gdims.y = L->dims[1]; kp.gdims.z = L->dims[2];
+    kp.grid.x = ctx->kp.grid.x / (s * s); kp.grid.y = ctx->kp.grid.y / (s * s); kp.grid.z = ctx->kp.grid.z / (s * s);
+    kp.gridh.x = ctx->kp.gridh.x * s; kp.gridh.y = ctx->kp.gridh.y * s; kp.gridh.z = ctx->kp.gridh.z * s;
+    kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, L->params, CL_TRUE, 0, sizeof kp, &kp, 0, NULL, NULL), "clEnqueueWriteBuffer(multigrid level parameters)");
+    L->kp = kp;
+    L->kp_sent = 1;
+    return HD_SUCCESS;
+}
+
+/* Level l's sigma_t buffer. */
+static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg->lv[l].sig; }
+
+/* Binds n buffers to kernel k's first arguments. */
+static hd_result hd__cl_mg_args(hd__ctx *ctx, int k, int n, const cl_mem *m)
+{
+    int i;
+    for (i = 0; i < n; ++i)
+        HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], (cl_uint)i, sizeof(cl_mem), &m[i]), "clSetKernelArg(multigrid)");
+    return HD_SUCCESS;
+}
+
+/* Runs kernel k over level l's voxels (channels: how many stacked in z). */
+static hd_result hd__cl_mg_run(hd__ctx *ctx, int k, int l, int channels)
+{
+    const int *d = ctx->be->mg->lv[l].dims;
+    return hd__cl_run(ctx, k, 3, (size_t)d[0], (size_t)d[1], (size_t)d[2] * (size_t)channels);
+}
+
+/* The variant of a kernel family (diffusion, residuals) for the boundary and RGB flags. */
+static int hd__cl_mg_variant(const hd__ctx *ctx, int first)
+{
+    return first + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+}
+
+/* One pass of kernel k over the voxels of colour `parity` of level l in the diffusion's
+   work-item mapping (hd__be_diffuse: one x-row per work-group, (gx + 1) / 2 items), its parity
+   argument at index `arg`. */
+static hd_result hd__cl_mg_colour_pass(hd__ctx *ctx, int k, int l, cl_uint arg, cl_int parity)
+{
+    hd__backend *be = ctx->be;
+    const int *d = be->mg->lv[l].dims;
+    size_t hx = ((size_t)d[0] + 1) / 2, local[3], wg = 0;
+    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+               "clGetKernelWorkGroupInfo");
+    local[0] = hx; local[1] = 1; local[2] = 1;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], arg, sizeof parity, &parity), "clSetKernelArg(parity)");
+    return hd__cl_run_local(ctx, k, 3, hx, (size_t)d[1], (size_t)d[2] * (size_t)be->mg->channels, hx <= wg ? local : NULL);
+}
+
+/* Binds level l to kernel k's nine HD__CL_BUFFERS arguments: sigma_t, E = the right-hand side,
+   phi = the correction, phi2 = the residual (written by the residual kernels only). */
+static hd_result hd__cl_mg_bind_level(hd__ctx *ctx, int k, int l)
+{
+    hd__backend *be = ctx->be;
+    hd__cl_level *L = &be->mg->lv[l];
+    cl_mem args[9];
+    args[0] = L->params; args[1] = be->vol; args[2] = be->tf; args[3] = be->maj; args[4] = hd__cl_mg_sig(be, l);
+    args[5] = L->rhs; args[6] = L->phi; args[7] = L->res; args[8] = be->img;
+    return hd__cl_mg_args(ctx, k, 9, args);
+}
+
+/* `sweeps` red-black sweeps of level l with the diffusion kernel; first = 0: red then black,
+   1: black then red (the adjoint order, for post-smoothing). */
+static hd_result hd__cl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+{
+    int k = hd__cl_mg_variant(ctx, HD__CL_DIFFUSE), s, h;
+    hd_result r;
+    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS) return r;
+    for (s = 0; s < sweeps; ++s)
+        for (h = 0; h < 2; ++h)
+            if ((r = hd__cl_mg_colour_pass(ctx, k, l, 9, first ^ h)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
+static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1 < mg->levels ? l + 1 : l];
+    cl_mem a[5];
+    hd_result r;
+    int k;
+    if (l == mg->levels - 1) {
+        if ((r = hd__cl_mg_smooth(ctx, l, HD__CL_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
+        return hd__cl_mg_smooth(ctx, l, HD__CL_MG_COARSEST_SWEEPS, 1);
+    }
+    if ((r = hd__cl_mg_smooth(ctx, l, HD__CL_MG_PRE, 0)) != HD_SUCCESS) return r;
+    k = hd__cl_mg_variant(ctx, HD__CL_MG_RESIDUAL);
+    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS || (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 0)) != HD_SUCCESS ||
+        (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 1)) != HD_SUCCESS)
+        return r;
+    a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = C->rhs; a[4] = C->phi;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT, 5, a)) != HD_SUCCESS ||
+        (r = hd__cl_mg_run(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels)) != HD_SUCCESS)
+        return r;
+    if ((r = hd__cl_mg_cycle(ctx, l + 1)) != HD_SUCCESS) return r;
+    a[0] = L->params; a[1] = C->params; a[2] = C->phi; a[3] = L->phi;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_PROLONG, 4, a)) != HD_SUCCESS ||
+        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 0)) != HD_SUCCESS ||
+        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 1)) != HD_SUCCESS)
+        return r;
+    return hd__cl_mg_smooth(ctx, l, HD__CL_MG_POST, 1);
+}
+
+/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
+   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
+static hd_result hd__cl_mg_res_f64(hd__ctx *ctx, cl_mem params, cl_mem E, cl_mem phi, cl_mem out, cl_int use_lo, cl_int negate)
+{
+    hd__backend *be = ctx->be;
+    cl_mem a[6];
+    int ki = hd__cl_mg_variant(ctx, HD__CL_MG_RES_F64);
+    cl_kernel k = be->kernels[ki];
+    hd_result r;
+    a[0] = params; a[1] = be->sig; a[2] = E; a[3] = phi; a[4] = be->mg->lo; a[5] = out;
+    if ((r = hd__cl_mg_args(ctx, ki, 6, a)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(k, 7, sizeof use_lo, &use_lo), "clSetKernelArg(use_lo)");
+    HD__CL_TRY(ctx, clSetKernelArg(k, 8, sizeof negate, &negate), "clSetKernelArg(negate)");
+    if ((r = hd__cl_mg_colour_pass(ctx, ki, 0, 6, 0)) != HD_SUCCESS) return r;
+    return hd__cl_mg_colour_pass(ctx, ki, 0, 6, 1);
+}
+
+/* Enqueues <a, b> per fine row into dot (double per row). */
+static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    cl_mem m[4];
+    hd_result r;
+    m[0] = mg->lv[0].params; m[1] = a; m[2] = b; m[3] = dot;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DOT, 4, m)) != HD_SUCCESS) return r;
+    return hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)mg->fine[1], (size_t)mg->fine[2] * (size_t)mg->channels, 1);
+}
+
+/* Reads the row sums of dot (blocking: after every pass enqueued before) and sums them in row
+   order, as the CPU's hd__mg_sum. */
+static hd_result hd__cl_mg_sum(hd__ctx *ctx, cl_mem dot, double *out)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    size_t rows = hd__cl_mg_rows(mg), i;
+    double s = 0.0;
+    HD__CL_TRY(ctx, clEnqueueReadBuffer(ctx->be->queue, dot, CL_TRUE, 0, rows * sizeof(double), mg->host_dot, 0, NULL, NULL),
+               "clEnqueueReadBuffer(multigrid row sums)");
+    for (i = 0; i < rows; ++i) s += mg->host_dot[i];
+    *out = s;
+    return HD_SUCCESS;
+}
+
+/* The parameters A depends on (restart CG when one changes): grid, flags, medium, 1/h^2, h. */
+static void hd__cl_mg_akey(const hd__kparams *kp, hd__kparams *key)
+{
+    memset(key, 0, sizeof *key);
+    key->gdims = kp->gdims;
+    key->counts.z = kp->counts.z;
+    key->medium = kp->medium;
+    key->grid = kp->grid;
+    key->gridh = kp->gridh;
+}
+
+/* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
+   when it changed; *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
+static hd_result hd__cl_mg_prepare(hd__ctx *ctx, int *restart)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    hd__kparams key;
+    hd_result r;
+    int l, stale;
+    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
+               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
+        hd__cl_mg_free(ctx);
+    if (!be->mg && (r = hd__cl_mg_alloc(ctx)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    for (l = 0; l < mg->levels; ++l)
+        if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
+    hd__cl_mg_akey(&ctx->kp, &key);
+    stale = memcmp(&key, &mg->akey, sizeof key) != 0 || ctx->iterations < mg->iteration || mg->sig_gen != be->sig_gen;
+    *restart = stale || !mg->have_dir || mg->iteration != ctx->iterations;
+    mg->akey = key;
+    mg->iteration = ctx->iterations;
+    if (mg->sig_gen != be->sig_gen || mg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+        for (l = 1; l < mg->levels; ++l) {
+            cl_mem a[4];
+            a[0] = mg->lv[l - 1].params; a[1] = mg->lv[l].params; a[2] = hd__cl_mg_sig(be, l - 1); a[3] = mg->lv[l].sig;
+            if ((r = hd__cl_mg_args(ctx, HD__CL_MG_SIG, 4, a)) != HD_SUCCESS ||
+                (r = hd__cl_mg_run(ctx, HD__CL_MG_SIG, l, mg->sig_channels)) != HD_SUCCESS)
+                return r;
+        }
+        mg->sig_gen = be->sig_gen;
+        mg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
+        *restart = stale = 1;
+    }
+    if (stale) return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(mg->fine, mg->channels));
+    return HD_SUCCESS;
+}
+
+/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
+static hd_result hd__be_multigrid(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg;
+    hd__cl_level *L;
+    int restart;
+    double rz, pq, rp, alpha;
+    cl_mem a[4];
+    hd_result r;
+    HD__CL_LOST_CHECK(ctx);
+    if (!be->fp64)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
+    if ((r = hd__cl_mg_prepare(ctx, &restart)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    L = &mg->lv[0];
+    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new) */
+    if ((r = hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, L->rhs, 1, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, L->phi, mg->dot_a)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &rz)) != HD_SUCCESS) return r;
+    mg->beta = restart || !(mg->rz > 0.0) ? 0.0f : (float)(rz / mg->rz);
+    mg->rz = rz;
+    a[0] = L->params; a[1] = L->phi; a[2] = mg->p;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DIR, 3, a)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_DIR], 3, sizeof mg->beta, &mg->beta), "clSetKernelArg(beta)");
+    if ((r = hd__cl_mg_run(ctx, HD__CL_MG_DIR, 0, mg->channels)) != HD_SUCCESS) return r;
+    /* q = A p; <p, q>, <r, p> */
+    if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_dot_rows(ctx, mg->p, L->res, mg->dot_a)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &pq)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_sum(ctx, mg->dot_b, &rp)) != HD_SUCCESS) return r;
+    mg->have_dir = 1;
+    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
+    if (!(pq > 0.0)) return HD_SUCCESS;
+    alpha = rp / pq;
+    a[0] = L->params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
+    if ((r = hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
     return HD_SUCCESS;
 }

@@ -476,6 +476,61 @@ static void case_half(hd_method method, hd_voxel_type type, const int *d, int li
     scene_free(&s);
 }
 
+/* HD_SOLVER_MULTIGRID (conjugate gradients preconditioned by a multigrid V-cycle, CPU design in
+   backends/hd_cpu_multigrid.h). steps > 0: `steps` solver steps from identical E and phi (test
+   hooks), phi compared with the deterministic bounds: the backend runs the CPU's passes in the
+   CPU's order (the shared hd_k_multigrid.h, row sums in row order), so only a kernel's float
+   rounding could differ; steps == 0: n whole HD iterations (diffusion_sweeps 4 = 4 steps each),
+   E, phi and the image with the stochastic bound, as the other whole-iteration cases. grid:
+   illumination_downsample (an odd grid exercises the levels' rounding down). A backend without
+   the solver (HD_ERROR_UNSUPPORTED at create: Vulkan and GL so far) is reported as skipped,
+   neither passed nor failed. */
+static void case_multigrid(hd_voxel_type type, const int *d, int lights, int rgb, int surface, int grid, int steps, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    hd_desc desc;
+    hd_result r;
+    scene_init(&s, type, d[0], d[1], d[2], lights, rgb, 1);
+    s.params.solver = HD_SOLVER_MULTIGRID;
+    s.params.rgb_scattering = rgb;
+    s.params.diffusion_boundary = surface ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+    s.params.illumination_downsample = grid;
+    guard_take(&g, &s);
+    if (steps > 0)
+        snprintf(name, sizeof name, "multigrid %d step%s %s %dx%dx%d %dch grid /%d%s%s", steps, steps > 1 ? "s" : "",
+                 type_name(type), d[0], d[1], d[2], rgb ? 3 : 1, grid, rgb ? " rgb-scattering" : "", surface ? " surface-boundary" : "");
+    else
+        snprintf(name, sizeof name, "iterate x%d %s %dx%dx%d %dL grid /%d multigrid%s%s", n, type_name(type), d[0], d[1], d[2],
+                 lights, grid, rgb ? " rgb-scattering" : "", surface ? " surface-boundary" : "");
+    desc = scene_desc(&s);
+    memset(&p, 0, sizeof p);
+    if ((r = hd_api_backend.create(&desc, &p.dut)) == HD_ERROR_UNSUPPORTED) {
+        printf("SKIP %-56s skipped (unsupported): %s\n", name, last_log);
+        ++n_skipped;
+    } else {
+        if (r == HD_SUCCESS) hd_api_backend.destroy(p.dut);
+        if (pair_create(&p, &s)) {
+            if (steps > 0) {
+                write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
+                write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
+                BOTH(&p, test_diffuse, (p.ref, steps), (p.dut, steps));
+                pair_compare(&p, CMP_PHI, &l2, &linf);
+            } else {
+                BOTH(&p, iterate, (p.ref, n), (p.dut, n));
+                pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+            }
+        }
+        report(name, &p, &g, l2, linf, steps > 0);
+        pair_destroy(&p);
+    }
+    guard_free(&g);
+    scene_free(&s);
+}
+
 /* CD (deterministic: upwind convection, diffusion, projection with the same jitter hash) or
    PT_SS / PT_MS (stochastic paths with identical seeds), whole iterations through the API. */
 static void case_method(hd_method method, hd_voxel_type type, const int *d, int lights, int mixed, int point, int n)
@@ -579,6 +634,16 @@ int main(int argc, char **argv)
     case_half(HD_METHOD_HD, HD_VOXEL_F32, odd, 1, 0, 1, HD_SOLVER_JACOBI, 8);
     case_half(HD_METHOD_HD, HD_VOXEL_U8, odd, 3, 1, 1, HD_SOLVER_RED_BLACK, 8);
     case_half(HD_METHOD_CD, HD_VOXEL_U16, odd, 3, 1, 0, HD_SOLVER_RED_BLACK, 8);
+    /* the multigrid solver: steps from identical illumination, then whole iterations; box and
+       surface boundary, RGB scattering, odd and even grids, downsampled (float16 storage with
+       multigrid is refused on every backend: hd_validate.h) */
+    case_multigrid(HD_VOXEL_U8, odd, 1, 0, 0, 1, 2, 0);
+    case_multigrid(HD_VOXEL_U16, odd, 1, 0, 1, 1, 3, 0);
+    case_multigrid(HD_VOXEL_F32, other, 3, 1, 0, 1, 2, 0);
+    case_multigrid(HD_VOXEL_U8, other, 3, 1, 1, 2, 12, 0);
+    case_multigrid(HD_VOXEL_U8, odd, 1, 0, 0, 1, 0, 8);
+    case_multigrid(HD_VOXEL_U16, odd, 3, 1, 1, 1, 0, 8);
+    case_multigrid(HD_VOXEL_F32, other, 1, 0, 1, 2, 0, 8);
     if (n_skipped) printf("%d passed, %d failed, %d skipped (unsupported)\n", n_passed, n_failed, n_skipped);
     else printf("%d passed, %d failed\n", n_passed, n_failed);
     return n_failed == 0 ? 0 : 1;
