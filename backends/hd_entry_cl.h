@@ -187,16 +187,36 @@ HD__CL_MG_RESIDUAL(hd_k_mg_residual_rgb, HD_FLAG_RGB_SCATTERING)
 HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface, HD_FLAG_SURFACE_BOUNDARY)
 HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING)
 
-/* A coarse level's right-hand side, the restriction of the fine residual fres; its correction
-   cphi starts at 0. */
-__kernel void hd_k_mg_restrict(__constant hd__kparams *pf, __constant hd__kparams *pc, __global float *fres,
-                               __global float *crhs, __global float *cphi)
+/* The restriction's first half, as the CPU's row: the share hd_mg_restrict_line of every fine
+   column x of coarse row (Y, Z), channel c, into the row buffer `line` (x-fastest, rows of
+   2 * hx, the fine grid's padded row), the columns of one parity per pass: the fine loads then
+   use the diffusion's addressing (K->cx = x) and are contiguous. An odd grid's last item reads
+   its rows' padding slot (finite, as the sweep's) and writes a column nobody reads. */
+__kernel void hd_k_mg_restrict_line(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
+                                    __global float *restrict fres, __global float *restrict line, int parity)
 {
-    hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
-    int X = (int)get_global_id(0), Y = (int)get_global_id(1), zz = (int)get_global_id(2), gz = pc->gdims.z;
+    hd__kctx kf = hd__cl_mg_ctx(pf);
+    int gz = pc->gdims.z, Y = (int)get_global_id(1), zz = (int)get_global_id(2), x = 2 * (int)get_global_id(0) + parity;
     kf.phi = fres;
+    kf.cx = x; kf.cp = parity; kf.cid = get_global_id(0);
+    line[((size_t)zz * pc->gdims.y + Y) * (size_t)(2 * kf.hx) + (size_t)x] = hd_mg_restrict_line(&kf, x, Y, zz % gz, zz / gz);
+}
+
+/* Its second half: a coarse level's right-hand side, the shares of fine columns 2 X - 1 .. 2 X + 2
+   combined in order (hd_mg_restrict_x); its correction cphi starts at 0. */
+__kernel void hd_k_mg_restrict(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
+                               __global float *restrict line, __global float *restrict crhs, __global float *restrict cphi)
+{
+    hd__kctx kc = hd__cl_mg_ctx(pc);
+    int X = (int)get_global_id(0), Y = (int)get_global_id(1), zz = (int)get_global_id(2), gx = pf->gdims.x;
+    __global const float *row = line + ((size_t)zz * pc->gdims.y + Y) * (size_t)(2 * ((gx + 1) >> 1));
+    float s = 0.0f;
+    for (int t = 0; t < 4; ++t) {
+        int x = 2 * X - 1 + t;
+        if (x >= 0 && x < gx) s = hd_mg_restrict_x(s, t, row[x]);
+    }
     kc.E = crhs; kc.phi = cphi;
-    hd__cl_mg_set_E(&kc, X, Y, zz, hd_mg_restrict(&kf, X, Y, zz % gz, zz / gz));
+    hd__cl_mg_set_E(&kc, X, Y, zz, s);
     hd__cl_mg_set_phi(&kc, X, Y, zz, 0.0f);
 }
 

@@ -41,7 +41,8 @@ enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_D
        /* HD_SOLVER_MULTIGRID's passes (hd_entry_cl.h); the residuals in four variants each, indexed
           by 2 * surface boundary + RGB scattering; those from HD__CL_MG_RES_F64 on compute in
           double and exist only on a device with cl_khr_fp64 */
-       HD__CL_MG_SIG, HD__CL_MG_RESIDUAL, HD__CL_MG_RESTRICT = HD__CL_MG_RESIDUAL + 4, HD__CL_MG_PROLONG, HD__CL_MG_DIR,
+       HD__CL_MG_SIG, HD__CL_MG_RESIDUAL, HD__CL_MG_RESTRICT_LINE = HD__CL_MG_RESIDUAL + 4, HD__CL_MG_RESTRICT,
+       HD__CL_MG_PROLONG, HD__CL_MG_DIR,
        HD__CL_MG_RES_F64, HD__CL_MG_DOT = HD__CL_MG_RES_F64 + 4, HD__CL_MG_UPDATE, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
@@ -51,7 +52,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_diffuse_surface_rgb_half", "hd_k_diffuse_jacobi_half", "hd_k_diffuse_jacobi_rgb_half",
     "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
     "hd_k_sum_light_half", "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
-    "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
+    "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict_line", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update"};
 
 struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (hd__be_multigrid, at the end) */
@@ -744,6 +745,7 @@ struct hd__cl_mg {
     int sig_surface;         /* ... and the boundary they were restricted for */
     cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
     cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
+    cl_mem line;             /* the restriction's row buffer: a fine row's shares per coarse row */
     double *host_dot;        /* their host copy, one row sum per fine row */
     double rz;               /* <r, z> of the previous step */
     float beta;
@@ -757,6 +759,11 @@ static size_t hd__cl_mg_slots(const int *d, int channels)
     return (size_t)channels * d[2] * (size_t)d[1] * 2 * (((size_t)d[0] + 1) / 2);
 }
 static size_t hd__cl_mg_rows(const struct hd__cl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
+/* The restriction's row buffer: a padded fine row per coarse row of level 1, the largest. */
+static size_t hd__cl_mg_line_floats(const struct hd__cl_mg *mg)
+{
+    return 2 * (((size_t)mg->fine[0] + 1) / 2) * (size_t)(mg->fine[1] / 2) * (size_t)(mg->fine[2] / 2) * (size_t)mg->channels;
+}
 
 static void hd__cl_mg_free(hd__ctx *ctx)
 {
@@ -769,6 +776,7 @@ static void hd__cl_mg_free(hd__ctx *ctx)
         hd__cl_release(&L->phi); hd__cl_release(&L->res);
     }
     hd__cl_release(&mg->p); hd__cl_release(&mg->lo); hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b);
+    hd__cl_release(&mg->line);
     hd__free(ctx, mg->host_dot);
     hd__free(ctx, mg);
     ctx->be->mg = NULL;
@@ -783,6 +791,7 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     int l;
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
     b = 2 * sizeof(double) * hd__cl_mg_rows(mg) + 2 * sizeof(float) * hd__cl_mg_slots(mg->fine, mg->channels);
+    b += sizeof(float) * hd__cl_mg_line_floats(mg);
     for (l = 0; l < mg->levels; ++l) {
         b += 3 * sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->channels);
         if (l > 0) b += sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->sig_channels);
@@ -812,7 +821,8 @@ static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
     if ((r = hd__cl_buffer(ctx, &mg->p, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's p")) != HD_SUCCESS ||
         (r = hd__cl_buffer(ctx, &mg->lo, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's lo")) != HD_SUCCESS ||
         (r = hd__cl_buffer(ctx, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS) {
+        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(mg) * sizeof(float), NULL, "multigrid's row buffer")) != HD_SUCCESS) {
         hd__cl_mg_free(ctx);
         return r;
     }
@@ -936,7 +946,16 @@ static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
     if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS || (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 0)) != HD_SUCCESS ||
         (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 1)) != HD_SUCCESS)
         return r;
-    a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = C->rhs; a[4] = C->phi;
+    a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = mg->line;
+    for (k = 0; k < 2; ++k) { /* the shares of the fine columns of each parity */
+        cl_int parity = k;
+        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT_LINE, 4, a)) != HD_SUCCESS) return r;
+        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 4, sizeof parity, &parity), "clSetKernelArg(parity)");
+        if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
+                            (size_t)C->dims[2] * (size_t)mg->channels)) != HD_SUCCESS)
+            return r;
+    }
+    a[0] = L->params; a[1] = C->params; a[2] = mg->line; a[3] = C->rhs; a[4] = C->phi;
     if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT, 5, a)) != HD_SUCCESS ||
         (r = hd__cl_mg_run(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels)) != HD_SUCCESS)
         return r;

@@ -74,9 +74,10 @@ HD_FN float hd_mg_fw(int t)
 /* Fine column x's share of coarse row (Y, Z), channel c: the fine residual (K's phi, K the fine
    grid) of the up to 16 fine rows 2 Z - 1 + a, 2 Y - 1 + b (a, b = 0..3) at x, weighted
    fw(a) fw(b), summed in a, b order (rows outside the grid skipped by a branch: the select form
-   hd_mg_prolong uses made the OpenCL step 1.12x slower here, 360 against 322 ms on the head CT,
-   and the rows' tests are uniform along x anyway). A CPU row computes it once per fine x (a vector loop) and
-   combines four of them per coarse voxel with hd_mg_restrict_x; hd_mg_restrict does both. */
+   hd_mg_prolong uses made the OpenCL step slower, 360 against 322 ms on the head CT in two runs
+   minutes apart, and the rows' tests are uniform along x anyway). A backend computes it once per fine x and
+   coarse row (the CPU a vector loop per row, OpenCL a pass into a row buffer) and combines four
+   of them per coarse voxel, in order, with hd_mg_restrict_x. */
 HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
@@ -97,18 +98,6 @@ HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
 HD_FN float hd_mg_restrict_x(float s, int t, float line)
 {
     return s + hd_mg_fw(t) * line;
-}
-
-/* The restricted residual at coarse voxel (X, Y, Z), channel c, from the fine grid K: the
-   right-hand side of the coarse level's equation. */
-HD_FN float hd_mg_restrict(HD_KARGS int X, int Y, int Z, int c)
-{
-    float s = 0.0f;
-    for (int t = 0; t < 4; ++t) {
-        int x = 2 * X - 1 + t;
-        if (x >= 0 && x < HD_PRM(gdims).x) s = hd_mg_restrict_x(s, t, hd_mg_restrict_line(HD_KPASS x, Y, Z, c));
-    }
-    return s;
 }
 
 /* ---- prolongation P: trilinear interpolation ---------------------------------------------------- */
