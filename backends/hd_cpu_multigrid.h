@@ -229,7 +229,7 @@ static HD__CPU_FLATTEN void hd__cpu_mg_sig_row(hd__backend *be, int r)
 }
 
 /* The right-hand side of level mg->cur: R = P^T / 8 of the residual of the level above
-   (hd_mg_restrict), each fine column's share of the row computed once (hd_mg_restrict_line, a
+   (hd_k_multigrid.h), each fine column's share of the row computed once (hd_mg_restrict_line, a
    vector loop) and four of them combined per coarse voxel (hd_mg_restrict_x); its phi (the
    correction) starts at 0. */
 static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
