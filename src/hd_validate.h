@@ -163,7 +163,7 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
 #endif
 #ifndef HD__BE_HAS_MULTIGRID
     if (p->solver == HD_SOLVER_MULTIGRID)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "solver MULTIGRID is not available on the %s backend (CPU only so far)", hd__be_name());
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "solver MULTIGRID is not available on the %s backend", hd__be_name());
 #endif
 #ifndef HD__BE_HAS_HALF
     if (p->illumination_precision == HD_PRECISION_FLOAT16)

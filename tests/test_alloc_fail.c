@@ -83,7 +83,8 @@ static hd_result af_cycle(af_state *st, af_log *log)
         p.solver = HD_SOLVER_JACOBI;
         if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
         if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
-        if (strcmp(hd_backend_name(), "cpu") == 0) { /* multigrid: CPU only so far */
+        /* multigrid where the backend has it (the others refuse it, which would log an error) */
+        if (strcmp(hd_backend_name(), "cpu") == 0 || strcmp(hd_backend_name(), "opencl") == 0) {
             p.solver = HD_SOLVER_MULTIGRID;           /* its levels come with the first V-cycle */
             p.diffusion_sweeps = 1;
             if (r == HD_SUCCESS) r = hd_set_params(ctx, &p);
