@@ -15,7 +15,7 @@
    GetProcAddress, ...), else eglGetProcAddress; the library links -lEGL only.
 
    Host state: every call restores what it touched: the program, uniform block binding 0, storage
-   buffer bindings 0..2, image units 0..6, the generic buffer bindings (uniform, storage, copy
+   buffer bindings 0..3, image units 0..6, the generic buffer bindings (uniform, storage, copy
    read/write, pixel pack/unpack), the active texture and the 2D/3D texture bindings of unit 0,
    and the pixel pack/unpack parameters (tests/gl/test_gl.c checks it).
 
@@ -27,6 +27,11 @@
    the TF, majorant grid and image accumulation are storage buffers; the parameter block a
    uniform buffer rewritten when it changes; hd_pc a plain uniform. Jacobi's phi2 and CD's spare
    swap names with phi / the light's volume, as the CPU backend swaps pointers.
+
+   HD_SOLVER_MULTIGRID (the end of this file; docs/DESIGN-GL.md): the levels and CG's vectors
+   are r32f 3D textures too, smoothed by the diffusion program on each level's own uniform
+   buffer; the other passes are hd_entry_glsl_multigrid.h, with GLSL doubles where the CPU sums
+   in double, the dot products' rows (storage buffer 3) summed on the host in row order.
 
    Errors: a shader that fails to compile or link is HD_ERROR_BACKEND with the driver's info log
    (source-string numbers in it name the files listed in hd_glsl_embedded.h); a GL error after a
@@ -1352,9 +1357,12 @@ static hd_result hd__gl_multigrid(hd__ctx *ctx)
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
     if (!(pq > 0.0)) return HD_SUCCESS;
     alpha = rp / pq;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
+    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
+                            mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
+        return r;
+    be->gl.Finish(); /* a step ends complete, as OpenCL's clFinish (timings per step mean the step) */
+    return hd__gl_check(ctx, "glFinish", __LINE__);
 }
 static hd_result hd__be_multigrid(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_multigrid(ctx)); }
 
