@@ -15,7 +15,7 @@
    GetProcAddress, ...), else eglGetProcAddress; the library links -lEGL only.
 
    Host state: every call restores what it touched: the program, uniform block binding 0, storage
-   buffer bindings 0..2, image units 0..6, the generic buffer bindings (uniform, storage, copy
+   buffer bindings 0..3, image units 0..6, the generic buffer bindings (uniform, storage, copy
    read/write, pixel pack/unpack), the active texture and the 2D/3D texture bindings of unit 0,
    and the pixel pack/unpack parameters (tests/gl/test_gl.c checks it).
 
@@ -27,6 +27,11 @@
    the TF, majorant grid and image accumulation are storage buffers; the parameter block a
    uniform buffer rewritten when it changes; hd_pc a plain uniform. Jacobi's phi2 and CD's spare
    swap names with phi / the light's volume, as the CPU backend swaps pointers.
+
+   HD_SOLVER_MULTIGRID (the end of this file; docs/DESIGN-GL.md): the levels and CG's vectors
+   are r32f 3D textures too, smoothed by the diffusion program on each level's own uniform
+   buffer; the other passes are hd_entry_glsl_multigrid.h, with GLSL doubles where the CPU sums
+   in double, the dot products' rows (storage buffer 3) summed on the host in row order.
 
    Errors: a shader that fails to compile or link is HD_ERROR_BACKEND with the driver's info log
    (source-string numbers in it name the files listed in hd_glsl_embedded.h); a GL error after a
@@ -56,6 +61,7 @@
     X(CREATEPROGRAM, CreateProgram) X(ATTACHSHADER, AttachShader) X(LINKPROGRAM, LinkProgram) \
     X(GETPROGRAMIV, GetProgramiv) X(GETPROGRAMINFOLOG, GetProgramInfoLog) X(DELETEPROGRAM, DeleteProgram) \
     X(USEPROGRAM, UseProgram) X(UNIFORM4I, Uniform4i) X(UNIFORM1F, Uniform1f) \
+    X(PROGRAMUNIFORM1F, ProgramUniform1f) X(PROGRAMUNIFORM1D, ProgramUniform1d) \
     X(DISPATCHCOMPUTE, DispatchCompute) X(MEMORYBARRIER, MemoryBarrier) \
     X(GENBUFFERS, GenBuffers) X(DELETEBUFFERS, DeleteBuffers) X(BINDBUFFER, BindBuffer) \
     X(BUFFERDATA, BufferData) X(BUFFERSUBDATA, BufferSubData) X(GETBUFFERSUBDATA, GetBufferSubData) \
@@ -83,7 +89,7 @@ static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
    (Vulkan measured 1.4-1.6x from the same specialization). Program slots past
    HD__GL_PROGRAM_COUNT hold these variants. */
-#define HD__GL_DIFFUSE_VARIANTS 4
+#define HD__GL_DIFFUSE_VARIANTS 8 /* bit 4: HD_FLAG_DIFFUSE_RHS (multigrid's levels) */
 #define HD__GL_SLOTS_F32 (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)
 /* Then the same slots again for float16 illumination storage (HD_ILLUM_R16F): only those of the
    stages that touch E / phi / phi2 are ever compiled (hd__gl_touches_illum). */
@@ -94,12 +100,13 @@ static int hd__gl_touches_illum(int stage)
 }
 static int hd__gl_diffuse_flags(int variant)
 {
-    return ((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0);
+    return ((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0) |
+           ((variant & 4) ? HD_FLAG_DIFFUSE_RHS : 0);
 }
 static int hd__gl_diffuse_slot(int counts_z)
 {
     return HD__GL_PROGRAM_COUNT + ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) +
-           ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
+           ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((counts_z & HD_FLAG_DIFFUSE_RHS) ? 4 : 0);
 }
 #define HD__GL_LOCAL_X 64 /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 /* The block of slices x rows each diffusion invocation relaxes (HD_DIFFUSE_ZK, HD_DIFFUSE_YK in
@@ -108,8 +115,13 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_DIFFUSE_ZK 4
 #define HD__GL_DIFFUSE_YK 2
 #define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
-#define HD__GL_SSBOS 3       /* storage buffers 0..2 */
+#define HD__GL_SSBOS 4       /* storage buffers 0..3 (3: multigrid's row sums) */
 
+/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..8), each in the
+   4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
+#define HD__GL_MG_STAGES 8
+#define HD__GL_MG_PROGRAMS (4 * HD__GL_MG_STAGES)
+struct hd__gl_mg;
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
@@ -152,6 +164,9 @@ struct hd__backend {
     size_t illum_floats, img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
+    unsigned sig_gen;           /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    struct hd__gl_mg *mg;       /* multigrid levels, NULL until first used */
+    GLuint mg_programs[HD__GL_MG_PROGRAMS]; /* by HD_MG_STAGE - 1, then the 4 flag variants */
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -347,15 +362,14 @@ static const char *const hd__gl_to_texture_src =
     "}\n";
 
 /* Compiles and links the program of slot p (a stage, or a diffusion variant) on its first use. */
+static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, const char *name, GLuint *out);
 static hd_result hd__gl_program(hd__ctx *ctx, int p)
 {
     int half = p >= HD__GL_SLOTS_F32, q = p % HD__GL_SLOTS_F32;
     int stage = q < HD__GL_PROGRAM_COUNT ? q : HD__GL_DIFFUSE;
     hd__backend *be = ctx->be;
     const char *src[1 + HD__GL_SOURCE_LINES];
-    char prefix[256], log[4096];
-    GLuint sh, prog;
-    GLint ok = 0;
+    char prefix[256];
     GLsizei n = 0;
     size_t i;
     if (be->programs[p]) return HD_SUCCESS;
@@ -374,6 +388,16 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
         n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
     }
+    return hd__gl_build(ctx, src, n, hd__gl_stage_names[stage], &be->programs[p]);
+}
+
+/* Compiles and links n source strings into *out. */
+static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, const char *name, GLuint *out)
+{
+    hd__backend *be = ctx->be;
+    char log[4096];
+    GLuint sh, prog;
+    GLint ok = 0;
     sh = be->gl.CreateShader(GL_COMPUTE_SHADER);
     if (!sh) return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: glCreateShader(GL_COMPUTE_SHADER) failed");
     be->gl.ShaderSource(sh, n, src, NULL);
@@ -384,7 +408,7 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         be->gl.GetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteShader(sh);
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s shader does not compile (source-string numbers: "
-                       "backends/hd_glsl_embedded.h):\n%s", hd__gl_stage_names[stage], log);
+                       "backends/hd_glsl_embedded.h):\n%s", name, log);
     }
     prog = be->gl.CreateProgram();
     be->gl.AttachShader(prog, sh);
@@ -395,9 +419,9 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         log[0] = '\0';
         be->gl.GetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteProgram(prog);
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", hd__gl_stage_names[stage], log);
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", name, log);
     }
-    be->programs[p] = prog;
+    *out = prog;
     HD__GL_CHECK(ctx, "building a program");
     return HD_SUCCESS;
 }
@@ -480,38 +504,62 @@ static void hd__gl_bind_image(hd__backend *be, GLuint unit, const hd__gl_tex *t,
     be->gl.BindImageTexture(unit, u->name, 0, GL_TRUE, 0, access, u->format);
 }
 
-static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
-                                 int pc_w)
+/* Sends ctx->kp to the backend's uniform buffer when it changed. */
+static void hd__gl_send_params(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    hd_result r;
-    const hd__gl_tex *lv = be->lv && light < be->nlv ? &be->lv[light] : NULL;
-    const hd__gl_tex *lv2 = be->lv ? &be->lv[be->nlv] : NULL;
-    int half = be->f16 && hd__gl_touches_illum(p);
-    int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
-    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
     if (!be->params_valid || memcmp(&be->params_kp, &ctx->kp, sizeof ctx->kp) != 0) {
         be->gl.BindBuffer(GL_UNIFORM_BUFFER, be->params);
         be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof ctx->kp, &ctx->kp, GL_STREAM_DRAW);
         be->params_kp = ctx->kp;
         be->params_valid = 1;
     }
-    be->gl.UseProgram(be->programs[slot]);
+}
+
+/* What one dispatch binds: the parameter block's buffer and the textures of image units 0..6
+   (NULL: the placeholder); half: the float16 program's units 2..4. */
+typedef struct hd__gl_binds {
+    GLuint params;
+    const hd__gl_tex *img[HD__GL_IMAGE_UNITS];
+    int half;
+} hd__gl_binds;
+
+/* Runs program prog over nx x ny x nz invocations (x in work groups of HD__GL_LOCAL_X) with the
+   bindings b and hd_pc = (pc_x, pc_y, pc_z, pc_w); what names it in errors. */
+static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const hd__gl_binds *b, int nx, int ny, int nz,
+                            int pc_x, int pc_y, int pc_z, int pc_w)
+{
+    hd__backend *be = ctx->be;
+    int i;
+    be->gl.UseProgram(prog);
     be->gl.Uniform4i(0, pc_x, pc_y, pc_z, pc_w);
-    be->gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, be->params);
+    be->gl.BindBufferBase(GL_UNIFORM_BUFFER, 0, b->params);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->tf ? be->tf : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->maj ? be->maj : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
-    hd__gl_bind_image(be, 0, &be->vol, GL_READ_ONLY, 0);
-    hd__gl_bind_image(be, 1, &be->sig, GL_READ_WRITE, 0);
-    hd__gl_bind_image(be, 2, &be->E, GL_READ_WRITE, half);
-    hd__gl_bind_image(be, 3, &be->phi, GL_READ_WRITE, half);
-    hd__gl_bind_image(be, 4, &be->phi2, GL_READ_WRITE, half);
-    hd__gl_bind_image(be, 5, lv, GL_READ_ONLY, 0);
-    hd__gl_bind_image(be, 6, lv2, GL_READ_WRITE, 0);
+    for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
+        hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
     be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
-    return hd__gl_check(ctx, hd__gl_stage_names[p], __LINE__);
+    return hd__gl_check(ctx, what, __LINE__);
+}
+
+static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
+                                 int pc_w)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    hd__gl_binds b;
+    int half = be->f16 && hd__gl_touches_illum(p);
+    int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
+    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
+    hd__gl_send_params(ctx);
+    b.params = be->params;
+    b.img[0] = &be->vol; b.img[1] = &be->sig; b.img[2] = &be->E; b.img[3] = &be->phi; b.img[4] = &be->phi2;
+    b.img[5] = be->lv && light < be->nlv ? &be->lv[light] : NULL;
+    b.img[6] = be->lv ? &be->lv[be->nlv] : NULL;
+    b.half = half;
+    return hd__gl_run(ctx, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
 }
 
 /* Runs one stage between hd__gl_enter and hd__gl_leave. */
@@ -616,6 +664,8 @@ static void hd__gl_free_lights(hd__backend *be)
     be->nlv = 0;
 }
 
+static void hd__gl_mg_free(hd__ctx *ctx);
+static void hd__gl_mg_free_host(hd__ctx *ctx);
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -624,6 +674,9 @@ static void hd__be_destroy(hd__ctx *ctx)
     if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__gl_enter(ctx) == HD_SUCCESS) {
         for (i = 0; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
+        for (i = 0; i < HD__GL_MG_PROGRAMS; ++i)
+            if (be->mg_programs[i]) be->gl.DeleteProgram(be->mg_programs[i]);
+        hd__gl_mg_free(ctx);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
@@ -632,6 +685,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_free_lights(be);
         hd__gl_leave(ctx, HD_SUCCESS);
     }
+    hd__gl_mg_free_host(ctx); /* left when GL was unreachable */
     hd__free(ctx, be->lv);
     if (be->own && be->egl) {
         if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -729,6 +783,7 @@ static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     int *g = ctx->gdims;
     hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
     hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
+    hd__gl_mg_free(ctx); /* its fine grid is this one */
     be->illum_floats = 0;
     be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     if (illum_floats == 0) return HD_SUCCESS;
@@ -789,6 +844,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what) { HD__GL_STAGE(ctx, h
 /* ---- stages ------------------------------------------------------------------------------------ */
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
+    ++ctx->be->sig_gen;
     HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
 }
 
@@ -923,6 +979,393 @@ static hd_result hd__gl_sum_lights(hd__ctx *ctx)
 static hd_result hd__be_sum_lights(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_sum_lights(ctx)); }
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
+/* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
+   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
+   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design), structured
+   as the OpenCL port (docs/DESIGN-OPENCL.md): the per-voxel math is the shared hd_k_multigrid.h
+   (entry points hd_entry_glsl_multigrid.h), the V-cycle's smoothing the diffusion program with
+   HD_FLAG_DIFFUSE_RHS on each level's own parameter block. Every level's sigma_t / rhs / phi /
+   residual and CG's p and lo are r32f 3D textures like the backend's own; the double passes are
+   GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
+   storage buffer 3) and the rows in row order on the host, as the CPU does. */
+#define HD__BE_HAS_MULTIGRID 1
+#define HD__GL_MG_MAX_LEVELS 12
+#define HD__GL_MG_PRE 2
+#define HD__GL_MG_POST 2
+#define HD__GL_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
+enum { HD__GL_MG_SIG = 1, HD__GL_MG_RESIDUAL, HD__GL_MG_RESTRICT, HD__GL_MG_PROLONG, HD__GL_MG_DIR, HD__GL_MG_RES_F64,
+       HD__GL_MG_DOT, HD__GL_MG_UPDATE };
+static const char *const hd__gl_mg_names[HD__GL_MG_STAGES] = {
+    "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
+    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update"};
+
+typedef struct hd__gl_level {
+    int dims[3];
+    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    int kp_sent;             /* params holds kp */
+    GLuint params;
+    hd__gl_tex sig;          /* coarse levels only (level 0 reads the backend's sigma_t) */
+    hd__gl_tex rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
+} hd__gl_level;
+
+struct hd__gl_mg {
+    hd__gl_level lv[HD__GL_MG_MAX_LEVELS];
+    int levels, channels, sig_channels, fine[3];
+    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
+    int sig_surface;         /* ... and the boundary they were restricted for */
+    hd__gl_tex p, lo;        /* the search direction; the iterate's low part (phi + lo) */
+    GLuint dot_a, dot_b;     /* per-row partial sums (double) */
+    double *host_dot;        /* their host copy */
+    double rz;               /* <r, z> of the previous step */
+    float beta;
+    int have_dir;
+    uint64_t iteration;
+    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
+};
+
+static size_t hd__gl_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
+static size_t hd__gl_mg_rows(const struct hd__gl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
+
+static void hd__gl_mg_free(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    int l;
+    if (!mg) return;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__gl_level *L = &mg->lv[l];
+        hd__gl_free_buffer(be, &L->params);
+        hd__gl_free_tex(be, &L->sig); hd__gl_free_tex(be, &L->rhs); hd__gl_free_tex(be, &L->phi); hd__gl_free_tex(be, &L->res);
+    }
+    hd__gl_free_tex(be, &mg->p); hd__gl_free_tex(be, &mg->lo);
+    hd__gl_free_buffer(be, &mg->dot_a); hd__gl_free_buffer(be, &mg->dot_b);
+    hd__free(ctx, mg->host_dot);
+    hd__free(ctx, mg);
+    be->mg = NULL;
+}
+
+/* The host side only (hd__be_destroy, when GL is unreachable). */
+static void hd__gl_mg_free_host(hd__ctx *ctx)
+{
+    struct hd__gl_mg *mg = ctx->be->mg;
+    if (!mg) return;
+    hd__free(ctx, mg->host_dot);
+    hd__free(ctx, mg);
+    ctx->be->mg = NULL;
+}
+
+/* Bytes the solver holds on the GPU (counted in method_bytes); 0 without it. */
+static size_t hd__be_solver_bytes(const hd__ctx *ctx)
+{
+    const struct hd__gl_mg *mg = ctx->be->mg;
+    size_t b;
+    int l;
+    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    b = 2 * sizeof(double) * hd__gl_mg_rows(mg) + 2 * sizeof(float) * hd__gl_mg_voxels(mg->fine, mg->channels);
+    for (l = 0; l < mg->levels; ++l) {
+        b += 3 * sizeof(float) * hd__gl_mg_voxels(mg->lv[l].dims, mg->channels);
+        if (l > 0) b += sizeof(float) * hd__gl_mg_voxels(mg->lv[l].dims, mg->sig_channels);
+    }
+    return b;
+}
+#define HD__BE_HAS_SOLVER_BYTES 1
+
+/* A level's grid of `channels` channels stacked in z, zeroed. */
+static hd_result hd__gl_mg_tex(hd__ctx *ctx, hd__gl_tex *t, const int *d, int channels, const char *what)
+{
+    return hd__gl_tex_new(ctx, t, d[0], d[1], d[2] * channels, NULL, what);
+}
+
+/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
+   one: hd_cpu_multigrid.h's rule) and CG's vectors, zeroed. */
+static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg;
+    int l, i, d[3];
+    hd_result r;
+    size_t rows;
+    be->mg = mg = (struct hd__gl_mg *)hd__calloc(ctx, 1, sizeof *mg);
+    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the multigrid levels");
+    mg->channels = ctx->channels;
+    mg->sig_channels = ctx->sig_channels;
+    mg->sig_gen = be->sig_gen - 1u; /* restrict sigma_t on first use */
+    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
+    rows = hd__gl_mg_rows(mg);
+    mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
+    if (!mg->host_dot) { hd__gl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows"); }
+    if ((r = hd__gl_mg_tex(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
+        (r = hd__gl_mg_tex(ctx, &mg->lo, d, mg->channels, "multigrid's lo")) != HD_SUCCESS ||
+        (r = hd__gl_buffer_data(ctx, &mg->dot_a, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__gl_buffer_data(ctx, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS) {
+        hd__gl_mg_free(ctx);
+        return r;
+    }
+    for (l = 0; l < HD__GL_MG_MAX_LEVELS; ++l) {
+        hd__gl_level *L = &mg->lv[l];
+        memcpy(L->dims, d, sizeof d);
+        mg->levels = l + 1;
+        be->gl.GenBuffers(1, &L->params);
+        if ((r = hd__gl_mg_tex(ctx, &L->rhs, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__gl_mg_tex(ctx, &L->phi, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__gl_mg_tex(ctx, &L->res, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (l > 0 && (r = hd__gl_mg_tex(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS)) {
+            hd__gl_mg_free(ctx);
+            return r;
+        }
+        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
+        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+    }
+    return HD_SUCCESS;
+}
+
+/* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
+static hd_result hd__gl_mg_params(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_level *L = &be->mg->lv[l];
+    hd__kparams kp = ctx->kp;
+    float s = (float)(1 << l);
+    kp.gdims.x = L->dims[0]; kp.gdims.y = L->dims[1]; kp.gdims.z = L->dims[2];
+    kp.grid.x = ctx->kp.grid.x / (s * s); kp.grid.y = ctx->kp.grid.y / (s * s); kp.grid.z = ctx->kp.grid.z / (s * s);
+    kp.gridh.x = ctx->kp.gridh.x * s; kp.gridh.y = ctx->kp.gridh.y * s; kp.gridh.z = ctx->kp.gridh.z * s;
+    kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
+    be->gl.BindBuffer(GL_UNIFORM_BUFFER, L->params);
+    be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof kp, &kp, GL_STATIC_DRAW);
+    L->kp = kp;
+    L->kp_sent = 1;
+    return hd__gl_check(ctx, "multigrid level parameters", __LINE__);
+}
+
+/* Level l's sigma_t. */
+static const hd__gl_tex *hd__gl_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg->lv[l].sig; }
+
+/* The program of multigrid stage `stage` for the flags in counts_z (RGB, surface), compiled on
+   first use: hd__gl_source up to hd_entry_glsl.h, then hd_entry_glsl_multigrid.h. */
+static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint *out)
+{
+    hd__backend *be = ctx->be;
+    int variant = ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
+    GLuint *slot = &be->mg_programs[(stage - 1) * 4 + variant];
+    const char *src[1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES];
+    char prefix[320];
+    size_t i;
+    hd_result r;
+    if (!*slot) {
+        /* the float residual reads the level's right-hand side (HD_DIFFUSE_FLAGS, as the sweep) */
+        snprintf(prefix, sizeof prefix,
+                 "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE 0\n#define HD_MG_STAGE %d\n"
+                 "#define HD_DIFFUSE_FLAGS %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
+                 HD_MAX_LIGHTS, stage, hd__gl_diffuse_flags(variant) | (stage == HD__GL_MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0),
+                 HD__GL_LOCAL_X);
+        src[0] = prefix;
+        for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
+        for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];
+        r = hd__gl_build(ctx, src, (GLsizei)(1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES), hd__gl_mg_names[stage - 1], slot);
+        if (r != HD_SUCCESS) return r;
+    }
+    *out = *slot;
+    return HD_SUCCESS;
+}
+
+/* Runs multigrid stage `stage` (flags of ctx->kp) with parameter block params, image units 1..4
+   and 6 (unit 6: the other grid, hd_entry_glsl_multigrid.h), over nx x ny x nz, hd_pc = pc. */
+static hd_result hd__gl_mg_pass(hd__ctx *ctx, int stage, GLuint params, const hd__gl_tex *sig, const hd__gl_tex *E,
+                                const hd__gl_tex *phi, const hd__gl_tex *phi2, const hd__gl_tex *other, int nx, int ny,
+                                int nz, int pc_x, int pc_y, int pc_z, int pc_w)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_binds b;
+    GLuint prog;
+    hd_result r;
+    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
+    memset(&b, 0, sizeof b);
+    b.params = params;
+    b.img[0] = &be->vol; b.img[1] = sig; b.img[2] = E; b.img[3] = phi; b.img[4] = phi2; b.img[6] = other;
+    return hd__gl_run(ctx, prog, hd__gl_mg_names[stage - 1], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
+}
+
+/* Sets the direction's beta or the update's alpha (hd_entry_glsl_multigrid.h, locations 1, 2) on
+   stage's program. */
+static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double alpha)
+{
+    hd__backend *be = ctx->be;
+    GLuint prog;
+    hd_result r;
+    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
+    if (stage == HD__GL_MG_DIR) be->gl.ProgramUniform1f(prog, 1, beta);
+    else be->gl.ProgramUniform1d(prog, 2, alpha);
+    return hd__gl_check(ctx, "multigrid's uniforms", __LINE__);
+}
+
+/* `sweeps` red-black sweeps of level l with the diffusion program (HD_FLAG_DIFFUSE_RHS variant);
+   first = 0: red then black, 1: black then red (the adjoint order, for post-smoothing). */
+static hd_result hd__gl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_level *L = &be->mg->lv[l];
+    int slot = hd__gl_diffuse_slot(L->kp.counts.z), s, h;
+    int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    hd__gl_binds b;
+    hd_result r;
+    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
+    memset(&b, 0, sizeof b);
+    b.params = L->params;
+    b.img[0] = &be->vol; b.img[1] = hd__gl_mg_sig(be, l); b.img[2] = &L->rhs; b.img[3] = &L->phi; b.img[4] = &L->res;
+    for (s = 0; s < sweeps; ++s)
+        for (h = 0; h < 2; ++h)
+            if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (L->dims[0] + 1) / 2, ny,
+                                nzb * be->mg->channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
+                return r;
+    return HD_SUCCESS;
+}
+
+/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
+static hd_result hd__gl_mg_cycle(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    hd__gl_level *L = &mg->lv[l], *C;
+    int ch = mg->channels;
+    hd_result r;
+    if (l == mg->levels - 1) {
+        if ((r = hd__gl_mg_smooth(ctx, l, HD__GL_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
+        return hd__gl_mg_smooth(ctx, l, HD__GL_MG_COARSEST_SWEEPS, 1);
+    }
+    C = &mg->lv[l + 1];
+    if ((r = hd__gl_mg_smooth(ctx, l, HD__GL_MG_PRE, 0)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL,
+                            L->dims[0], L->dims[1], L->dims[2] * ch, 0, 0, 0, ch)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, NULL, NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
+                            C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch)) != HD_SUCCESS ||
+        (r = hd__gl_mg_cycle(ctx, l + 1)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, NULL, NULL, &C->phi, NULL, &L->phi, L->dims[0], L->dims[1],
+                            L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch)) != HD_SUCCESS)
+        return r;
+    return hd__gl_mg_smooth(ctx, l, HD__GL_MG_POST, 1);
+}
+
+/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
+   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
+static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex *E, const hd__gl_tex *phi,
+                                   const hd__gl_tex *out, int use_lo, int negate)
+{
+    struct hd__gl_mg *mg = ctx->be->mg;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, use_lo, negate, 0, mg->channels);
+}
+
+/* <a, b> per fine row into dot, then the rows summed in row order on the host (as the CPU's
+   hd__mg_sum). */
+static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot, double *out)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    size_t rows = hd__gl_mg_rows(mg), i;
+    double s = 0.0;
+    hd_result r;
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
+    if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, mg->fine[1],
+                            mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels)) != HD_SUCCESS)
+        return r;
+    be->gl.BindBuffer(GL_COPY_READ_BUFFER, dot);
+    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(rows * sizeof(double)), mg->host_dot);
+    HD__GL_CHECK(ctx, "reading multigrid's row sums");
+    for (i = 0; i < rows; ++i) s += mg->host_dot[i];
+    *out = s;
+    return HD_SUCCESS;
+}
+
+/* The parameters A depends on (restart CG when one changes): grid, flags, medium, 1/h^2, h. */
+static void hd__gl_mg_akey(const hd__kparams *kp, hd__kparams *key)
+{
+    memset(key, 0, sizeof *key);
+    key->gdims = kp->gdims;
+    key->counts.z = kp->counts.z;
+    key->medium = kp->medium;
+    key->grid = kp->grid;
+    key->gridh = kp->gridh;
+}
+
+/* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
+   when it changed; *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
+static hd_result hd__gl_mg_prepare(hd__ctx *ctx, int *restart)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    hd__kparams key;
+    hd_result r;
+    int l, stale;
+    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
+               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
+        hd__gl_mg_free(ctx);
+    if (!be->mg && (r = hd__gl_mg_alloc(ctx)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    for (l = 0; l < mg->levels; ++l)
+        if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return r;
+    hd__gl_send_params(ctx);
+    hd__gl_mg_akey(&ctx->kp, &key);
+    stale = memcmp(&key, &mg->akey, sizeof key) != 0 || ctx->iterations < mg->iteration || mg->sig_gen != be->sig_gen;
+    *restart = stale || !mg->have_dir || mg->iteration != ctx->iterations;
+    mg->akey = key;
+    mg->iteration = ctx->iterations;
+    if (mg->sig_gen != be->sig_gen || mg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+        for (l = 1; l < mg->levels; ++l) {
+            const int *d = mg->lv[l].dims;
+            if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL,
+                                    &mg->lv[l].sig, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
+                                    mg->sig_channels)) != HD_SUCCESS)
+                return r;
+        }
+        mg->sig_gen = be->sig_gen;
+        mg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
+        *restart = stale = 1;
+    }
+    if (stale) return hd__gl_tex_zero(ctx, &mg->lo);
+    return HD_SUCCESS;
+}
+
+/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
+static hd_result hd__gl_multigrid(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg;
+    hd__gl_level *L;
+    int restart;
+    double rz, pq, rp, alpha;
+    hd_result r;
+    if ((r = hd__gl_mg_prepare(ctx, &restart)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    L = &mg->lv[0];
+    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new) */
+    if ((r = hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &L->rhs, 1, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_mg_dot(ctx, &L->rhs, &L->phi, mg->dot_a, &rz)) != HD_SUCCESS) return r;
+    mg->beta = restart || !(mg->rz > 0.0) ? 0.0f : (float)(rz / mg->rz);
+    mg->rz = rz;
+    /* p = z + beta p, z = 0 */
+    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, mg->beta, 0.0)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_DIR, L->params, NULL, &L->phi, &mg->p, NULL, NULL, mg->fine[0], mg->fine[1],
+                            mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
+        return r;
+    /* q = A p; <p, q>, <r, p> */
+    if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a, &pq)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b, &rp)) != HD_SUCCESS) return r;
+    mg->have_dir = 1;
+    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
+    if (!(pq > 0.0)) return HD_SUCCESS;
+    alpha = rp / pq;
+    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS ||
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
+                            mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
+        return r;
+    be->gl.Finish(); /* a step ends complete, as OpenCL's clFinish (timings per step mean the step) */
+    return hd__gl_check(ctx, "glFinish", __LINE__);
+}
+static hd_result hd__be_multigrid(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_multigrid(ctx)); }
+
 static hd_result hd__be_path(hd__ctx *ctx)
 {
     HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0));
