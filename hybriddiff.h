@@ -443,6 +443,7 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #include "backends/hd_prelude_c.h"
 #include "src/hd_internal.h"
 #include "backends/kernels/hd_kernels.h"
+#include "src/hd_multigrid_cg.h"
 #if defined(HYBRIDDIFF_BACKEND_CPU)
 #include "backends/hd_cpu.h"
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)

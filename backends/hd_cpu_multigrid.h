@@ -71,8 +71,7 @@ typedef struct hd__cpu_level {
 struct hd__cpu_mg {
     hd__cpu_level lv[HD__MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
-    int sig_surface;         /* ... and the boundary they were restricted for */
+    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     int cur;                 /* the level a transfer pass writes (coarse) */
     float *p;                /* CG's search direction (fine grid) */
     float *lo;               /* the iterate's low part: CG's iterate is phi + lo, phi its float
@@ -81,12 +80,8 @@ struct hd__cpu_mg {
     hd__kctx opk;
     hd__cpu_grid opg, fineg; /* A p into level 0's res; f - A phi into level 0's rhs (r) */
     double *dot_a, *dot_b;   /* per-row partial sums of the dot products (level 0's rows) */
-    double rz;               /* <r, z> of the previous step (beta's denominator) */
     double alpha;
     float beta;
-    int have_dir;            /* p holds a direction of the current CG run */
-    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
-    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
     double vcycle_seconds;   /* wall time in V-cycles (benchmark: a step against a V-cycle) */
 };
 
@@ -178,7 +173,7 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    mg->sig_gen = be->sig_gen - 1u; /* restrict sigma_t on first use */
+    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = (size_t)d[1] * d[2] * (size_t)mg->channels;
     fine = hd__mg_vox(d) * (size_t)mg->channels;
@@ -429,33 +424,12 @@ static void hd__cpu_mg_update_row(hd__backend *be, int r)
     for (x = 0; x < gx; ++x) phi[x] = hd_mg_update_of(phi[x], &lo[x], p[x], alpha);
 }
 
-/* The sum of the first `rows` entries of d in row order (the same bits for any thread count). */
-static double hd__mg_sum(const double *d, int rows)
-{
-    double s = 0.0;
-    int r;
-    for (r = 0; r < rows; ++r) s += d[r];
-    return s;
-}
-
-/* The parameters A depends on (restart CG when one changes): grid, flags, medium, 1/h^2, h. */
-static void hd__mg_akey(const hd__kparams *kp, hd__kparams *key)
-{
-    memset(key, 0, sizeof *key);
-    key->gdims = kp->gdims;
-    key->counts.z = kp->counts.z;
-    key->medium = kp->medium;
-    key->grid = kp->grid;
-    key->gridh = kp->gridh;
-}
-
 /* Rebuilds the levels if the grid changed, refreshes every level's parameters and restricts
    sigma_t when it changed; returns whether CG must restart. */
 static hd_result hd__cpu_mg_prepare(hd__ctx *ctx, int *restart)
 {
     hd__backend *be = ctx->be;
     struct hd__cpu_mg *mg = be->mg;
-    hd__kparams key;
     hd_result r;
     int l, stale;
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
@@ -465,20 +439,10 @@ static hd_result hd__cpu_mg_prepare(hd__ctx *ctx, int *restart)
     mg = be->mg;
     for (l = 0; l < mg->levels; ++l) hd__cpu_mg_params(ctx, l);
     hd__cpu_mg_fine_params(ctx);
-    hd__mg_akey(&ctx->kp, &key);
-    /* A changed, or phi was reset (the iteration count went back): the old low part of the
-       iterate belongs to another phi (it is at most half an ulp of it, so a stale one would only
-       perturb the start) */
-    stale = memcmp(&key, &mg->akey, sizeof key) != 0 || ctx->iterations < mg->iteration || mg->sig_gen != be->sig_gen;
-    *restart = stale || !mg->have_dir || mg->iteration != ctx->iterations;
-    mg->akey = key;
-    mg->iteration = ctx->iterations;
-    if (mg->sig_gen != be->sig_gen || mg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
         for (mg->cur = 1; mg->cur < mg->levels; ++mg->cur)
             hd__cpu_parallel(be, hd__cpu_mg_sig_row, mg->lv[mg->cur].dims[1] * mg->lv[mg->cur].dims[2] * mg->sig_channels);
-        mg->sig_gen = be->sig_gen;
-        mg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
-        *restart = stale = 1;
+        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
     }
     if (stale) memset(mg->lo, 0, hd__mg_vox(mg->fine) * (size_t)mg->channels * sizeof(float));
     return HD_SUCCESS;
@@ -502,16 +466,15 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     hd__cpu_mg_cycle(be, 0);
     mg->vcycle_seconds += hd__now() - t0;
     hd__cpu_parallel(be, hd__cpu_mg_rz_row, rows);
-    rz = hd__mg_sum(mg->dot_a, rows);
-    mg->beta = restart || !(mg->rz > 0.0) ? 0.0f : (float)(rz / mg->rz);
-    mg->rz = rz;
+    rz = hd__mg_row_sum(mg->dot_a, (size_t)rows);
+    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
     hd__cpu_parallel(be, hd__cpu_mg_dir_row, rows);
     be->grid = &mg->opg; /* q = A p */
     hd__cpu_parallel(be, hd__cpu_mg_op_row, rows);
-    pq = hd__mg_sum(mg->dot_a, rows);
-    rp = hd__mg_sum(mg->dot_b, rows);
+    pq = hd__mg_row_sum(mg->dot_a, (size_t)rows);
+    rp = hd__mg_row_sum(mg->dot_b, (size_t)rows);
     be->grid = NULL;
-    mg->have_dir = 1;
+    mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
     if (!(pq > 0.0)) return HD_SUCCESS;
     mg->alpha = rp / pq;

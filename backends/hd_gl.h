@@ -1011,16 +1011,11 @@ typedef struct hd__gl_level {
 struct hd__gl_mg {
     hd__gl_level lv[HD__GL_MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
-    int sig_surface;         /* ... and the boundary they were restricted for */
+    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     hd__gl_tex p, lo;        /* the search direction; the iterate's low part (phi + lo) */
     GLuint dot_a, dot_b;     /* per-row partial sums (double) */
     double *host_dot;        /* their host copy */
-    double rz;               /* <r, z> of the previous step */
     float beta;
-    int have_dir;
-    uint64_t iteration;
-    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
 };
 
 static size_t hd__gl_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
@@ -1089,7 +1084,7 @@ static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    mg->sig_gen = be->sig_gen - 1u; /* restrict sigma_t on first use */
+    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = hd__gl_mg_rows(mg);
     mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
@@ -1257,13 +1252,12 @@ static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex
 }
 
 /* <a, b> per fine row into dot, then the rows summed in row order on the host (as the CPU's
-   hd__mg_sum). */
+   hd__mg_row_sum). */
 static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot, double *out)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
-    size_t rows = hd__gl_mg_rows(mg), i;
-    double s = 0.0;
+    size_t rows = hd__gl_mg_rows(mg);
     hd_result r;
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
     if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, mg->fine[1],
@@ -1272,20 +1266,8 @@ static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_t
     be->gl.BindBuffer(GL_COPY_READ_BUFFER, dot);
     be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(rows * sizeof(double)), mg->host_dot);
     HD__GL_CHECK(ctx, "reading multigrid's row sums");
-    for (i = 0; i < rows; ++i) s += mg->host_dot[i];
-    *out = s;
+    *out = hd__mg_row_sum(mg->host_dot, rows);
     return HD_SUCCESS;
-}
-
-/* The parameters A depends on (restart CG when one changes): grid, flags, medium, 1/h^2, h. */
-static void hd__gl_mg_akey(const hd__kparams *kp, hd__kparams *key)
-{
-    memset(key, 0, sizeof *key);
-    key->gdims = kp->gdims;
-    key->counts.z = kp->counts.z;
-    key->medium = kp->medium;
-    key->grid = kp->grid;
-    key->gridh = kp->gridh;
 }
 
 /* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
@@ -1294,7 +1276,6 @@ static hd_result hd__gl_mg_prepare(hd__ctx *ctx, int *restart)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
-    hd__kparams key;
     hd_result r;
     int l, stale;
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
@@ -1305,12 +1286,7 @@ static hd_result hd__gl_mg_prepare(hd__ctx *ctx, int *restart)
     for (l = 0; l < mg->levels; ++l)
         if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return r;
     hd__gl_send_params(ctx);
-    hd__gl_mg_akey(&ctx->kp, &key);
-    stale = memcmp(&key, &mg->akey, sizeof key) != 0 || ctx->iterations < mg->iteration || mg->sig_gen != be->sig_gen;
-    *restart = stale || !mg->have_dir || mg->iteration != ctx->iterations;
-    mg->akey = key;
-    mg->iteration = ctx->iterations;
-    if (mg->sig_gen != be->sig_gen || mg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
         for (l = 1; l < mg->levels; ++l) {
             const int *d = mg->lv[l].dims;
             if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL,
@@ -1318,9 +1294,7 @@ static hd_result hd__gl_mg_prepare(hd__ctx *ctx, int *restart)
                                     mg->sig_channels)) != HD_SUCCESS)
                 return r;
         }
-        mg->sig_gen = be->sig_gen;
-        mg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
-        *restart = stale = 1;
+        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
     }
     if (stale) return hd__gl_tex_zero(ctx, &mg->lo);
     return HD_SUCCESS;
@@ -1342,8 +1316,7 @@ static hd_result hd__gl_multigrid(hd__ctx *ctx)
     if ((r = hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &L->rhs, 1, 0)) != HD_SUCCESS) return r;
     if ((r = hd__gl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
     if ((r = hd__gl_mg_dot(ctx, &L->rhs, &L->phi, mg->dot_a, &rz)) != HD_SUCCESS) return r;
-    mg->beta = restart || !(mg->rz > 0.0) ? 0.0f : (float)(rz / mg->rz);
-    mg->rz = rz;
+    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
     /* p = z + beta p, z = 0 */
     if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, mg->beta, 0.0)) != HD_SUCCESS ||
         (r = hd__gl_mg_pass(ctx, HD__GL_MG_DIR, L->params, NULL, &L->phi, &mg->p, NULL, NULL, mg->fine[0], mg->fine[1],
@@ -1353,7 +1326,7 @@ static hd_result hd__gl_multigrid(hd__ctx *ctx)
     if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS) return r;
     if ((r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a, &pq)) != HD_SUCCESS) return r;
     if ((r = hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b, &rp)) != HD_SUCCESS) return r;
-    mg->have_dir = 1;
+    mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
     if (!(pq > 0.0)) return HD_SUCCESS;
     alpha = rp / pq;

@@ -741,17 +741,12 @@ typedef struct hd__cl_level {
 struct hd__cl_mg {
     hd__cl_level lv[HD__CL_MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
-    int sig_surface;         /* ... and the boundary they were restricted for */
+    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
     cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
     cl_mem line;             /* the restriction's row buffer: a fine row's shares per coarse row */
     double *host_dot;        /* their host copy, one row sum per fine row */
-    double rz;               /* <r, z> of the previous step */
     float beta;
-    int have_dir;
-    uint64_t iteration;
-    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
 };
 
 static size_t hd__cl_mg_slots(const int *d, int channels)
@@ -813,7 +808,7 @@ static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    mg->sig_gen = be->sig_gen - 1u; /* restrict sigma_t on first use */
+    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = hd__cl_mg_rows(mg);
     mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
@@ -997,28 +992,15 @@ static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot
 }
 
 /* Reads the row sums of dot (blocking: after every pass enqueued before) and sums them in row
-   order, as the CPU's hd__mg_sum. */
+   order, as the CPU's hd__mg_row_sum. */
 static hd_result hd__cl_mg_sum(hd__ctx *ctx, cl_mem dot, double *out)
 {
     struct hd__cl_mg *mg = ctx->be->mg;
-    size_t rows = hd__cl_mg_rows(mg), i;
-    double s = 0.0;
+    size_t rows = hd__cl_mg_rows(mg);
     HD__CL_TRY(ctx, clEnqueueReadBuffer(ctx->be->queue, dot, CL_TRUE, 0, rows * sizeof(double), mg->host_dot, 0, NULL, NULL),
                "clEnqueueReadBuffer(multigrid row sums)");
-    for (i = 0; i < rows; ++i) s += mg->host_dot[i];
-    *out = s;
+    *out = hd__mg_row_sum(mg->host_dot, rows);
     return HD_SUCCESS;
-}
-
-/* The parameters A depends on (restart CG when one changes): grid, flags, medium, 1/h^2, h. */
-static void hd__cl_mg_akey(const hd__kparams *kp, hd__kparams *key)
-{
-    memset(key, 0, sizeof *key);
-    key->gdims = kp->gdims;
-    key->counts.z = kp->counts.z;
-    key->medium = kp->medium;
-    key->grid = kp->grid;
-    key->gridh = kp->gridh;
 }
 
 /* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
@@ -1027,7 +1009,6 @@ static hd_result hd__cl_mg_prepare(hd__ctx *ctx, int *restart)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
-    hd__kparams key;
     hd_result r;
     int l, stale;
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
@@ -1038,12 +1019,7 @@ static hd_result hd__cl_mg_prepare(hd__ctx *ctx, int *restart)
     for (l = 0; l < mg->levels; ++l)
         if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
     if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
-    hd__cl_mg_akey(&ctx->kp, &key);
-    stale = memcmp(&key, &mg->akey, sizeof key) != 0 || ctx->iterations < mg->iteration || mg->sig_gen != be->sig_gen;
-    *restart = stale || !mg->have_dir || mg->iteration != ctx->iterations;
-    mg->akey = key;
-    mg->iteration = ctx->iterations;
-    if (mg->sig_gen != be->sig_gen || mg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)) {
+    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
         for (l = 1; l < mg->levels; ++l) {
             cl_mem a[4];
             a[0] = mg->lv[l - 1].params; a[1] = mg->lv[l].params; a[2] = hd__cl_mg_sig(be, l - 1); a[3] = mg->lv[l].sig;
@@ -1051,9 +1027,7 @@ static hd_result hd__cl_mg_prepare(hd__ctx *ctx, int *restart)
                 (r = hd__cl_mg_run(ctx, HD__CL_MG_SIG, l, mg->sig_channels)) != HD_SUCCESS)
                 return r;
         }
-        mg->sig_gen = be->sig_gen;
-        mg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
-        *restart = stale = 1;
+        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
     }
     if (stale) return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(mg->fine, mg->channels));
     return HD_SUCCESS;
@@ -1080,8 +1054,7 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     if ((r = hd__cl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
     if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, L->phi, mg->dot_a)) != HD_SUCCESS) return r;
     if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &rz)) != HD_SUCCESS) return r;
-    mg->beta = restart || !(mg->rz > 0.0) ? 0.0f : (float)(rz / mg->rz);
-    mg->rz = rz;
+    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
     a[0] = L->params; a[1] = L->phi; a[2] = mg->p;
     if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DIR, 3, a)) != HD_SUCCESS) return r;
     HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_DIR], 3, sizeof mg->beta, &mg->beta), "clSetKernelArg(beta)");
@@ -1092,7 +1065,7 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b)) != HD_SUCCESS) return r;
     if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &pq)) != HD_SUCCESS) return r;
     if ((r = hd__cl_mg_sum(ctx, mg->dot_b, &rp)) != HD_SUCCESS) return r;
-    mg->have_dir = 1;
+    mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
     if (!(pq > 0.0)) return HD_SUCCESS;
     alpha = rp / pq;
