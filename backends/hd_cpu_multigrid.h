@@ -266,58 +266,17 @@ static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
 /* ---- the V-cycle: z = M r ------------------------------------------------------------------------ */
 static int hd__mg_rows(const hd__cpu_level *L, int channels) { return L->dims[1] * L->dims[2] * channels; }
 
-/* The smoother's own schedule (so the V-cycle can run the colours in either order; hd_cpu.h's
-   hd__cpu_red_black runs red first): blocks of rows (y), each walked through every z, and per
-   colour two passes, the even blocks then the odd ones. A row's vector loads read its neighbour
-   rows whole, so no block may write a row while another block reads it: two blocks of one pass
-   are never neighbours. The row itself is hd_cpu.h's (hd__cpu_diffuse_row_at): the same bits. */
-static int hd__mg_block_rows(const hd__backend *be)
-{
-    int rows = be->grid->k->p->gdims.y / (4 * be->nthreads);
-    return rows > 16 ? 16 : rows < 4 ? 4 : rows;
-}
-static int hd__mg_pass_blocks(const hd__backend *be)
-{
-    int rows = hd__mg_block_rows(be), nb = (be->grid->k->p->gdims.y + rows - 1) / rows;
-    return (nb + 1 - be->block_pass) / 2;
-}
-/* Item r = c * n + k (n = hd__mg_pass_blocks): block 2 k + be->block_pass of channel c. */
-static void hd__cpu_mg_smooth_block(hd__backend *be, int r)
-{
-    int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z, n = hd__mg_pass_blocks(be);
-    int rows = hd__mg_block_rows(be), c = r / n, y0 = (2 * (r % n) + be->block_pass) * rows;
-    int y1 = y0 + rows < gy ? y0 + rows : gy, y, z;
-    for (z = 0; z < gz; ++z)
-        for (y = y0; y < y1; ++y) hd__cpu_diffuse_row_at(be, y, z, c);
-}
-
-/* Red-black sweeps on be->grid; first = 0: red then black, 1: black then red (the adjoint
-   order, for post-smoothing). */
-static void hd__cpu_mg_smooth(hd__backend *be, int sweeps, int first)
-{
-    int s, h;
-    be->jacobi = 0;
-    for (s = 0; s < sweeps; ++s)
-        for (h = 0; h < 2; ++h) {
-            be->parity = first ^ h;
-            for (be->block_pass = 0; be->block_pass < 2; ++be->block_pass) {
-                int items = hd__mg_pass_blocks(be) * be->grid->k->p->gdims.w;
-                if (items > 0) hd__cpu_parallel(be, hd__cpu_mg_smooth_block, items);
-            }
-        }
-}
-
 static void hd__cpu_mg_cycle(hd__backend *be, int l)
 {
     struct hd__cpu_mg *mg = be->mg;
     hd__cpu_level *L = &mg->lv[l];
     be->grid = &L->g;
     if (l == mg->levels - 1) {
-        hd__cpu_mg_smooth(be, HD__MG_COARSEST_SWEEPS, 0);
-        hd__cpu_mg_smooth(be, HD__MG_COARSEST_SWEEPS, 1);
+        hd__cpu_red_black(be, HD__MG_COARSEST_SWEEPS, 0);
+        hd__cpu_red_black(be, HD__MG_COARSEST_SWEEPS, 1);
         return;
     }
-    hd__cpu_mg_smooth(be, HD__MG_PRE, 0);
+    hd__cpu_red_black(be, HD__MG_PRE, 0);
     hd__cpu_parallel(be, hd__cpu_residual_row, hd__mg_rows(L, mg->channels));
     mg->cur = l + 1;
     hd__cpu_parallel(be, hd__cpu_mg_restrict_row, hd__mg_rows(&mg->lv[l + 1], mg->channels));
@@ -325,7 +284,7 @@ static void hd__cpu_mg_cycle(hd__backend *be, int l)
     mg->cur = l + 1;
     hd__cpu_parallel(be, hd__cpu_mg_prolong_row, hd__mg_rows(L, mg->channels));
     be->grid = &L->g;
-    hd__cpu_mg_smooth(be, HD__MG_POST, 1);
+    hd__cpu_red_black(be, HD__MG_POST, 1);
 }
 
 /* ---- the fine residual in double ------------------------------------------------------------------ */
