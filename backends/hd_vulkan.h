@@ -25,7 +25,8 @@
    image3Ds, the TF, majorants and image accumulation storage buffers, the parameter block a
    ring of slots in one host-visible uniform buffer (a dynamic offset per iteration, so recorded
    iterations each see their own parameters). No sub-allocator: there are at most a dozen
-   resources plus one per CD light (<= 66 + 10), each large, far below maxMemoryAllocationCount
+   resources plus one per CD light (<= 66 + 10) plus HD_SOLVER_MULTIGRID's (4 per level, <= 12
+   levels, and 5; the coarse levels small), far below maxMemoryAllocationCount
    (4096 guaranteed), so every resource has its own vkAllocateMemory; a sub-allocator would add
    code and save nothing measurable. With params.illumination_precision FLOAT16, E, phi and phi2
    are r16f (VK_FORMAT_R16_SFLOAT) images, read and written by the _half SPIR-V of the stages

@@ -22,9 +22,10 @@
         $HD_VK_NO_F64=1 (a device without shaderFloat64) hd_create refuses it with
         HD_ERROR_UNSUPPORTED and a log line, a context switched to it refuses at hd_iterate and
         renders again with red-black; hd_vulkan_record refuses it (its steps read dot products
-        back); HD_VK_MEMORY_LIMIT between red-black's and multigrid's needs fails the first step
-        with HD_ERROR_OUT_OF_DEVICE_MEMORY at several points of the levels' allocation, and a
-        device lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
+        back); a new illumination grid (hd_set_params) gets new levels; HD_VK_MEMORY_LIMIT
+        between red-black's and multigrid's needs fails the first step with
+        HD_ERROR_OUT_OF_DEVICE_MEMORY at many points of the levels' allocation, and a device
+        lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
         destroyed with no object left (validation on, no message).
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
@@ -449,12 +450,17 @@ static void test_multigrid(void)
         ok = 0;
     }
     unsetenv("HD_VK_NO_F64");
-    /* not recordable */
+    /* not recordable; new levels for a new grid (illumination_downsample), and back */
     d.params.solver = HD_SOLVER_MULTIGRID;
     if ((r = hd_create(&d, &h)) == HD_SUCCESS) {
+        hd_params p = d.params;
         mg_log[0] = '\0';
         ok &= hd_vulkan_record(h, (void *)never_used, 1) == HD_ERROR_UNSUPPORTED && strstr(mg_log, "MULTIGRID") != NULL;
         ok &= hd_iterate(h, 1) == HD_SUCCESS;
+        p.illumination_downsample = 2;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
+        p.illumination_downsample = 1;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
         ok &= hd_destroy(h) == HD_SUCCESS;
     } else {
         ok = 0;
@@ -473,7 +479,7 @@ static void test_multigrid(void)
             oom += r == HD_ERROR_OUT_OF_DEVICE_MEMORY;
             fits += r == HD_SUCCESS;
             ok &= r == HD_ERROR_OUT_OF_DEVICE_MEMORY || r == HD_SUCCESS;
-            p.solver = HD_SOLVER_RED_BLACK; /* the levels are freed again: red-black still renders */
+            p.solver = HD_SOLVER_RED_BLACK; /* a failed allocation freed what it made: red-black still renders */
             ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
         }
         ok &= hd_destroy(h) == HD_SUCCESS;
