@@ -105,6 +105,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 12
+#define HD__VK_MG_PIPELINES (8 * 4) /* HD_SOLVER_MULTIGRID: 8 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -169,7 +170,7 @@ struct hd__backend {
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
     struct hd__vk_mg *mg;         /* HD_SOLVER_MULTIGRID's levels, CG vectors and sets, or NULL */
-    VkPipeline mg_pipes[8 * 4];   /* its passes, per pass and flags variant (RGB, surface), made on first use */
+    VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     unsigned sig_gen;             /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
@@ -1147,7 +1148,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines_half[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines_half[i], NULL);
         for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
-        for (i = 0; i < 8 * 4; ++i)
+        for (i = 0; i < HD__VK_MG_PIPELINES; ++i)
             if (be->mg_pipes[i]) be->fn.vkDestroyPipeline(be->device, be->mg_pipes[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
