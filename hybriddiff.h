@@ -155,8 +155,10 @@ typedef enum hd_solver {
     HD_SOLVER_MULTIGRID,     /* conjugate gradients preconditioned by a geometric multigrid
                                 V-cycle (red-black smoothing on every level); diffusion_sweeps
                                 counts CG steps (one V-cycle and two residual passes each);
-                                +about 22 bytes per voxel and channel. CPU backend only for now:
-                                the GPU backends return HD_ERROR_UNSUPPORTED */
+                                +about 22 bytes per voxel and channel. Every backend; OpenCL
+                                and Vulkan need double precision (cl_khr_fp64, shaderFloat64:
+                                a caller's Vulkan device must have enabled it), else
+                                HD_ERROR_UNSUPPORTED */
     HD_SOLVER_COUNT
 } hd_solver;
 
@@ -372,7 +374,9 @@ HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
    current method into the caller's VkCommandBuffer (passed as void*, in the recording state,
    from a pool of desc.vulkan.queue_family) instead of submitting them; hd_iterate submits and
    waits itself. Changed inputs are uploaded first (submitted and waited for). The caller
-   submits the command buffer and waits for it before the next call on this context. */
+   submits the command buffer and waits for it before the next call on this context.
+   HD_SOLVER_MULTIGRID (with HD or CD diffusing) cannot be recorded: each step reads its dot
+   products back on the host; HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_vulkan_record(hd_context ctx, void *command_buffer, int n);
 
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as

@@ -18,7 +18,10 @@
    only one of the two stores is compiled.
    HD_ILLUM_R16F (scripts/build-spirv's _half modules of the stages that touch E / phi): E, phi
    and phi2 are r16f (VK_FORMAT_R16_SFLOAT, params.illumination_precision FLOAT16), converted by
-   imageLoad / imageStore, the arithmetic float32; r16f needs shaderStorageImageExtendedFormats. */
+   imageLoad / imageStore, the arithmetic float32; r16f needs shaderStorageImageExtendedFormats.
+   Binding 11: HD_SOLVER_MULTIGRID's row sums (doubles, hd_entry_glsl_multigrid.h, its modules
+   compiled with HD_MG_STAGE = n and HD_STAGE 0); its passes' flags, like the diffusion stage's,
+   are hd_sc_flags, and their beta / alpha come in the push constants (HD_MG_PUSH_SCALARS). */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 #extension GL_EXT_control_flow_attributes : require
 #define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
@@ -44,7 +47,8 @@ layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;
 layout(constant_id = 2) const int hd_sc_jacobi = 0;
 layout(constant_id = 3) const int hd_sc_yk = 1;
-#if HD_STAGE == 3 /* HD_STAGE_DIFFUSE (hd_entry_glsl.h); the other stages read counts.z */
+#define HD_MG_PUSH_SCALARS 1
+#if HD_STAGE == 3 || defined(HD_MG_STAGE) /* HD_STAGE_DIFFUSE (hd_entry_glsl.h), multigrid; the other stages read counts.z */
 #define HD_DIFFUSE_FLAGS hd_sc_flags
 #define HD_DIFFUSE_ZK hd_sc_zk
 #define HD_DIFFUSE_YK hd_sc_yk

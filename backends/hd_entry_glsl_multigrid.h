@@ -1,13 +1,19 @@
-/* hd_entry_glsl_multigrid.h - GLSL 4.30 text, not C: the OpenGL backend's HD_SOLVER_MULTIGRID
-   passes, one program each, selected by -DHD_MG_STAGE=n (hd_gl.h), in place of hd_entry_glsl.h
-   (scripts/embed-glsl). The math is the shared hd_k_multigrid.h / hd_k_diffuse.h; the V-cycle's
-   smoothing is hd_entry_glsl.h's diffusion program on the level's bindings. One invocation per
-   voxel (x along the 64-wide work group).
+/* hd_entry_glsl_multigrid.h - GLSL text, not C: HD_SOLVER_MULTIGRID's passes, one program (GL,
+   hd_gl.h; 4.30, scripts/embed-glsl) or SPIR-V module (Vulkan, hd_vulkan.h; 4.50,
+   scripts/build-spirv) each, selected by HD_MG_STAGE=n, in place of hd_entry_glsl.h. The math is
+   the shared hd_k_multigrid.h / hd_k_diffuse.h; the V-cycle's smoothing is hd_entry_glsl.h's
+   diffusion stage on the level's bindings. One invocation per voxel (x along the 64-wide work
+   group).
    GLSL has one parameter block (binding 0) and no kernel context: the block bound is the grid
    the shared function READS (hd_k_multigrid.h's K); the other grid's dims come in hd_pc and it
-   is reached through image unit 6 (hd_i_lv2, r32f, read-write), which no multigrid pass uses
-   otherwise. Other units as the sweep's: 1 sigma_t, 2 E, 3 phi, 4 phi2. Double precision is
-   core GLSL 4.00 (llvmpipe compiles it); the row sums go to storage buffer 3, doubles. */
+   is reached through hd_i_lv2 (r32f, read-write; GL image unit 6, Vulkan binding 10), which no
+   multigrid pass uses otherwise. Other grids as the sweep's: sig, E, phi, phi2. Double precision
+   is core GLSL 4.00 (llvmpipe compiles it; Vulkan: the device feature shaderFloat64, which
+   lavapipe has). The row sums go to a storage buffer of doubles: GL binding 3, Vulkan binding 11
+   (3 is the majorant grid there). beta and alpha: GL uniforms at locations 1 and 2; Vulkan has no
+   loose uniforms, so they come in the push constants the direction and update passes leave free
+   (HD_MG_PUSH_SCALARS, hd_bind_vk_glsl.h): beta's bits in hd_pc.x, alpha's low and high words in
+   hd_pc.x and hd_pc.y. */
 #define HD_MG_SIG 1      /* K fine; hd_pc = coarse dims, sigma_t channels; coarse sigma_t -> unit 6 */
 #define HD_MG_RESIDUAL 2 /* K the level (sig, E = rhs, phi); f - A phi in float -> phi2 */
 #define HD_MG_RESTRICT 3 /* K fine (phi = its residual); hd_pc = coarse dims, channels; rhs -> unit 6, phi2 = 0 */
@@ -16,9 +22,15 @@
 #define HD_MG_RES_F64 6  /* K fine (sig, E, phi, phi2 = lo); hd_pc.x use_lo, .y negate; -> unit 6 */
 #define HD_MG_DOT 7      /* K level 0 (E, phi): the row sums -> hd_mg_row_sums */
 #define HD_MG_UPDATE 8   /* phi + lo (phi2) += alpha p (E) */
+#ifdef HD_MG_PUSH_SCALARS
+layout(std430, binding = 11) writeonly buffer hd_b_dot { double hd_mg_row_sums[]; };
+#define hd_mg_beta intBitsToFloat(hd_pc.x)
+#define hd_mg_alpha packDouble2x32(uvec2(hd_pc.xy))
+#else
 layout(std430, binding = 3) writeonly buffer hd_b_dot { double hd_mg_row_sums[]; };
 layout(location = 1) uniform float hd_mg_beta;
 layout(location = 2) uniform double hd_mg_alpha;
+#endif
 
 float hd_mg_other(int x, int y, int zz)
 {

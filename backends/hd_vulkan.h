@@ -25,7 +25,8 @@
    image3Ds, the TF, majorants and image accumulation storage buffers, the parameter block a
    ring of slots in one host-visible uniform buffer (a dynamic offset per iteration, so recorded
    iterations each see their own parameters). No sub-allocator: there are at most a dozen
-   resources plus one per CD light (<= 66 + 10), each large, far below maxMemoryAllocationCount
+   resources plus one per CD light (<= 66 + 10) plus HD_SOLVER_MULTIGRID's (4 per level, <= 12
+   levels, and 5; the coarse levels small), far below maxMemoryAllocationCount
    (4096 guaranteed), so every resource has its own vkAllocateMemory; a sub-allocator would add
    code and save nothing measurable. With params.illumination_precision FLOAT16, E, phi and phi2
    are r16f (VK_FORMAT_R16_SFLOAT) images, read and written by the _half SPIR-V of the stages
@@ -99,10 +100,12 @@ typedef struct hd__vk_fns {
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
        HD__VK_PATH, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
-#define HD__VK_DIFFUSE_VARIANTS 128 /* diffusion pipelines per context, one per flags value, solver and precision (64 today) */
+#define HD__VK_DIFFUSE_VARIANTS 160 /* diffusion pipelines per context, one per flags value, solver and precision
+                                     (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
-#define HD__VK_BINDINGS 11
+#define HD__VK_BINDINGS 12
+#define HD__VK_MG_PIPELINES (8 * 4) /* HD_SOLVER_MULTIGRID: 8 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -165,6 +168,11 @@ struct hd__backend {
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
     int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
     const char *no_half;          /* why r16f storage images are missing, or NULL */
+    const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
+    struct hd__vk_mg *mg;         /* HD_SOLVER_MULTIGRID's levels, CG vectors and sets, or NULL */
+    VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
+    unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
+    unsigned sig_gen;             /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
@@ -383,6 +391,7 @@ static hd_result hd__vk_create_device(hd__ctx *ctx)
     be->fn.vkGetPhysicalDeviceFeatures(be->phys, &have);
     memset(&want, 0, sizeof want);
     want.shaderStorageImageExtendedFormats = have.shaderStorageImageExtendedFormats; /* r16f: float16 illumination */
+    want.shaderFloat64 = have.shaderFloat64; /* HD_SOLVER_MULTIGRID's double residual, dot products, update */
     memset(&qci, 0, sizeof qci);
     qci.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
     qci.queueFamilyIndex = be->queue_family;
@@ -849,12 +858,11 @@ static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
     return HD_SUCCESS;
 }
 
-/* The diffusion pipeline for the current flags and solver, made on first use and kept until
-   hd_destroy (a command buffer recorded by hd_vulkan_record may still name an older one). */
-static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipeline *out)
+/* The diffusion pipeline for the flags word `flags` and the solver, made on first use and kept
+   until hd_destroy (a command buffer recorded by hd_vulkan_record may still name an older one). */
+static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_t jacobi, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
-    int32_t flags = ctx->kp.counts.z;
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
@@ -871,6 +879,12 @@ static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipelin
     be->diffuse_half[be->ndiffuse] = be->f16;
     *out = be->diffuse[be->ndiffuse++];
     return HD_SUCCESS;
+}
+
+/* ... for the current flags (ctx->kp). */
+static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipeline *out)
+{
+    return hd__vk_diffuse_pipeline_for(ctx, ctx->kp.counts.z, jacobi, out);
 }
 
 /* A compute descriptor-set layout of n bindings (binding i of types[i], one descriptor each)
@@ -920,7 +934,7 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
+        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     VkDescriptorPoolSize ps[3];
     VkDescriptorPoolCreateInfo dpci;
     hd_result r;
@@ -931,7 +945,7 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 3 * HD_MAX_LIGHTS;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * HD_MAX_LIGHTS;
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = HD_MAX_LIGHTS;
@@ -941,16 +955,59 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* Writes set `set`: binding 0 the parameter buffer `params` (dynamic offset, one block), the
+   others im[i] / bu[i] (absent resources, NULL or not allocated, bind placeholders: at float16
+   storage an r16f one for E / phi / phi2, a view's format must match the shader's). */
+static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buffer *params, const hd__vk_image *const *im,
+                             const hd__vk_buffer *const *bu)
+{
+    hd__backend *be = ctx->be;
+    VkWriteDescriptorSet w[HD__VK_BINDINGS];
+    VkDescriptorBufferInfo bi[HD__VK_BINDINGS];
+    VkDescriptorImageInfo ii[HD__VK_BINDINGS];
+    int i;
+    for (i = 0; i < HD__VK_BINDINGS; ++i) {
+        memset(&w[i], 0, sizeof w[i]);
+        w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        w[i].dstSet = set;
+        w[i].dstBinding = (uint32_t)i;
+        w[i].descriptorCount = 1;
+        if (i == 0 || bu[i]) {
+            const hd__vk_buffer *x = i == 0 ? params : bu[i]->buffer ? bu[i] : &be->dummy_buffer;
+            bi[i].buffer = x->buffer;
+            bi[i].offset = 0;
+            bi[i].range = i == 0 ? sizeof(hd__kparams) : VK_WHOLE_SIZE;
+            w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            w[i].pBufferInfo = &bi[i];
+        } else {
+            const hd__vk_image *x = im[i] && im[i]->image ? im[i] : be->f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
+            ii[i].sampler = VK_NULL_HANDLE;
+            ii[i].imageView = x->view;
+            ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
+            w[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+            w[i].pImageInfo = &ii[i];
+        }
+    }
+    be->fn.vkUpdateDescriptorSets(be->device, HD__VK_BINDINGS, w, 0, NULL);
+}
+
+/* The buffers every set binds (TF, majorants, image; binding 11, multigrid's row sums, a
+   placeholder unless given) into bu. */
+static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, const hd__vk_buffer *dot)
+{
+    bu[2] = &be->tf; bu[3] = &be->maj; bu[8] = &be->img; bu[11] = dot ? dot : &be->dummy_buffer;
+}
+
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
-   spare) at bindings 9 and 10; set 0 serves every other stage. Absent resources bind dummies
-   (at float16 storage an r16f one for E / phi / phi2: a view's format must match the shader's).
-   Nothing may be in flight (the backend waits after each stage; hd_vulkan_record's contract). */
+   spare) at bindings 9 and 10; set 0 serves every other stage (multigrid's passes have their own,
+   hd__vk_mg_sets). Nothing may be in flight (the backend waits after each stage;
+   hd_vulkan_record's contract). */
 static hd_result hd__vk_sets(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     VkDescriptorSetLayout layouts[HD_MAX_LIGHTS];
     VkDescriptorSetAllocateInfo ai;
-    int n = be->nlv > 0 ? be->nlv : 1, s, i;
+    int n = be->nlv > 0 ? be->nlv : 1, s;
     if (be->sets_valid) return HD_SUCCESS;
     HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, be->dpool, 0), "vkResetDescriptorPool");
     for (s = 0; s < n; ++s) layouts[s] = be->set_layout;
@@ -961,42 +1018,18 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
     ai.pSetLayouts = layouts;
     HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, be->sets), "vkAllocateDescriptorSets");
     for (s = 0; s < n; ++s) {
-        VkWriteDescriptorSet w[HD__VK_BINDINGS];
-        VkDescriptorBufferInfo bi[HD__VK_BINDINGS];
-        VkDescriptorImageInfo ii[HD__VK_BINDINGS];
         const hd__vk_image *im[HD__VK_BINDINGS];
         const hd__vk_buffer *bu[HD__VK_BINDINGS];
         memset(im, 0, sizeof im);
         memset(bu, 0, sizeof bu);
-        bu[0] = &be->params; im[1] = &be->vol; bu[2] = &be->tf; bu[3] = &be->maj; im[4] = &be->sig;
-        im[5] = &be->E; im[6] = &be->phi; im[7] = &be->phi2; bu[8] = &be->img;
+        hd__vk_common_buffers(be, bu, NULL);
+        im[1] = &be->vol; im[4] = &be->sig; im[5] = &be->E; im[6] = &be->phi; im[7] = &be->phi2;
         im[9] = be->nlv > 0 ? &be->lv[s] : &be->dummy;
         im[10] = be->nlv > 0 ? &be->lv[be->nlv] : &be->dummy;
-        for (i = 0; i < HD__VK_BINDINGS; ++i) {
-            memset(&w[i], 0, sizeof w[i]);
-            w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-            w[i].dstSet = be->sets[s];
-            w[i].dstBinding = (uint32_t)i;
-            w[i].descriptorCount = 1;
-            if (bu[i]) {
-                const hd__vk_buffer *x = bu[i]->buffer ? bu[i] : &be->dummy_buffer;
-                bi[i].buffer = x->buffer;
-                bi[i].offset = 0;
-                bi[i].range = i == 0 ? sizeof(hd__kparams) : VK_WHOLE_SIZE;
-                w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-                w[i].pBufferInfo = &bi[i];
-            } else {
-                const hd__vk_image *x = im[i]->image ? im[i] : be->f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
-                ii[i].sampler = VK_NULL_HANDLE;
-                ii[i].imageView = x->view;
-                ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
-                w[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-                w[i].pImageInfo = &ii[i];
-            }
-        }
-        be->fn.vkUpdateDescriptorSets(be->device, HD__VK_BINDINGS, w, 0, NULL);
+        hd__vk_write_set(ctx, be->sets[s], &be->params, im, bu);
     }
     be->sets_valid = 1;
+    be->sets_gen++;
     return HD_SUCCESS;
 }
 
@@ -1038,8 +1071,20 @@ static hd_result hd__vk_params(hd__ctx *ctx, uint32_t *offset)
     return HD_SUCCESS;
 }
 
+/* Records, after a barrier, one dispatch of pipeline pipe over groups of 64 x 1 x 1 covering
+   nx x ny x nz, with descriptor set `set` at parameter offset `offset` and push constants pc. */
+static void hd__vk_record_dispatch(hd__backend *be, VkCommandBuffer cb, VkPipeline pipe, VkDescriptorSet set, uint32_t offset,
+                                   int nx, int ny, int nz, const int32_t *pc)
+{
+    hd__vk_barrier(be, cb);
+    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+    be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->layout, 0, 1, &set, 1, &offset);
+    be->fn.vkCmdPushConstants(cb, be->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, 4 * sizeof pc[0], pc);
+    be->fn.vkCmdDispatch(cb, ((uint32_t)nx + HD__VK_LOCAL_X - 1) / HD__VK_LOCAL_X, (uint32_t)ny, (uint32_t)nz);
+}
+
 /* Records one dispatch of pipeline pipe over groups of 64 x 1 x 1 covering nx x ny x nz, with
-   the given set and push constants, after a barrier. */
+   the given set (of be->sets) and push constants, after a barrier. */
 static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pipe, int set, int nx, int ny, int nz,
                                  int pc0, int pc1, int pc2, int pc3)
 {
@@ -1050,11 +1095,7 @@ static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pi
     if (nx <= 0 || ny <= 0 || nz <= 0) return HD_SUCCESS;
     if ((r = hd__vk_params(ctx, &offset)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
-    hd__vk_barrier(be, cb);
-    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
-    be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->layout, 0, 1, &be->sets[set], 1, &offset);
-    be->fn.vkCmdPushConstants(cb, be->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-    be->fn.vkCmdDispatch(cb, ((uint32_t)nx + HD__VK_LOCAL_X - 1) / HD__VK_LOCAL_X, (uint32_t)ny, (uint32_t)nz);
+    hd__vk_record_dispatch(be, cb, pipe, be->sets[set], offset, nx, ny, nz, pc);
     return HD_SUCCESS;
 }
 
@@ -1085,6 +1126,8 @@ static void hd__vk_free_lights(hd__ctx *ctx)
     be->sets_valid = 0;
 }
 
+static void hd__vk_mg_free(hd__ctx *ctx);
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1094,6 +1137,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->open && !be->lost) hd__vk_flush(ctx);
         be->fn.vkDeviceWaitIdle(be->device); /* also after a lost device: then it returns at once */
         hd__vk_free_lights(ctx);
+        hd__vk_mg_free(ctx);
         hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
         hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2); hd__vk_free_image(ctx, &be->dummy);
         hd__vk_free_image(ctx, &be->dummy16);
@@ -1104,6 +1148,8 @@ static void hd__be_destroy(hd__ctx *ctx)
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines_half[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines_half[i], NULL);
         for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
+        for (i = 0; i < HD__VK_MG_PIPELINES; ++i)
+            if (be->mg_pipes[i]) be->fn.vkDestroyPipeline(be->device, be->mg_pipes[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
         if (be->set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, be->set_layout, NULL);
@@ -1139,6 +1185,22 @@ static void hd__vk_check_half(hd__ctx *ctx)
         be->no_half = "VK_FORMAT_R16_SFLOAT images cannot be copied (no TRANSFER_SRC / TRANSFER_DST)";
     else if (!f.shaderStorageImageExtendedFormats)
         be->no_half = "the device lacks shaderStorageImageExtendedFormats (r16f storage images)";
+}
+
+/* Whether the device has shaderFloat64 (HD_SOLVER_MULTIGRID's double passes): be->no_f64 says why
+   not. The own device enables it where the physical device has it; a caller's device must have
+   enabled it (Vulkan cannot be asked which features a device was created with, so only the
+   physical device's is checked, as for r16f). $HD_VK_NO_F64=1 plays a device without it. */
+static void hd__vk_check_f64(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkPhysicalDeviceFeatures f;
+    be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
+    be->no_f64 = NULL;
+    if (hd__vk_env_flag("HD_VK_NO_F64"))
+        be->no_f64 = "$HD_VK_NO_F64 is set (the test knob that plays a device without shaderFloat64)";
+    else if (!f.shaderFloat64)
+        be->no_f64 = "the device lacks shaderFloat64 (the solver's residuals and dot products are double)";
 }
 
 /* HD_ERROR_UNSUPPORTED, logged, when float16 illumination is asked for and the device lacks it. */
@@ -1222,6 +1284,9 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if ((r = hd__vk_ring(ctx, 16)) != HD_SUCCESS) return r;
     hd__vk_check_half(ctx);
     if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r;
+    hd__vk_check_f64(ctx);
+    if (ctx->params.solver == HD_SOLVER_MULTIGRID && be->no_f64)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name, be->no_f64);
     if (!be->no_half && (r = hd__vk_image_new_as(ctx, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
         return r;
     if ((r = hd__vk_buffer_create(ctx, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
@@ -1337,6 +1402,7 @@ static hd_result hd__be_classify(hd__ctx *ctx)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
+    ++ctx->be->sig_gen;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CLASSIFY], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
@@ -1488,6 +1554,459 @@ static hd_result hd__be_path(hd__ctx *ctx)
     return hd__vk_flush(ctx);
 }
 
+/* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
+   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
+   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design), structured as
+   the GL port (hd_gl.h): the per-voxel math is the shared hd_k_multigrid.h (entry points
+   hd_entry_glsl_multigrid.h, SPIR-V hd__spv_mg_*), the V-cycle's smoothing the diffusion pipeline
+   specialized with HD_FLAG_DIFFUSE_RHS on each level's own parameter block; the restarts, beta and
+   the row-order sum are hd_multigrid_cg.h's. Every level's sigma_t / rhs / phi / residual and CG's
+   p and lo are r32f storage images like the backend's own; the double passes need shaderFloat64;
+   the dot products are summed per row on the device (x in order, doubles into a host-visible
+   storage buffer at binding 11) and the rows in row order on the host, as the CPU does.
+   Vulkan binds through descriptor sets, not per pass as GL does: each pass's combination of
+   images (a level's smoothing, a restriction, ...) is a set of the multigrid's own pool, written
+   when the levels are made and again whenever the backend's sets are rebuilt (its sigma_t, E and
+   phi may be new: be->sets_gen); the parameter blocks are slots of the multigrid's own uniform
+   buffer, one per level and one for the fine ctx->kp, bound with a dynamic offset.
+   A step is three submissions, each waited for: r, the V-cycle and <r, z> (read back: beta);
+   the direction, q = A p, <p, q> and <r, p> (read back: alpha); the update. So hd_vulkan_record
+   cannot record it (HD_ERROR_UNSUPPORTED there). */
+#define HD__BE_HAS_MULTIGRID 1
+#define HD__VK_MG_MAX_LEVELS 12
+#define HD__VK_MG_PRE 2
+#define HD__VK_MG_POST 2
+#define HD__VK_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
+enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROLONG, HD__VK_MG_DIR, HD__VK_MG_RES_F64,
+       HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_STAGES = HD__VK_MG_UPDATE };
+/* CG's passes' sets (level 0 and the backend's grids) */
+enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
+       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_CG_SETS };
+#define HD__VK_MG_SETS (4 * HD__VK_MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
+
+typedef struct hd__vk_level {
+    int dims[3];
+    hd__kparams kp;           /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
+    hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
+    /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
+    VkDescriptorSet smooth, restrict_to, prolong_from, coarsen;
+} hd__vk_level;
+
+struct hd__vk_mg {
+    hd__vk_level lv[HD__VK_MG_MAX_LEVELS];
+    int levels, channels, sig_channels, fine[3];
+    hd__mg_cg cg;             /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
+    hd__vk_image p, lo;       /* the search direction; the iterate's low part (phi + lo) */
+    hd__vk_buffer dot_a, dot_b; /* per-row partial sums (double), host-visible */
+    hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
+    VkDeviceSize slot_bytes;
+    VkDescriptorPool pool;
+    VkDescriptorSet cg_sets[HD__VK_MG_CG_SETS];
+    unsigned sets_gen;        /* be->sets_gen the sets were written at */
+    int sets_valid;
+};
+
+static const char *const hd__vk_mg_names[HD__VK_MG_STAGES] = {
+    "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
+    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update"};
+
+static size_t hd__vk_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
+static size_t hd__vk_mg_rows(const struct hd__vk_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
+
+/* Frees the levels, vectors, buffers and sets; nothing of theirs may be in flight (the callers
+   flushed, or hd__be_destroy waited for the device). */
+static void hd__vk_mg_free(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg = be->mg;
+    int l;
+    if (!mg) return;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__vk_level *L = &mg->lv[l];
+        hd__vk_free_image(ctx, &L->sig); hd__vk_free_image(ctx, &L->rhs); hd__vk_free_image(ctx, &L->phi); hd__vk_free_image(ctx, &L->res);
+    }
+    hd__vk_free_image(ctx, &mg->p); hd__vk_free_image(ctx, &mg->lo);
+    hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
+    if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
+    hd__free(ctx, mg);
+    be->mg = NULL;
+}
+
+/* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
+static size_t hd__be_solver_bytes(const hd__ctx *ctx)
+{
+    const struct hd__vk_mg *mg = ctx->be->mg;
+    size_t b;
+    int l;
+    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    b = 2 * sizeof(double) * hd__vk_mg_rows(mg) + 2 * sizeof(float) * hd__vk_mg_voxels(mg->fine, mg->channels);
+    for (l = 0; l < mg->levels; ++l) {
+        b += 3 * sizeof(float) * hd__vk_mg_voxels(mg->lv[l].dims, mg->channels);
+        if (l > 0) b += sizeof(float) * hd__vk_mg_voxels(mg->lv[l].dims, mg->sig_channels);
+    }
+    return b;
+}
+#define HD__BE_HAS_SOLVER_BYTES 1
+
+/* A level's grid of `channels` channels stacked in z, zeroed (by the next submission). */
+static hd_result hd__vk_mg_image(hd__ctx *ctx, hd__vk_image *im, const int *d, int channels, const char *what)
+{
+    return hd__vk_image_new(ctx, im, d[0], d[1], d[2] * channels, what);
+}
+
+/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
+   one: hd_cpu_multigrid.h's rule), CG's vectors (zeroed), the row-sum buffers, the parameter
+   slots and the set pool. On failure everything made so far is freed again. */
+static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg = be->mg;
+    VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
+    VkDescriptorPoolSize ps[3];
+    VkDescriptorPoolCreateInfo dpci;
+    size_t rows = hd__vk_mg_rows(mg);
+    int l, i, d[3];
+    hd_result r;
+    for (i = 0; i < 3; ++i) d[i] = mg->fine[i];
+    if ((r = hd__vk_mg_image(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
+        (r = hd__vk_mg_image(ctx, &mg->lo, d, mg->channels, "multigrid's lo")) != HD_SUCCESS ||
+        (r = hd__vk_buffer_create(ctx, &mg->dot_a, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+                                  "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__vk_buffer_create(ctx, &mg->dot_b, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+                                  "multigrid's row sums")) != HD_SUCCESS)
+        return r;
+    for (l = 0; l < HD__VK_MG_MAX_LEVELS; ++l) {
+        hd__vk_level *L = &mg->lv[l];
+        memcpy(L->dims, d, sizeof d);
+        mg->levels = l + 1;
+        if ((r = hd__vk_mg_image(ctx, &L->rhs, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__vk_mg_image(ctx, &L->phi, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (r = hd__vk_mg_image(ctx, &L->res, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
+            (l > 0 && (r = hd__vk_mg_image(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS))
+            return r;
+        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
+        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+    }
+    mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
+    if ((r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(mg->levels + 1),
+                                  VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
+        return r;
+    ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD__VK_MG_SETS;
+    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD__VK_MG_SETS;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * HD__VK_MG_SETS;
+    memset(&dpci, 0, sizeof dpci);
+    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    dpci.maxSets = HD__VK_MG_SETS;
+    dpci.poolSizeCount = 3;
+    dpci.pPoolSizes = ps;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &mg->pool), "vkCreateDescriptorPool");
+    return HD_SUCCESS;
+}
+
+static hd_result hd__vk_mg_alloc(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg;
+    hd_result r;
+    int i;
+    be->mg = mg = (struct hd__vk_mg *)hd__calloc(ctx, 1, sizeof *mg);
+    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the multigrid levels");
+    mg->channels = ctx->channels;
+    mg->sig_channels = ctx->sig_channels;
+    for (i = 0; i < 3; ++i) mg->fine[i] = ctx->gdims[i];
+    hd__mg_cg_init(&mg->cg, be->sig_gen);
+    if ((r = hd__vk_mg_alloc_parts(ctx)) != HD_SUCCESS) {
+        hd__vk_flush(ctx); /* the new images' clears were recorded: submit them before the images go */
+        hd__vk_mg_free(ctx);
+        return r;
+    }
+    return HD_SUCCESS;
+}
+
+/* Level l's sigma_t. */
+static const hd__vk_image *hd__vk_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg->lv[l].sig; }
+
+/* Writes one multigrid set: sigma_t, E, phi, phi2 (bindings 4..7), the other grid (10) and the
+   row sums (11); NULL binds a placeholder. */
+static void hd__vk_mg_write(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_image *sig, const hd__vk_image *E,
+                            const hd__vk_image *phi, const hd__vk_image *phi2, const hd__vk_image *other,
+                            const hd__vk_buffer *dot)
+{
+    hd__backend *be = ctx->be;
+    const hd__vk_image *im[HD__VK_BINDINGS];
+    const hd__vk_buffer *bu[HD__VK_BINDINGS];
+    memset(im, 0, sizeof im);
+    memset(bu, 0, sizeof bu);
+    hd__vk_common_buffers(be, bu, dot);
+    im[1] = &be->vol; im[4] = sig; im[5] = E; im[6] = phi; im[7] = phi2; im[10] = other;
+    hd__vk_write_set(ctx, set, &be->mg->params, im, bu);
+}
+
+/* Every pass's set (hd_gl.h's bindings per pass), written when the levels are new or the
+   backend's sets were rebuilt since (its grids may be new). Nothing is in flight. */
+static hd_result hd__vk_mg_sets(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg = be->mg;
+    VkDescriptorSetLayout layouts[HD__VK_MG_SETS];
+    VkDescriptorSet sets[HD__VK_MG_SETS];
+    VkDescriptorSetAllocateInfo ai;
+    hd__vk_level *L0 = &mg->lv[0];
+    int n = 4 * mg->levels + HD__VK_MG_CG_SETS, i, l;
+    if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
+    mg->sets_valid = 0;
+    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, mg->pool, 0), "vkResetDescriptorPool (multigrid)");
+    for (i = 0; i < n; ++i) layouts[i] = be->set_layout;
+    memset(&ai, 0, sizeof ai);
+    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    ai.descriptorPool = mg->pool;
+    ai.descriptorSetCount = (uint32_t)n;
+    ai.pSetLayouts = layouts;
+    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, sets), "vkAllocateDescriptorSets (multigrid)");
+    for (l = 0; l < mg->levels; ++l) {
+        hd__vk_level *L = &mg->lv[l], *C = l + 1 < mg->levels ? &mg->lv[l + 1] : NULL;
+        L->smooth = sets[4 * l];
+        L->restrict_to = sets[4 * l + 1];
+        L->prolong_from = sets[4 * l + 2];
+        L->coarsen = sets[4 * l + 3];
+        hd__vk_mg_write(ctx, L->smooth, hd__vk_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, NULL);
+        if (C) {
+            hd__vk_mg_write(ctx, L->restrict_to, NULL, NULL, &L->res, &C->phi, &C->rhs, NULL);
+            hd__vk_mg_write(ctx, L->prolong_from, NULL, NULL, &C->phi, NULL, &L->phi, NULL);
+        }
+        if (l > 0) hd__vk_mg_write(ctx, L->coarsen, hd__vk_mg_sig(be, l - 1), NULL, NULL, NULL, &L->sig, NULL);
+    }
+    for (i = 0; i < HD__VK_MG_CG_SETS; ++i) mg->cg_sets[i] = sets[4 * mg->levels + i];
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], &be->sig, &be->E, &be->phi, &mg->lo, &L0->rhs, NULL);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], &be->sig, &L0->phi, &mg->p, &mg->lo, &L0->res, NULL);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RZ], NULL, &L0->rhs, &L0->phi, NULL, NULL, &mg->dot_a);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DIR], NULL, &L0->phi, &mg->p, NULL, NULL, NULL);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ], NULL, &mg->p, &L0->res, NULL, NULL, &mg->dot_a);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP], NULL, &L0->rhs, &mg->p, NULL, NULL, &mg->dot_b);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_UPDATE], NULL, &mg->p, &be->phi, &mg->lo, NULL, NULL);
+    mg->sets_gen = be->sets_gen;
+    mg->sets_valid = 1;
+    return HD_SUCCESS;
+}
+
+/* Every level's parameter block (the CPU's hd__cpu_mg_params) and the fine one into their slots
+   (nothing is in flight: each step ends waited for). */
+static void hd__vk_mg_params(hd__ctx *ctx)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    int l;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__vk_level *L = &mg->lv[l];
+        hd__kparams kp = ctx->kp;
+        float s = (float)(1 << l);
+        kp.gdims.x = L->dims[0]; kp.gdims.y = L->dims[1]; kp.gdims.z = L->dims[2];
+        kp.grid.x = ctx->kp.grid.x / (s * s); kp.grid.y = ctx->kp.grid.y / (s * s); kp.grid.z = ctx->kp.grid.z / (s * s);
+        kp.gridh.x = ctx->kp.gridh.x * s; kp.gridh.y = ctx->kp.gridh.y * s; kp.gridh.z = ctx->kp.gridh.z * s;
+        kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+        L->kp = kp;
+        memcpy((char *)mg->params.map + (size_t)l * mg->slot_bytes, &kp, sizeof kp);
+    }
+    memcpy((char *)mg->params.map + (size_t)mg->levels * mg->slot_bytes, &ctx->kp, sizeof ctx->kp);
+}
+
+/* The flags the passes' pipelines are specialized for: RGB scattering and the boundary (the
+   variant), and the rhs flag for the levels' float residual (as hd_gl.h's programs). */
+static int hd__vk_mg_variant(int counts_z)
+{
+    return ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
+}
+
+/* The pipeline of multigrid pass `stage` for the current flags, made on first use. */
+static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
+{
+    static const uint32_t *const code[HD__VK_MG_STAGES] = {hd__spv_mg_sig, hd__spv_mg_residual, hd__spv_mg_restrict,
+                                                           hd__spv_mg_prolong, hd__spv_mg_dir, hd__spv_mg_res_f64,
+                                                           hd__spv_mg_dot, hd__spv_mg_update};
+    static const size_t size[HD__VK_MG_STAGES] = {sizeof hd__spv_mg_sig, sizeof hd__spv_mg_residual, sizeof hd__spv_mg_restrict,
+                                                  sizeof hd__spv_mg_prolong, sizeof hd__spv_mg_dir, sizeof hd__spv_mg_res_f64,
+                                                  sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update};
+    hd__backend *be = ctx->be;
+    int variant = hd__vk_mg_variant(ctx->kp.counts.z);
+    VkPipeline *slot = &be->mg_pipes[(stage - 1) * 4 + variant];
+    int32_t flags = (int32_t)(((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0) |
+                              (stage == HD__VK_MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0));
+    hd_result r;
+    if (!*slot && (r = hd__vk_pipeline_code(ctx, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
+        HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__vk_mg_names[stage - 1]);
+        return r;
+    }
+    *out = *slot;
+    return HD_SUCCESS;
+}
+
+/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz. */
+static hd_result hd__vk_mg_pass(hd__ctx *ctx, VkCommandBuffer cb, int stage, VkDescriptorSet set, int slot, int nx, int ny,
+                                int nz, int32_t pc0, int32_t pc1, int32_t pc2, int32_t pc3)
+{
+    hd__backend *be = ctx->be;
+    VkPipeline pipe;
+    int32_t pc[4];
+    hd_result r;
+    if ((r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
+    pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
+    hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg->slot_bytes), nx, ny, nz, pc);
+    return HD_SUCCESS;
+}
+
+/* `sweeps` red-black sweeps of level l with the diffusion pipeline (HD_FLAG_DIFFUSE_RHS flags);
+   first = 0: red then black, 1: black then red (the adjoint order, for post-smoothing). */
+static hd_result hd__vk_mg_smooth(hd__ctx *ctx, VkCommandBuffer cb, int l, int sweeps, int first)
+{
+    hd__backend *be = ctx->be;
+    hd__vk_level *L = &be->mg->lv[l];
+    int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
+    uint32_t offset = (uint32_t)((VkDeviceSize)l * be->mg->slot_bytes);
+    VkPipeline pipe;
+    hd_result r;
+    int s, h;
+    if ((r = hd__vk_diffuse_pipeline_for(ctx, flags, 0, &pipe)) != HD_SUCCESS) return r;
+    for (s = 0; s < sweeps; ++s)
+        for (h = 0; h < 2; ++h) {
+            int32_t pc[4];
+            pc[0] = first ^ h; pc[1] = 0; pc[2] = nzb; pc[3] = 0;
+            hd__vk_record_dispatch(be, cb, pipe, L->smooth, offset, (L->dims[0] + 1) / 2, ny, nzb * be->mg->channels, pc);
+        }
+    return HD_SUCCESS;
+}
+
+/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
+static hd_result hd__vk_mg_cycle(hd__ctx *ctx, VkCommandBuffer cb, int l)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    hd__vk_level *L = &mg->lv[l], *C;
+    int ch = mg->channels;
+    hd_result r;
+    if (l == mg->levels - 1) {
+        if ((r = hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
+        return hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_COARSEST_SWEEPS, 1);
+    }
+    C = &mg->lv[l + 1];
+    if ((r = hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_PRE, 0)) != HD_SUCCESS ||
+        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * ch, 0, 0, 0, ch)) != HD_SUCCESS ||
+        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
+                            C->dims[1], C->dims[2], ch)) != HD_SUCCESS ||
+        (r = hd__vk_mg_cycle(ctx, cb, l + 1)) != HD_SUCCESS ||
+        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch,
+                            L->dims[0], L->dims[1], L->dims[2], ch)) != HD_SUCCESS)
+        return r;
+    return hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_POST, 1);
+}
+
+/* The fine residual in double (hd_mg_res_f64) with set `set`: f - A (phi + lo) (the fine slot,
+   use_lo) or, negate, A p (level 0's slot, E = z = 0, phi = p). */
+static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set, int slot, int use_lo, int negate)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
+                          negate, 0, mg->channels);
+}
+
+/* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
+static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
+}
+
+/* Submits what was recorded, the row sums made visible to the host, and waits. */
+static hd_result hd__vk_mg_sync(hd__ctx *ctx, VkCommandBuffer cb)
+{
+    hd__vk_barrier(ctx->be, cb);
+    return hd__vk_flush(ctx);
+}
+
+/* Rebuilds the levels if the grid changed, writes the parameter slots, writes the sets, and
+   records the restriction of sigma_t when it changed and lo's zeroing when it is stale;
+   *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
+static hd_result hd__vk_mg_prepare(hd__ctx *ctx, VkCommandBuffer *cb, int *restart)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg = be->mg;
+    hd_result r;
+    int l, stale;
+    if (be->no_f64)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
+                       be->no_f64);
+    if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
+               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
+        hd__vk_mg_free(ctx);
+    if (!be->mg && (r = hd__vk_mg_alloc(ctx)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    hd__vk_mg_params(ctx);
+    if ((r = hd__vk_begin(ctx, cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
+    if ((r = hd__vk_mg_sets(ctx)) != HD_SUCCESS) return r;
+    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
+        for (l = 1; l < mg->levels; ++l) {
+            const int *d = mg->lv[l].dims;
+            if ((r = hd__vk_mg_pass(ctx, *cb, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0],
+                                    d[1], d[2], mg->sig_channels)) != HD_SUCCESS)
+                return r;
+        }
+        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
+    }
+    if (stale) hd__vk_zero_image(be, *cb, mg->lo.image, HD__VK_G);
+    return HD_SUCCESS;
+}
+
+/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
+static hd_result hd__be_multigrid(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    struct hd__vk_mg *mg;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    int restart, i;
+    int32_t bits[2];
+    double rz, pq, rp, alpha;
+    float beta;
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_mg_prepare(ctx, &cb, &restart)) != HD_SUCCESS) return r;
+    mg = be->mg;
+    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new); <r, z> */
+    if ((r = hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0)) != HD_SUCCESS ||
+        (r = hd__vk_mg_cycle(ctx, cb, 0)) != HD_SUCCESS || (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_RZ])) != HD_SUCCESS ||
+        (r = hd__vk_mg_sync(ctx, cb)) != HD_SUCCESS)
+        return r;
+    rz = hd__mg_row_sum((const double *)mg->dot_a.map, hd__vk_mg_rows(mg));
+    beta = hd__mg_cg_beta(&mg->cg, rz, restart);
+    /* p = z + beta p, z = 0; q = A p; <p, q>, <r, p> */
+    memcpy(&bits[0], &beta, sizeof beta);
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
+                            mg->fine[2] * mg->channels, bits[0], 0, 0, mg->channels)) != HD_SUCCESS ||
+        (r = hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
+        (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS ||
+        (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_RP])) != HD_SUCCESS || (r = hd__vk_mg_sync(ctx, cb)) != HD_SUCCESS)
+        return r;
+    pq = hd__mg_row_sum((const double *)mg->dot_a.map, hd__vk_mg_rows(mg));
+    rp = hd__mg_row_sum((const double *)mg->dot_b.map, hd__vk_mg_rows(mg));
+    mg->cg.have_dir = 1;
+    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
+    if (!(pq > 0.0)) return HD_SUCCESS;
+    alpha = rp / pq;
+    /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
+    for (i = 0; i < 2; ++i) {
+        uint64_t u;
+        memcpy(&u, &alpha, sizeof u);
+        bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
+    }
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
+                            mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels)) != HD_SUCCESS)
+        return r;
+    return hd__vk_flush(ctx);
+}
+
 /* ---- recording into the caller's command buffer ------------------------------------------------ */
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
 static hd_result hd__prepare(hd__ctx *ctx);
@@ -1506,6 +2025,10 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
     if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
+    if (ctx->params.solver == HD_SOLVER_MULTIGRID && !ctx->params.disable_diffusion &&
+        (ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
+                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
     /* uploads, allocations and clears are submitted and waited for here; only iterations are
        recorded, each with its own parameter slot */
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;

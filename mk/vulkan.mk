@@ -12,13 +12,17 @@
 #                                       it/s per method; BENCH_ARGS=--sweeps for the first part,
 #                                       --variants for bench/hdbench_sweep.comp's cost breakdown,
 #                                       --ab FILE.spv [--ab-zk n] to A/B a diffusion module
+#   make bench-vulkan-multigrid         build/hdbench_mg_vulkan on the head CT: ms per
+#                                       HD_SOLVER_MULTIGRID step, Vulkan against the CPU in one
+#                                       process (interleaved rounds), grid /1 and /2, box and
+#                                       surface boundary (BENCH_ARGS: --rounds, --steps, --downsample)
 # Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 VK_LDLIBS := -lvulkan
 VK_CONF := tests/conformance
 VK_DEPS := $(VK_CONF)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
 VK_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
-.PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan
+.PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan bench-vulkan-multigrid
 
 $(B)/conf_impl_vk.o: $(VK_CONF)/impl_vk.c $(VK_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
@@ -53,5 +57,13 @@ $(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(B)/hdbench_vulkan_spirv.h $(LIB_SR
 
 bench-vulkan: $(B)/hdbench_vulkan data
 	$(B)/hdbench_vulkan data/head.nrrd 2 $(BENCH_ARGS)
+
+$(B)/hdbench_mg_vulkan.o: bench/hdbench_mg_vulkan.c $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu_vk.o $(B)/conf_impl_vk.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)
+
+bench-vulkan-multigrid: $(B)/hdbench_mg_vulkan data
+	$(B)/hdbench_mg_vulkan data/head.nrrd $(BENCH_ARGS)
 
 test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx

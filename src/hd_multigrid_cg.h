@@ -1,5 +1,5 @@
 /* hd_multigrid_cg.h - the host-side bookkeeping of HD_SOLVER_MULTIGRID that is the same on every
-   backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h; Vulkan has no multigrid yet):
+   backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h, hd_vulkan.h):
    when conjugate gradients restart, when the coarse levels' sigma_t must be restricted again, beta,
    and the row-order sum of the dot products' row sums. The passes are each backend's; their
    per-voxel math is backends/kernels/hd_k_multigrid.h. The design is at the top of

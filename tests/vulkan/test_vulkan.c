@@ -17,7 +17,16 @@
         8 against 12 bytes per voxel); with $HD_VK_NO_HALF=1 (a device without r16f storage
         images) hd_create refuses FLOAT16 with HD_ERROR_UNSUPPORTED and a log line, and a context
         switched to it by hd_set_params refuses at hd_iterate, then renders again at FLOAT32
-        (validation on, no message).
+        (validation on, no message);
+     6. HD_SOLVER_MULTIGRID: steps run (method_bytes grows by the solver's levels); with
+        $HD_VK_NO_F64=1 (a device without shaderFloat64) hd_create refuses it with
+        HD_ERROR_UNSUPPORTED and a log line, a context switched to it refuses at hd_iterate and
+        renders again with red-black; hd_vulkan_record refuses it (its steps read dot products
+        back); a new illumination grid (hd_set_params) gets new levels; HD_VK_MEMORY_LIMIT
+        between red-black's and multigrid's needs fails the first step with
+        HD_ERROR_OUT_OF_DEVICE_MEMORY at many points of the levels' allocation, and a device
+        lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
+        destroyed with no object left (validation on, no message).
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
@@ -30,6 +39,7 @@ static unsigned long caller_messages; /* from the caller's own messenger (test 2
 static unsigned long gipa_calls;
 static char lost_log[512];    /* the last error logged that mentions VK_ERROR_DEVICE_LOST */
 static char half_log[512];    /* the last message that mentions FLOAT16 */
+static char mg_log[512];      /* the last message that mentions MULTIGRID */
 
 #define CHECK(cond) \
     do { if (!(cond)) { ++failures; fprintf(stderr, "  %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
@@ -40,6 +50,7 @@ static void count_log(void *user, hd_log_level level, hd_result code, const char
     if (strncmp(msg, "vulkan validation", 17) == 0) ++messages;
     if (strstr(msg, "VK_ERROR_DEVICE_LOST")) snprintf(lost_log, sizeof lost_log, "%s", msg);
     if (strstr(msg, "FLOAT16")) snprintf(half_log, sizeof half_log, "%s", msg);
+    if (strstr(msg, "MULTIGRID")) snprintf(mg_log, sizeof mg_log, "%s", msg);
     if (level == HD_LOG_ERROR) fprintf(stderr, "  log: %s\n", msg);
 }
 
@@ -392,6 +403,109 @@ static void test_half(void)
            ok && messages == 0 ? "PASS" : "FAIL", b16, b32, messages);
 }
 
+/* 6: multigrid: its refusals, out of device memory in its levels, a lost device in its steps. */
+static size_t solver_bytes(hd_solver solver)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats st;
+    memset(&st, 0, sizeof st);
+    d.params.solver = solver;
+    if (hd_create(&d, &h) != HD_SUCCESS) return 0;
+    if (hd_iterate(h, 2) != HD_SUCCESS || hd_get_stats(h, &st) != HD_SUCCESS) st.method_bytes = 0;
+    hd_destroy(h);
+    return st.method_bytes;
+}
+
+static void test_multigrid(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_result r;
+    size_t brb = solver_bytes(HD_SOLVER_RED_BLACK), bmg = solver_bytes(HD_SOLVER_MULTIGRID);
+    int ok = brb > 0 && bmg > brb, k, oom = 0, fits = 0, lost = 0;
+    char n[32];
+    VkCommandBuffer never_used = (VkCommandBuffer)(void *)&d; /* refused before any use */
+    d.vulkan.enable_validation = 1;
+    messages = 0;
+    /* without shaderFloat64 */
+    setenv("HD_VK_NO_F64", "1", 1);
+    d.params.solver = HD_SOLVER_MULTIGRID;
+    mg_log[0] = '\0';
+    r = hd_create(&d, &h);
+    ok &= r == HD_ERROR_UNSUPPORTED && strstr(mg_log, "HD_VK_NO_F64") != NULL;
+    if (r == HD_SUCCESS) hd_destroy(h);
+    d.params.solver = HD_SOLVER_RED_BLACK;
+    if ((r = hd_create(&d, &h)) == HD_SUCCESS) {
+        hd_params p = d.params;
+        ok &= hd_iterate(h, 1) == HD_SUCCESS;
+        p.solver = HD_SOLVER_MULTIGRID;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS;
+        mg_log[0] = '\0';
+        ok &= hd_iterate(h, 1) == HD_ERROR_UNSUPPORTED && strstr(mg_log, "shaderFloat64") != NULL;
+        p.solver = HD_SOLVER_RED_BLACK;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
+        ok &= hd_destroy(h) == HD_SUCCESS;
+    } else {
+        ok = 0;
+    }
+    unsetenv("HD_VK_NO_F64");
+    /* not recordable; new levels for a new grid (illumination_downsample), and back */
+    d.params.solver = HD_SOLVER_MULTIGRID;
+    if ((r = hd_create(&d, &h)) == HD_SUCCESS) {
+        hd_params p = d.params;
+        mg_log[0] = '\0';
+        ok &= hd_vulkan_record(h, (void *)never_used, 1) == HD_ERROR_UNSUPPORTED && strstr(mg_log, "MULTIGRID") != NULL;
+        ok &= hd_iterate(h, 1) == HD_SUCCESS;
+        p.illumination_downsample = 2;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
+        p.illumination_downsample = 1;
+        ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
+        ok &= hd_destroy(h) == HD_SUCCESS;
+    } else {
+        ok = 0;
+    }
+    /* out of device memory inside the levels' allocation: limits from below red-black's needs
+       (about 280 KB here, staging buffer included) to above multigrid's (about 500 KB), 20 KB apart */
+    for (k = 0; k < 16; ++k) {
+        snprintf(n, sizeof n, "%d", 240000 + 20000 * k);
+        setenv("HD_VK_MEMORY_LIMIT", n, 1);
+        d.params.solver = HD_SOLVER_RED_BLACK;
+        if ((r = hd_create(&d, &h)) != HD_SUCCESS) { ok = 0; break; }
+        if (hd_iterate(h, 1) == HD_SUCCESS) {
+            hd_params p = d.params;
+            p.solver = HD_SOLVER_MULTIGRID;
+            r = hd_set_params(h, &p) == HD_SUCCESS ? hd_iterate(h, 1) : HD_ERROR_BACKEND;
+            oom += r == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+            fits += r == HD_SUCCESS;
+            ok &= r == HD_ERROR_OUT_OF_DEVICE_MEMORY || r == HD_SUCCESS;
+            p.solver = HD_SOLVER_RED_BLACK; /* a failed allocation freed what it made: red-black still renders */
+            ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS;
+        }
+        ok &= hd_destroy(h) == HD_SUCCESS;
+    }
+    unsetenv("HD_VK_MEMORY_LIMIT");
+    /* the device lost at each submission of the first steps */
+    d.params.solver = HD_SOLVER_MULTIGRID;
+    for (k = 3; k <= 12; ++k) {
+        snprintf(n, sizeof n, "%d", k);
+        setenv("HD_VK_LOSE_DEVICE", n, 1);
+        if ((r = hd_create(&d, &h)) != HD_SUCCESS) continue;
+        r = hd_iterate(h, 2);
+        lost += r == HD_ERROR_DEVICE_LOST;
+        ok &= r == HD_ERROR_DEVICE_LOST && hd_iterate(h, 1) == HD_ERROR_DEVICE_LOST;
+        ok &= hd_destroy(h) == HD_SUCCESS;
+    }
+    unsetenv("HD_VK_LOSE_DEVICE");
+    ok &= oom >= 3 && fits > 0 && lost >= 8;
+    CHECK(ok);
+    CHECK(messages == 0);
+    printf("%s multigrid: method_bytes %zu against %zu with red-black; refused (HD_ERROR_UNSUPPORTED, logged) without shaderFloat64 "
+           "and by hd_vulkan_record; out of device memory in the levels at %d limits (fits at %d), device lost in a step (%d of 10), "
+           "destroyed with no object left (%lu validation messages)\n",
+           ok && messages == 0 ? "PASS" : "FAIL", bmg, brb, oom, fits, lost, messages);
+}
+
 int main(void)
 {
     if (test_messenger()) {
@@ -399,6 +513,7 @@ int main(void)
         test_out_of_memory();
         test_device_lost();
         test_half();
+        test_multigrid();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
