@@ -8,7 +8,7 @@ CPPFLAGS := -I. -D_POSIX_C_SOURCE=200809L
 LDLIBS  := -lm -lpthread -lz
 B       := build
 
-.PHONY: all test clean help data render bench
+.PHONY: all test clean help data render bench bench-rb-schedule
 all: $(B)/hdtest $(B)/hdrender $(B)/hdbench
 
 help:
@@ -17,6 +17,7 @@ help:
 	@echo "make data      fetch the head CT into data/ (Debian package invesalius-examples)"
 	@echo "make render    fetch the data, build hdrender and render the head to out/head.png"
 	@echo "make bench     print the benchmark figures (bench/hdbench)"
+	@echo "make bench-rb-schedule   the CPU red-black schedule against the previous one, one process"
 	@echo "make dist      regenerate dist/hybriddiff.h (after every source change; see mk/dist.mk)"
 	@echo "make check-generated   embedded kernels, SPIR-V and dist/hybriddiff.h are up to date"
 	@echo "mk/*.mk        per-backend and per-tool targets, each listed at the top of its file"
@@ -40,6 +41,13 @@ $(B)/hdrender: examples/hdrender.c examples/*.h $(LIB_SRC) | $(B)
 
 $(B)/hdbench: bench/hdbench.c bench/hdbench_triad.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+# the CPU red-black schedule against the one before it, in one process (bench/hdbench_rb_schedule.c)
+$(B)/hdbench_rb_schedule: bench/hdbench_rb_schedule.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+bench-rb-schedule: $(B)/hdbench_rb_schedule data
+	$(B)/hdbench_rb_schedule data/head.nrrd 2
 
 $(B):
 	mkdir -p $(B)
