@@ -6,9 +6,13 @@
 #   make eval-multigrid the multigrid study: HD's PSNR against PT_MS over time, red-black and
 #                       multigrid CG (head-tissue, 128^2, illumination grid /2; ~6 min on 2 cores)
 #                       -> docs/eval/multigrid/
+#   make build/hdslab   a homogeneous slab against PT_MS (examples/hdslab.c: why HD is too dark)
 .PHONY: eval eval-paper eval-multigrid
 
 $(B)/hdeval: examples/hdeval.c $(wildcard examples/*.h) $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+$(B)/hdslab: examples/hdslab.c $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 eval: $(B)/hdeval
