@@ -128,7 +128,7 @@ static hd_result iterate_step(void *h) { return hd_iterate(*(hd_context *)h, 1);
 /* ---- the plain stencil on the Vulkan device ------------------------------------------------- */
 typedef struct stencil {
     hd__ctx *ctx;
-    int ssbo, cur, g[3];
+    int ssbo, cur, g[3]; /* ssbo: 0 r32f images, 1 float buffers, 2 the buffers as vec4 (x-packed) */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
     VkPipeline pipeline;
@@ -242,7 +242,8 @@ static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
     memcpy(s->g, g, sizeof s->g);
     for (i = 0; i < 3; ++i) types[i] = ssbo ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     if ((r = hd__vk_layouts(ctx, types, 3, 4 * sizeof(int32_t), &s->set_layout, &s->layout)) != HD_SUCCESS) return r;
-    r = ssbo ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo, sizeof hd__spv_stencil_ssbo, NULL, s->layout, &s->pipeline)
+    r = ssbo == 2 ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo4, sizeof hd__spv_stencil_ssbo4, NULL, s->layout, &s->pipeline)
+      : ssbo ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo, sizeof hd__spv_stencil_ssbo, NULL, s->layout, &s->pipeline)
              : hd__vk_compute_pipeline(ctx, hd__spv_stencil_image, sizeof hd__spv_stencil_image, NULL, s->layout, &s->pipeline);
     if (r != HD_SUCCESS) return r;
     if ((r = stencil_resources(s)) != HD_SUCCESS) return r;
@@ -263,7 +264,7 @@ static hd_result stencil_step(void *user)
     be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->pipeline);
     be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &s->sets[s->cur], 0, NULL);
     be->fn.vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-    be->fn.vkCmdDispatch(cb, ((uint32_t)s->g[0] + 63u) / 64u, (uint32_t)s->g[1], (uint32_t)s->g[2]);
+    be->fn.vkCmdDispatch(cb, ((uint32_t)s->g[0] / (s->ssbo == 2 ? 4u : 1u) + 63u) / 64u, (uint32_t)s->g[1], (uint32_t)s->g[2]);
     s->cur ^= 1;
     return hd__vk_flush(s->ctx);
 }
@@ -652,10 +653,10 @@ static hd_result library_state(hd_context h, float *st, float *e, float *phi, si
    best of rounds; first the check of RB / PACKED against the library. */
 static void variant_figures(const hd_desc *base, const int *g, int rounds)
 {
-    double best[NVAR + 2], v_;
+    double best[NVAR + 4], v_;
     hd_desc d = *base;
     hd_context h;
-    stencil st;
+    stencil st, sb[2]; /* r32f images; float buffers, the buffers as vec4 */
     variants v;
     size_t n = (size_t)g[0] * g[1] * g[2];
     float *lst = (float *)malloc(n * sizeof(float)), *le = (float *)malloc(n * sizeof(float));
@@ -664,6 +665,7 @@ static void variant_figures(const hd_desc *base, const int *g, int rounds)
     const int nsweeps = 8;
     memset(best, 0, sizeof best);
     memset(&st, 0, sizeof st);
+    memset(sb, 0, sizeof sb);
     memset(&v, 0, sizeof v);
     d.params.solver = HD_SOLVER_RED_BLACK;
     d.params.anisotropy = 0.3f; /* 1 - albedo g != 1: the check covers sigma' */
@@ -675,22 +677,28 @@ static void variant_figures(const hd_desc *base, const int *g, int rounds)
         ok = ok && ctx->gdims[0] == g[0] && ctx->gdims[1] == g[1] && ctx->gdims[2] == g[2] && ctx->sig_channels >= 1;
     }
     ok = ok && stencil_init(&st, hd__lookup(h, NULL), g, 0) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[0], hd__lookup(h, NULL), g, 1) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[1], hd__lookup(h, NULL), g, 2) == HD_SUCCESS;
     ok = ok && variants_init(&v, hd__lookup(h, NULL), g, lst, le) == HD_SUCCESS;
     if (ok) {
         variants_params(&v, hd__lookup(h, NULL));
         if (variants_check(&v, lphi, n, nsweeps) != 0) printf("check: some variants compute other values (above)\n");
     }
     for (k = 0; ok && k < rounds; ++k)
-        for (f = 0; f <= NVAR + 1; ++f) {
+        for (f = 0; f <= NVAR + 3; ++f) {
             if (f < NVAR && !variant_wanted(f)) continue;
             if (f < NVAR) v.cur = f;
-            v_ = f == NVAR ? rate(stencil_step, &st) : f == NVAR + 1 ? rate(sweep_step, &h) : rate(variant_step, &v);
+            v_ = f == NVAR ? rate(stencil_step, &st) : f == NVAR + 1 ? rate(sweep_step, &h)
+               : f > NVAR + 1 ? rate(stencil_step, &sb[f - NVAR - 2]) : rate(variant_step, &v);
             if (v_ > best[f]) best[f] = v_;
         }
     if (ok) {
         printf("%-48s %9s %12s %12s\n", "sweep variant (bench/hdbench_sweep.comp)", "sweeps/s", "/ image3D", "/ library");
         printf("%-48s %9.1f %12.2f %12.2f\n", "plain 7-point stencil, storage image3D", best[NVAR], 1.0, best[NVAR] / best[NVAR + 1]);
         printf("%-48s %9.1f %12.2f %12.2f\n", "library red-black sweep (its module)", best[NVAR + 1], best[NVAR + 1] / best[NVAR], 1.0);
+        for (f = 0; f < 2; ++f)
+            printf("%-48s %9.1f %12.2f %12.2f\n", f ? "plain stencil, storage buffer as vec4 (x-packed)" : "plain stencil, storage buffer (float)",
+                   best[NVAR + 2 + f], best[NVAR + 2 + f] / best[NVAR], best[NVAR + 2 + f] / best[NVAR + 1]);
         for (f = 0; f < NVAR; ++f)
             if (variant_wanted(f))
                 printf("%-48s %9.1f %12.2f %12.2f\n", hd__sweep_variants[f].name, best[f], best[f] / best[NVAR], best[f] / best[NVAR + 1]);
@@ -698,6 +706,8 @@ static void variant_figures(const hd_desc *base, const int *g, int rounds)
         printf("the variant figures failed (see the log)\n");
     }
     if (st.ctx) stencil_free(&st);
+    for (k = 0; k < 2; ++k)
+        if (sb[k].ctx) stencil_free(&sb[k]);
     if (v.ctx) variants_free(&v);
     free(lst); free(le); free(lphi);
     hd_destroy(h);
