@@ -9,8 +9,11 @@
        the best of `rounds` round-robin passes, so a burst of load elsewhere hits one pass only;
      - iterations/s of every method (HD, CD, PT_SS, PT_MS) with 1 and 3 lights, through hd_iterate
        (skipped with --sweeps).
-     - with --variants instead: the plain image3D stencil beside bench/hdbench_sweep.comp's variants
-       of the sweep's memory access (what lavapipe's cost is made of);
+     - with --variants instead: the plain image3D stencil (and through storage buffers, as floats
+       and as x-packed vec4) and the library's red-black sweep beside bench/hdbench_sweep.comp's
+       variants of the sweep's memory access (what lavapipe's cost is made of), on the library's
+       head-CT sigma_t and E; first every variant that computes the library's update (rb, the
+       x-packed p4 / p2) is checked against the library's phi after 8 sweeps;
      - with --ab FILE.spv also: the library's sweeps with the diffusion module FILE (a candidate
        build/spirv/diffuse.spv, specialized and dispatched for blocks of --ab-zk slices x --ab-yk
        rows per invocation, default 1 x 1), interleaved with the library's own.
