@@ -45,7 +45,7 @@
    Bindings: 0 st, 1 E, 2 phi (r32f storage), 3 packed (st, phi) (rg32f storage), 4 st, 5 E,
    6 phi (sampler3D over the images of bindings 0-2), 7 st, 8 E, 9 phi, 10 out (rgba32f x-packed,
    nx / 4 wide), 11 st, 12 E, 13 phi (rg32f x-packed, nx / 2 wide). Push constants: dims, ctl
-   (x parity, y run-time ZK), prm (xyz: 0.6666667 / h^2 per axis, w: the sigma' floor), med (x
+   (x parity, y run-time ZK), prm (xyz: 1 / h^2 per axis, w: the sigma' floor), med (x
    albedo, y anisotropy g): RB and PACKED take the library's parameters from them. */
 #extension GL_EXT_control_flow_attributes : enable
 layout(local_size_x = LX, local_size_y = LY, local_size_z = 1) in;
@@ -238,9 +238,9 @@ float lib_update(float st, float e, float sxm, float sxp, float sym, float syp, 
 {
     float a = med.x, ag = 1.0f - a * med.y, fl = prm.w;
     float sp = st * ag, dn = (1.0f - a) * st, num = a * st * e;
-    lib_axis(prm.x, sp, ag * sxm, ag * sxp, pxm, pxp, ixm, ixp, fl, num, dn);
-    lib_axis(prm.y, sp, ag * sym, ag * syp, pym, pyp, iym, iyp, fl, num, dn);
-    lib_axis(prm.z, sp, ag * szm, ag * szp, pzm, pzp, izm, izp, fl, num, dn);
+    lib_axis(0.6666667f * prm.x, sp, ag * sxm, ag * sxp, pxm, pxp, ixm, ixp, fl, num, dn);
+    lib_axis(0.6666667f * prm.y, sp, ag * sym, ag * syp, pym, pyp, iym, iyp, fl, num, dn);
+    lib_axis(0.6666667f * prm.z, sp, ag * szm, ag * szp, pzm, pzp, izm, izp, fl, num, dn);
     return num / dn;
 }
 

@@ -568,12 +568,13 @@ static int variant_wanted(int k)
 }
 
 /* The library's parameters for RB / PACKED (hd_k_diffuse.h reads them from the parameter block):
-   0.6666667 / h^2 per axis and the sigma' floor, albedo and anisotropy. */
+   1 / h^2 per axis (the shader multiplies by 0.6666667 as hd_k_diffuse.h does), the sigma' floor,
+   albedo and anisotropy. */
 static void variants_params(variants *v, const hd__ctx *ctx)
 {
-    v->prm[0] = 0.6666667f * ctx->kp.grid.x;
-    v->prm[1] = 0.6666667f * ctx->kp.grid.y;
-    v->prm[2] = 0.6666667f * ctx->kp.grid.z;
+    v->prm[0] = ctx->kp.grid.x;
+    v->prm[1] = ctx->kp.grid.y;
+    v->prm[2] = ctx->kp.grid.z;
     v->prm[3] = ctx->kp.grid.w;
     v->med[0] = ctx->kp.medium.y;
     v->med[1] = ctx->kp.medium.z;
