@@ -23,10 +23,43 @@
     11 LOADS1  one load and the store
     12 LIBLS   LIB, XK x YK x ZK voxels (same-colour voxels of a row x rows x slices) per
                invocation, all loads before all stores
+    13 RB     the library's grey box update as it is now (hd_k_diffuse.h: hd_diffuse_own_of, an
+              axis' two faces over one division, hd_diffuse_box_axis), r32f, 14 loads per voxel,
+              ZK voxels per invocation along z: the reference the packed variants are checked
+              against (`--check`), itself checked against the library's module
+    14 PACKED x-packed texels: PK (4: rgba32f, 2: rg32f) x-consecutive voxels of st, E and phi
+              per texel, the images nx / PK texels wide (the same bytes in the same order as the
+              r32f grids). A half-sweep invocation relaxes a block of ZK slices x YK rows of one
+              texel each: per texel its PK / 2 voxels of the half-sweep's colour (components
+              o, o + 2 with o = (y + z + parity) & 1), their x-neighbours inside the texel except
+              one, taken from the texel before (o = 0, component 3) or after (o = 1, component 0);
+              the y- and z-neighbours are the same components of the adjacent rows' texels,
+              loaded once per block as the library's hd_diffuse_block does. The whole texel is
+              stored back, the other colour's components as loaded (a half-sweep never writes
+              them, so the value stored is the value there). Loads per invocation: 5 per row (st,
+              phi, E, the side texel's st and phi) + 4 (YK + ZK) for the block's faces.
+    15 PSTENCIL the plain stencil of hdbench_stencil.comp on rgba32f x-packed texels (4 voxels per
+              invocation, 7 loads and 1 store per texel), Jacobi phi4 -> out4, one pass per step
+    16 PCOPY  out4 = phi4 / 2 on rgba32f x-packed texels: 1 load and 1 store per 4 voxels (LOADS1's
+              twin: what an rgba32f texel op costs against an r32f one)
    Bindings: 0 st, 1 E, 2 phi (r32f storage), 3 packed (st, phi) (rg32f storage), 4 st, 5 E,
-   6 phi (sampler3D over the images of bindings 0-2). */
+   6 phi (sampler3D over the images of bindings 0-2), 7 st, 8 E, 9 phi, 10 out (rgba32f x-packed,
+   nx / 4 wide), 11 st, 12 E, 13 phi (rg32f x-packed, nx / 2 wide). Push constants: dims, ctl
+   (x parity, y run-time ZK), prm (xyz: 1 / h^2 per axis, w: the sigma' floor), med (x
+   albedo, y anisotropy g): RB and PACKED take the library's parameters from them. */
+#extension GL_EXT_control_flow_attributes : enable
 layout(local_size_x = LX, local_size_y = LY, local_size_z = 1) in;
-layout(push_constant) uniform hd_sweep_pc { ivec4 dims; ivec4 ctl; };
+layout(push_constant) uniform hd_sweep_pc { ivec4 dims; ivec4 ctl; vec4 prm; vec4 med; };
+layout(binding = 7, rgba32f) uniform image3D st4_i;
+layout(binding = 8, rgba32f) uniform image3D e4_i;
+layout(binding = 9, rgba32f) uniform image3D phi4_i;
+layout(binding = 10, rgba32f) uniform image3D out4_i;
+layout(binding = 11, rg32f) uniform image3D st2_i;
+layout(binding = 12, rg32f) uniform image3D e2_i;
+layout(binding = 13, rg32f) uniform image3D phi2_i;
+#ifndef PK
+#define PK 4
+#endif
 layout(binding = 0, r32f) uniform image3D st_i;
 layout(binding = 1, r32f) uniform image3D e_i;
 layout(binding = 2, r32f) uniform image3D phi_i;
@@ -176,6 +209,199 @@ float lib_value(ivec3 p)
     return num / den;
 }
 
+/* ---- 13 RB, 14 PACKED: the library's update (hd_k_diffuse.h, grey, box boundary, rhs off) ---- */
+#ifndef YK
+#define YK 1
+#endif
+/* hd_diffuse_box_den */
+float lib_den(float sp, float s, bool inside, float fl)
+{
+    return max(sp + (inside ? s : sp), fl);
+}
+
+/* hd_diffuse_box_axis: an axis' two faces over one division */
+void lib_axis(float a, float sp, float s0, float s1, float p0, float p1, bool in0, bool in1, float fl, inout float num,
+              inout float dn)
+{
+    float d0 = lib_den(sp, s0, in0, fl), d1 = lib_den(sp, s1, in1, fl);
+    float t = a / (d0 * d1);
+    float q0 = in0 ? p0 * d1 : 0.0f, q1 = in1 ? p1 * d0 : 0.0f;
+    num += t * (q0 + q1);
+    dn += t * (d0 + d1);
+}
+
+/* hd_diffuse_own_of + hd_diffuse_box_of + the entry's division: the voxel's sigma_t st and E e,
+   its neighbours' sigma_t s* and phi p* (x-, x+, y-, y+, z-, z+), whether each is in the grid */
+float lib_update(float st, float e, float sxm, float sxp, float sym, float syp, float szm, float szp, float pxm,
+                 float pxp, float pym, float pyp, float pzm, float pzp, bool ixm, bool ixp, bool iym, bool iyp,
+                 bool izm, bool izp)
+{
+    float a = med.x, ag = 1.0f - a * med.y, fl = prm.w;
+    float sp = st * ag, dn = (1.0f - a) * st, num = a * st * e;
+    lib_axis(0.6666667f * prm.x, sp, ag * sxm, ag * sxp, pxm, pxp, ixm, ixp, fl, num, dn);
+    lib_axis(0.6666667f * prm.y, sp, ag * sym, ag * syp, pym, pyp, iym, iyp, fl, num, dn);
+    lib_axis(0.6666667f * prm.z, sp, ag * szm, ag * szp, pzm, pzp, izm, izp, fl, num, dn);
+    return num / dn;
+}
+
+#if HD_SV == 13
+/* 13 RB: ZK voxels of the half-sweep's colour along z, 14 loads each (coordinates clamped: an
+   out-of-grid neighbour's value is dropped by its flag), all loads before all stores */
+void rb_main()
+{
+    int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y), z0 = int(gl_GlobalInvocationID.z) * ZK;
+    float v[ZK];
+    [[unroll]] for (int k = 0; k < ZK; ++k) {
+        int z = min(z0 + k, dims.z - 1), yc = min(y, dims.y - 1);
+        int xv = min(2 * x + ((y + z0 + k + ctl.x) & 1), dims.x - 1);
+        ivec3 p = ivec3(xv, yc, z);
+        ivec3 xm = ivec3(max(xv - 1, 0), yc, z), xp = ivec3(min(xv + 1, dims.x - 1), yc, z);
+        ivec3 ym = ivec3(xv, max(yc - 1, 0), z), yp = ivec3(xv, min(yc + 1, dims.y - 1), z);
+        ivec3 zm = ivec3(xv, yc, max(z - 1, 0)), zp = ivec3(xv, yc, min(z + 1, dims.z - 1));
+        v[k] = lib_update(imageLoad(st_i, p).r, imageLoad(e_i, p).r, imageLoad(st_i, xm).r, imageLoad(st_i, xp).r,
+                          imageLoad(st_i, ym).r, imageLoad(st_i, yp).r, imageLoad(st_i, zm).r, imageLoad(st_i, zp).r,
+                          imageLoad(phi_i, xm).r, imageLoad(phi_i, xp).r, imageLoad(phi_i, ym).r,
+                          imageLoad(phi_i, yp).r, imageLoad(phi_i, zm).r, imageLoad(phi_i, zp).r, xv > 0,
+                          xv < dims.x - 1, yc > 0, yc < dims.y - 1, z > 0, z < dims.z - 1);
+    }
+    [[unroll]] for (int k = 0; k < ZK; ++k) {
+        int xv = 2 * x + ((y + z0 + k + ctl.x) & 1);
+        if (xv < dims.x && y < dims.y && z0 + k < dims.z) imageStore(phi_i, ivec3(xv, y, z0 + k), vec4(v[k], 0.0f, 0.0f, 0.0f));
+    }
+}
+#endif
+
+#if HD_SV == 14
+#if PK == 4
+#define LDST(p) imageLoad(st4_i, (p))
+#define LDE(p) imageLoad(e4_i, (p))
+#define LDPHI(p) imageLoad(phi4_i, (p))
+#define STPHI(p, v) imageStore(phi4_i, (p), (v))
+#else
+#define LDST(p) imageLoad(st2_i, (p))
+#define LDE(p) imageLoad(e2_i, (p))
+#define LDPHI(p) imageLoad(phi2_i, (p))
+#define STPHI(p, v) imageStore(phi2_i, (p), (v))
+#endif
+#define NO (PK / 2) /* voxels of one colour per texel */
+#define DB (YK * ZK)
+
+/* Voxel n (0 .. NO - 1) of colour o in texel t: component 2 n + o. */
+float own_c(vec4 t, int n, int o)
+{
+#if PK == 4
+    return n == 0 ? (o != 0 ? t.y : t.x) : (o != 0 ? t.w : t.z);
+#else
+    return o != 0 ? t.y : t.x;
+#endif
+}
+
+/* Its x - 1 neighbour: in the texel, or component PK - 1 of the texel before (side, o = 0). */
+float xm_c(vec4 t, vec4 side, int n, int o)
+{
+#if PK == 4
+    return n == 0 ? (o != 0 ? t.x : side.w) : (o != 0 ? t.z : t.y);
+#else
+    return o != 0 ? t.x : side.y;
+#endif
+}
+
+/* Its x + 1 neighbour: in the texel, or component 0 of the texel after (side, o = 1). */
+float xp_c(vec4 t, vec4 side, int n, int o)
+{
+#if PK == 4
+    return n == 0 ? (o != 0 ? t.z : t.y) : (o != 0 ? side.x : t.w);
+#else
+    return o != 0 ? side.x : t.y;
+#endif
+}
+
+/* Texel t with its colour-o voxels replaced by v0 (and v1). */
+vec4 with_own(vec4 t, float v0, float v1, int o)
+{
+#if PK == 4
+    return o != 0 ? vec4(t.x, v0, t.z, v1) : vec4(v0, t.y, v1, t.w);
+#else
+    return o != 0 ? vec4(t.x, v0, 0.0f, 0.0f) : vec4(v0, t.y, 0.0f, 0.0f);
+#endif
+}
+
+void packed_main()
+{
+    int W = dims.x / PK, t = int(gl_GlobalInvocationID.x), tc = min(t, W - 1);
+    int y0 = int(gl_GlobalInvocationID.y) * YK, z0 = int(gl_GlobalInvocationID.z) * ZK;
+    /* per block row r = k YK + j: own texel's st, phi, E; the side texel's st and phi */
+    vec4 S[DB], P[DB], E[DB], SS[DB], PS[DB];
+    vec4 sym[ZK], pym[ZK], syp[ZK], pyp[ZK], szm[YK], pzm[YK], szp[YK], pzp[YK];
+    float v[DB * NO];
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, o = (y0 + j + z0 + k + ctl.x) & 1;
+            int y = min(y0 + j, dims.y - 1), z = min(z0 + k, dims.z - 1), ts = clamp(tc - 1 + 2 * o, 0, W - 1);
+            S[r] = LDST(ivec3(tc, y, z));
+            P[r] = LDPHI(ivec3(tc, y, z));
+            E[r] = LDE(ivec3(tc, y, z));
+            SS[r] = LDST(ivec3(ts, y, z));
+            PS[r] = LDPHI(ivec3(ts, y, z));
+        }
+    [[unroll]] for (int k = 0; k < ZK; ++k) {
+        int z = min(z0 + k, dims.z - 1), ym = max(y0 - 1, 0), yp = min(y0 + YK, dims.y - 1);
+        sym[k] = LDST(ivec3(tc, ym, z));
+        pym[k] = LDPHI(ivec3(tc, ym, z));
+        syp[k] = LDST(ivec3(tc, yp, z));
+        pyp[k] = LDPHI(ivec3(tc, yp, z));
+    }
+    [[unroll]] for (int j = 0; j < YK; ++j) {
+        int y = min(y0 + j, dims.y - 1), zm = max(z0 - 1, 0), zp = min(z0 + ZK, dims.z - 1);
+        szm[j] = LDST(ivec3(tc, y, zm));
+        pzm[j] = LDPHI(ivec3(tc, y, zm));
+        szp[j] = LDST(ivec3(tc, y, zp));
+        pzp[j] = LDPHI(ivec3(tc, y, zp));
+    }
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, o = (y0 + j + z0 + k + ctl.x) & 1, y = y0 + j, z = z0 + k;
+            int rym = max(r - 1, 0), ryp = min(r + 1, DB - 1), rzm = max(r - YK, 0), rzp = min(r + YK, DB - 1);
+            vec4 sa = j > 0 ? S[rym] : sym[k], sb = j < YK - 1 ? S[ryp] : syp[k];
+            vec4 sc = k > 0 ? S[rzm] : szm[j], sd = k < ZK - 1 ? S[rzp] : szp[j];
+            vec4 pa = j > 0 ? P[rym] : pym[k], pb = j < YK - 1 ? P[ryp] : pyp[k];
+            vec4 pc = k > 0 ? P[rzm] : pzm[j], pd = k < ZK - 1 ? P[rzp] : pzp[j];
+            [[unroll]] for (int n = 0; n < NO; ++n) {
+                int x = PK * t + 2 * n + o;
+                v[r * NO + n] = lib_update(own_c(S[r], n, o), own_c(E[r], n, o), xm_c(S[r], SS[r], n, o),
+                                           xp_c(S[r], SS[r], n, o), own_c(sa, n, o), own_c(sb, n, o), own_c(sc, n, o),
+                                           own_c(sd, n, o), xm_c(P[r], PS[r], n, o), xp_c(P[r], PS[r], n, o),
+                                           own_c(pa, n, o), own_c(pb, n, o), own_c(pc, n, o), own_c(pd, n, o), x > 0,
+                                           x < dims.x - 1, y > 0, y < dims.y - 1, z > 0, z < dims.z - 1);
+            }
+        }
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, o = (y0 + j + z0 + k + ctl.x) & 1;
+            if (t < W && y0 + j < dims.y && z0 + k < dims.z)
+                STPHI(ivec3(t, y0 + j, z0 + k), with_own(P[r], v[r * NO], v[r * NO + NO - 1], o));
+        }
+}
+#endif
+
+#if HD_SV == 15
+/* 15 PSTENCIL: b = (rhs + the 6 neighbours of a) / 7 for the 4 voxels of texel t, zero outside */
+void pstencil_main()
+{
+    int W = dims.x / 4, t = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y), z = int(gl_GlobalInvocationID.z);
+    if (t >= W || y >= dims.y || z >= dims.z) return;
+    vec4 a = imageLoad(phi4_i, ivec3(t, y, z)), s = imageLoad(e4_i, ivec3(t, y, z));
+    s += vec4(0.0f, a.x, a.y, a.z) + vec4(a.y, a.z, a.w, 0.0f);
+    if (t > 0) s.x += imageLoad(phi4_i, ivec3(t - 1, y, z)).w;
+    if (t < W - 1) s.w += imageLoad(phi4_i, ivec3(t + 1, y, z)).x;
+    if (y > 0) s += imageLoad(phi4_i, ivec3(t, y - 1, z));
+    if (y < dims.y - 1) s += imageLoad(phi4_i, ivec3(t, y + 1, z));
+    if (z > 0) s += imageLoad(phi4_i, ivec3(t, y, z - 1));
+    if (z < dims.z - 1) s += imageLoad(phi4_i, ivec3(t, y, z + 1));
+    imageStore(out4_i, ivec3(t, y, z), s * (1.0f / 7.0f));
+}
+#endif
+
 /* ZK voxels per invocation along z (one per slice, each of this half-sweep's colour) */
 void main()
 {
@@ -184,6 +410,22 @@ void main()
 #endif
 #ifndef XK
 #define XK 1
+#endif
+#if HD_SV == 13
+    rb_main();
+    return;
+#elif HD_SV == 14
+    packed_main();
+    return;
+#elif HD_SV == 15
+    pstencil_main();
+    return;
+#elif HD_SV == 16
+    {
+        ivec3 p = ivec3(gl_GlobalInvocationID);
+        if (p.x < dims.x / 4 && p.y < dims.y && p.z < dims.z) imageStore(out4_i, p, imageLoad(phi4_i, p) * 0.5f);
+    }
+    return;
 #endif
 #if HD_SV == 12
     /* 12 LIBLS: the ZK voxels' loads and arithmetic first, then their stores, so that a texel two

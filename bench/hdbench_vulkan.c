@@ -9,8 +9,11 @@
        the best of `rounds` round-robin passes, so a burst of load elsewhere hits one pass only;
      - iterations/s of every method (HD, CD, PT_SS, PT_MS) with 1 and 3 lights, through hd_iterate
        (skipped with --sweeps).
-     - with --variants instead: the plain image3D stencil beside bench/hdbench_sweep.comp's variants
-       of the sweep's memory access (what lavapipe's cost is made of);
+     - with --variants instead: the plain image3D stencil (and through storage buffers, as floats
+       and as x-packed vec4) and the library's red-black sweep beside bench/hdbench_sweep.comp's
+       variants of the sweep's memory access (what lavapipe's cost is made of), on the library's
+       head-CT sigma_t and E; first every variant that computes the library's update (rb, the
+       x-packed p4 / p2) is checked against the library's phi after 8 sweeps;
      - with --ab FILE.spv also: the library's sweeps with the diffusion module FILE (a candidate
        build/spirv/diffuse.spv, specialized and dispatched for blocks of --ab-zk slices x --ab-yk
        rows per invocation, default 1 x 1), interleaved with the library's own.
@@ -21,6 +24,7 @@
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"
 #include "hdbench_vulkan_spirv.h" /* generated into the build directory by mk/vulkan.mk */
+#include <math.h>
 #include <stdio.h>
 
 static double budget = 2.0;
@@ -127,7 +131,7 @@ static hd_result iterate_step(void *h) { return hd_iterate(*(hd_context *)h, 1);
 /* ---- the plain stencil on the Vulkan device ------------------------------------------------- */
 typedef struct stencil {
     hd__ctx *ctx;
-    int ssbo, cur, g[3];
+    int ssbo, cur, g[3]; /* ssbo: 0 r32f images, 1 float buffers, 2 the buffers as vec4 (x-packed) */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
     VkPipeline pipeline;
@@ -241,7 +245,8 @@ static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
     memcpy(s->g, g, sizeof s->g);
     for (i = 0; i < 3; ++i) types[i] = ssbo ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     if ((r = hd__vk_layouts(ctx, types, 3, 4 * sizeof(int32_t), &s->set_layout, &s->layout)) != HD_SUCCESS) return r;
-    r = ssbo ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo, sizeof hd__spv_stencil_ssbo, NULL, s->layout, &s->pipeline)
+    r = ssbo == 2 ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo4, sizeof hd__spv_stencil_ssbo4, NULL, s->layout, &s->pipeline)
+      : ssbo ? hd__vk_compute_pipeline(ctx, hd__spv_stencil_ssbo, sizeof hd__spv_stencil_ssbo, NULL, s->layout, &s->pipeline)
              : hd__vk_compute_pipeline(ctx, hd__spv_stencil_image, sizeof hd__spv_stencil_image, NULL, s->layout, &s->pipeline);
     if (r != HD_SUCCESS) return r;
     if ((r = stencil_resources(s)) != HD_SUCCESS) return r;
@@ -262,18 +267,22 @@ static hd_result stencil_step(void *user)
     be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->pipeline);
     be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &s->sets[s->cur], 0, NULL);
     be->fn.vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-    be->fn.vkCmdDispatch(cb, ((uint32_t)s->g[0] + 63u) / 64u, (uint32_t)s->g[1], (uint32_t)s->g[2]);
+    be->fn.vkCmdDispatch(cb, ((uint32_t)s->g[0] / (s->ssbo == 2 ? 4u : 1u) + 63u) / 64u, (uint32_t)s->g[1], (uint32_t)s->g[2]);
     s->cur ^= 1;
     return hd__vk_flush(s->ctx);
 }
 
 /* ---- variants of the sweep's memory access (bench/hdbench_sweep.comp, --variants) ------------- */
 #define NVAR ((int)(sizeof hd__sweep_variants / sizeof hd__sweep_variants[0]))
-#define VAR_BINDINGS 7
+#define VAR_BINDINGS 14
+#define VAR_IMAGES 11
 typedef struct variants {
     hd__ctx *ctx;
     int g[3], cur;
-    hd__vk_image im[4]; /* st, E, phi (r32f), packed (st, phi) (rg32f) */
+    float prm[4], med[4]; /* push constants of RB / PACKED: the library's parameters (variants_params) */
+    /* st, E, phi (r32f), packed (st, phi) (rg32f); st, E, phi, out x-packed by 4 (rgba32f); st, E,
+       phi x-packed by 2 (rg32f) */
+    hd__vk_image im[VAR_IMAGES];
     VkSampler sampler;
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -287,7 +296,7 @@ static void variants_free(variants *v)
     hd__backend *be = v->ctx->be;
     int i;
     be->fn.vkDeviceWaitIdle(be->device);
-    for (i = 0; i < 4; ++i) hd__vk_free_image(v->ctx, &v->im[i]);
+    for (i = 0; i < VAR_IMAGES; ++i) hd__vk_free_image(v->ctx, &v->im[i]);
     for (i = 0; i < NVAR; ++i)
         if (v->pipe[i]) be->fn.vkDestroyPipeline(be->device, v->pipe[i], NULL);
     if (v->pool) be->fn.vkDestroyDescriptorPool(be->device, v->pool, NULL);
@@ -299,8 +308,11 @@ static void variants_free(variants *v)
     }
 }
 
-/* st: a CT-like mix of empty (0) and medium voxels; E: as the stencil's rhs; phi 0. */
-static hd_result variants_data(variants *v)
+/* st and E: the library's (lib_st, lib_e: the head CT's sigma_t and one direct pass) where given,
+   else a CT-like mix of empty (0) and medium voxels and the stencil's rhs; phi 0. The x-packed
+   images hold the same floats in the same order (a texel is PK x-consecutive voxels), so they take
+   the same arrays. */
+static hd_result variants_data(variants *v, const float *lib_st, const float *lib_e)
 {
     size_t n = (size_t)v->g[0] * v->g[1] * v->g[2], i;
     float *st = (float *)malloc(n * sizeof(float)), *e = (float *)malloc(n * sizeof(float));
@@ -308,18 +320,26 @@ static hd_result variants_data(variants *v)
     hd_result r = HD_ERROR_OUT_OF_MEMORY;
     if (st && e && pk) {
         for (i = 0; i < n; ++i) {
-            st[i] = i % 89 < 20 ? 0.0f : 0.05f + (float)(i % 89) * 0.01f;
-            e[i] = (float)(i % 97) * 0.01f;
+            st[i] = lib_st ? lib_st[i] : i % 89 < 20 ? 0.0f : 0.05f + (float)(i % 89) * 0.01f;
+            e[i] = lib_e ? lib_e[i] : (float)(i % 97) * 0.01f;
             pk[2 * i] = st[i];
             pk[2 * i + 1] = 0.0f;
         }
         r = hd__vk_upload_image(v->ctx, &v->im[0], st);
         if (r == HD_SUCCESS) r = hd__vk_upload_image(v->ctx, &v->im[1], e);
         if (r == HD_SUCCESS) r = hd__vk_upload_image(v->ctx, &v->im[3], pk);
+        for (i = 0; r == HD_SUCCESS && i < 2; ++i) { /* rgba32f x4 and rg32f x2: st, E */
+            r = hd__vk_upload_image(v->ctx, &v->im[4 + 4 * i], st);
+            if (r == HD_SUCCESS) r = hd__vk_upload_image(v->ctx, &v->im[5 + 4 * i], e);
+        }
     }
     free(st); free(e); free(pk);
     return r;
 }
+
+/* Bindings 4-6 are samplers over images 0-2; 0-3 and 7-13 storage images 0-3 and 4-10. */
+static int var_sampled(int binding) { return binding >= 4 && binding < 7; }
+static int var_image(int binding) { return binding < 4 ? binding : binding < 7 ? binding - 4 : binding - 3; }
 
 static hd_result variants_set(variants *v)
 {
@@ -330,7 +350,7 @@ static hd_result variants_set(variants *v)
     VkWriteDescriptorSet w[VAR_BINDINGS];
     VkDescriptorImageInfo ii[VAR_BINDINGS];
     int i;
-    ps[0].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[0].descriptorCount = 4;
+    ps[0].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[0].descriptorCount = VAR_IMAGES;
     ps[1].type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER; ps[1].descriptorCount = 3;
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
@@ -350,9 +370,9 @@ static hd_result variants_set(variants *v)
         w[i].dstSet = v->set;
         w[i].dstBinding = (uint32_t)i;
         w[i].descriptorCount = 1;
-        w[i].descriptorType = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-        ii[i].sampler = i < 4 ? VK_NULL_HANDLE : v->sampler;
-        ii[i].imageView = v->im[i < 4 ? i : i - 4].view;
+        w[i].descriptorType = var_sampled(i) ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+        ii[i].sampler = var_sampled(i) ? v->sampler : VK_NULL_HANDLE;
+        ii[i].imageView = v->im[var_image(i)].view;
         ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
         w[i].pImageInfo = &ii[i];
     }
@@ -371,7 +391,7 @@ static hd_result variants_pipelines(variants *v)
     return HD_SUCCESS;
 }
 
-static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
+static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g, const float *lib_st, const float *lib_e)
 {
     hd__backend *be = ctx->be;
     VkDescriptorType types[VAR_BINDINGS];
@@ -382,10 +402,19 @@ static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
     memset(v, 0, sizeof *v);
     v->ctx = ctx;
     memcpy(v->g, g, sizeof v->g);
-    for (i = 0; i < 4 && (r = hd__vk_image_create_as(ctx, &v->im[i], g[0], g[1], g[2], i == 3 ? VK_FORMAT_R32G32_SFLOAT : VK_FORMAT_R32_SFLOAT,
-                                                     VK_IMAGE_USAGE_SAMPLED_BIT, "a variant image")) == HD_SUCCESS; ++i)
-        r = hd__vk_image_init(ctx, &v->im[i]);
-    if (r != HD_SUCCESS || (r = variants_data(v)) != HD_SUCCESS) return r;
+    if (g[0] % 4 != 0) { /* the x-packed variants assume whole texels */
+        fprintf(stderr, "hdbench_vulkan: --variants needs nx %% 4 == 0 (nx = %d)\n", g[0]);
+        return HD_ERROR_INVALID_DIMENSIONS;
+    }
+    for (i = 0, r = HD_SUCCESS; i < VAR_IMAGES && r == HD_SUCCESS; ++i) {
+        int pk = i >= 4 && i < 8 ? 4 : i >= 8 ? 2 : 1;
+        VkFormat f = pk == 4 ? VK_FORMAT_R32G32B32A32_SFLOAT : pk == 2 || i == 3 ? VK_FORMAT_R32G32_SFLOAT : VK_FORMAT_R32_SFLOAT;
+        if ((r = hd__vk_image_create_as(ctx, &v->im[i], g[0] / pk, g[1], g[2], f, i < 3 ? VK_IMAGE_USAGE_SAMPLED_BIT : 0,
+                                        "a variant image")) == HD_SUCCESS)
+            r = hd__vk_image_init(ctx, &v->im[i]);
+        if (pk == 4) v->im[i].texel = 16; /* the library's images know r32f, rg32f and r16f only */
+    }
+    if (r != HD_SUCCESS || (r = variants_data(v, lib_st, lib_e)) != HD_SUCCESS) return r;
     memset(&sci, 0, sizeof sci);
     sci.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
     sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
@@ -393,8 +422,8 @@ static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g)
     create = (PFN_vkCreateSampler)be->fn.vkGetDeviceProcAddr(be->device, "vkCreateSampler"); /* the library needs none */
     HD__VK_TRY(ctx, create(be->device, &sci, NULL, &v->sampler), "vkCreateSampler");
     for (i = 0; i < VAR_BINDINGS; ++i)
-        types[i] = i < 4 ? VK_DESCRIPTOR_TYPE_STORAGE_IMAGE : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    if ((r = hd__vk_layouts(ctx, types, VAR_BINDINGS, 8 * sizeof(int32_t), &v->set_layout, &v->layout)) != HD_SUCCESS)
+        types[i] = var_sampled(i) ? VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER : VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    if ((r = hd__vk_layouts(ctx, types, VAR_BINDINGS, 16 * sizeof(int32_t), &v->set_layout, &v->layout)) != HD_SUCCESS)
         return r;
     if ((r = variants_pipelines(v)) != HD_SUCCESS) return r;
     return variants_set(v);
@@ -408,21 +437,26 @@ static hd_result variant_step(void *user)
     VkCommandBuffer cb;
     uint32_t lx = (uint32_t)hd__sweep_variants[v->cur].lx, ly = (uint32_t)hd__sweep_variants[v->cur].ly;
     uint32_t zk = (uint32_t)hd__sweep_variants[v->cur].zk, yk = (uint32_t)hd__sweep_variants[v->cur].yk;
-    uint32_t xk = (uint32_t)hd__sweep_variants[v->cur].xk;
-    int32_t pc[8];
+    uint32_t xk = (uint32_t)hd__sweep_variants[v->cur].xk, sv = (uint32_t)hd__sweep_variants[v->cur].sv;
+    /* invocations along x: one per texel of the x-packed images (14 PACKED: nx / PK; 15 PSTENCIL,
+       16 PCOPY: nx / 4), else one per voxel of a colour (nx / 2, rounded up) */
+    uint32_t nx = sv == 14 ? (uint32_t)(v->g[0] / hd__sweep_variants[v->cur].pk) : sv >= 15 ? (uint32_t)v->g[0] / 4u : (uint32_t)(v->g[0] + 1) / 2;
+    int32_t pc[16];
     hd_result r;
     int parity;
     if ((r = hd__vk_cmd(v->ctx, &cb)) != HD_SUCCESS) return r;
     memset(pc, 0, sizeof pc);
     pc[0] = v->g[0]; pc[1] = v->g[1]; pc[2] = v->g[2];
     pc[5] = (int32_t)zk; /* ZRT variants read their count here */
+    memcpy(&pc[8], v->prm, sizeof v->prm);
+    memcpy(&pc[12], v->med, sizeof v->med);
     be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->pipe[v->cur]);
     be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->layout, 0, 1, &v->set, 0, NULL);
-    for (parity = 0; parity < 2; ++parity) {
+    for (parity = 0; parity < (sv >= 15 ? 1 : 2); ++parity) { /* 15, 16: one pass over every texel */
         pc[4] = parity;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
-        be->fn.vkCmdDispatch(cb, ((uint32_t)(v->g[0] + 1) / 2 + lx * xk - 1) / (lx * xk), ((uint32_t)v->g[1] + ly * yk - 1) / (ly * yk),
+        be->fn.vkCmdDispatch(cb, (nx + lx * xk - 1) / (lx * xk), ((uint32_t)v->g[1] + ly * yk - 1) / (ly * yk),
                               ((uint32_t)v->g[2] + zk - 1) / zk);
     }
     return hd__vk_flush(v->ctx);
@@ -533,35 +567,170 @@ static int variant_wanted(int k)
     return 0;
 }
 
+/* The library's parameters for RB / PACKED (hd_k_diffuse.h reads them from the parameter block):
+   1 / h^2 per axis (the shader multiplies by 0.6666667 as hd_k_diffuse.h does), the sigma' floor,
+   albedo and anisotropy. */
+static void variants_params(variants *v, const hd__ctx *ctx)
+{
+    v->prm[0] = ctx->kp.grid.x;
+    v->prm[1] = ctx->kp.grid.y;
+    v->prm[2] = ctx->kp.grid.z;
+    v->prm[3] = ctx->kp.grid.w;
+    v->med[0] = ctx->kp.medium.y;
+    v->med[1] = ctx->kp.medium.z;
+    v->med[2] = v->med[3] = 0.0f;
+}
+
+/* The phi image variant k writes (r32f, rgba32f x4 or rg32f x2: the same floats in the same order). */
+static hd__vk_image *variant_phi(variants *v, int k)
+{
+    return hd__sweep_variants[k].sv != 14 ? &v->im[2] : hd__sweep_variants[k].pk == 4 ? &v->im[6] : &v->im[10];
+}
+
+/* --variants checks every RB / PACKED variant against the library: `nsweeps` red-black sweeps from
+   phi = 0 on the library's sigma_t and E (lib_phi: the library's phi after them), the variant's
+   phi read back and compared voxel by voxel. A variant that computes other values is no candidate,
+   however fast. Returns the number of variants off by more than a few ulps (max rel 1e-5). */
+static int variants_check(variants *v, const float *lib_phi, size_t n, int nsweeps)
+{
+    float *zero = (float *)calloc(n, sizeof(float)), *out = (float *)malloc(n * sizeof(float));
+    float *first = (float *)malloc(n * sizeof(float)); /* the first variant's phi (13 RB, r32f) */
+    const char *fname = "";
+    int k, bad = 0, nfirst = 0;
+    double big = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) big = fabs(lib_phi[i]) > big ? fabs(lib_phi[i]) : big;
+    printf("check: %d red-black sweeps from phi = 0 on the library's sigma_t and E; max |phi| %.4g\n", nsweeps, big);
+    for (k = 0; zero && out && first && k < NVAR; ++k) {
+        int sv = hd__sweep_variants[k].sv, s;
+        double maxd = 0.0, l2d = 0.0, l2 = 0.0;
+        size_t ndiff = 0, nfd = 0;
+        if (sv != 13 && sv != 14) continue;
+        v->cur = k;
+        if (hd__vk_upload_image(v->ctx, variant_phi(v, k), zero) != HD_SUCCESS) { ++bad; continue; }
+        for (s = 0; s < nsweeps; ++s)
+            if (variant_step(v) != HD_SUCCESS) break;
+        if (s < nsweeps || hd__vk_download_image(v->ctx, variant_phi(v, k), out) != HD_SUCCESS) { ++bad; continue; }
+        for (i = 0; i < n; ++i) {
+            double d = fabs((double)out[i] - lib_phi[i]);
+            if (out[i] != lib_phi[i]) ++ndiff;
+            if (nfirst && out[i] != first[i]) ++nfd;
+            if (!(d <= maxd)) maxd = d; /* NaN sticks */
+            l2d += d * d;
+            l2 += (double)lib_phi[i] * lib_phi[i];
+        }
+        if (!nfirst++) {
+            memcpy(first, out, n * sizeof(float));
+            fname = hd__sweep_variants[k].name;
+        }
+        printf("check %-12s vs the library: %8zu of %zu voxels differ, max |diff| / max |phi| %.3g, rel L2 %.3g; vs %s: %zu differ%s\n",
+               hd__sweep_variants[k].name, ndiff, n, maxd / big, sqrt(l2d / l2), fname, nfd,
+               !(maxd <= 1e-5 * big) ? "  WRONG" : "");
+        if (!(maxd <= 1e-5 * big)) ++bad;
+    }
+    free(zero);
+    free(out);
+    free(first);
+    return bad;
+}
+
+/* The library's sigma_t (channel 0), E after one direct pass and phi after nsweeps red-black sweeps
+   from 0: the variants' data and the check's reference. */
+static hd_result library_state(hd_context h, float *st, float *e, float *phi, size_t n, int nsweeps)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__vk_image *sig = &ctx->be->sig;
+    float *all = NULL;
+    hd_result r = hd__test_direct(h, 1); /* allocates the images first */
+    if (r == HD_SUCCESS && !(all = (float *)malloc((size_t)sig->extent[0] * sig->extent[1] * sig->extent[2] * sizeof(float))))
+        r = HD_ERROR_OUT_OF_MEMORY;
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, sig, all);
+    if (r == HD_SUCCESS) memcpy(st, all, n * sizeof(float));
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->E, e);
+    if (r == HD_SUCCESS) r = hd__test_diffuse(h, nsweeps);
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->phi, phi);
+    free(all);
+    return r;
+}
+
+/* The plain image3D stencil, the library's red-black sweep and every sweep variant, round-robin,
+   best of rounds; first the check of RB / PACKED against the library. */
+/* The median over the rounds of per[r][f] / per[r][ref] (figures of one round run back to back, so
+   a burst of load elsewhere hits both: steadier than best / best on a busy machine). */
+static double median_ratio(const double *per, int rounds, int nf, int f, int ref)
+{
+    double q[64], t;
+    int n = 0, i, j;
+    for (i = 0; i < rounds && n < 64; ++i)
+        if (per[(size_t)i * nf + ref] > 0.0) q[n++] = per[(size_t)i * nf + f] / per[(size_t)i * nf + ref];
+    for (i = 1; i < n; ++i) /* insertion sort: a few dozen rounds at most */
+        for (j = i; j > 0 && q[j - 1] > q[j]; --j) { t = q[j]; q[j] = q[j - 1]; q[j - 1] = t; }
+    return n == 0 ? 0.0 : n % 2 ? q[n / 2] : 0.5 * (q[n / 2 - 1] + q[n / 2]);
+}
+
 static void variant_figures(const hd_desc *base, const int *g, int rounds)
 {
-    double best[NVAR + 1], v_;
+    double best[NVAR + 4], v_, *per = (double *)calloc((size_t)rounds * (NVAR + 4), sizeof(double)); /* per[round][figure] */
     hd_desc d = *base;
     hd_context h;
-    stencil st;
+    stencil st, sb[2]; /* r32f images; float buffers, the buffers as vec4 */
     variants v;
+    size_t n = (size_t)g[0] * g[1] * g[2];
+    float *lst = (float *)malloc(n * sizeof(float)), *le = (float *)malloc(n * sizeof(float));
+    float *lphi = (float *)malloc(n * sizeof(float));
     int k, f, ok;
+    const int nsweeps = 8;
     memset(best, 0, sizeof best);
+    memset(&st, 0, sizeof st);
+    memset(sb, 0, sizeof sb);
+    memset(&v, 0, sizeof v);
+    d.params.solver = HD_SOLVER_RED_BLACK;
+    d.params.anisotropy = 0.3f; /* 1 - albedo g != 1: the check covers sigma' */
     if (hd_create(&d, &h) != HD_SUCCESS) { printf("Vulkan unavailable\n"); return; }
-    ok = stencil_init(&st, hd__lookup(h, NULL), g, 0) == HD_SUCCESS;
-    ok = ok && variants_init(&v, hd__lookup(h, NULL), g) == HD_SUCCESS;
+    ok = lst && le && lphi && per;
+    if (ok) {
+        hd__ctx *ctx = hd__lookup(h, NULL);
+        ok = library_state(h, lst, le, lphi, n, nsweeps) == HD_SUCCESS;
+        ok = ok && ctx->gdims[0] == g[0] && ctx->gdims[1] == g[1] && ctx->gdims[2] == g[2] && ctx->sig_channels >= 1;
+    }
+    ok = ok && stencil_init(&st, hd__lookup(h, NULL), g, 0) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[0], hd__lookup(h, NULL), g, 1) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[1], hd__lookup(h, NULL), g, 2) == HD_SUCCESS;
+    ok = ok && variants_init(&v, hd__lookup(h, NULL), g, lst, le) == HD_SUCCESS;
+    if (ok) {
+        variants_params(&v, hd__lookup(h, NULL));
+        if (variants_check(&v, lphi, n, nsweeps) != 0) printf("check: some variants compute other values (above)\n");
+    }
     for (k = 0; ok && k < rounds; ++k)
-        for (f = 0; f <= NVAR; ++f) {
+        for (f = 0; f <= NVAR + 3; ++f) {
             if (f < NVAR && !variant_wanted(f)) continue;
             if (f < NVAR) v.cur = f;
-            v_ = f == NVAR ? rate(stencil_step, &st) : rate(variant_step, &v);
+            v_ = f == NVAR ? rate(stencil_step, &st) : f == NVAR + 1 ? rate(sweep_step, &h)
+               : f > NVAR + 1 ? rate(stencil_step, &sb[f - NVAR - 2]) : rate(variant_step, &v);
             if (v_ > best[f]) best[f] = v_;
+            per[(size_t)k * (NVAR + 4) + f] = v_;
         }
     if (ok) {
-        printf("%-48s %9s %12s\n", "sweep variant (bench/hdbench_sweep.comp)", "sweeps/s", "/ image3D");
-        printf("%-48s %9.1f %12.2f\n", "plain 7-point stencil, storage image3D", best[NVAR], 1.0);
-        for (f = 0; f < NVAR; ++f)
-            if (variant_wanted(f)) printf("%-48s %9.1f %12.2f\n", hd__sweep_variants[f].name, best[f], best[f] / best[NVAR]);
+        printf("%-40s %9s %10s %10s %11s %11s\n", "sweep variant (bench/hdbench_sweep.comp)", "sweeps/s", "/ image3D", "/ library",
+               "median of", "rounds' ratios");
+        for (f = 0; f < NVAR + 4; ++f) {
+            int o = f < 4 ? NVAR + f : f - 4; /* the stencils and the library first */
+            static const char *own[4] = {"plain 7-point stencil, storage image3D", "library red-black sweep (its module)",
+                                         "plain stencil, storage buffer (float)", "plain stencil, buffer as vec4 (x-packed)"};
+            if (o < NVAR && !variant_wanted(o)) continue;
+            printf("%-40s %9.1f %10.2f %10.2f %11.2f %11.2f\n", o < NVAR ? hd__sweep_variants[o].name : own[o - NVAR], best[o],
+                   best[o] / best[NVAR], best[o] / best[NVAR + 1], median_ratio(per, rounds, NVAR + 4, o, NVAR),
+                   median_ratio(per, rounds, NVAR + 4, o, NVAR + 1));
+        }
+        printf("(best of %d rounds; the medians are over the rounds of figure / image3D stencil and / library in the same round)\n", rounds);
     } else {
         printf("the variant figures failed (see the log)\n");
     }
-    stencil_free(&st);
-    variants_free(&v);
+    if (st.ctx) stencil_free(&st);
+    for (k = 0; k < 2; ++k)
+        if (sb[k].ctx) stencil_free(&sb[k]);
+    if (v.ctx) variants_free(&v);
+    free(lst); free(le); free(lphi); free(per);
     hd_destroy(h);
 }
 
