@@ -193,11 +193,13 @@ HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_F
    use the diffusion's addressing (K->cx = x) and are contiguous. An odd grid's last item reads
    its rows' padding slot (finite, as the sweep's) and writes a column nobody reads. */
 __kernel void hd_k_mg_restrict_line(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
-                                    __global float *restrict fres, __global float *restrict line, int parity)
+                                    __global float *restrict fres, __global float *restrict line, int parity,
+                                    __global float *restrict fsig)
 {
     hd__kctx kf = hd__cl_mg_ctx(pf);
     int gz = pc->gdims.z, Y = (int)get_global_id(1), zz = (int)get_global_id(2), x = 2 * (int)get_global_id(0) + parity;
     kf.phi = fres;
+    kf.sig = fsig; /* the mask hd_mg_medium */
     kf.cx = x; kf.cp = parity; kf.cid = get_global_id(0);
     line[((size_t)zz * pc->gdims.y + Y) * (size_t)(2 * kf.hx) + (size_t)x] = hd_mg_restrict_line(&kf, x, Y, zz % gz, zz / gz);
 }
@@ -225,16 +227,19 @@ __kernel void hd_k_mg_restrict(__constant hd__kparams *restrict pf, __constant h
    store are contiguous (the coarse loads are gathers in any mapping: a coarse row's colours
    alternate with x). */
 __kernel void hd_k_mg_prolong(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
-                              __global float *restrict cphi, __global float *restrict fphi, int parity)
+                              __global float *restrict cphi, __global float *restrict fphi, int parity,
+                              __global float *restrict fsig)
 {
     hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
     int gz = pf->gdims.z, y = (int)get_global_id(1), z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz;
-    int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp;
+    int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp, xk = hd_mini(x, pf->gdims.x - 1);
     kc.phi = cphi;
     kf.phi = fphi;
+    kf.sig = fsig; /* the mask hd_mg_medium */
     kf.cx = x; kf.cp = cp; kf.cid = get_global_id(0);
     hd__cl_mg_set_phi(&kf, x, y, z + c * gz,
-                      hd__cl_mg_get_phi(&kf, x, y, z + c * gz) + hd_mg_prolong(&kc, hd_mini(x, pf->gdims.x - 1), y, z, c));
+                      hd__cl_mg_get_phi(&kf, x, y, z + c * gz) +
+                          hd_mg_prolong(&kc, xk, y, z, c) * hd_mg_medium(&kf, 0, xk, y, z));
 }
 
 /* p = z + beta p, then z = 0. */

@@ -16,8 +16,9 @@
    hd_pc.x and hd_pc.y. */
 #define HD_MG_SIG 1      /* K fine; hd_pc = coarse dims, sigma_t channels; coarse sigma_t -> unit 6 */
 #define HD_MG_RESIDUAL 2 /* K the level (sig, E = rhs, phi); f - A phi in float -> phi2 */
-#define HD_MG_RESTRICT 3 /* K fine (phi = its residual); hd_pc = coarse dims, channels; rhs -> unit 6, phi2 = 0 */
-#define HD_MG_PROLONG 4  /* K coarse (phi = its correction); hd_pc = fine dims, channels; unit 6 += P */
+#define HD_MG_RESTRICT 3 /* K fine (phi = its residual, sig); hd_pc = coarse dims, channels; rhs -> unit 6, phi2 = 0 */
+#define HD_MG_PROLONG 4  /* K coarse (phi = its correction; sig = the FINE sigma_t, for hd_mg_medium);
+                            hd_pc = fine dims, channels; unit 6 += P */
 #define HD_MG_DIR 5      /* E = z, phi = p: p = z + beta p, z = 0 */
 #define HD_MG_RES_F64 6  /* K fine (sig, E, phi, phi2 = lo); hd_pc.x use_lo, .y negate; -> unit 6 */
 #define HD_MG_DOT 7      /* K level 0 (E, phi): the row sums -> hd_mg_row_sums */
@@ -65,7 +66,8 @@ void main()
 #elif HD_MG_STAGE == HD_MG_PROLONG
     if (x < hd_pc.x && y < hd_pc.y && zz < hd_pc.z * hd_pc.w) {
         int z = zz % hd_pc.z, c = zz / hd_pc.z;
-        hd_mg_set_other(x, y, zz, hd_mg_other(x, y, zz) + hd_mg_prolong(x, y, z, c));
+        hd_mg_set_other(x, y, zz, hd_mg_other(x, y, zz) +
+                                      hd_mg_prolong(x, y, z, c) * hd_mg_medium((z * hd_pc.y + y) * hd_pc.x + x, x, y, z));
     }
 #elif HD_MG_STAGE == HD_MG_RESIDUAL
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w) {

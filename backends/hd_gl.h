@@ -1232,10 +1232,10 @@ static hd_result hd__gl_mg_cycle(hd__ctx *ctx, int l)
     if ((r = hd__gl_mg_smooth(ctx, l, HD__GL_MG_PRE, 0)) != HD_SUCCESS ||
         (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL,
                             L->dims[0], L->dims[1], L->dims[2] * ch, 0, 0, 0, ch)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, NULL, NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
                             C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch)) != HD_SUCCESS ||
         (r = hd__gl_mg_cycle(ctx, l + 1)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, NULL, NULL, &C->phi, NULL, &L->phi, L->dims[0], L->dims[1],
+        (r = hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0], L->dims[1],
                             L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch)) != HD_SUCCESS)
         return r;
     return hd__gl_mg_smooth(ctx, l, HD__GL_MG_POST, 1);

@@ -929,7 +929,7 @@ static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
     hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1 < mg->levels ? l + 1 : l];
-    cl_mem a[5];
+    cl_mem a[5], fsig;
     hd_result r;
     int k;
     if (l == mg->levels - 1) {
@@ -942,10 +942,12 @@ static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
         (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 1)) != HD_SUCCESS)
         return r;
     a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = mg->line;
+    fsig = hd__cl_mg_sig(be, l); /* the transfers' mask, hd_mg_medium (argument 5 of both) */
     for (k = 0; k < 2; ++k) { /* the shares of the fine columns of each parity */
         cl_int parity = k;
         if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT_LINE, 4, a)) != HD_SUCCESS) return r;
         HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 4, sizeof parity, &parity), "clSetKernelArg(parity)");
+        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 5, sizeof fsig, &fsig), "clSetKernelArg(fsig)");
         if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
                             (size_t)C->dims[2] * (size_t)mg->channels)) != HD_SUCCESS)
             return r;
@@ -956,6 +958,7 @@ static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
         return r;
     if ((r = hd__cl_mg_cycle(ctx, l + 1)) != HD_SUCCESS) return r;
     a[0] = L->params; a[1] = C->params; a[2] = C->phi; a[3] = L->phi;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_PROLONG], 5, sizeof fsig, &fsig), "clSetKernelArg(fsig)");
     if ((r = hd__cl_mg_args(ctx, HD__CL_MG_PROLONG, 4, a)) != HD_SUCCESS ||
         (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 0)) != HD_SUCCESS ||
         (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 1)) != HD_SUCCESS)

@@ -1772,8 +1772,9 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
         L->coarsen = sets[4 * l + 3];
         hd__vk_mg_write(ctx, L->smooth, hd__vk_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, NULL);
         if (C) {
-            hd__vk_mg_write(ctx, L->restrict_to, NULL, NULL, &L->res, &C->phi, &C->rhs, NULL);
-            hd__vk_mg_write(ctx, L->prolong_from, NULL, NULL, &C->phi, NULL, &L->phi, NULL);
+            /* both with the fine sigma_t: the transfers' mask (hd_mg_medium) */
+            hd__vk_mg_write(ctx, L->restrict_to, hd__vk_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, NULL);
+            hd__vk_mg_write(ctx, L->prolong_from, hd__vk_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, NULL);
         }
         if (l > 0) hd__vk_mg_write(ctx, L->coarsen, hd__vk_mg_sig(be, l - 1), NULL, NULL, NULL, &L->sig, NULL);
     }

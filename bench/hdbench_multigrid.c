@@ -13,6 +13,7 @@
    storage of phi sets (rounding to nearest is about 0.29 ulp rms).
    Usage: hdbench_multigrid [data/head.nrrd] [--cap SECONDS] [--tol T] [--downsample N]
                             [--print-every STEPS] [--surface-only] [--f64]
+                            [--tissue-error REF_STEPS [--tissue-ref FILE]]
    Figures, not a test: nothing here passes or fails. */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
@@ -81,6 +82,42 @@ static double residual_kernel_f64(hd_context h, int iterate)
    wall seconds have passed; prints the residual every `print_every` steps. */
 static int f64; /* --f64: the residual evaluated in double (residual_f64) */
 
+/* --tissue-error STEPS: the error that matters under the box boundary, where the residual does
+   not (air's diagonal, about 1e4 tissue's, makes one float32 ulp of phi a residual of order 1):
+   |phi - phi_ref| / |phi_ref| in L2 over the medium voxels only (sigma' at least half the
+   floor, the surface boundary's "empty" test), phi_ref the multigrid solver's phi after STEPS
+   steps (its fixed point is red-black's: solvers_multigrid_matches_red_black). Printed at
+   1, 2, 4, 8, ... batches instead of every print_every. --tissue-ref FILE: the reference is read
+   from FILE.box / FILE.surface if it exists, else written there (to compare two builds against
+   one reference). */
+static float *tissue_ref;
+static unsigned char *tissue_mask;
+
+/* The medium voxels of a context's grid (channel 0's sigma_t) into tissue_mask. */
+static void tissue_mask_of(hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    size_t n = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], i;
+    float empty_below = 0.5f * ctx->kp.grid.w / (1.0f - ctx->kp.medium.y * ctx->kp.medium.z);
+    tissue_mask = (unsigned char *)malloc(n);
+    for (i = 0; i < n; ++i) tissue_mask[i] = ctx->be->sig[i] >= empty_below;
+}
+
+/* The relative L2 error of phi (channel 0) over the medium voxels against tissue_ref. */
+static double tissue_error(hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    size_t n = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], i;
+    double e2 = 0.0, r2 = 0.0;
+    for (i = 0; i < n; ++i)
+        if (tissue_mask[i]) {
+            double d = (double)ctx->be->phi[i] - tissue_ref[i];
+            e2 += d * d;
+            r2 += (double)tissue_ref[i] * tissue_ref[i];
+        }
+    return r2 > 0.0 ? sqrt(e2 / r2) : -1.0;
+}
+
 static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threads, int print_every, const char *name)
 {
     mg_run r;
@@ -94,10 +131,11 @@ static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threa
         r.steps += batch;
         hd__test_residual(ctx, &res);
         if (f64) res = residual_f64(ctx);
-        if (r.steps % (batch * print_every) == 0 || res < tol) {
+        if (tissue_ref ? ((r.steps / batch) & (r.steps / batch - 1)) == 0 : r.steps % (batch * print_every) == 0 || res < tol) {
             hd__ctx *c = hd__lookup(ctx, NULL);
-            printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, residual %.3e (kernel coefficients %.3e", name,
-                   r.steps, r.wall, r.cpu, res, f64 ? residual_kernel_f64(ctx, 0) : res);
+            printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, ", name, r.steps, r.wall, r.cpu);
+            if (tissue_ref) printf("tissue error %.3e, ", tissue_error(ctx));
+            printf("residual %.3e (kernel coefficients %.3e", res, f64 ? residual_kernel_f64(ctx, 0) : res);
             if (f64 && c && c->be->mg && c->params.solver == HD_SOLVER_MULTIGRID)
                 printf("; the solver's iterate phi + lo %.3e", residual_kernel_f64(ctx, 1));
             printf(")\n");
@@ -134,9 +172,9 @@ static double residual_ulp_f64(hd_context h)
 
 int main(int argc, char **argv)
 {
-    const char *path = "data/head.nrrd";
+    const char *path = "data/head.nrrd", *ref_file = NULL;
     double cap = 300.0, tol = 1e-4;
-    int i, boundary, threads = (int)sysconf(_SC_NPROCESSORS_ONLN), downsample = 1, print_every = 20, first = HD_BOUNDARY_BOX;
+    int i, ref_steps = 0, boundary, threads = (int)sysconf(_SC_NPROCESSORS_ONLN), downsample = 1, print_every = 20, first = HD_BOUNDARY_BOX;
     hd_volume_file vf;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--cap") == 0 && i + 1 < argc) cap = atof(argv[++i]);
@@ -145,6 +183,8 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--print-every") == 0 && i + 1 < argc) print_every = atoi(argv[++i]);
         else if (strcmp(argv[i], "--surface-only") == 0) first = HD_BOUNDARY_SURFACE;
         else if (strcmp(argv[i], "--f64") == 0) f64 = 1;
+        else if (strcmp(argv[i], "--tissue-error") == 0 && i + 1 < argc) ref_steps = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--tissue-ref") == 0 && i + 1 < argc) ref_file = argv[++i];
         else path = argv[i];
     }
     if (hd_volume_load_nrrd(path, &vf, NULL) != HD_SUCCESS) {
@@ -173,6 +213,41 @@ int main(int argc, char **argv)
         if (hd_create(&d, &mg) != HD_SUCCESS) return 1;
         if (hd__test_direct(rb, 4) != HD_SUCCESS || hd__test_direct(mg, 4) != HD_SUCCESS) return 1;
         printf("\nboundary %s:\n", boundary == HD_BOUNDARY_BOX ? "box" : "surface");
+        if (ref_steps > 0) { /* the reference: ref_steps multigrid steps from the same E */
+            hd_context ref;
+            hd__ctx *rc;
+            double rres = -1.0;
+            size_t n;
+            if (hd_create(&d, &ref) != HD_SUCCESS || hd__test_direct(ref, 4) != HD_SUCCESS ||
+                hd__test_diffuse(ref, ref_steps) != HD_SUCCESS)
+                return 1;
+            rc = hd__lookup(ref, NULL);
+            n = (size_t)rc->gdims[0] * rc->gdims[1] * rc->gdims[2];
+            free(tissue_ref);
+            free(tissue_mask);
+            tissue_ref = (float *)malloc(n * sizeof(float));
+            memcpy(tissue_ref, rc->be->phi, n * sizeof(float));
+            tissue_mask_of(ref);
+            if (ref_file) { /* --tissue-ref FILE.box / FILE.surface: one reference for two builds */
+                char fn[1024];
+                FILE *f;
+                snprintf(fn, sizeof fn, "%s.%s", ref_file, boundary == HD_BOUNDARY_BOX ? "box" : "surface");
+                if ((f = fopen(fn, "rb")) != NULL) {
+                    if (fread(tissue_ref, sizeof(float), n, f) != n) return 1;
+                    printf("reference read from %s (this run's own: tissue error %.3e against it)\n", fn,
+                           tissue_error(ref));
+                } else if ((f = fopen(fn, "wb")) != NULL) {
+                    if (fwrite(tissue_ref, sizeof(float), n, f) != n) return 1;
+                    printf("reference written to %s\n", fn);
+                }
+                if (f) fclose(f);
+            }
+            hd__test_residual(ref, &rres);
+            printf("reference: %d multigrid steps (float residual %.3e); tolerance off, every solver runs --cap s\n",
+                   ref_steps, rres);
+            tol = 0.0;
+            hd_destroy(ref);
+        }
         b = solve(mg, 1, tol, cap, threads, print_every, "multigrid PCG steps");
         /* the double residual costs about a sweep's time x 20: checked every 250 sweeps */
         a = solve(rb, f64 ? 250 : 25, tol, cap, threads, print_every, "red-black sweeps  ");

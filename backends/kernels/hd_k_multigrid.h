@@ -34,18 +34,22 @@
    its fine grid's voxels per axis rounded down, so all 8 exist), sigma_t channel ch.
    Channel 0: the harmonic mean, i.e. the mean of the children's D, so a coarse voxel conducts like
    its most conductive part (the arithmetic mean of sigma_t made voxels of soft tissue and bone, or
-   of air and tissue, insulators, and the cycle diverged on a sphere in air). Box boundary: every
-   child counts, air floored at 1e-4 per world unit (air conducts). Surface boundary: empty
-   children (sigma' = sigma_t (1 - albedo g) below half the floor) are vacuum, not medium: the
-   mean is over the medium children, and a coarse voxel with fewer than 4 of them is empty.
+   of air and tissue, insulators, and the cycle diverged on a sphere in air). Empty children
+   (sigma' = sigma_t (1 - albedo g) below half the floor, hd_mg_medium) do not count while at
+   least 4 of the 8 are medium: the mean is over the medium children. With fewer, the surface
+   boundary makes the coarse voxel empty and the box boundary takes the mean over every child,
+   air floored at 1e-4 per world unit (air conducts). Why the box boundary ignores air in a mostly
+   medium voxel: with the transfers masked to medium voxels (hd_mg_medium) the coarse grid's
+   medium is then the fine grid's to within a fine voxel, where one air child used to make the
+   voxel an air-like conductor (24^3 sphere, 12 steps: 3.8e-6 with every child, 1.9e-6 so).
    RGB scattering's colour channels 1..3: the plain mean. Children in z, y, x order. */
 HD_FN float hd_mg_coarse_sig(HD_KARGS int X, int Y, int Z, int ch)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int surface = (HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0 ? 1 : 0;
     float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);
-    float s = 0.0f;
-    int n = 0;
+    float s = 0.0f, sa = 0.0f;
+    int n = 0, na = 0;
     for (int k = 2 * Z; k <= 2 * Z + 1; ++k)
         for (int j = 2 * Y; j <= 2 * Y + 1; ++j)
             for (int i = 2 * X; i <= 2 * X + 1; ++i) {
@@ -53,13 +57,34 @@ HD_FN float hd_mg_coarse_sig(HD_KARGS int X, int Y, int Z, int ch)
                 if (ch != 0) {
                     s += v;
                     n += 1;
-                } else if (!(surface != 0 && v < empty_below)) {
-                    s += 1.0f / (v > 1e-4f ? v : 1e-4f);
+                } else if (!(v < empty_below)) {
+                    s += 1.0f / v;
                     n += 1;
+                } else {
+                    sa += 1.0f / (v > 1e-4f ? v : 1e-4f);
+                    na += 1;
                 }
             }
     if (ch != 0) return s / HD_F(n);
-    return surface != 0 && n < 4 ? 0.0f : HD_F(n) / s;
+    if (n >= 4) return HD_F(n) / s;
+    return surface != 0 ? 0.0f : HD_F(n + na) / (s + sa);
+}
+
+/* ---- the transfers' mask ----------------------------------------------------------------------- */
+/* 1 if voxel (x, y, z) of K's grid (channel-0 index j of its sigma_t) is medium or the boundary is
+   the surface one, else 0: under the box boundary the restriction reads the residual, and the
+   prolongation writes the correction, of medium voxels only (M stays symmetric: R = (D P)^T / 8
+   for the prolongation D P, D this mask). Why: air's floored D makes its faces about 1e4 times
+   tissue's conductance; trilinear interpolation spread a quarter of the tissue's correction into
+   the air beside it, an error of that much energy that CG's line search scaled every step down
+   to nothing (24^3 sphere, max error after 12 steps 9.1e-3 unmasked, 3.8e-6 masked; the
+   smoothers alone carry air's own correction). The surface boundary's empty voxels are identity
+   rows already, and its transfers keep their bits (a product by 1). */
+HD_FN float hd_mg_medium(HD_KARGS int j, int x, int y, int z)
+{
+    float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);
+    if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0) return 1.0f;
+    return HD_GET(sig, j, x, y, z) < empty_below ? 0.0f : 1.0f;
 }
 
 /* ---- restriction R = P^T / 8 (full weighting) ------------------------------------------------- */
@@ -73,7 +98,7 @@ HD_FN float hd_mg_fw(int t)
 
 /* Fine column x's share of coarse row (Y, Z), channel c: the fine residual (K's phi, K the fine
    grid) of the up to 16 fine rows 2 Z - 1 + a, 2 Y - 1 + b (a, b = 0..3) at x, weighted
-   fw(a) fw(b), summed in a, b order (rows outside the grid skipped by a branch: the select form
+   fw(a) fw(b), each residual times its voxel's hd_mg_medium (K's sigma_t), summed in a, b order (rows outside the grid skipped by a branch: the select form
    hd_mg_prolong uses made the OpenCL step slower, 360 against 322 ms on the head CT in two runs
    minutes apart, and the rows' tests are uniform along x anyway). A backend computes it once per fine x and
    coarse row (the CPU a vector loop per row, OpenCL a pass into a row buffer) and combines four
@@ -88,7 +113,8 @@ HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
         for (int b = 0; b < 4; ++b) {
             int y = 2 * Y - 1 + b;
             if (y < 0 || y >= gy) continue;
-            line += (hd_mg_fw(a) * hd_mg_fw(b)) * HD_GET(phi, ((c * gz + z) * gy + y) * gx + x, x, y, z + c * gz);
+            line += (hd_mg_fw(a) * hd_mg_fw(b)) * (HD_GET(phi, ((c * gz + z) * gy + y) * gx + x, x, y, z + c * gz) *
+                                                    hd_mg_medium(HD_KPASS (z * gy + y) * gx + x, x, y, z));
         }
     }
     return line;
@@ -117,7 +143,8 @@ HD_FN float hd_mg_pw(int t)
    linear map, so the V-cycle stays a symmetric preconditioner). Terms beyond the grid are skipped
    by a select on a clamped load, not a branch (the x tests vary along a row): the CPU's step took
    0.83x (box) and 0.91x (surface boundary) of its time before (head CT, full resolution); skipping rather than adding a zero term
-   keeps the CPU's bits (a zero term could flip the sign of a zero sum). */
+   keeps the CPU's bits (a zero term could flip the sign of a zero sum). The caller multiplies the
+   value by the fine voxel's hd_mg_medium (the restriction's mask) before adding it. */
 HD_FN float hd_mg_prolong(HD_KARGS int x, int y, int z, int c)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
