@@ -1140,7 +1140,8 @@ static const char *const hd__gl_source[] = {
 "   residual of 1.2e-4 on the head CT at half resolution; the difference form in double is exact\n",
 "   to the last bit of its float inputs. in_* say whether the neighbour on each side lies in the\n",
 "   grid (the CPU passes literals for interior voxels). An empty voxel's row under the surface\n",
-"   boundary is phi = 0: its residual is -(phi + lo). */\n",
+"   boundary is phi + lo = 0: its residual is -(phi + lo) (exactly 0: after each step phi holds the\n",
+"   sweeps' extrapolation there and lo its negative, hd_diffuse_extrapolate). */\n",
 "HD_FN double hd_mg_res_f64(HD_KARGS int x, int y, int z, int c, int surface, int rgb, int use_lo, int in_xm,\n",
 "                           int in_xp, int in_ym, int in_yp, int in_zm, int in_zp)\n",
 "{\n",
@@ -1799,7 +1800,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1495 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1496 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])
