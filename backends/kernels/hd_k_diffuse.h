@@ -11,9 +11,9 @@
      freely, so every tissue surface acts nearly as phi = 0.
    - surface (HD_FLAG_SURFACE_BOUNDARY): empty voxels (sigma' below half the floor) are not
      solved for (they hold the Marshak extrapolation of their medium neighbours, for the
-     projection: hd_diffuse_surface_end) and a face between a medium voxel and an empty one (or the box) carries the Marshak vacuum
-     condition J = phi_s / 2 (no light enters from outside): conductance 1 / (h / (2D) + 2) per
-     area, i.e. w = 1 / (h^2 / (2 D) + 2 h) = 1 / (1.5 sigma' h^2 + 2 h). */
+     projection: hd_diffuse_surface_end) and a face between a medium voxel and an empty one (or
+     the box) carries the Marshak vacuum condition J = phi_s / 2 (no light enters from outside):
+     conductance 1 / (h / (2D) + 2) per area, i.e. w = 1 / (h^2 / (2 D) + 2 h) = 1 / (1.5 sigma' h^2 + 2 h). */
 
 /* The flags word the diffusion tests (RGB scattering, boundary). A backend may define it as a
    compile-time constant per pipeline (Vulkan: a specialization constant, hd_bind_vk_glsl.h), so
@@ -250,8 +250,8 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
 }
 
 /* The surface boundary's update from loaded values, the arguments as hd_diffuse_box_of's: an
-   empty voxel gets its extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward empty neighbours or
-   the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
+   empty voxel gets its extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward
+   empty neighbours or the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
    so the CPU's row loop stays branch-free. */
 HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
                                   float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
