@@ -268,8 +268,10 @@ typedef struct hd_params {
     hd_boundary diffusion_boundary; /* where the diffusion's vacuum is: HD_BOUNDARY_BOX (default,
                                METHOD.md: phi = 0 outside the volume box, empty voxels solved
                                with a floored D, so air drains light) or HD_BOUNDARY_SURFACE
-                               (empty voxels hold phi = 0 and the medium's surface carries the
-                               Marshak vacuum condition; closer to PT_MS, see docs/EVALUATION.md) */
+                               (the medium's surface carries the Marshak vacuum condition; empty
+                               voxels are not solved for and hold the Marshak extrapolation of
+                               their medium neighbours' phi, which the projection interpolates
+                               toward; closer to PT_MS, see docs/EVALUATION.md) */
     hd_precision illumination_precision; /* storage of E and phi (and Jacobi's buffer):
                                HD_PRECISION_FLOAT16 stores them as IEEE binary16, rounded to
                                nearest even, while every operation stays float32: 2 bytes per

@@ -22,7 +22,9 @@
    4. q = A p (the same double-summed residual with a zero right-hand side),
       alpha = <r, p> / <p, q>;
    5. phi + lo += alpha p in double, phi the float rounding of the sum (what the projection
-      reads), lo the rest: the iterate keeps about 48 bits, and phi is the solution rounded once.
+      reads), lo the rest: the iterate keeps about 48 bits, and phi is the solution rounded once;
+   6. surface boundary: the empty voxels' phi = the sweeps' Marshak extrapolation, lo = -phi
+      (hd__cpu_mg_extrap_row: the iterate stays 0 on their identity rows).
    The dot products are summed in double, per row and then in row order: the same bits for any
    thread count. Step 5 is an exact line search along p, so the error's energy norm never grows,
    whatever p is. CG restarts (beta = 0) at each new HD iteration (a new E: ctx->iterations
@@ -78,6 +80,7 @@ struct hd__cpu_mg {
     int levels, channels, sig_channels, fine[3];
     hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     int cur;                 /* the level a transfer pass writes (coarse) */
+    int colour;              /* the colour ((x + y + z) & 1) hd__cpu_mg_extrap_row writes */
     float *p;                /* CG's search direction (fine grid) */
     float *lo;               /* the iterate's low part: CG's iterate is phi + lo, phi its float
                                 rounding (hd__cpu_mg_update_row) */
@@ -391,6 +394,23 @@ static void hd__cpu_mg_update_row(hd__backend *be, int r)
     for (x = 0; x < gx; ++x) phi[x] = hd_mg_update_of(phi[x], &lo[x], p[x], alpha);
 }
 
+/* Empty voxels of the surface boundary, colour mg->colour, of row r: phi = the extrapolation the
+   sweeps store there (hd_diffuse_extrapolate, read by the projection), lo = -phi, so CG's iterate
+   phi + lo stays exactly 0 on those identity rows (hd_mg_res_f64's -(phi + lo); z and so p are 0
+   there, the V-cycle's rows being identity rows too). */
+static HD__CPU_FLATTEN void hd__cpu_mg_extrap_row(hd__backend *be, int r)
+{
+    struct hd__cpu_mg *mg = be->mg;
+    int gx = mg->lv[0].dims[0], gy = mg->lv[0].dims[1], gz = mg->lv[0].dims[2], x;
+    int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
+    float *phi = be->phi + (size_t)r * gx, *lo = mg->lo + (size_t)r * gx, v = 0.0f;
+    for (x = (y + z + mg->colour) & 1; x < gx; x += 2)
+        if (hd_diffuse_extrapolate(&be->k, x, y, z, c, &v)) {
+            phi[x] = v;
+            lo[x] = -v;
+        }
+}
+
 /* Rebuilds the levels if the grid changed, refreshes every level's parameters and restricts
    sigma_t when it changed; returns whether CG must restart. */
 static hd_result hd__cpu_mg_prepare(hd__ctx *ctx, int *restart)
@@ -443,9 +463,12 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     be->grid = NULL;
     mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (!(pq > 0.0)) return HD_SUCCESS;
-    mg->alpha = rp / pq;
-    hd__cpu_parallel(be, hd__cpu_mg_update_row, rows);
+    if (pq > 0.0) {
+        mg->alpha = rp / pq;
+        hd__cpu_parallel(be, hd__cpu_mg_update_row, rows);
+    }
+    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) /* one colour at a time: it reads the other */
+        for (mg->colour = 0; mg->colour < 2; ++mg->colour) hd__cpu_parallel(be, hd__cpu_mg_extrap_row, rows);
     return HD_SUCCESS;
 }
 #define HD__BE_HAS_MULTIGRID 1

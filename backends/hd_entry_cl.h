@@ -301,4 +301,21 @@ __kernel void hd_k_mg_update(__constant hd__kparams *p, __global float *phi, __g
     hd__cl_mg_set_phi(&k, x, y, zz, f);
     hd__cl_mg_set_phi2(&k, x, y, zz, l);
 }
+
+/* Surface boundary: the empty voxels of colour `colour` ((x + y + z) & 1) get phi = the sweeps'
+   extrapolation, lo = -phi (hd_diffuse_extrapolate; p the fine parameters, without the
+   right-hand-side flag). */
+__kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __global float *E, __global float *phi,
+                             __global float *lo, int colour)
+{
+    hd__kctx k = hd__cl_mg_ctx(p);
+    int x = (int)get_global_id(0), y = (int)get_global_id(1), zz = (int)get_global_id(2), gz = p->gdims.z;
+    float v = 0.0f;
+    k.sig = sig; k.E = E; k.phi = phi; k.phi2 = lo;
+    if (((x + y + zz % gz + colour) & 1) != 0) return;
+    if (hd_diffuse_extrapolate(&k, x, y, zz % gz, zz / gz, &v) != 0) {
+        hd__cl_mg_set_phi(&k, x, y, zz, v);
+        hd__cl_mg_set_phi2(&k, x, y, zz, -v);
+    }
+}
 #endif

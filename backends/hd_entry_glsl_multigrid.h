@@ -23,6 +23,7 @@
 #define HD_MG_RES_F64 6  /* K fine (sig, E, phi, phi2 = lo); hd_pc.x use_lo, .y negate; -> unit 6 */
 #define HD_MG_DOT 7      /* K level 0 (E, phi): the row sums -> hd_mg_row_sums */
 #define HD_MG_UPDATE 8   /* phi + lo (phi2) += alpha p (E) */
+#define HD_MG_EXTRAP 9   /* K fine (sig, E, phi, phi2 = lo); hd_pc.x colour: empty voxels' phi = extrapolation, lo = -phi */
 #ifdef HD_MG_PUSH_SCALARS
 layout(std430, binding = 11) writeonly buffer hd_b_dot { double hd_mg_row_sums[]; };
 #define hd_mg_beta intBitsToFloat(hd_pc.x)
@@ -99,6 +100,16 @@ void main()
         float f = hd_mg_update_of(HD_GET(phi, 0, x, y, zz), l, HD_GET(E, 0, x, y, zz), hd_mg_alpha);
         HD_SET(phi, 0, x, y, zz, f);
         HD_SET(phi2, 0, x, y, zz, l);
+    }
+#elif HD_MG_STAGE == HD_MG_EXTRAP
+    /* surface boundary: hd_diffuse_extrapolate on the voxels of colour hd_pc.x, so none it reads
+       is being written (the CPU's hd__cpu_mg_extrap_row) */
+    if (x < g.x && y < g.y && zz < g.z * hd_pc.w && ((x + y + zz % g.z + hd_pc.x) & 1) == 0) {
+        float v = 0.0f;
+        if (hd_diffuse_extrapolate(x, y, zz % g.z, zz / g.z, v) != 0) {
+            HD_SET(phi, 0, x, y, zz, v);
+            HD_SET(phi2, 0, x, y, zz, -v);
+        }
     }
 #else
 #error "hd_entry_glsl_multigrid.h: define HD_MG_STAGE"

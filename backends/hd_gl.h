@@ -117,9 +117,9 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
 #define HD__GL_SSBOS 4       /* storage buffers 0..3 (3: multigrid's row sums) */
 
-/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..8), each in the
+/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..9), each in the
    4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
-#define HD__GL_MG_STAGES 8
+#define HD__GL_MG_STAGES 9
 #define HD__GL_MG_PROGRAMS (4 * HD__GL_MG_STAGES)
 struct hd__gl_mg;
 typedef struct hd__gl_tex {
@@ -994,10 +994,11 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_sum_
 #define HD__GL_MG_POST 2
 #define HD__GL_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
 enum { HD__GL_MG_SIG = 1, HD__GL_MG_RESIDUAL, HD__GL_MG_RESTRICT, HD__GL_MG_PROLONG, HD__GL_MG_DIR, HD__GL_MG_RES_F64,
-       HD__GL_MG_DOT, HD__GL_MG_UPDATE };
+       HD__GL_MG_DOT, HD__GL_MG_UPDATE, HD__GL_MG_EXTRAP };
 static const char *const hd__gl_mg_names[HD__GL_MG_STAGES] = {
     "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
-    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update"};
+    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
+    "multigrid extrapolation"};
 
 typedef struct hd__gl_level {
     int dims[3];
@@ -1328,12 +1329,22 @@ static hd_result hd__gl_multigrid(hd__ctx *ctx)
     if ((r = hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b, &rp)) != HD_SUCCESS) return r;
     mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (!(pq > 0.0)) return HD_SUCCESS;
-    alpha = rp / pq;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
-                            mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
-        return r;
+    if (pq > 0.0) {
+        alpha = rp / pq;
+        if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS ||
+            (r = hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0],
+                                mg->fine[1], mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
+            return r;
+    }
+    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
+       one colour per pass; the fine parameters (no right-hand-side flag) */
+    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) {
+        int colour;
+        for (colour = 0; colour < 2; ++colour)
+            if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, mg->fine[0],
+                                    mg->fine[1], mg->fine[2] * mg->channels, colour, 0, 0, mg->channels)) != HD_SUCCESS)
+                return r;
+    }
     be->gl.Finish(); /* a step ends complete, as OpenCL's clFinish (timings per step mean the step) */
     return hd__gl_check(ctx, "glFinish", __LINE__);
 }

@@ -43,7 +43,8 @@ enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_D
           double and exist only on a device with cl_khr_fp64 */
        HD__CL_MG_SIG, HD__CL_MG_RESIDUAL, HD__CL_MG_RESTRICT_LINE = HD__CL_MG_RESIDUAL + 4, HD__CL_MG_RESTRICT,
        HD__CL_MG_PROLONG, HD__CL_MG_DIR,
-       HD__CL_MG_RES_F64, HD__CL_MG_DOT = HD__CL_MG_RES_F64 + 4, HD__CL_MG_UPDATE, HD__CL_KERNEL_COUNT };
+       HD__CL_MG_RES_F64, HD__CL_MG_DOT = HD__CL_MG_RES_F64 + 4, HD__CL_MG_UPDATE, HD__CL_MG_EXTRAP,
+       HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
     "hd_k_diffuse_surface_rgb", "hd_k_diffuse_jacobi", "hd_k_diffuse_jacobi_rgb", "hd_k_diffuse_jacobi_surface",
@@ -53,7 +54,8 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
     "hd_k_sum_light_half", "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
     "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict_line", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
-    "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update"};
+    "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
+    "hd_k_mg_extrap"};
 
 struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (hd__be_multigrid, at the end) */
 static void hd__cl_mg_free(hd__ctx *ctx);
@@ -246,7 +248,7 @@ static hd_result hd__cl_build(hd__ctx *ctx)
         return r;
     }
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
-        if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_UPDATE) continue; /* not compiled (HD_MG_F64) */
+        if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_EXTRAP) continue; /* not compiled (HD_MG_F64) */
         be->kernels[k] = clCreateKernel(be->program, hd__cl_kernel_names[k], &e);
         if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(ctx, e, hd__cl_kernel_names[k], 0, __LINE__); }
     }
@@ -1070,12 +1072,25 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     if ((r = hd__cl_mg_sum(ctx, mg->dot_b, &rp)) != HD_SUCCESS) return r;
     mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (!(pq > 0.0)) return HD_SUCCESS;
-    alpha = rp / pq;
-    a[0] = L->params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
-    if ((r = hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels)) != HD_SUCCESS) return r;
+    if (pq > 0.0) {
+        alpha = rp / pq;
+        a[0] = L->params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
+        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
+        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
+        if ((r = hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels)) != HD_SUCCESS) return r;
+    }
+    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
+       one colour at a time; the fine parameters (no right-hand-side flag) */
+    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) {
+        cl_mem e[5];
+        cl_int colour;
+        e[0] = be->params; e[1] = be->sig; e[2] = be->E; e[3] = be->phi; e[4] = mg->lo;
+        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_EXTRAP, 5, e)) != HD_SUCCESS) return r;
+        for (colour = 0; colour < 2; ++colour) {
+            HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_EXTRAP], 5, sizeof colour, &colour), "clSetKernelArg(colour)");
+            if ((r = hd__cl_mg_run(ctx, HD__CL_MG_EXTRAP, 0, mg->channels)) != HD_SUCCESS) return r;
+        }
+    }
     HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
     return HD_SUCCESS;
 }

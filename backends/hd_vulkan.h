@@ -105,7 +105,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 12
-#define HD__VK_MG_PIPELINES (8 * 4) /* HD_SOLVER_MULTIGRID: 8 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
+#define HD__VK_MG_PIPELINES (9 * 4) /* HD_SOLVER_MULTIGRID: 9 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -1578,10 +1578,10 @@ static hd_result hd__be_path(hd__ctx *ctx)
 #define HD__VK_MG_POST 2
 #define HD__VK_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
 enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROLONG, HD__VK_MG_DIR, HD__VK_MG_RES_F64,
-       HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_STAGES = HD__VK_MG_UPDATE };
+       HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_EXTRAP, HD__VK_MG_STAGES = HD__VK_MG_EXTRAP };
 /* CG's passes' sets (level 0 and the backend's grids) */
 enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
-       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_CG_SETS };
+       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
 #define HD__VK_MG_SETS (4 * HD__VK_MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
 
 typedef struct hd__vk_level {
@@ -1609,7 +1609,8 @@ struct hd__vk_mg {
 
 static const char *const hd__vk_mg_names[HD__VK_MG_STAGES] = {
     "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
-    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update"};
+    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
+    "multigrid extrapolation"};
 
 static size_t hd__vk_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
 static size_t hd__vk_mg_rows(const struct hd__vk_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
@@ -1786,6 +1787,7 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ], NULL, &mg->p, &L0->res, NULL, NULL, &mg->dot_a);
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP], NULL, &L0->rhs, &mg->p, NULL, NULL, &mg->dot_b);
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_UPDATE], NULL, &mg->p, &be->phi, &mg->lo, NULL, NULL);
+    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_EXTRAP], &be->sig, &be->E, &be->phi, &mg->lo, NULL, NULL);
     mg->sets_gen = be->sets_gen;
     mg->sets_valid = 1;
     return HD_SUCCESS;
@@ -1823,10 +1825,11 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
 {
     static const uint32_t *const code[HD__VK_MG_STAGES] = {hd__spv_mg_sig, hd__spv_mg_residual, hd__spv_mg_restrict,
                                                            hd__spv_mg_prolong, hd__spv_mg_dir, hd__spv_mg_res_f64,
-                                                           hd__spv_mg_dot, hd__spv_mg_update};
+                                                           hd__spv_mg_dot, hd__spv_mg_update, hd__spv_mg_extrap};
     static const size_t size[HD__VK_MG_STAGES] = {sizeof hd__spv_mg_sig, sizeof hd__spv_mg_residual, sizeof hd__spv_mg_restrict,
                                                   sizeof hd__spv_mg_prolong, sizeof hd__spv_mg_dir, sizeof hd__spv_mg_res_f64,
-                                                  sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update};
+                                                  sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update,
+                                                  sizeof hd__spv_mg_extrap};
     hd__backend *be = ctx->be;
     int variant = hd__vk_mg_variant(ctx->kp.counts.z);
     VkPipeline *slot = &be->mg_pipes[(stage - 1) * 4 + variant];
@@ -1993,18 +1996,26 @@ static hd_result hd__be_multigrid(hd__ctx *ctx)
     rp = hd__mg_row_sum((const double *)mg->dot_b.map, hd__vk_mg_rows(mg));
     mg->cg.have_dir = 1;
     /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (!(pq > 0.0)) return HD_SUCCESS;
-    alpha = rp / pq;
-    /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
-    for (i = 0; i < 2; ++i) {
-        uint64_t u;
-        memcpy(&u, &alpha, sizeof u);
-        bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    if (pq > 0.0) {
+        alpha = rp / pq;
+        /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
+        for (i = 0; i < 2; ++i) {
+            uint64_t u;
+            memcpy(&u, &alpha, sizeof u);
+            bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
+        }
+        if ((r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
+                                mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels)) != HD_SUCCESS)
+            return r;
     }
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS ||
-        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
-                            mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels)) != HD_SUCCESS)
-        return r;
+    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
+       one colour per pass; the fine parameters (slot `levels`: no right-hand-side flag) */
+    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)
+        for (i = 0; i < 2; ++i)
+            if ((r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0],
+                                    mg->fine[1], mg->fine[2] * mg->channels, i, 0, 0, mg->channels)) != HD_SUCCESS)
+                return r;
     return hd__vk_flush(ctx);
 }
 

@@ -237,7 +237,9 @@ static void test_diffusion_jacobi_matches(void)
 /* The surface boundary (HD_FLAG_SURFACE_BOUNDARY): a 12^3 block of medium with a uniform source,
    centred in a 20^3 grid of empty voxels, converges (relative residual below 1e-5) to exactly the
    phi of the same block filling a 12^3 grid with the same h: a face toward an empty voxel and a
-   face toward the box's outside carry the same Marshak weight, and empty voxels hold phi = 0.
+   face toward the box's outside carry the same Marshak weight, and the medium's updates do not
+   read the empty voxels' phi. Here the empty voxels hold 0: their Marshak extrapolation
+   (test_diffusion_surface_extrapolation) clamps at 0, as 1.5 sigma' h = 2.25 exceeds 2.
    The box boundary drains the block through the air: its phi is lower everywhere (measured:
    mean phi of the block 0.86x the surface boundary's at sigma_t h = 1.5). */
 static void test_diffusion_surface_boundary(void)
@@ -289,6 +291,72 @@ static void test_diffusion_surface_boundary(void)
     kfix_free(&box);
 }
 
+/* Under the surface boundary an empty voxel holds the Marshak extrapolation of its medium
+   neighbours j: the mean of phi_j (2 - 1.5 sigma'_j h) / (2 + 1.5 sigma'_j h) (0 without any),
+   recomputed here in double from the converged phi. An 8^3 block of uneven sigma_t (1.5 sigma' h
+   from 0.75 to 1.35) in a 14^3 grid of air, one corner voxel of the block emptied (3 medium
+   neighbours), another's sigma_t raised past 4 / (3 h) (its factor clamps at 0). With
+   HD_FLAG_DIFFUSE_RHS (multigrid's correction equations) a sweep puts 0 there instead. */
+static void test_diffusion_surface_extrapolation(void)
+{
+    kfix f;
+    int n = 14, o = 3, m = 8, x, y, z, q, nonzero = 0, multi = 0, s, parity;
+    double res, maxd = 0, maxv = 0, h = 1.0 / n, maxrhs = 0;
+    kfix_init(&f, n, 20.0f, 1.0f);
+    f.p.medium.y = 0.9f;
+    f.p.counts.z = HD_FLAG_SURFACE_BOUNDARY;
+    for (z = o; z < o + m; ++z)
+        for (y = o; y < o + m; ++y)
+            for (x = o; x < o + m; ++x) {
+                size_t i = ((size_t)z * n + y) * n + x;
+                f.sig[i] = 7.0f + (float)((x + 2 * y + 3 * z) % 6);
+                f.E[i] = 1.0f;
+            }
+    f.sig[((size_t)o * n + o) * n + o] = 0.0f; /* a corner emptied */
+    f.E[((size_t)o * n + o) * n + o] = 0.0f;
+    f.sig[((size_t)(o + m - 1) * n + o + m - 1) * n + o + m - 1] = 60.0f; /* 1.5 sigma' h = 6.4: factor 0 */
+    solve(&f, 1e-6, 4000, &res);
+    CHECK(res < 1e-6);
+    for (z = 0; z < n; ++z)
+        for (y = 0; y < n; ++y)
+            for (x = 0; x < n; ++x) {
+                static const int d[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
+                size_t i = ((size_t)z * n + y) * n + x;
+                double sum = 0, cnt = 0, expect;
+                if (f.phi[i] > maxv) maxv = f.phi[i];
+                if (f.sig[i] > 0.0f) continue;
+                for (q = 0; q < 6; ++q) {
+                    int u = x + d[q][0], v = y + d[q][1], w = z + d[q][2];
+                    double sp, g;
+                    if (u < 0 || v < 0 || w < 0 || u >= n || v >= n || w >= n) continue;
+                    sp = f.sig[((size_t)w * n + v) * n + u]; /* g = 0: sigma' = sigma_t */
+                    if (sp + sp < 1e-3) continue;
+                    g = 1.5 * sp * h;
+                    sum += (g < 2 ? 2 - g : 0) / (2 + g) * f.phi[((size_t)w * n + v) * n + u];
+                    cnt += 1;
+                }
+                expect = cnt > 0 ? sum / cnt : 0.0;
+                if (fabs(f.phi[i] - expect) > maxd) maxd = fabs(f.phi[i] - expect);
+                if (cnt == 0) CHECK(f.phi[i] == 0.0f);
+                nonzero += f.phi[i] > 0.0f;
+                multi += cnt >= 3 && f.phi[i] > 0.0f;
+            }
+    fprintf(stderr, "  extrapolation: max |phi - expected| on empty voxels %.2e of max phi %.3e; %d nonzero, %d with 3+ medium neighbours\n",
+            maxd, maxv, nonzero, multi);
+    CHECK(maxv > 0 && maxd <= 1e-5 * maxv);
+    CHECK(nonzero >= 6 * (m - 2) * (m - 2) && multi == 1);
+    /* the right-hand-side flag: empty rows are identity rows (phi = 0) */
+    f.p.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    for (s = 0; s < 1; ++s)
+        for (parity = 0; parity < 2; ++parity)
+            for (z = 0; z < n; ++z)
+                for (y = 0; y < n; ++y) hd_diffuse_row(&f.k, y, z, 0, parity, 0);
+    for (x = 0; x < n * n * n; ++x)
+        if (f.sig[x] == 0.0f && fabs(f.phi[x]) > maxrhs) maxrhs = fabs(f.phi[x]);
+    CHECK(maxrhs == 0.0);
+    kfix_free(&f);
+}
+
 /* The hash gives uniform numbers: mean 1/2, variance 1/12, and no two dims alike. */
 static void test_rng_uniform(void)
 {
@@ -314,5 +382,6 @@ const hd_test_case hd_tests_kernels[] = {
     {"kernels_diffusion_point_source", test_diffusion_point_source},
     {"kernels_diffusion_jacobi_matches", test_diffusion_jacobi_matches},
     {"kernels_diffusion_surface_boundary", test_diffusion_surface_boundary},
+    {"kernels_diffusion_surface_extrapolation", test_diffusion_surface_extrapolation},
 };
 const int hd_tests_kernels_count = sizeof hd_tests_kernels / sizeof hd_tests_kernels[0];

@@ -9,10 +9,11 @@
    - box (default, METHOD.md): phi = 0 outside the box, reached through the voxel's own D. Empty
      voxels are solved too, with the floored D: air conducts light to the box faces almost
      freely, so every tissue surface acts nearly as phi = 0.
-   - surface (HD_FLAG_SURFACE_BOUNDARY): empty voxels (sigma' below half the floor) hold phi = 0
-     and a face between a medium voxel and an empty one (or the box) carries the Marshak vacuum
-     condition J = phi_s / 2 (no light enters from outside): conductance 1 / (h / (2D) + 2) per
-     area, i.e. w = 1 / (h^2 / (2 D) + 2 h) = 1 / (1.5 sigma' h^2 + 2 h). */
+   - surface (HD_FLAG_SURFACE_BOUNDARY): empty voxels (sigma' below half the floor) are not
+     solved for (they hold the Marshak extrapolation of their medium neighbours, for the
+     projection: hd_diffuse_surface_end) and a face between a medium voxel and an empty one (or
+     the box) carries the Marshak vacuum condition J = phi_s / 2 (no light enters from outside):
+     conductance 1 / (h / (2D) + 2) per area, i.e. w = 1 / (h^2 / (2 D) + 2 h) = 1 / (1.5 sigma' h^2 + 2 h). */
 
 /* The flags word the diffusion tests (RGB scattering, boundary). A backend may define it as a
    compile-time constant per pipeline (Vulkan: a specialization constant, hd_bind_vk_glsl.h), so
@@ -154,14 +155,19 @@ HD_FN float hd_diffuse_box_den(float sp, float s, int inside, float fl)
 
 /* The denominator d of a surface boundary face (scale: the axis' 1 / h^2, h its spacing), its
    numerator in *a and in *open whether its neighbour's phi enters the update (empty neighbours
-   and the box's outside are vacuum: Marshak weight, phi 0). */
-HD_FN float hd_diffuse_surface_den(float scale, float h, float sp, float s, int inside, float fl, HD_INOUT(float) a,
-                                   HD_INOUT(float) open)
+   and the box's outside are vacuum: Marshak weight, phi 0). self: 1 if the voxel itself is medium;
+   for an empty one (0) a face toward a medium neighbour j gives instead the Marshak extrapolation's
+   factor a / d = max(0, 2 - 1.5 s_j h) / (2 + 1.5 s_j h) (hd_diffuse_surface_end), so the axis'
+   sum and its one division serve both (d in [2, 3e6 + 2], as a vacuum face's). */
+HD_FN float hd_diffuse_surface_den(float scale, float h, float sp, float s, int inside, float fl, float self,
+                                   HD_INOUT(float) a, HD_INOUT(float) open)
 {
     float spj = inside != 0 ? s : 0.0f, o = hd_diffuse_open_of(spj, inside, fl);
+    float m = o * self; /* 1: a medium face of a medium voxel (selects on values, no branch) */
+    float g = 1.5f * (o == 0.0f ? sp : spj) * h; /* vacuum face: 1.5 sp h; extrapolation: 1.5 s_j h */
     HD_DEREF(open) = o;
-    HD_DEREF(a) = o == 0.0f ? h * scale : 0.6666667f * scale;
-    return o == 0.0f ? 1.5f * sp * h + 2.0f : hd_maxf(sp + spj, fl);
+    HD_DEREF(a) = m != 0.0f ? 0.6666667f * scale : (o == 0.0f ? h * scale : hd_maxf(0.0f, 2.0f - g));
+    return m != 0.0f ? hd_maxf(sp + spj, fl) : g + 2.0f;
 }
 
 /* An axis' two faces of the box boundary's update, toward neighbours with sigma' s0, s1 and phi
@@ -178,26 +184,49 @@ HD_FN void hd_diffuse_box_axis(float a, float sp, float s0, float s1, float p0, 
 }
 
 /* The same under the surface boundary (scale: the axis' 1 / h^2, h its spacing): vacuum faces add
-   their weight to *dn only. */
-HD_FN void hd_diffuse_surface_axis(float scale, float h, float sp, float s0, float s1, float p0, float p1, int in0,
-                                   int in1, float fl, HD_INOUT(float) num, HD_INOUT(float) dn)
+   their weight to *dn only. self (hd_diffuse_open_of of the voxel's own sigma'): 0 for an empty
+   voxel, whose *num then accumulates the Marshak extrapolation instead, sum of e_j phi_j over its
+   medium neighbours j with e_j = max(0, 2 - 1.5 s_j h) / (2 + 1.5 s_j h) (a linear profile from
+   medium voxel j that reaches the face's boundary value at h / 2, the Marshak face's assumption,
+   continued to the empty voxel's centre; hd_diffuse_surface_den), and *cnt counts them. The same
+   operations as without the extrapolation for a medium voxel (the same bits), 4 divisions per
+   update still. */
+HD_FN void hd_diffuse_surface_axis(float scale, float h, float sp, float self, float s0, float s1, float p0, float p1,
+                                   int in0, int in1, float fl, HD_INOUT(float) num, HD_INOUT(float) dn,
+                                   HD_INOUT(float) cnt)
 {
     float a0, a1, o0, o1;
-    float d0 = hd_diffuse_surface_den(scale, h, sp, s0, in0, fl, HD_REF(a0), HD_REF(o0));
-    float d1 = hd_diffuse_surface_den(scale, h, sp, s1, in1, fl, HD_REF(a1), HD_REF(o1));
+    float d0 = hd_diffuse_surface_den(scale, h, sp, s0, in0, fl, self, HD_REF(a0), HD_REF(o0));
+    float d1 = hd_diffuse_surface_den(scale, h, sp, s1, in1, fl, self, HD_REF(a1), HD_REF(o1));
     float r = 1.0f / (d0 * d1), u0 = a0 * d1, u1 = a1 * d0;
     float q0 = in0 != 0 ? o0 * u0 * p0 : 0.0f, q1 = in1 != 0 ? o1 * u1 * p1 : 0.0f;
     HD_DEREF(num) += r * (q0 + q1);
     HD_DEREF(dn) += r * (u0 + u1);
+    HD_DEREF(cnt) += o0 + o1;
 }
 
-/* The surface boundary's end of the update: an empty voxel (sigma' sp below half the floor) gets
-   num 0 and den 1 (phi = 0). */
-HD_FN float hd_diffuse_surface_end(float sp, float fl, float num, float dn, HD_INOUT(float) den)
+/* The surface boundary's start of the update: the voxel's own source term src and self
+   (hd_diffuse_open_of of its sigma' sp: 1 medium, 0 empty) in *self; an empty voxel's sum starts
+   at 0 (it holds the extrapolation, hd_diffuse_surface_end). */
+HD_FN float hd_diffuse_surface_start(float src, float sp, float fl, HD_INOUT(float) self)
 {
-    float self = hd_diffuse_open_of(sp, 1, fl); /* 0: the voxel itself is empty */
-    HD_DEREF(den) = self * dn + (1.0f - self);
-    return self * num;
+    float o = hd_diffuse_open_of(sp, 1, fl);
+    HD_DEREF(self) = o;
+    return o * src; /* a product, not a select: gcc sank src's loads under a select's branch, and the
+                       CPU's row loops stopped vectorising (12 against 3.4 ns per update) */
+}
+
+/* The surface boundary's end of the update. A medium voxel: num / dn. An empty voxel (self 0)
+   takes no part in the medium's equations (its faces are vacuum faces), so the value it stores is
+   free: with extrap (the ordinary solve), the Marshak extrapolation of its medium neighbours,
+   num / cnt, the mean of their e_j phi_j (0 if it has none: num 0, den 1), which the projection
+   interpolates toward instead of a placeholder 0 (docs/EVALUATION.md, "Why converged HD is too
+   dark against PT_MS"); without (HD_FLAG_DIFFUSE_RHS: multigrid's correction equations), num 0 and
+   den 1: an identity row, phi = 0. No division here: num / den is the caller's. */
+HD_FN float hd_diffuse_surface_end(float self, float num, float dn, float cnt, int extrap, HD_INOUT(float) den)
+{
+    HD_DEREF(den) = self * dn + (1.0f - self) * (extrap != 0 ? hd_maxf(cnt, 1.0f) : 1.0f);
+    return extrap != 0 ? num : self * num;
 }
 
 /* The box boundary's update from loaded values: num and dn the voxel's own part
@@ -221,22 +250,24 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
 }
 
 /* The surface boundary's update from loaded values, the arguments as hd_diffuse_box_of's: an
-   empty voxel gets num 0 and den 1 (phi = 0); a medium voxel's faces toward empty neighbours or
-   the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
+   empty voxel gets its extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward
+   empty neighbours or the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
    so the CPU's row loop stays branch-free. */
 HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
                                   float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
                                   float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
                                   int in_zp, HD_INOUT(float) den)
 {
-    float fl = HD_PRM(grid).w;
-    hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl, HD_REF(num),
-                            HD_REF(dn));
-    hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp, s_ym, s_yp, p_ym, p_yp, in_ym, in_yp, fl, HD_REF(num),
-                            HD_REF(dn));
-    hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp, s_zm, s_zp, p_zm, p_zp, in_zm, in_zp, fl, HD_REF(num),
-                            HD_REF(dn));
-    return hd_diffuse_surface_end(sp, fl, num, dn, den);
+    float fl = HD_PRM(grid).w, cnt = 0.0f, self;
+    int extrap = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) == 0 ? 1 : 0;
+    num = hd_diffuse_surface_start(num, sp, fl, HD_REF(self));
+    hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, self, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl,
+                            HD_REF(num), HD_REF(dn), HD_REF(cnt));
+    hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp, self, s_ym, s_yp, p_ym, p_yp, in_ym, in_yp, fl,
+                            HD_REF(num), HD_REF(dn), HD_REF(cnt));
+    hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp, self, s_zm, s_zp, p_zm, p_zp, in_zm, in_zp, fl,
+                            HD_REF(num), HD_REF(dn), HD_REF(cnt));
+    return hd_diffuse_surface_end(self, num, dn, cnt, extrap, den);
 }
 
 /* The update from loaded values under the configured boundary (HD_DIFFUSE_FLAGS). */
@@ -283,25 +314,27 @@ HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_
     float sp, ag, dn, fl = HD_PRM(grid).w;
     float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     if (surface != 0) {
-        hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp,
+        float cnt = 0.0f, self;
+        num = hd_diffuse_surface_start(num, sp, fl, HD_REF(self));
+        hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, self,
                                 hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
                                 hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
                                 hd_diffuse_nb_phi(HD_KPASS in_xm, i - 1, x - 1, y, z, c),
                                 hd_diffuse_nb_phi(HD_KPASS in_xp, i + 1, x + 1, y, z, c), in_xm, in_xp, fl,
-                                HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp,
+                                HD_REF(num), HD_REF(dn), HD_REF(cnt));
+        hd_diffuse_surface_axis(HD_PRM(grid).y, HD_PRM(gridh).y, sp, self,
                                 hd_diffuse_nb_sigp(HD_KPASS in_ym, i - gx, x, y - 1, z, c, rgb, ag),
                                 hd_diffuse_nb_sigp(HD_KPASS in_yp, i + gx, x, y + 1, z, c, rgb, ag),
                                 hd_diffuse_nb_phi(HD_KPASS in_ym, i - gx, x, y - 1, z, c),
                                 hd_diffuse_nb_phi(HD_KPASS in_yp, i + gx, x, y + 1, z, c), in_ym, in_yp, fl,
-                                HD_REF(num), HD_REF(dn));
-        hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp,
+                                HD_REF(num), HD_REF(dn), HD_REF(cnt));
+        hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp, self,
                                 hd_diffuse_nb_sigp(HD_KPASS in_zm, i - sxy, x, y, z - 1, c, rgb, ag),
                                 hd_diffuse_nb_sigp(HD_KPASS in_zp, i + sxy, x, y, z + 1, c, rgb, ag),
                                 hd_diffuse_nb_phi(HD_KPASS in_zm, i - sxy, x, y, z - 1, c),
                                 hd_diffuse_nb_phi(HD_KPASS in_zp, i + sxy, x, y, z + 1, c), in_zm, in_zp, fl,
-                                HD_REF(num), HD_REF(dn));
-        return hd_diffuse_surface_end(sp, fl, num, dn, den);
+                                HD_REF(num), HD_REF(dn), HD_REF(cnt));
+        return hd_diffuse_surface_end(self, num, dn, cnt, rhs == 0 ? 1 : 0, den);
     }
     hd_diffuse_box_axis(0.6666667f * HD_PRM(grid).x, sp, hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
                         hd_diffuse_nb_sigp(HD_KPASS in_xp, i + 1, x + 1, y, z, c, rgb, ag),
@@ -377,5 +410,31 @@ HD_FN float hd_diffuse_residual(HD_KARGS int x, int y, int z, int c, HD_INOUT(fl
     /* sigma_s E with the channel's albedo (per channel with RGB scattering, as the update uses) */
     HD_DEREF(rhs) = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? HD_GET(E, ic, x, y, z + c * gz)
                   : hd_diffuse_albedo(HD_KPASS i, x, y, z, c, rgb) * HD_GET(sig, i, x, y, z) * HD_GET(E, ic, x, y, z + c * gz);
+    /* an empty voxel under the surface boundary holds its extrapolation, not an equation: no
+       residual (the medium's equations do not read it) */
+    if ((HD_DIFFUSE_FLAGS & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS)) == HD_FLAG_SURFACE_BOUNDARY &&
+        hd_diffuse_open_of(hd_diffuse_sigp(HD_KPASS i, x, y, z, c, rgb, hd_diffuse_ag(HD_KPASS HD_PRM(medium).y)), 1,
+                           HD_PRM(grid).w) == 0.0f)
+        return 0.0f;
     return num - den * HD_GET(phi, ic, x, y, z + c * gz);
+}
+
+/* The value an empty voxel (x, y, z) of channel c holds under the surface boundary
+   (hd_diffuse_surface_end: the Marshak extrapolation of its medium neighbours), in *v; returns 1
+   for such a voxel, 0 for a medium one or under the box boundary (nothing to store). Multigrid's
+   pass after each conjugate-gradient step (its iterate is 0 there: an identity row), so its phi
+   holds what the sweeps' does; the same hd_diffuse_terms, so the same bits for the same
+   neighbours. It reads the 6 neighbours' phi (the medium ones' enter): a backend runs it one
+   colour ((x + y + z) & 1) at a time, so no voxel it reads is being written. */
+HD_FN int hd_diffuse_extrapolate(HD_KARGS int x, int y, int z, int c, HD_INOUT(float) v)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y;
+    int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
+    float den, num, sp;
+    if ((HD_DIFFUSE_FLAGS & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS)) != HD_FLAG_SURFACE_BOUNDARY) return 0;
+    sp = hd_diffuse_sigp(HD_KPASS (z * gy + y) * gx + x, x, y, z, c, rgb, hd_diffuse_ag(HD_KPASS HD_PRM(medium).y));
+    if (hd_diffuse_open_of(sp, 1, HD_PRM(grid).w) != 0.0f) return 0;
+    num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
+    HD_DEREF(v) = num / den;
+    return 1;
 }

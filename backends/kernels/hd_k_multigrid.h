@@ -214,7 +214,8 @@ HD_FN double hd_mg_face_f64(HD_KARGS double r, double pi, float sp, float ag, in
    residual of 1.2e-4 on the head CT at half resolution; the difference form in double is exact
    to the last bit of its float inputs. in_* say whether the neighbour on each side lies in the
    grid (the CPU passes literals for interior voxels). An empty voxel's row under the surface
-   boundary is phi = 0: its residual is -(phi + lo). */
+   boundary is phi + lo = 0: its residual is -(phi + lo) (exactly 0: after each step phi holds the
+   sweeps' extrapolation there and lo its negative, hd_diffuse_extrapolate). */
 HD_FN double hd_mg_res_f64(HD_KARGS int x, int y, int z, int c, int surface, int rgb, int use_lo, int in_xm,
                            int in_xp, int in_ym, int in_yp, int in_zm, int in_zp)
 {
