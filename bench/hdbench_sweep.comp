@@ -42,12 +42,35 @@
               invocation, 7 loads and 1 store per texel), Jacobi phi4 -> out4, one pass per step
     16 PCOPY  out4 = phi4 / 2 on rgba32f x-packed texels: 1 load and 1 store per 4 voxels (LOADS1's
               twin: what an rgba32f texel op costs against an r32f one)
+    17 SGB    RB's update on a block of ZK slices x YK rows (one voxel of the half-sweep's colour per
+              row, the library's hd_diffuse_block shape) with the x-neighbours shared across lanes:
+              lane l of a subgroup (64x1 work groups: consecutive x, the same rows) loads per row
+              its voxel's st and E and the other colour's voxel of its x-pair (2l + 1 - o: st,
+              phi), which is one x-neighbour; the other one is the next / previous lane's
+              (subgroupShuffle, lane +- 1); the subgroup's edge lane takes its missing neighbour
+              from one gather per block (lane i loads row i's edge texel, then subgroupShuffle
+              from lane r), so a block of YK ZK <= gl_SubgroupSize rows makes 4 loads per row + 2
+              + the faces' 4 (YK + ZK), against the library's 6 per row + the same faces. The y- /
+              z-neighbour in the block is the adjacent row's x-pair partner (its colour
+              alternates). Needs the subgroup basic + shuffle operations. PK 1: the neighbour by
+              subgroupShuffleUp / Down (both made, one picked: the direction is the row's colour)
+              (the edge by subgroupShuffle from lane r: subgroupBroadcast needs a literal lane),
+              else (PK 4) subgroupShuffle from lane l +- 1.
+    18 SHUF   LOADS1 (one load and the store per voxel) with the loaded value passed through a
+              subgroup operation before the store, PK selecting it (timing only, wrong values):
+              0 none, 1 subgroupShuffleDown(v, 1), 2 subgroupShuffle(v, id + 1 + ctl.z) (an index
+              the compiler cannot fold), 3 four subgroupShuffleDown in a row: what one costs
    Bindings: 0 st, 1 E, 2 phi (r32f storage), 3 packed (st, phi) (rg32f storage), 4 st, 5 E,
    6 phi (sampler3D over the images of bindings 0-2), 7 st, 8 E, 9 phi, 10 out (rgba32f x-packed,
    nx / 4 wide), 11 st, 12 E, 13 phi (rg32f x-packed, nx / 2 wide). Push constants: dims, ctl
    (x parity, y run-time ZK), prm (xyz: 1 / h^2 per axis, w: the sigma' floor), med (x
    albedo, y anisotropy g): RB and PACKED take the library's parameters from them. */
 #extension GL_EXT_control_flow_attributes : enable
+#if HD_SV == 17 || HD_SV == 18
+#extension GL_KHR_shader_subgroup_basic : enable
+#extension GL_KHR_shader_subgroup_shuffle : enable
+#extension GL_KHR_shader_subgroup_shuffle_relative : enable
+#endif
 layout(local_size_x = LX, local_size_y = LY, local_size_z = 1) in;
 layout(push_constant) uniform hd_sweep_pc { ivec4 dims; ivec4 ctl; vec4 prm; vec4 med; };
 layout(binding = 7, rgba32f) uniform image3D st4_i;
@@ -402,6 +425,114 @@ void pstencil_main()
 }
 #endif
 
+#if HD_SV == 17
+/* 17 SGB: the block of ZK slices x YK rows, x-neighbours from the neighbouring lanes (above) */
+#define DB (YK * ZK)
+void sgb_main()
+{
+    int x = int(gl_GlobalInvocationID.x), y0 = int(gl_GlobalInvocationID.y) * YK, z0 = int(gl_GlobalInvocationID.z) * ZK;
+    int sl = int(gl_SubgroupInvocationID), sn = int(gl_SubgroupSize), x0 = x - sl; /* the subgroup's first lane */
+    int nx = dims.x;
+    float S[DB], E[DB], BS[DB], BP[DB], v[DB];
+    float sym[ZK], pym[ZK], syp[ZK], pyp[ZK], szm[YK], pzm[YK], szp[YK], pzp[YK];
+    /* the edge gather: lane i loads row i's neighbour outside the subgroup (o = 0: voxel
+       2 x0 - 1 left of lane 0's; o = 1: voxel 2 (x0 + sn) right of the last lane's) */
+    float est, eph;
+    {
+        int r = min(sl, DB - 1), k = r / YK, j = r - k * YK, o = (y0 + j + z0 + k + ctl.x) & 1;
+        int y = min(y0 + j, dims.y - 1), z = min(z0 + k, dims.z - 1);
+        int xe = clamp(o != 0 ? 2 * (x0 + sn) : 2 * x0 - 1, 0, nx - 1);
+        est = imageLoad(st_i, ivec3(xe, y, z)).r;
+        eph = imageLoad(phi_i, ivec3(xe, y, z)).r;
+    }
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, o = (y0 + j + z0 + k + ctl.x) & 1;
+            int y = min(y0 + j, dims.y - 1), z = min(z0 + k, dims.z - 1);
+            int xv = min(2 * x + o, nx - 1), xb = min(2 * x + 1 - o, nx - 1);
+            S[r] = imageLoad(st_i, ivec3(xv, y, z)).r;
+            E[r] = imageLoad(e_i, ivec3(xv, y, z)).r;
+            BS[r] = imageLoad(st_i, ivec3(xb, y, z)).r;
+            BP[r] = imageLoad(phi_i, ivec3(xb, y, z)).r;
+        }
+    [[unroll]] for (int k = 0; k < ZK; ++k) {
+        int z = min(z0 + k, dims.z - 1), ym = max(y0 - 1, 0), yp = min(y0 + YK, dims.y - 1);
+        int o0 = (y0 + z0 + k + ctl.x) & 1, o1 = (y0 + YK - 1 + z0 + k + ctl.x) & 1;
+        int xa = min(2 * x + o0, nx - 1), xc = min(2 * x + o1, nx - 1);
+        sym[k] = imageLoad(st_i, ivec3(xa, ym, z)).r;
+        pym[k] = imageLoad(phi_i, ivec3(xa, ym, z)).r;
+        syp[k] = imageLoad(st_i, ivec3(xc, yp, z)).r;
+        pyp[k] = imageLoad(phi_i, ivec3(xc, yp, z)).r;
+    }
+    [[unroll]] for (int j = 0; j < YK; ++j) {
+        int y = min(y0 + j, dims.y - 1), zm = max(z0 - 1, 0), zp = min(z0 + ZK, dims.z - 1);
+        int o0 = (y0 + j + z0 + ctl.x) & 1, o1 = (y0 + j + z0 + ZK - 1 + ctl.x) & 1;
+        int xa = min(2 * x + o0, nx - 1), xc = min(2 * x + o1, nx - 1);
+        szm[j] = imageLoad(st_i, ivec3(xa, y, zm)).r;
+        pzm[j] = imageLoad(phi_i, ivec3(xa, y, zm)).r;
+        szp[j] = imageLoad(st_i, ivec3(xc, y, zp)).r;
+        pzp[j] = imageLoad(phi_i, ivec3(xc, y, zp)).r;
+    }
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, o = (y0 + j + z0 + k + ctl.x) & 1, y = y0 + j, z = z0 + k;
+            int xv = 2 * x + o, d = 2 * o - 1; /* the other x-neighbour is lane sl + d's partner */
+            bool edge = sl + d < 0 || sl + d >= sn;
+#if PK == 1 /* relative shuffles (both directions, one picked) and a broadcast from lane r */
+            float su = subgroupShuffleUp(BS[r], 1u), sd_ = subgroupShuffleDown(BS[r], 1u);
+            float pu = subgroupShuffleUp(BP[r], 1u), pd_ = subgroupShuffleDown(BP[r], 1u);
+            float ns = o != 0 ? sd_ : su, np = o != 0 ? pd_ : pu;
+            float es = subgroupShuffle(est, uint(r)), ep = subgroupShuffle(eph, uint(r));
+#else
+            float ns = subgroupShuffle(BS[r], uint(clamp(sl + d, 0, sn - 1)));
+            float np = subgroupShuffle(BP[r], uint(clamp(sl + d, 0, sn - 1)));
+            float es = subgroupShuffle(est, uint(r)), ep = subgroupShuffle(eph, uint(r));
+#endif
+            ns = edge ? es : ns;
+            np = edge ? ep : np;
+            /* x - 1 / x + 1: the partner is x + 1 for o = 0, x - 1 for o = 1 */
+            float sxm = o != 0 ? BS[r] : ns, sxp = o != 0 ? ns : BS[r];
+            float pxm = o != 0 ? BP[r] : np, pxp = o != 0 ? np : BP[r];
+            /* y- / z-neighbours inside the block: the adjacent row's partner */
+            int rym = max(r - 1, 0), ryp = min(r + 1, DB - 1), rzm = max(r - YK, 0), rzp = min(r + YK, DB - 1);
+            float sa = j > 0 ? BS[rym] : sym[k], sb = j < YK - 1 ? BS[ryp] : syp[k];
+            float sc = k > 0 ? BS[rzm] : szm[j], sd = k < ZK - 1 ? BS[rzp] : szp[j];
+            float pa = j > 0 ? BP[rym] : pym[k], pb = j < YK - 1 ? BP[ryp] : pyp[k];
+            float pc = k > 0 ? BP[rzm] : pzm[j], pd = k < ZK - 1 ? BP[rzp] : pzp[j];
+            v[r] = lib_update(S[r], E[r], sxm, sxp, sa, sb, sc, sd, pxm, pxp, pa, pb, pc, pd, xv > 0, xv < nx - 1,
+                              y > 0, y < dims.y - 1, z > 0, z < dims.z - 1);
+        }
+    [[unroll]] for (int k = 0; k < ZK; ++k)
+        [[unroll]] for (int j = 0; j < YK; ++j) {
+            int r = k * YK + j, xv = 2 * x + ((y0 + j + z0 + k + ctl.x) & 1);
+            if (xv < nx && y0 + j < dims.y && z0 + k < dims.z)
+                imageStore(phi_i, ivec3(xv, y0 + j, z0 + k), vec4(v[r], 0.0f, 0.0f, 0.0f));
+        }
+}
+#endif
+
+#if HD_SV == 18
+/* 18 SHUF: LOADS1 with the value through PK's subgroup operation (timing only) */
+void shuf_main()
+{
+    int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y), z = int(gl_GlobalInvocationID.z);
+    int xv = min(2 * x + ((y + z + ctl.x) & 1), dims.x - 1);
+    ivec3 p = ivec3(xv, min(y, dims.y - 1), min(z, dims.z - 1));
+    float v = imageLoad(e_i, p).r;
+#if PK == 1
+    v = subgroupShuffleDown(v, 1u);
+#elif PK == 2
+    v = subgroupShuffle(v, (gl_SubgroupInvocationID + 1u + uint(ctl.z)) & (gl_SubgroupSize - 1u));
+#elif PK == 3
+    v = subgroupShuffleDown(v, 1u) + 0.5f;
+    v = subgroupShuffleDown(v, 1u) + 0.5f;
+    v = subgroupShuffleDown(v, 1u) + 0.5f;
+    v = subgroupShuffleDown(v, 1u);
+#endif
+    if (y < dims.y && z < dims.z && 2 * x < dims.x) imageStore(phi_i, p, vec4(v * 0.5f, 0.0f, 0.0f, 0.0f));
+}
+#endif
+
 /* ZK voxels per invocation along z (one per slice, each of this half-sweep's colour) */
 void main()
 {
@@ -419,6 +550,12 @@ void main()
     return;
 #elif HD_SV == 15
     pstencil_main();
+    return;
+#elif HD_SV == 17
+    sgb_main();
+    return;
+#elif HD_SV == 18
+    shuf_main();
     return;
 #elif HD_SV == 16
     {

@@ -440,7 +440,7 @@ static hd_result variant_step(void *user)
     uint32_t xk = (uint32_t)hd__sweep_variants[v->cur].xk, sv = (uint32_t)hd__sweep_variants[v->cur].sv;
     /* invocations along x: one per texel of the x-packed images (14 PACKED: nx / PK; 15 PSTENCIL,
        16 PCOPY: nx / 4), else one per voxel of a colour (nx / 2, rounded up) */
-    uint32_t nx = sv == 14 ? (uint32_t)(v->g[0] / hd__sweep_variants[v->cur].pk) : sv >= 15 ? (uint32_t)v->g[0] / 4u : (uint32_t)(v->g[0] + 1) / 2;
+    uint32_t nx = sv == 14 ? (uint32_t)(v->g[0] / hd__sweep_variants[v->cur].pk) : sv == 15 || sv == 16 ? (uint32_t)v->g[0] / 4u : (uint32_t)(v->g[0] + 1) / 2;
     int32_t pc[16];
     hd_result r;
     int parity;
@@ -452,7 +452,7 @@ static hd_result variant_step(void *user)
     memcpy(&pc[12], v->med, sizeof v->med);
     be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->pipe[v->cur]);
     be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, v->layout, 0, 1, &v->set, 0, NULL);
-    for (parity = 0; parity < (sv >= 15 ? 1 : 2); ++parity) { /* 15, 16: one pass over every texel */
+    for (parity = 0; parity < (sv == 15 || sv == 16 ? 1 : 2); ++parity) { /* 15, 16: one pass over every texel */
         pc[4] = parity;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
@@ -605,7 +605,7 @@ static int variants_check(variants *v, const float *lib_phi, size_t n, int nswee
         int sv = hd__sweep_variants[k].sv, s;
         double maxd = 0.0, l2d = 0.0, l2 = 0.0;
         size_t ndiff = 0, nfd = 0;
-        if (sv != 13 && sv != 14) continue;
+        if (sv != 13 && sv != 14 && sv != 17) continue;
         v->cur = k;
         if (hd__vk_upload_image(v->ctx, variant_phi(v, k), zero) != HD_SUCCESS) { ++bad; continue; }
         for (s = 0; s < nsweeps; ++s)
@@ -653,6 +653,32 @@ static hd_result library_state(hd_context h, float *st, float *e, float *phi, si
     return r;
 }
 
+/* The device's subgroup properties (17 SGB and 18 SHUF need the basic and shuffle operations and
+   SGB a subgroup of at least its block's rows; a smaller one shows as WRONG in the check). */
+static void subgroup_properties(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    PFN_vkGetPhysicalDeviceProperties2 gp2 = (PFN_vkGetPhysicalDeviceProperties2)be->gipa(be->instance, "vkGetPhysicalDeviceProperties2");
+    VkPhysicalDeviceSubgroupProperties sg;
+    VkPhysicalDeviceProperties2 p2;
+    if (!gp2) { printf("subgroups: vkGetPhysicalDeviceProperties2 missing\n"); return; }
+    memset(&sg, 0, sizeof sg);
+    memset(&p2, 0, sizeof p2);
+    sg.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+    p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    p2.pNext = &sg;
+    gp2(be->phys, &p2);
+    printf("subgroups: size %u, stages 0x%x (compute %d), operations 0x%x (basic %d, vote %d, arithmetic %d, ballot %d, "
+           "shuffle %d, shuffle_relative %d, clustered %d, quad %d), quad in all stages %d\n", sg.subgroupSize,
+           (unsigned)sg.supportedStages, !!(sg.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT), (unsigned)sg.supportedOperations,
+           !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_BASIC_BIT), !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_VOTE_BIT),
+           !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT), !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_BALLOT_BIT),
+           !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_BIT),
+           !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_SHUFFLE_RELATIVE_BIT),
+           !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_CLUSTERED_BIT), !!(sg.supportedOperations & VK_SUBGROUP_FEATURE_QUAD_BIT),
+           (int)sg.quadOperationsInAllStages);
+}
+
 /* The plain image3D stencil, the library's red-black sweep and every sweep variant, round-robin,
    best of rounds; first the check of RB / PACKED against the library. */
 /* The median over the rounds of per[r][f] / per[r][ref] (figures of one round run back to back, so
@@ -688,6 +714,7 @@ static void variant_figures(const hd_desc *base, const int *g, int rounds)
     d.params.anisotropy = 0.3f; /* 1 - albedo g != 1: the check covers sigma' */
     if (hd_create(&d, &h) != HD_SUCCESS) { printf("Vulkan unavailable\n"); return; }
     ok = lst && le && lphi && per;
+    subgroup_properties(hd__lookup(h, NULL));
     if (ok) {
         hd__ctx *ctx = hd__lookup(h, NULL);
         ok = library_state(h, lst, le, lphi, n, nsweeps) == HD_SUCCESS;
