@@ -55,11 +55,14 @@
               alternates). Needs the subgroup basic + shuffle operations. PK 1: the neighbour by
               subgroupShuffleUp / Down (both made, one picked: the direction is the row's colour)
               (the edge by subgroupShuffle from lane r: subgroupBroadcast needs a literal lane),
-              else (PK 4) subgroupShuffle from lane l +- 1.
+              else (PK 4) subgroupShuffle from lane l +- 1; PK 2 as PK 4 without the edge
+              gather (timing only, wrong values at the edges: what the 2 loads per block cost).
     18 SHUF   LOADS1 (one load and the store per voxel) with the loaded value passed through a
               subgroup operation before the store, PK selecting it (timing only, wrong values):
               0 none, 1 subgroupShuffleDown(v, 1), 2 subgroupShuffle(v, id + 1 + ctl.z) (an index
-              the compiler cannot fold), 3 four subgroupShuffleDown in a row: what one costs
+              the compiler cannot fold), 3 four subgroupShuffleDown in a row, 5 eight independent
+              subgroupShuffleDown (of v + k, summed), 6 eight subgroupShuffle (of v + k, lane
+              id + k + ctl.z): what one costs
    Bindings: 0 st, 1 E, 2 phi (r32f storage), 3 packed (st, phi) (rg32f storage), 4 st, 5 E,
    6 phi (sampler3D over the images of bindings 0-2), 7 st, 8 E, 9 phi, 10 out (rgba32f x-packed,
    nx / 4 wide), 11 st, 12 E, 13 phi (rg32f x-packed, nx / 2 wide). Push constants: dims, ctl
@@ -442,8 +445,13 @@ void sgb_main()
         int r = min(sl, DB - 1), k = r / YK, j = r - k * YK, o = (y0 + j + z0 + k + ctl.x) & 1;
         int y = min(y0 + j, dims.y - 1), z = min(z0 + k, dims.z - 1);
         int xe = clamp(o != 0 ? 2 * (x0 + sn) : 2 * x0 - 1, 0, nx - 1);
+#if PK == 2 /* timing only, wrong at the subgroups' edges: no edge gather */
+        est = float(xe);
+        eph = 0.0f;
+#else
         est = imageLoad(st_i, ivec3(xe, y, z)).r;
         eph = imageLoad(phi_i, ivec3(xe, y, z)).r;
+#endif
     }
     [[unroll]] for (int k = 0; k < ZK; ++k)
         [[unroll]] for (int j = 0; j < YK; ++j) {
@@ -528,6 +536,15 @@ void shuf_main()
     v = subgroupShuffleDown(v, 1u) + 0.5f;
     v = subgroupShuffleDown(v, 1u) + 0.5f;
     v = subgroupShuffleDown(v, 1u);
+#elif PK == 5
+    float w = 0.0f;
+    [[unroll]] for (int k = 1; k <= 8; ++k) w += subgroupShuffleDown(v + float(k), 1u);
+    v = w;
+#elif PK == 6
+    float w = 0.0f;
+    [[unroll]] for (int k = 1; k <= 8; ++k)
+        w += subgroupShuffle(v + float(k), (gl_SubgroupInvocationID + uint(k + ctl.z)) & (gl_SubgroupSize - 1u));
+    v = w;
 #endif
     if (y < dims.y && z < dims.z && 2 * x < dims.x) imageStore(phi_i, p, vec4(v * 0.5f, 0.0f, 0.0f, 0.0f));
 }

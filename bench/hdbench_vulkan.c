@@ -605,7 +605,7 @@ static int variants_check(variants *v, const float *lib_phi, size_t n, int nswee
         int sv = hd__sweep_variants[k].sv, s;
         double maxd = 0.0, l2d = 0.0, l2 = 0.0;
         size_t ndiff = 0, nfd = 0;
-        if (sv != 13 && sv != 14 && sv != 17) continue;
+        if ((sv != 13 && sv != 14 && sv != 17) || (sv == 17 && hd__sweep_variants[k].pk == 2)) continue; /* 17 SGB, PK 2: timing only */
         v->cur = k;
         if (hd__vk_upload_image(v->ctx, variant_phi(v, k), zero) != HD_SUCCESS) { ++bad; continue; }
         for (s = 0; s < nsweeps; ++s)
