@@ -84,7 +84,7 @@ static const char *usage_text_method =
     "  --sweeps N              diffusion solver sweeps per iteration (default 4)\n"
     "  --solver S              diffusion solver: rb (red-black Gauss-Seidel, default), jacobi,\n"
     "                          multigrid (CG steps preconditioned by a V-cycle; --sweeps counts\n"
-    "                          steps, default 1; CPU only; best with --boundary surface)\n"
+    "                          steps, default 1; every backend, Vulkan with shaderFloat64)\n"
     "  --tracking ratio|delta  transmittance estimator (default ratio)\n"
     "  --boundary box|surface  the diffusion's vacuum: phi = 0 outside the volume box (default,\n"
     "                          the paper's), or the Marshak condition at the medium's surface\n"
