@@ -448,8 +448,9 @@ static void hd__cpu_diffuse_block(hd__backend *be, int r)
    the first's new ones. Both fit in one walk through z: at step z the first colour in plane z,
    then the second in plane z - 1, whose first-colour neighbours (planes z - 2 .. z) are all new
    by then, while the first colour in plane z read the second's plane z - 1 before it changed. So
-   each plane streams through the caches once per sweep instead of once per colour (head CT, one
-   thread, the same process: 1.26-1.36x per sweep). The same updates from the same values as
+   each plane streams through the caches once per sweep instead of once per colour (head CT, 2
+   threads, `make bench-rb-schedule`: 1.30-1.35x per sweep with the box boundary, 1.18-1.21x with
+   the surface boundary). The same updates from the same values as
    relaxing colour by colour: the same bits, for any block size and thread count.
    Threads take blocks of rows (y). Rows beside a block's edge depend on the next block's, so a
    sweep is two parallel passes:
