@@ -927,6 +927,26 @@ static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uin
     return HD_SUCCESS;
 }
 
+/* A descriptor pool for `sets` sets of the backend's set layout (hd__vk_pipelines' types: per set
+   1 dynamic uniform buffer, 7 storage images, 4 storage buffers): the backend's sets and the
+   multigrid's (HD_SOLVER_MULTIGRID) each have one. */
+static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool)
+{
+    hd__backend *be = ctx->be;
+    VkDescriptorPoolSize ps[3];
+    VkDescriptorPoolCreateInfo dpci;
+    ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = sets;
+    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * sets;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * sets;
+    memset(&dpci, 0, sizeof dpci);
+    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+    dpci.maxSets = sets;
+    dpci.poolSizeCount = 3;
+    dpci.pPoolSizes = ps;
+    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, pool), "vkCreateDescriptorPool");
+    return HD_SUCCESS;
+}
+
 static hd_result hd__vk_pipelines(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -935,24 +955,13 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
-    VkDescriptorPoolSize ps[3];
-    VkDescriptorPoolCreateInfo dpci;
     hd_result r;
     int i;
     if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
         if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
-    ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD_MAX_LIGHTS;
-    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD_MAX_LIGHTS;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * HD_MAX_LIGHTS;
-    memset(&dpci, 0, sizeof dpci);
-    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    dpci.maxSets = HD_MAX_LIGHTS;
-    dpci.poolSizeCount = 3;
-    dpci.pPoolSizes = ps;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &be->dpool), "vkCreateDescriptorPool");
-    return HD_SUCCESS;
+    return hd__vk_pool(ctx, HD_MAX_LIGHTS, &be->dpool); /* a set per light */
 }
 
 /* Writes set `set`: binding 0 the parameter buffer `params` (dynamic offset, one block), the
@@ -1664,8 +1673,6 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = be->mg;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
-    VkDescriptorPoolSize ps[3];
-    VkDescriptorPoolCreateInfo dpci;
     size_t rows = hd__vk_mg_rows(mg);
     int l, i, d[3];
     hd_result r;
@@ -1693,16 +1700,7 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
     if ((r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(mg->levels + 1),
                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
         return r;
-    ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = HD__VK_MG_SETS;
-    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * HD__VK_MG_SETS;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * HD__VK_MG_SETS;
-    memset(&dpci, 0, sizeof dpci);
-    dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    dpci.maxSets = HD__VK_MG_SETS;
-    dpci.poolSizeCount = 3;
-    dpci.pPoolSizes = ps;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &mg->pool), "vkCreateDescriptorPool");
-    return HD_SUCCESS;
+    return hd__vk_pool(ctx, HD__VK_MG_SETS, &mg->pool);
 }
 
 static hd_result hd__vk_mg_alloc(hd__ctx *ctx)
