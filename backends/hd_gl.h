@@ -1019,7 +1019,6 @@ struct hd__gl_mg {
     float beta;
 };
 
-static size_t hd__gl_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
 static size_t hd__gl_mg_rows(const struct hd__gl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
 
 static void hd__gl_mg_free(hd__ctx *ctx)
@@ -1054,15 +1053,8 @@ static void hd__gl_mg_free_host(hd__ctx *ctx)
 static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 {
     const struct hd__gl_mg *mg = ctx->be->mg;
-    size_t b;
-    int l;
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    b = 2 * sizeof(double) * hd__gl_mg_rows(mg) + 2 * sizeof(float) * hd__gl_mg_voxels(mg->fine, mg->channels);
-    for (l = 0; l < mg->levels; ++l) {
-        b += 3 * sizeof(float) * hd__gl_mg_voxels(mg->lv[l].dims, mg->channels);
-        if (l > 0) b += sizeof(float) * hd__gl_mg_voxels(mg->lv[l].dims, mg->sig_channels);
-    }
-    return b;
+    return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
 }
 #define HD__BE_HAS_SOLVER_BYTES 1
 
@@ -1110,7 +1102,7 @@ static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
             return r;
         }
         if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     return HD_SUCCESS;
 }

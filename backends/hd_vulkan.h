@@ -1621,7 +1621,6 @@ static const char *const hd__vk_mg_names[HD__VK_MG_STAGES] = {
     "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
     "multigrid extrapolation"};
 
-static size_t hd__vk_mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
 static size_t hd__vk_mg_rows(const struct hd__vk_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
 
 /* Frees the levels, vectors, buffers and sets; nothing of theirs may be in flight (the callers
@@ -1647,15 +1646,8 @@ static void hd__vk_mg_free(hd__ctx *ctx)
 static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 {
     const struct hd__vk_mg *mg = ctx->be->mg;
-    size_t b;
-    int l;
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    b = 2 * sizeof(double) * hd__vk_mg_rows(mg) + 2 * sizeof(float) * hd__vk_mg_voxels(mg->fine, mg->channels);
-    for (l = 0; l < mg->levels; ++l) {
-        b += 3 * sizeof(float) * hd__vk_mg_voxels(mg->lv[l].dims, mg->channels);
-        if (l > 0) b += sizeof(float) * hd__vk_mg_voxels(mg->lv[l].dims, mg->sig_channels);
-    }
-    return b;
+    return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
 }
 #define HD__BE_HAS_SOLVER_BYTES 1
 
@@ -1694,7 +1686,7 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
             (l > 0 && (r = hd__vk_mg_image(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS))
             return r;
         if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
     if ((r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(mg->levels + 1),

@@ -1,7 +1,8 @@
 /* hd_multigrid_cg.h - the host-side bookkeeping of HD_SOLVER_MULTIGRID that is the same on every
    backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h, hd_vulkan.h):
    when conjugate gradients restart, when the coarse levels' sigma_t must be restricted again, beta,
-   and the row-order sum of the dot products' row sums. The passes are each backend's; their
+   the row-order sum of the dot products' row sums, and the levels' grids and bytes (GL and Vulkan;
+   the CPU keeps its own count, OpenCL pads its rows). The passes are each backend's; their
    per-voxel math is backends/kernels/hd_k_multigrid.h. The design is at the top of
    hd_cpu_multigrid.h. */
 #ifndef HD_MULTIGRID_CG_H
@@ -69,6 +70,33 @@ HD__MAYBE_UNUSED static double hd__mg_row_sum(const double *d, size_t rows)
     size_t r;
     for (r = 0; r < rows; ++r) s += d[r];
     return s;
+}
+
+/* Level l's grid: the fine grid halved l times, rounded down (hd_cpu_multigrid.h's rule; halving
+   a grid already halved and rounded down is the same as dividing by 2^l once). */
+HD__MAYBE_UNUSED static void hd__mg_level_dims(const int *fine, int l, int *d)
+{
+    int i;
+    for (i = 0; i < 3; ++i) d[i] = fine[i] / (1 << l);
+}
+
+/* Values of `channels` channels on grid d. */
+HD__MAYBE_UNUSED static size_t hd__mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
+
+/* Bytes of the solver's state on a backend whose grids are unpadded, one float per value (GL and
+   Vulkan; counted in method_bytes): the two row-sum buffers (a double per fine row and channel),
+   p and lo on the fine grid, each of `levels` levels' rhs, phi and residual, and the coarse
+   levels' sigma_t of sig_channels channels. */
+HD__MAYBE_UNUSED static size_t hd__mg_bytes(const int *fine, int levels, int channels, int sig_channels)
+{
+    size_t b = 2 * sizeof(double) * (size_t)fine[1] * fine[2] * channels + 2 * sizeof(float) * hd__mg_voxels(fine, channels);
+    int l, d[3];
+    for (l = 0; l < levels; ++l) {
+        hd__mg_level_dims(fine, l, d);
+        b += 3 * sizeof(float) * hd__mg_voxels(d, channels);
+        if (l > 0) b += sizeof(float) * hd__mg_voxels(d, sig_channels);
+    }
+    return b;
 }
 
 #endif
