@@ -137,12 +137,7 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 static void hd__cpu_mg_params(hd__ctx *ctx, int l)
 {
     hd__cpu_level *L = &ctx->be->mg->lv[l];
-    float s = (float)(1 << l);
-    L->kp = ctx->kp;
-    L->kp.gdims.x = L->dims[0]; L->kp.gdims.y = L->dims[1]; L->kp.gdims.z = L->dims[2];
-    L->kp.grid.x = ctx->kp.grid.x / (s * s); L->kp.grid.y = ctx->kp.grid.y / (s * s); L->kp.grid.z = ctx->kp.grid.z / (s * s);
-    L->kp.gridh.x = ctx->kp.gridh.x * s; L->kp.gridh.y = ctx->kp.gridh.y * s; L->kp.gridh.z = ctx->kp.gridh.z * s;
-    L->kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    L->kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
     L->k = ctx->be->k;
     L->k.p = &L->kp;
     L->k.sig = l == 0 ? ctx->be->sig : L->sig;

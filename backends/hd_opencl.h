@@ -847,12 +847,7 @@ static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
 static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
 {
     hd__cl_level *L = &ctx->be->mg->lv[l];
-    hd__kparams kp = ctx->kp;
-    float s = (float)(1 << l);
-    kp.gdims.x = L->dims[0]; kp.gdims.y = L->dims[1]; kp.gdims.z = L->dims[2];
-    kp.grid.x = ctx->kp.grid.x / (s * s); kp.grid.y = ctx->kp.grid.y / (s * s); kp.grid.z = ctx->kp.grid.z / (s * s);
-    kp.gridh.x = ctx->kp.gridh.x * s; kp.gridh.y = ctx->kp.gridh.y * s; kp.gridh.z = ctx->kp.gridh.z * s;
-    kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
     if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
     HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, L->params, CL_TRUE, 0, sizeof kp, &kp, 0, NULL, NULL), "clEnqueueWriteBuffer(multigrid level parameters)");
     L->kp = kp;

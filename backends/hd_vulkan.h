@@ -1791,12 +1791,7 @@ static void hd__vk_mg_params(hd__ctx *ctx)
     int l;
     for (l = 0; l < mg->levels; ++l) {
         hd__vk_level *L = &mg->lv[l];
-        hd__kparams kp = ctx->kp;
-        float s = (float)(1 << l);
-        kp.gdims.x = L->dims[0]; kp.gdims.y = L->dims[1]; kp.gdims.z = L->dims[2];
-        kp.grid.x = ctx->kp.grid.x / (s * s); kp.grid.y = ctx->kp.grid.y / (s * s); kp.grid.z = ctx->kp.grid.z / (s * s);
-        kp.gridh.x = ctx->kp.gridh.x * s; kp.gridh.y = ctx->kp.gridh.y * s; kp.gridh.z = ctx->kp.gridh.z * s;
-        kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+        hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
         L->kp = kp;
         memcpy((char *)mg->params.map + (size_t)l * mg->slot_bytes, &kp, sizeof kp);
     }

@@ -1,8 +1,8 @@
 /* hd_multigrid_cg.h - the host-side bookkeeping of HD_SOLVER_MULTIGRID that is the same on every
    backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h, hd_vulkan.h):
    when conjugate gradients restart, when the coarse levels' sigma_t must be restricted again, beta,
-   the row-order sum of the dot products' row sums, and the levels' grids and bytes (GL and Vulkan;
-   the CPU keeps its own count, OpenCL pads its rows). The passes are each backend's; their
+   the row-order sum of the dot products' row sums, the levels' parameter blocks, and their grids
+   and bytes (GL and Vulkan; the CPU keeps its own count, OpenCL pads its rows). The passes are each backend's; their
    per-voxel math is backends/kernels/hd_k_multigrid.h. The design is at the top of
    hd_cpu_multigrid.h. */
 #ifndef HD_MULTIGRID_CG_H
@@ -78,6 +78,19 @@ HD__MAYBE_UNUSED static void hd__mg_level_dims(const int *fine, int l, int *d)
 {
     int i;
     for (i = 0; i < 3; ++i) d[i] = fine[i] / (1 << l);
+}
+
+/* Level l's parameter block: the fine one with the level's grid d, 1 / h^2 and h of its spacing
+   (2^l fine voxels), and the right-hand-side flag (each level smooths A e = its rhs). */
+HD__MAYBE_UNUSED static hd__kparams hd__mg_level_kp(const hd__kparams *fine, int l, const int *d)
+{
+    hd__kparams kp = *fine;
+    float s = (float)(1 << l);
+    kp.gdims.x = d[0]; kp.gdims.y = d[1]; kp.gdims.z = d[2];
+    kp.grid.x = fine->grid.x / (s * s); kp.grid.y = fine->grid.y / (s * s); kp.grid.z = fine->grid.z / (s * s);
+    kp.gridh.x = fine->gridh.x * s; kp.gridh.y = fine->gridh.y * s; kp.gridh.z = fine->gridh.z * s;
+    kp.counts.z |= HD_FLAG_DIFFUSE_RHS;
+    return kp;
 }
 
 /* Values of `channels` channels on grid d. */
