@@ -118,17 +118,8 @@ static void hd__cpu_mg_free(hd__ctx *ctx)
 static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 {
     const struct hd__cpu_mg *mg = ctx->be->mg;
-    size_t b = 0;
-    int l;
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    b += 2 * sizeof(double) * (size_t)mg->lv[0].dims[1] * mg->lv[0].dims[2] * (size_t)mg->channels; /* row sums */
-    b += 2 * hd__mg_vox(mg->lv[0].dims) * (size_t)mg->channels * sizeof(float);                      /* p, lo */
-    for (l = 0; l < mg->levels; ++l) {
-        size_t v = hd__mg_vox(mg->lv[l].dims);
-        b += v * 3 * (size_t)mg->channels * sizeof(float); /* rhs, phi, res */
-        if (l > 0) b += v * (size_t)mg->sig_channels * sizeof(float);
-    }
-    return b;
+    return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
 }
 #define HD__BE_HAS_SOLVER_BYTES 1
 
@@ -203,7 +194,7 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
                            d[0], d[1], d[2]);
         }
         if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
+        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     return HD_SUCCESS;
 }

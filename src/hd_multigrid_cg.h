@@ -1,8 +1,8 @@
 /* hd_multigrid_cg.h - the host-side bookkeeping of HD_SOLVER_MULTIGRID that is the same on every
    backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h, hd_vulkan.h):
    when conjugate gradients restart, when the coarse levels' sigma_t must be restricted again, beta,
-   the row-order sum of the dot products' row sums, the levels' parameter blocks, and their grids
-   and bytes (GL and Vulkan; the CPU keeps its own count, OpenCL pads its rows). The passes are each backend's; their
+   the row-order sum of the dot products' row sums, the levels' grids and parameter blocks, and
+   the solver's bytes (OpenCL pads its rows: its own count). The passes are each backend's; their
    per-voxel math is backends/kernels/hd_k_multigrid.h. The design is at the top of
    hd_cpu_multigrid.h. */
 #ifndef HD_MULTIGRID_CG_H
@@ -96,8 +96,8 @@ HD__MAYBE_UNUSED static hd__kparams hd__mg_level_kp(const hd__kparams *fine, int
 /* Values of `channels` channels on grid d. */
 HD__MAYBE_UNUSED static size_t hd__mg_voxels(const int *d, int channels) { return (size_t)channels * d[0] * (size_t)d[1] * d[2]; }
 
-/* Bytes of the solver's state on a backend whose grids are unpadded, one float per value (GL and
-   Vulkan; counted in method_bytes): the two row-sum buffers (a double per fine row and channel),
+/* Bytes of the solver's state on a backend whose grids are unpadded, one float per value (CPU, GL
+   and Vulkan; counted in method_bytes): the two row-sum buffers (a double per fine row and channel),
    p and lo on the fine grid, each of `levels` levels' rhs, phi and residual, and the coarse
    levels' sigma_t of sig_channels channels. */
 HD__MAYBE_UNUSED static size_t hd__mg_bytes(const int *fine, int levels, int channels, int sig_channels)
