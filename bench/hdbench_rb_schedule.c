@@ -73,7 +73,7 @@ static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
 {
     hd__backend *be = ctx->be;
     hd__cpu_grid g;
-    size_t n = be->illum_floats;
+    size_t n = be->illum_slots; /* phi in the colour layout, padding slots included */
     float *start = (float *)malloc(n * sizeof(float));
     unsigned long long hash[2] = {0, 0};
     int r, i, s, rep, y, z;
