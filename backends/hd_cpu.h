@@ -311,7 +311,7 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
    colour's half of the row at id - 1 + cp and id + cp, the y +- 1 and z +- 1 neighbours at id in
    the neighbouring rows' halves of the other colour: unit-stride loads, no permutes. The loop
    loads the values itself and hands them to the shared pure functions of hd_k_diffuse.h
-   (hd_diffuse_own_of, hd_diffuse_box_of / _surface_of) with rgb, rhs and the boundary as
+   (hd_diffuse_own_of, hd_diffuse_box_of / _surface_rhs_of) with rgb, rhs and the boundary as
    literals and every in-grid flag 1, so each variant is a branch-free loop the compiler
    vectorises; the same operations in the same order as hd_diffuse_terms_loaded, so the same
    bits as the per-voxel path (hd_diffuse_row), which edge rows take. The stride-2 loop over the
@@ -395,11 +395,12 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
         num = hd_diffuse_own_of(K, st, al, HD__CPU_LD(E, p[0] + id), rhs, &sp, &dn);
 #define HD__CPU_NB(j, i) hd__cpu_nb_sigp(K, sg[s[j] + (i)], rgb != 0 ? sg[a[j] + (i)] : 0.0f, rgb, ag)
         if (surface)
-            num = hd_diffuse_surface_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
-                                        HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
-                                        HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
-                                        HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
-                                        HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1, &den);
+            num = hd_diffuse_surface_rhs_of(K, rhs, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq),
+                                            HD__CPU_NB(2, id), HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
+                                            HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
+                                            HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
+                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1,
+                                            &den);
         else
             num = hd_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
                                     HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
