@@ -522,7 +522,8 @@ static void hd__cpu_diffuse_block(hd__backend *be, int r)
    by then, while the first colour in plane z read the second's plane z - 1 before it changed. So
    each plane streams through the caches once per sweep instead of once per colour (head CT, 2
    threads, `make bench-rb-schedule`: 1.30-1.35x per sweep with the box boundary, 1.18-1.21x with
-   the surface boundary). The same updates from the same values as
+   the surface boundary on the x-fastest layout; 1.07-1.12x and 1.07x with the colour layout's
+   cheaper rows, load 2). The same updates from the same values as
    relaxing colour by colour: the same bits, for any block size and thread count.
    Threads take blocks of rows (y). Rows beside a block's edge depend on the next block's, so a
    sweep is two parallel passes:

@@ -32,6 +32,13 @@
    Cost: about 15 red-black sweeps of wall time per step (head CT, surface boundary, 2 threads:
    300 ms against 20.5 ms per sweep at 256x256x108, 47.8 against 3.23 at half resolution); the
    V-cycle is two thirds of it, the two double-summed residual passes most of the rest.
+   Every level's buffers are in the colour layout (hd__mg_slots), so the smoothing runs the
+   sweep's unit-stride rows, but the transfers (hd_mg_prolong, hd_mg_restrict_line) and the
+   double residual load through coordinates, now gathers across the two colour halves: a step
+   went from 213 to 280 ms (box) and 268 to 316 ms (surface) at full resolution, 30 to 40 and 38
+   to 45 ms at half (one A/B pair, load 2; perf: the prolongation 1.7x, the restriction and the
+   extrapolation 1.3-1.4x, the double residual 1.2x). Not yet addressed: a pure
+   hd_mg_prolong_of on values the row loads once would undo most of it.
 
    The V-cycle is a symmetric positive definite preconditioner (M^-1 symmetric, what CG needs):
    - every level's smoothing and residual are the shared kernel's (hd_k_diffuse.h: the same

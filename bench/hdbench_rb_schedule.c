@@ -7,7 +7,9 @@
      - the same rows relaxed over and over (48 rows, L2-resident): the row code's own rate, what
        a sweep would cost if the memory traffic were free.
    Interleaved rounds from the same phi, best of each; the phi of both schedules is compared bit
-   for bit. Head CT, one light, box and surface boundary.
+   for bit. Head CT, one light, box and surface boundary. Both schedules run the library's current
+   row code (since the colour layout, hd_prelude_c.h: unit-stride half-rows), so the ratio is the
+   schedule's alone; the row code before it is measured by building this file at an older commit.
    Usage: hdbench_rb_schedule [data/head.nrrd] [threads (default 2)]
    Figures, not a test. */
 #define HYBRIDDIFF_IMPLEMENTATION
