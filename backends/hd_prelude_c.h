@@ -167,7 +167,10 @@ typedef struct hd__kctx {
    the test there (hd_cpu.h); elsewhere it is one well-predicted branch. */
 #define HD_GET(buf, i, x, y, z) HD__LD_##buf((i), (x), (y), (z))
 #define HD_SET(buf, i, x, y, z, v) HD__ST_##buf((i), (x), (y), (z), (v))
-#define HD__C_AT(xx, yy, zz) hd__split_slot(K->p->gdims.x, K->p->gdims.y, (xx), (yy), (zz))
+/* hd__split_slot in int arithmetic, as the kernels' own indices (i, ic) are: the projection's 16
+   loads per sample pay for every instruction of the address */
+#define HD__C_AT(xx, yy, zz) \
+    ((((zz) * 2 + (((xx) + (yy) + (zz)) & 1)) * K->p->gdims.y + (yy)) * ((K->p->gdims.x + 1) >> 1) + ((xx) >> 1))
 #define HD__LD_vol(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->vol[(i)])
 #define HD__LD_lv(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv[(i)])
 #define HD__LD_lv2(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv2[(i)])
