@@ -25,7 +25,9 @@ struct hd__backend {
     float *sig, *E, *phi, *phi2, *img;
     uint16_t *Eh, *phih, *phi2h; /* E, phi, phi2 as binary16 (illumination_precision FLOAT16),
                                     the float pointers then NULL */
-    size_t illum_floats;     /* elements of E (and of phi, phi2), whatever their precision */
+    size_t illum_floats;     /* voxels of E (and of phi, phi2) over all channels */
+    size_t illum_slots;      /* their elements in the colour layout (hd__split_slots: one padding
+                                slot per row when gx is odd), whatever their precision */
     hd__kctx k;
     int parity, jacobi;      /* the diffusion pass being run (red-black: the colour relaxed first) */
     const struct hd__cpu_grid *grid; /* the grid the diffusion pass works on */
@@ -195,6 +197,7 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
 }
 
 #define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: Eh, phih, phi2h */
+#define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */
 static void hd__cpu_free_illum(hd__ctx *ctx, float **f, uint16_t **h)
@@ -226,7 +229,7 @@ static void hd__cpu_bind_illum(hd__backend *be)
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
-    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    size_t slots = hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels);
     int ok;
     hd__free(ctx, be->sig);
     be->sig = be->k.sig = NULL;
@@ -234,14 +237,16 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__cpu_free_illum(ctx, &be->phi, &be->phih);
     hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
-    be->illum_floats = 0;
+    be->illum_floats = be->illum_slots = 0;
     if (illum_floats == 0) return HD_SUCCESS;
-    be->sig = (float *)hd__calloc(ctx, gvox * (size_t)ctx->sig_channels, sizeof(float));
-    ok = hd__cpu_alloc_illum(ctx, illum_floats, &be->E, &be->Eh);
-    ok &= hd__cpu_alloc_illum(ctx, illum_floats, &be->phi, &be->phih);
+    be->sig = (float *)hd__calloc(ctx, hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->sig_channels),
+                                  sizeof(float));
+    ok = hd__cpu_alloc_illum(ctx, slots, &be->E, &be->Eh);
+    ok &= hd__cpu_alloc_illum(ctx, slots, &be->phi, &be->phih);
     if (!be->sig || !ok)
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", illum_floats);
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", slots);
     be->illum_floats = illum_floats;
+    be->illum_slots = slots;
     be->k.sig = be->sig;
     hd__cpu_bind_illum(be);
     return HD_SUCCESS;
@@ -255,7 +260,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    ok = hd__cpu_alloc_illum(ctx, be->illum_floats, &be->phi2, &be->phi2h);
+    ok = hd__cpu_alloc_illum(ctx, be->illum_slots, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
     if (!ok) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
     return HD_SUCCESS;
@@ -273,7 +278,7 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
-    size_t n = be->illum_floats;
+    size_t n = be->illum_slots;
     if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, n * sizeof(float));
     if ((what & HD__DIRTY_PHI) && be->phi) memset(be->phi, 0, n * sizeof(float));
     if ((what & HD__DIRTY_PHI) && be->phi2) memset(be->phi2, 0, n * sizeof(float));
@@ -298,62 +303,28 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
 /* ---- diffusion -------------------------------------------------------------------------------
    A pass works on be->grid: the illumination grid itself, or a multigrid level
    (hd_cpu_multigrid.h), each with its own kernel context (parameters and buffers).
-   Rows inside the grid in y and z relax their interior voxels through a contiguous loop over a
-   row buffer: hd_diffuse_terms_box / _surface with literal in-grid flags have no branches, so
-   the compiler vectorises them (the branchy strided loop of hd_diffuse_row did not: 50 ms
-   against 10 ms per sweep on the head CT with AVX-512). Red-black computes only its colour, a
-   loop of literal stride 2 that gcc vectorises with permutes: 1.8-2x faster per sweep than
-   computing the whole row and keeping half (box 23-28 -> 13 ms on the head CT). Same function,
-   same operations: the same bits as hd_diffuse_row. Edge rows and the two end voxels take the
-   general path. */
+   sigma_t, E and phi are stored colour by colour (hd_prelude_c.h, hd__split_slot): a row's
+   voxels of one colour are contiguous, and so are the voxels of the other colour they read.
+   Rows inside the grid in y and z relax their interior voxels of one colour through a loop
+   over the packed index id (x = 2 id + cp, cp the x parity of the colour's first voxel): own
+   sigma_t and E from the colour's half of the row, the x - 1 / x + 1 neighbours from the other
+   colour's half of the row at id - 1 + cp and id + cp, the y +- 1 and z +- 1 neighbours at id in
+   the neighbouring rows' halves of the other colour: unit-stride loads, no permutes. The loop
+   loads the values itself and hands them to the shared pure functions of hd_k_diffuse.h
+   (hd_diffuse_own_of, hd_diffuse_box_of / _surface_rhs_of) with rgb, rhs and the boundary as
+   literals and every in-grid flag 1, so each variant is a branch-free loop the compiler
+   vectorises; the same operations in the same order as hd_diffuse_terms_loaded, so the same
+   bits as the per-voxel path (hd_diffuse_row), which edge rows take. The stride-2 loop over the
+   x-fastest layout this replaces needed permutes for every load: 1.77 against 1.06 ns per update
+   for the whole row (Jacobi) with the rows in L2 (bench/hdbench_rb_schedule.c). The two end
+   voxels go through hd_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
+   neighbour lies outside the row). */
 #define HD__CPU_ROW_MAX 8192
-/* The interior voxels xs, xs + step, ... of the row through `terms` with rgb and rhs literals;
-   row[x] = expr of num_ and den_. step is a literal too: a variable stride is not vectorised. */
-#define HD__CPU_ROW_LOOP(terms, rgb, rhs, xs, step, expr)                                        \
-    do {                                                                                        \
-        for (x = (xs); x < gx - 1; x += (step)) {                                               \
-            float den_, num_ = terms(K, x, y, z, c, 1, 1, 1, 1, 1, 1, rgb, rhs, &den_);          \
-            row[x] = (expr);                                                                    \
-        }                                                                                       \
-    } while (0)
-/* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) through `terms` with literal
-   in-grid flags, so they take no branch either (through hd_diffuse_terms' run-time flags they
-   cost about 5 % of a red-black sweep on the head CT). */
-#define HD__CPU_ROW_ENDS(terms, rgb, rhs, first, last, expr)                                     \
-    do {                                                                                        \
-        float den_, num_;                                                                       \
-        if (first) {                                                                            \
-            x = 0;                                                                              \
-            num_ = terms(K, x, y, z, c, 0, 1, 1, 1, 1, 1, rgb, rhs, &den_);                      \
-            row[x] = (expr);                                                                    \
-        }                                                                                       \
-        if (last) {                                                                             \
-            x = gx - 1;                                                                         \
-            num_ = terms(K, x, y, z, c, 1, 0, 1, 1, 1, 1, rgb, rhs, &den_);                      \
-            row[x] = (expr);                                                                    \
-        }                                                                                       \
-    } while (0)
-/* M (HD__CPU_ROW_LOOP or HD__CPU_ROW_ENDS) for the grid's flags: each combination a copy of its
-   own, so none keeps a test. */
-#define HD__CPU_SWITCH_VARIANTS(M, xs, step, expr)                                                 \
-    switch (hd__cpu_row_variant(K)) {                                                           \
-    case 0: M(hd_diffuse_terms_box, 0, 0, xs, step, expr); break;                                  \
-    case 1: M(hd_diffuse_terms_box, 1, 0, xs, step, expr); break;                                  \
-    case 2: M(hd_diffuse_terms_box, 0, 1, xs, step, expr); break;                                  \
-    case 3: M(hd_diffuse_terms_box, 1, 1, xs, step, expr); break;                                  \
-    case 4: M(hd_diffuse_terms_surface, 0, 0, xs, step, expr); break;                              \
-    case 5: M(hd_diffuse_terms_surface, 1, 0, xs, step, expr); break;                              \
-    case 6: M(hd_diffuse_terms_surface, 0, 1, xs, step, expr); break;                              \
-    default: M(hd_diffuse_terms_surface, 1, 1, xs, step, expr); break;                             \
-    }
-#define HD__CPU_ROW_VARIANTS(xs, step, expr) HD__CPU_SWITCH_VARIANTS(HD__CPU_ROW_LOOP, xs, step, expr)
-/* the ends through HD__CPU_ROW_ENDS: first if first, last if last */
-#define HD__CPU_END_VARIANTS(first, last, expr) HD__CPU_SWITCH_VARIANTS(HD__CPU_ROW_ENDS, first, last, expr)
 
 /* A grid the diffusion passes work on. */
 typedef struct hd__cpu_grid {
     const hd__kctx *k;       /* its parameters (gdims, 1/h^2, flags) and buffers */
-    float *res;              /* the residual pass's output (multigrid) */
+    float *res;              /* the residual pass's output (multigrid), in the colour layout */
 } hd__cpu_grid;
 
 static int hd__cpu_row_variant(const hd__kctx *K)
@@ -373,44 +344,145 @@ static int hd__cpu_row_variant(const hd__kctx *K)
 #define HD__CPU_FLATTEN
 #endif
 
-/* Stores the relaxed colour (red-black colour `parity`) or the whole row (Jacobi) of row[] into
-   phi or phi2 as binary16 (illumination_precision FLOAT16). */
-static void hd__cpu_store_row_half(const hd__backend *be, const hd__kctx *K, const float *row, int y, int z, int c,
-                                   int parity)
+/* Voxels of x parity xpar in a row of gx voxels: the length of that colour's half-row. */
+static int hd__cpu_half_len(int gx, int xpar) { return (gx - xpar + 1) >> 1; }
+
+/* Where one colour of row (y, z) of channel c finds its values: the start of each half-row, as
+   slots (hd__split_slot of the half's first voxel). Index 0: the row's own colour (x parity x0);
+   1: the other colour of the same row (the x-neighbours); 2, 3: the rows y - 1, y + 1 and 4, 5:
+   the slices z - 1, z + 1, at the same x (their halves of the other colour). s: sigma_t, a: its
+   RGB albedo channel 1 + c, p: E, phi and phi2 (channel c). */
+typedef struct hd__cpu_rows {
+    size_t s[6], a[6], p[6];
+} hd__cpu_rows;
+
+static void hd__cpu_rows_of(const hd__kctx *K, int y, int z, int c, int x0, hd__cpu_rows *o)
 {
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
-    uint16_t *dst = (be->jacobi ? K->phi2h : K->phih) + ((size_t)(c * gz + z) * gy + y) * gx;
-    if (be->jacobi) for (x = 0; x < gx; ++x) dst[x] = hd_f2h(row[x]);
-    else for (x = (y + z + parity) & 1; x < gx; x += 2) dst[x] = hd_f2h(row[x]);
+    static const int dy[6] = {0, 0, -1, 1, 0, 0}, dz[6] = {0, 0, 0, 0, -1, 1};
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, j;
+    for (j = 0; j < 6; ++j) {
+        int xp = j == 1 ? x0 ^ 1 : x0, yy = y + dy[j], zj = z + dz[j];
+        o->s[j] = hd__split_slot(gx, gy, xp, yy, zj);
+        o->a[j] = hd__split_slot(gx, gy, xp, yy, zj + (1 + c) * gz);
+        o->p[j] = hd__split_slot(gx, gy, xp, yy, zj + c * gz);
+    }
+}
+
+/* E, phi or phi2 at slot o in K's storage precision (K->f16 a literal in the row loops). */
+#define HD__CPU_LD(buf, o) (K->f16 != 0 ? hd_h2f(K->buf##h[(o)]) : K->buf[(o)])
+
+/* sigma' of a neighbour with sigma_t st and RGB albedo channel sc: hd_diffuse_sigp on loaded
+   values (ag: 1 - albedo g of the grey albedo, used without RGB scattering). */
+HD__CPU_INLINE float hd__cpu_nb_sigp(const hd__kctx *K, float st, float sc, int rgb, float ag)
+{
+    return rgb != 0 ? hd_diffuse_sigp_of(K, st, hd_diffuse_albedo_of(K, sc, rgb)) : ag * st;
+}
+
+/* The interior voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into
+   out[id]: num / den, or with residual the residual num - den phi. rgb, rhs, surface and residual
+   are literals at every call (HD__CPU_COLOUR_VARIANTS), so the loop has no test. */
+HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o, int lo, int hi, int cp, float *out,
+                                        int rgb, int rhs, int surface, int residual)
+{
+    const float *sg = K->sig;
+    const size_t *s = o->s, *a = o->a, *p = o->p;
+    int id;
+    for (id = lo; id <= hi; ++id) {
+        int xm = id - 1 + cp, xq = id + cp;
+        float sp, dn, den, num;
+        float st = sg[s[0] + id], al = hd_diffuse_albedo_of(K, rgb != 0 ? sg[a[0] + id] : 0.0f, rgb);
+        float ag = hd_diffuse_ag(K, al);
+        num = hd_diffuse_own_of(K, st, al, HD__CPU_LD(E, p[0] + id), rhs, &sp, &dn);
+#define HD__CPU_NB(j, i) hd__cpu_nb_sigp(K, sg[s[j] + (i)], rgb != 0 ? sg[a[j] + (i)] : 0.0f, rgb, ag)
+        if (surface)
+            num = hd_diffuse_surface_rhs_of(K, rhs, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq),
+                                            HD__CPU_NB(2, id), HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
+                                            HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
+                                            HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
+                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1,
+                                            &den);
+        else
+            num = hd_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
+                                    HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
+                                    HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
+                                    HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
+                                    HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1, &den);
+#undef HD__CPU_NB
+        out[id] = residual ? num - den * HD__CPU_LD(phi, p[0] + id) : num / den;
+    }
+}
+
+/* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) of the colour with x parity x0
+   into out[x >> 1], through `terms` with literal in-grid flags, so they take no branch either
+   (through hd_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep). */
+#define HD__CPU_ROW_ENDS(terms, rgb, rhs, residual)                                                   \
+    do {                                                                                            \
+        float den_, num_;                                                                           \
+        if (x0 == 0) {                                                                              \
+            num_ = terms(K, 0, y, z, c, 0, 1, 1, 1, 1, 1, rgb, rhs, &den_);                          \
+            out[0] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0]) : num_ / den_;               \
+        }                                                                                           \
+        if (((gx - 1 - x0) & 1) == 0) {                                                             \
+            num_ = terms(K, gx - 1, y, z, c, 1, 0, 1, 1, 1, 1, rgb, rhs, &den_);                     \
+            out[(gx - 1) >> 1] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0] + ((gx - 1) >> 1)) \
+                                            : num_ / den_;                                          \
+        }                                                                                           \
+    } while (0)
+/* One case of the variant switch: the interior loop and the ends with rgb, rhs and the boundary
+   literal. */
+#define HD__CPU_COLOUR_CASE(rgb, rhs, surface, residual)                                              \
+    do {                                                                                            \
+        hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual);  \
+        if (surface) HD__CPU_ROW_ENDS(hd_diffuse_terms_surface, rgb, rhs, residual);                  \
+        else HD__CPU_ROW_ENDS(hd_diffuse_terms_box, rgb, rhs, residual);                              \
+    } while (0)
+#define HD__CPU_COLOUR_VARIANTS(residual)                                                            \
+    switch (hd__cpu_row_variant(K)) {                                                               \
+    case 0: HD__CPU_COLOUR_CASE(0, 0, 0, residual); break;                                          \
+    case 1: HD__CPU_COLOUR_CASE(1, 0, 0, residual); break;                                          \
+    case 2: HD__CPU_COLOUR_CASE(0, 1, 0, residual); break;                                          \
+    case 3: HD__CPU_COLOUR_CASE(1, 1, 0, residual); break;                                          \
+    case 4: HD__CPU_COLOUR_CASE(0, 0, 1, residual); break;                                          \
+    case 5: HD__CPU_COLOUR_CASE(1, 0, 1, residual); break;                                          \
+    case 6: HD__CPU_COLOUR_CASE(0, 1, 1, residual); break;                                          \
+    default: HD__CPU_COLOUR_CASE(1, 1, 1, residual); break;                                         \
+    }
+
+/* Relaxes the voxels of x parity x0 of interior row (y, z) of channel c (3 <= gx, 0 < y < gy - 1,
+   0 < z < gz - 1) into phi (red-black: in place, the colour reads only the other one) or phi2
+   (Jacobi): computed into a local half-row, then stored contiguously (a store through K's
+   pointers inside the loop might alias its loads, which would keep the compiler from
+   vectorising it). */
+HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c, int x0, int jacobi)
+{
+    int gx = K->p->gdims.x, n = hd__cpu_half_len(gx, x0), i;
+    float out[HD__CPU_ROW_MAX / 2 + 1];
+    hd__cpu_rows o;
+    hd__cpu_rows_of(K, y, z, c, x0, &o);
+    HD__CPU_COLOUR_VARIANTS(0)
+    if (K->f16) {
+        uint16_t *dst = (jacobi ? K->phi2h : K->phih) + o.p[0];
+        for (i = 0; i < n; ++i) dst[i] = hd_f2h(out[i]);
+    } else {
+        memcpy((jacobi ? K->phi2 : K->phi) + o.p[0], out, (size_t)n * sizeof(float));
+    }
 }
 
 /* Relaxes row (y, z) of channel c: red-black its colour `parity` (voxels with x + y + z + parity
-   even), Jacobi (be->jacobi) the whole row into phi2. */
+   even), Jacobi (be->jacobi) both colours into phi2. */
 HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, int y, int z, int c, int parity)
 {
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x, x0;
-    float row[HD__CPU_ROW_MAX];
-    float *dst;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z;
     if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
         hd_diffuse_row(K, y, z, c, parity, be->jacobi);
         return;
     }
-    /* Jacobi: every voxel of the row; red-black: its colour (x0, x0 + 2, ...), into row[] */
-    x0 = be->jacobi ? 0 : ((y + z + parity) & 1);
-    /* float32 destination (float16 grids have no float view: K->phi is NULL there) */
-    dst = K->f16 ? NULL : (be->jacobi ? K->phi2 : K->phi) + ((size_t)(c * gz + z) * gy + y) * gx;
-    /* red-black float32: row[] starts as the row itself, so after the colour is relaxed into it
-       the whole row goes back with one memcpy instead of a scalar stride-2 copy (gcc does not
-       vectorise that store; it took about 8 % of a red-black sweep). The other colour goes back
-       unchanged, and no other thread touches this row during the pass (the block schedule:
-       a pass never writes a row a neighbour block reads), so rewriting it races with nothing. */
-    if (!be->jacobi && dst != NULL) memcpy(row, dst, (size_t)gx * sizeof(float));
-    if (be->jacobi) HD__CPU_ROW_VARIANTS(1, 1, num_ / den_)
-    else HD__CPU_ROW_VARIANTS(2 - x0, 2, num_ / den_)
-    /* the ends of the kept colour only: the whole row goes back */
-    HD__CPU_END_VARIANTS(be->jacobi || x0 == 0, be->jacobi || ((gx - 1 - x0) & 1) == 0, num_ / den_)
-    if (K->f16) { hd__cpu_store_row_half(be, K, row, y, z, c, parity); return; }
-    memcpy(dst, row, (size_t)gx * sizeof(float));
+    if (be->jacobi) {
+        hd__cpu_relax_colour(K, y, z, c, 0, 1);
+        hd__cpu_relax_colour(K, y, z, c, 1, 1);
+    } else {
+        hd__cpu_relax_colour(K, y, z, c, (y + z + parity) & 1, 0);
+    }
 }
 
 /* The row on a copy of the grid's kernel context whose storage precision (f16) is a literal:
@@ -450,7 +522,8 @@ static void hd__cpu_diffuse_block(hd__backend *be, int r)
    by then, while the first colour in plane z read the second's plane z - 1 before it changed. So
    each plane streams through the caches once per sweep instead of once per colour (head CT, 2
    threads, `make bench-rb-schedule`: 1.30-1.35x per sweep with the box boundary, 1.18-1.21x with
-   the surface boundary). The same updates from the same values as
+   the surface boundary on the x-fastest layout; 1.07-1.12x and 1.07x with the colour layout's
+   cheaper rows, load 2). The same updates from the same values as
    relaxing colour by colour: the same bits, for any block size and thread count.
    Threads take blocks of rows (y). Rows beside a block's edge depend on the next block's, so a
    sweep is two parallel passes:
@@ -535,31 +608,30 @@ static void hd__cpu_red_black(hd__backend *be, int sweeps, int first)
     }
 }
 
-/* The residual f - A phi of row r (= (c * gz + z) * gy + y) of be->grid into out[] (float32
-   grids: multigrid's). The loop writes a local row first, as stores through `out` might alias
-   the parameters, which kept gcc from hoisting their loads and vectorising it. */
-static HD__CPU_FLATTEN void hd__cpu_residual_row_into(const hd__backend *be, int r, float *out)
+/* The residual f - A phi of row r (= (c * gz + z) * gy + y) of be->grid into its res, in the
+   colour layout (float32 grids: multigrid's): each colour's half-row through the sweep's loop
+   (hd__cpu_colour_loop with residual), written to a local half-row first (stores through res
+   might alias the loads, which would keep the compiler from vectorising the loop). */
+static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
 {
     hd__kctx k = *be->grid->k; /* f16 a literal 0: no per-load precision test in the loop */
     const hd__kctx *K = &k;
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    float *res = be->grid->res;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x, x0;
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
-    const float *prow = K->phi + ((size_t)(c * gz + z) * gy + y) * gx;
-    float row[HD__CPU_ROW_MAX], rhs;
+    float rhs;
     k.f16 = 0;
     if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
-        for (x = 0; x < gx; ++x) out[x] = hd_diffuse_residual(K, x, y, z, c, &rhs);
+        for (x = 0; x < gx; ++x) res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hd_diffuse_residual(K, x, y, z, c, &rhs);
         return;
     }
-    HD__CPU_ROW_VARIANTS(1, 1, num_ - den_ * prow[x])
-    HD__CPU_END_VARIANTS(1, 1, num_ - den_ * prow[x])
-    memcpy(out, row, (size_t)gx * sizeof(float));
-}
-
-/* The residual of row r into be->grid->res. */
-static void hd__cpu_residual_row(hd__backend *be, int r)
-{
-    hd__cpu_residual_row_into(be, r, be->grid->res + (size_t)r * be->grid->k->p->gdims.x);
+    for (x0 = 0; x0 < 2; ++x0) {
+        float out[HD__CPU_ROW_MAX / 2 + 1];
+        hd__cpu_rows o;
+        hd__cpu_rows_of(K, y, z, c, x0, &o);
+        HD__CPU_COLOUR_VARIANTS(1)
+        memcpy(res + o.p[0], out, (size_t)hd__cpu_half_len(gx, x0) * sizeof(float));
+    }
 }
 
 static void hd__cpu_project_row(hd__backend *be, int py)
@@ -616,16 +688,40 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     memcpy(dst, ctx->be->img, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
     return HD_SUCCESS;
 }
+/* Copies E or phi between the colour layout and the API's x-fastest channel-planar order, one
+   direction per call: into dst (src NULL; binary16 widened exactly) or from src (dst NULL; rounded
+   to nearest even), as the OpenCL backend's hd__cl_copy_illumination. Padding slots are not
+   touched (they stay 0). */
+static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst)
+{
+    hd__backend *be = ctx->be;
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
+    float *f = which == HD_ILLUMINATION_DIRECT ? be->E : be->phi;
+    uint16_t *h = which == HD_ILLUMINATION_DIRECT ? be->Eh : be->phih;
+    for (zz = 0; zz < nz; ++zz)
+        for (y = 0; y < gy; ++y)
+            for (x = 0; x < gx; ++x) {
+                size_t s = hd__split_slot(gx, gy, x, y, zz);
+                if (h) {
+                    if (src) h[s] = hd_f2h(*src++);
+                    else *dst++ = hd_h2f(h[s]);
+                } else {
+                    if (src) f[s] = *src++;
+                    else *dst++ = f[s];
+                }
+            }
+}
+
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
-    const hd__backend *be = ctx->be;
-    const uint16_t *h = which == HD_ILLUMINATION_DIRECT ? be->Eh : be->phih;
-    size_t i;
-    if (h) {
-        for (i = 0; i < be->illum_floats; ++i) dst[i] = hd_h2f(h[i]);
-        return HD_SUCCESS;
-    }
-    memcpy(dst, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, be->illum_floats * sizeof(float));
+    hd__cpu_copy_illumination(ctx, which, NULL, dst);
+    return HD_SUCCESS;
+}
+
+/* The inverse, for the test hooks (src/hd_test_hooks.h). */
+HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+{
+    hd__cpu_copy_illumination(ctx, which, src, NULL);
     return HD_SUCCESS;
 }
 

@@ -388,16 +388,17 @@ static size_t hd__cl_illum_bytes(const hd__backend *be, size_t n)
 
 /* Elements of a colour-layout grid of `slices` z-slices (gz per channel): each row of gx voxels
    takes 2 * ((gx + 1) / 2) slots, one of them padding when gx is odd. */
+#define HD__BE_SPLIT_LAYOUT 1 /* hd_get_stats counts the layout's padding slots */
 static size_t hd__cl_slots(const hd__ctx *ctx, size_t slices)
 {
-    return slices * (size_t)ctx->gdims[1] * 2 * (((size_t)ctx->gdims[0] + 1) / 2);
+    return hd__split_slots(ctx->gdims[0], ctx->gdims[1], slices);
 }
 
-/* The slot of voxel (x, y, zz) in the colour layout: hd_prelude_cl.h's HD__CL_AT, host side. */
+/* The slot of voxel (x, y, zz) in the colour layout: hd_prelude_cl.h's HD__CL_AT, host side (the
+   CPU backend's layout too, hd_prelude_c.h). */
 static size_t hd__cl_slot(const hd__ctx *ctx, int x, int y, int zz)
 {
-    size_t hx = ((size_t)ctx->gdims[0] + 1) / 2;
-    return (((size_t)zz * 2 + (size_t)((x + y + zz) & 1)) * (size_t)ctx->gdims[1] + (size_t)y) * hx + (size_t)(x >> 1);
+    return hd__split_slot(ctx->gdims[0], ctx->gdims[1], x, y, zz);
 }
 
 /* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
@@ -753,7 +754,7 @@ struct hd__cl_mg {
 
 static size_t hd__cl_mg_slots(const int *d, int channels)
 {
-    return (size_t)channels * d[2] * (size_t)d[1] * 2 * (((size_t)d[0] + 1) / 2);
+    return hd__split_slots(d[0], d[1], (size_t)channels * d[2]);
 }
 static size_t hd__cl_mg_rows(const struct hd__cl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
 /* The restriction's row buffer: a padded fine row per coarse row of level 1, the largest. */

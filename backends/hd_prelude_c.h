@@ -90,6 +90,29 @@ HD_FN uint16_t hd_f2h(float f)
     return (uint16_t)(sign | h);
 }
 
+/* The colour-separated layout of the buffers the diffusion reads (sigma_t with its RGB channels,
+   E, phi, phi2; also the CPU multigrid's vectors), the same on the CPU and OpenCL backends
+   (hd_prelude_cl.h's HD__CL_AT): voxel (x, y, zz), zz = z + c * gz for channel c, has colour
+   k = (x + y + zz) & 1 and lives at slot
+       ((zz * 2 + k) * gy + y) * hx + (x >> 1),   hx = (gx + 1) / 2,
+   i.e. each z-slice (of each channel) holds its colour-0 voxels row by row, then its colour-1
+   voxels; a row of odd gx has one padding slot in one colour, which stays 0. Why: red-black
+   relaxes one colour at a time, and in this layout a row's voxels of one colour and their
+   neighbours of the other colour are contiguous, so the CPU's row loop loads them unit-stride
+   (hd_cpu.h) instead of at stride 2 through permutes. hd__split_slot is the host-side formula
+   (the OpenCL backend's copies to and from the API's x-fastest order use it too). */
+HD_FN size_t hd__split_slot(int gx, int gy, int x, int y, int zz)
+{
+    return (((size_t)zz * 2 + (size_t)((x + y + zz) & 1)) * (size_t)gy + (size_t)y) * (((size_t)gx + 1) >> 1) +
+           (size_t)(x >> 1);
+}
+/* Slots of a grid of `slices` z-slices (gz per channel): 2 * hx per row, one of them padding
+   when gx is odd. */
+HD_FN size_t hd__split_slots(int gx, int gy, size_t slices)
+{
+    return slices * (size_t)gy * 2 * (((size_t)gx + 1) >> 1);
+}
+
 /* Structs: GLSL has no typedef. */
 #define HD_STRUCT(name) typedef struct name {
 #define HD_STRUCT_END(name) } name;
@@ -134,28 +157,35 @@ typedef struct hd__kctx {
 #define HD_KARGS const hd__kctx *K,
 #define HD_KPASS K,
 #define HD_PRM(name) (K->p->name)
-/* Buffer element i; x,y,z is the same element as image coordinates (channel c at z + c*dz), which
-   image-backed GPU preludes use instead of i. The illumination buffers E, phi, phi2 go through
+/* Buffer element i; x,y,z is the same element as image coordinates (channel c at z + c*dz).
+   The volume (vol) and CD's light volumes (lv, lv2) are x-fastest and use i. The buffers the
+   diffusion reads (sig with its RGB channels, E, phi, phi2) are in the colour-separated layout
+   (hd__split_slot above) of the grid K->p->gdims describes, so they use the coordinates; the
+   shared kernels pass them everywhere. The illumination buffers E, phi, phi2 go through
    HD__LD_ / HD__ST_ (pasted on the buffer's name): float32 or binary16 by K->f16. The CPU
    backend runs its vectorised rows on a copy of K whose f16 is a literal, so the compiler drops
    the test there (hd_cpu.h); elsewhere it is one well-predicted branch. */
-#define HD_GET(buf, i, x, y, z) ((void)(x), (void)(y), (void)(z), HD__LD_##buf(i))
-#define HD_SET(buf, i, x, y, z, v) ((void)(x), (void)(y), (void)(z), HD__ST_##buf((i), (v)))
-#define HD__LD_PLAIN(buf, i) (K->buf[(i)])
-#define HD__LD_vol(i) HD__LD_PLAIN(vol, i)
-#define HD__LD_sig(i) HD__LD_PLAIN(sig, i)
-#define HD__LD_lv(i) HD__LD_PLAIN(lv, i)
-#define HD__LD_lv2(i) HD__LD_PLAIN(lv2, i)
-#define HD__ST_sig(i, v) (K->sig[(i)] = (v))
-#define HD__ST_lv2(i, v) (K->lv2[(i)] = (v))
-#define HD__LD_HALF(buf, i) (K->f16 != 0 ? hd_h2f(K->buf##h[(i)]) : K->buf[(i)])
-#define HD__ST_HALF(buf, i, v) (K->f16 != 0 ? (void)(K->buf##h[(i)] = hd_f2h(v)) : (void)(K->buf[(i)] = (v)))
-#define HD__LD_E(i) HD__LD_HALF(E, i)
-#define HD__LD_phi(i) HD__LD_HALF(phi, i)
-#define HD__LD_phi2(i) HD__LD_HALF(phi2, i)
-#define HD__ST_E(i, v) HD__ST_HALF(E, i, v)
-#define HD__ST_phi(i, v) HD__ST_HALF(phi, i, v)
-#define HD__ST_phi2(i, v) HD__ST_HALF(phi2, i, v)
+#define HD_GET(buf, i, x, y, z) HD__LD_##buf((i), (x), (y), (z))
+#define HD_SET(buf, i, x, y, z, v) HD__ST_##buf((i), (x), (y), (z), (v))
+/* hd__split_slot in int arithmetic, as the kernels' own indices (i, ic) are: the projection's 16
+   loads per sample pay for every instruction of the address */
+#define HD__C_AT(xx, yy, zz) \
+    ((((zz) * 2 + (((xx) + (yy) + (zz)) & 1)) * K->p->gdims.y + (yy)) * ((K->p->gdims.x + 1) >> 1) + ((xx) >> 1))
+#define HD__LD_vol(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->vol[(i)])
+#define HD__LD_lv(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv[(i)])
+#define HD__LD_lv2(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv2[(i)])
+#define HD__ST_lv2(i, x, y, z, v) ((void)(x), (void)(y), (void)(z), K->lv2[(i)] = (v))
+#define HD__LD_sig(i, x, y, z) ((void)(i), K->sig[HD__C_AT(x, y, z)])
+#define HD__ST_sig(i, x, y, z, v) ((void)(i), K->sig[HD__C_AT(x, y, z)] = (v))
+#define HD__LD_HALF(buf, x, y, z) (K->f16 != 0 ? hd_h2f(K->buf##h[HD__C_AT(x, y, z)]) : K->buf[HD__C_AT(x, y, z)])
+#define HD__ST_HALF(buf, x, y, z, v) \
+    (K->f16 != 0 ? (void)(K->buf##h[HD__C_AT(x, y, z)] = hd_f2h(v)) : (void)(K->buf[HD__C_AT(x, y, z)] = (v)))
+#define HD__LD_E(i, x, y, z) ((void)(i), HD__LD_HALF(E, x, y, z))
+#define HD__LD_phi(i, x, y, z) ((void)(i), HD__LD_HALF(phi, x, y, z))
+#define HD__LD_phi2(i, x, y, z) ((void)(i), HD__LD_HALF(phi2, x, y, z))
+#define HD__ST_E(i, x, y, z, v) ((void)(i), HD__ST_HALF(E, x, y, z, v))
+#define HD__ST_phi(i, x, y, z, v) ((void)(i), HD__ST_HALF(phi, x, y, z, v))
+#define HD__ST_phi2(i, x, y, z, v) ((void)(i), HD__ST_HALF(phi2, x, y, z, v))
 #define HD_GET1(buf, i) (K->buf[(i)])
 #define HD_SET1(buf, i, v) (K->buf[(i)] = (v))
 #endif

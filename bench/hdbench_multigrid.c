@@ -32,15 +32,35 @@ typedef struct mg_run { int steps; double wall, cpu, res; } mg_run;
 
 static double cpu_seconds(void) { return (double)clock() / CLOCKS_PER_SEC; }
 
-/* The relative residual of the context's fine grid evaluated in double (hd_residual_f64.c):
-   below float32's rounding floor. -1 when it cannot be computed. */
+/* A copy of `slices` z-slices (gz per channel) of a buffer in the CPU backend's colour layout
+   (hd_prelude_c.h's hd__split_slot) in x-fastest order; NULL if out of memory. */
+static float *x_fastest(const hd__ctx *ctx, const float *buf, int slices)
+{
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], x, y, zz;
+    float *out = (float *)malloc((size_t)gx * gy * slices * sizeof(float)), *o = out;
+    if (!out) return NULL;
+    for (zz = 0; zz < slices; ++zz)
+        for (y = 0; y < gy; ++y)
+            for (x = 0; x < gx; ++x) *o++ = buf[hd__split_slot(gx, gy, x, y, zz)];
+    return out;
+}
+
+/* The relative residual of the context's fine grid evaluated in double (hd_residual_f64.c, on
+   x-fastest copies): below float32's rounding floor. -1 when it cannot be computed. */
 static double residual_f64(hd_context h)
 {
     hd__ctx *ctx = hd__lookup(h, NULL);
     size_t gvox;
+    float *sig, *E, *phi;
+    double r = -1.0;
     if (!ctx || !ctx->be->sig || !ctx->be->E || !ctx->be->phi) return -1.0;
     gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
-    return hdb_residual_f64(&ctx->kp, ctx->be->sig, gvox * (size_t)ctx->sig_channels, ctx->be->E, ctx->be->phi);
+    sig = x_fastest(ctx, ctx->be->sig, ctx->gdims[2] * ctx->sig_channels);
+    E = x_fastest(ctx, ctx->be->E, ctx->gdims[2] * ctx->channels);
+    phi = x_fastest(ctx, ctx->be->phi, ctx->gdims[2] * ctx->channels);
+    if (sig && E && phi) r = hdb_residual_f64(&ctx->kp, sig, gvox * (size_t)ctx->sig_channels, E, phi);
+    free(sig); free(E); free(phi);
+    return r;
 }
 
 /* The relative residual of the equation the library solves, with the kernel's own float
@@ -99,8 +119,10 @@ static void tissue_mask_of(hd_context h)
     hd__ctx *ctx = hd__lookup(h, NULL);
     size_t n = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], i;
     float empty_below = 0.5f * ctx->kp.grid.w / (1.0f - ctx->kp.medium.y * ctx->kp.medium.z);
+    float *sig = x_fastest(ctx, ctx->be->sig, ctx->gdims[2]);
     tissue_mask = (unsigned char *)malloc(n);
-    for (i = 0; i < n; ++i) tissue_mask[i] = ctx->be->sig[i] >= empty_below;
+    for (i = 0; i < n; ++i) tissue_mask[i] = sig[i] >= empty_below;
+    free(sig);
 }
 
 /* The relative L2 error of phi (channel 0) over the medium voxels against tissue_ref. */
@@ -111,7 +133,9 @@ static double tissue_error(hd_context h)
     double e2 = 0.0, r2 = 0.0;
     for (i = 0; i < n; ++i)
         if (tissue_mask[i]) {
-            double d = (double)ctx->be->phi[i] - tissue_ref[i];
+            int gx = ctx->gdims[0], gy = ctx->gdims[1];
+            double d = (double)ctx->be->phi[hd__split_slot(gx, gy, (int)(i % gx), (int)(i / gx % gy), (int)(i / gx / gy))] -
+                       tissue_ref[i];
             e2 += d * d;
             r2 += (double)tissue_ref[i] * tissue_ref[i];
         }
@@ -156,7 +180,7 @@ static double residual_ulp_f64(hd_context h)
     float *phi, *keep;
     double res;
     if (!ctx || !ctx->be->phi) return -1.0;
-    n = ctx->be->illum_floats;
+    n = ctx->be->illum_slots; /* the padding slots too: residual_f64 reads only the voxels */
     phi = ctx->be->phi;
     if (!(keep = (float *)malloc(n * sizeof(float)))) return -1.0;
     memcpy(keep, phi, n * sizeof(float));
@@ -225,8 +249,7 @@ int main(int argc, char **argv)
             n = (size_t)rc->gdims[0] * rc->gdims[1] * rc->gdims[2];
             free(tissue_ref);
             free(tissue_mask);
-            tissue_ref = (float *)malloc(n * sizeof(float));
-            memcpy(tissue_ref, rc->be->phi, n * sizeof(float));
+            tissue_ref = x_fastest(rc, rc->be->phi, rc->gdims[2]); /* channel 0 */
             tissue_mask_of(ref);
             if (ref_file) { /* --tissue-ref FILE.box / FILE.surface: one reference for two builds */
                 char fn[1024];

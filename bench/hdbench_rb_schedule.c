@@ -7,7 +7,9 @@
      - the same rows relaxed over and over (48 rows, L2-resident): the row code's own rate, what
        a sweep would cost if the memory traffic were free.
    Interleaved rounds from the same phi, best of each; the phi of both schedules is compared bit
-   for bit. Head CT, one light, box and surface boundary.
+   for bit. Head CT, one light, box and surface boundary. Both schedules run the library's current
+   row code (since the colour layout, hd_prelude_c.h: unit-stride half-rows), so the ratio is the
+   schedule's alone; the row code before it is measured by building this file at an older commit.
    Usage: hdbench_rb_schedule [data/head.nrrd] [threads (default 2)]
    Figures, not a test. */
 #define HYBRIDDIFF_IMPLEMENTATION
@@ -73,7 +75,7 @@ static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
 {
     hd__backend *be = ctx->be;
     hd__cpu_grid g;
-    size_t n = be->illum_floats;
+    size_t n = be->illum_slots; /* phi in the colour layout, padding slots included */
     float *start = (float *)malloc(n * sizeof(float));
     unsigned long long hash[2] = {0, 0};
     int r, i, s, rep, y, z;

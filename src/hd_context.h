@@ -757,8 +757,14 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
        plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
+#ifdef HD__BE_SPLIT_LAYOUT /* the colour layout: one padding slot per row when gx is odd */
+    out->method_bytes = hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->sig_channels) * sizeof(float) +
+                        hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels) *
+                            hd__illum_elem_bytes(ctx) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+#else
     out->method_bytes = gvox * sizeof(float) * (size_t)ctx->sig_channels +
                         hd__illum_floats(ctx) * hd__illum_elem_bytes(ctx) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+#endif
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
 #ifdef HD__BE_HAS_SOLVER_BYTES
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (CPU multigrid levels) */

@@ -73,14 +73,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_i
     HD__GET_CTX(ctx, h);
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
 #if defined(HYBRIDDIFF_BACKEND_CPU)
-    if (ctx->params.illumination_precision == HD_PRECISION_FLOAT16) { /* stored as binary16 */
-        uint16_t *dst = which == HD_ILLUMINATION_DIRECT ? ctx->be->Eh : ctx->be->phih;
-        size_t i;
-        for (i = 0; i < ctx->be->illum_floats; ++i) dst[i] = hd_f2h(src[i]);
-        return HD_SUCCESS;
-    }
-    memcpy(which == HD_ILLUMINATION_DIRECT ? ctx->be->E : ctx->be->phi, src, ctx->be->illum_floats * sizeof(float));
-    return HD_SUCCESS;
+    return hd__cpu_write_illumination(ctx, which, src);
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
     return hd__cl_write_illumination(ctx, which, src);
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)

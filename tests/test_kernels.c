@@ -7,7 +7,9 @@
 #include "hd_test.h"
 #include <stdlib.h>
 
-/* A host kernel context over an n^3 grid of one value per voxel, box of side 1. */
+/* A host kernel context over an n^3 grid of one value per voxel, box of side 1. The volume is
+   x-fastest; sigma_t, E and phi are in the diffusion's colour layout (hd_prelude_c.h): voxel
+   (x, y, z) at KAT(f, x, y, z). */
 typedef struct kfix {
     hd__kparams p;
     hd__kctx k;
@@ -16,6 +18,10 @@ typedef struct kfix {
     int n;
 } kfix;
 
+#define KAT(f, x, y, z) hd__split_slot((f).n, (f).n, (x), (y), (z))
+/* Slots of a grid of n^3 voxels in the colour layout (n odd: one padding slot per row). */
+static size_t kfix_slots(int n) { return hd__split_slots(n, n, (size_t)n); }
+
 static void kfix_init(kfix *f, int n, float extinction, float majorant_factor)
 {
     int i, cells = (n + 7) / 8;
@@ -23,9 +29,9 @@ static void kfix_init(kfix *f, int n, float extinction, float majorant_factor)
     memset(f, 0, sizeof *f);
     f->n = n;
     f->vol = (float *)calloc(nv, sizeof(float));
-    f->sig = (float *)calloc(nv, sizeof(float));
-    f->E = (float *)calloc(nv, sizeof(float));
-    f->phi = (float *)calloc(nv, sizeof(float));
+    f->sig = (float *)calloc(kfix_slots(n), sizeof(float));
+    f->E = (float *)calloc(kfix_slots(n), sizeof(float));
+    f->phi = (float *)calloc(kfix_slots(n), sizeof(float));
     f->maj = (float *)calloc((size_t)cells * cells * cells, sizeof(float));
     /* TF: alpha = value, white */
     f->tf[0] = f->tf[1] = f->tf[2] = 1.0f; f->tf[3] = 0.0f;
@@ -160,12 +166,13 @@ static void test_diffusion_point_source(void)
 {
     kfix f;
     int n = 33, c = 16, i, x, y, z, sweeps;
-    size_t nv = (size_t)n * n * n;
     double res, sigma_t = 9.0, albedo = 0.5, h = 1.0 / n, D, sa, L, Q, maxasym = 0, maxphi = 0, maxerr = 0;
     kfix_init(&f, n, (float)sigma_t, 1.0f);
     f.p.medium.y = (float)albedo;
-    for (i = 0; i < (int)nv; ++i) f.sig[i] = (float)sigma_t;
-    f.E[(c * n + c) * n + c] = 1000.0f;
+    for (z = 0; z < n; ++z)
+        for (y = 0; y < n; ++y)
+            for (x = 0; x < n; ++x) f.sig[KAT(f, x, y, z)] = (float)sigma_t;
+    f.E[KAT(f, c, c, c)] = 1000.0f;
     sweeps = solve(&f, 1e-5, 3000, &res);
     fprintf(stderr, "  residual %.2e after %d sweeps\n", res, sweeps);
     CHECK(res < 1e-5);
@@ -173,9 +180,9 @@ static void test_diffusion_point_source(void)
     for (z = 0; z < n; ++z)
         for (y = 0; y < n; ++y)
             for (x = 0; x < n; ++x) {
-                float v = f.phi[(z * n + y) * n + x];
-                float m = f.phi[(z * n + y) * n + (n - 1 - x)];
-                float s = f.phi[(x * n + z) * n + y];
+                float v = f.phi[KAT(f, x, y, z)];
+                float m = f.phi[KAT(f, n - 1 - x, y, z)];
+                float s = f.phi[KAT(f, y, z, x)];
                 if (fabs(v - m) > maxasym) maxasym = fabs(v - m);
                 if (fabs(v - s) > maxasym) maxasym = fabs(v - s);
                 if (v > maxphi) maxphi = v;
@@ -190,7 +197,7 @@ static void test_diffusion_point_source(void)
     for (i = 5; i <= 10; ++i) {
         double r = i * h;
         double expect = Q * exp(-r / L) / (4.0 * 3.14159265358979 * D * r);
-        double got = f.phi[(c * n + c) * n + c + i];
+        double got = f.phi[KAT(f, c + i, c, c)];
         double err = fabs(got - expect) / expect;
         if (err > maxerr) maxerr = err;
         fprintf(stderr, "  r = %d h: phi %.5e, Green %.5e, rel. error %.3f\n", i, got, expect, err);
@@ -206,12 +213,13 @@ static void test_diffusion_jacobi_matches(void)
     int n = 17, i, s, y, z, parity;
     size_t nv = (size_t)n * n * n;
     double maxd = 0, maxv = 0, res;
-    float *phi2 = (float *)calloc(nv, sizeof(float));
+    float *phi2 = (float *)calloc(kfix_slots(n), sizeof(float));
     kfix_init(&a, n, 20.0f, 1.0f);
     kfix_init(&b, n, 20.0f, 1.0f);
-    for (i = 0; i < (int)nv; ++i) {
-        a.sig[i] = b.sig[i] = 5.0f + (float)(i % 7);
-        a.E[i] = b.E[i] = (float)((i * 37) % 11);
+    for (i = 0; i < (int)nv; ++i) { /* voxel i = (z n + y) n + x */
+        size_t j = KAT(a, i % n, (i / n) % n, i / (n * n));
+        a.sig[j] = b.sig[j] = 5.0f + (float)(i % 7);
+        a.E[j] = b.E[j] = (float)((i * 37) % 11);
     }
     a.p.medium.y = b.p.medium.y = 0.8f;
     solve(&a, 1e-6, 4000, &res);
@@ -222,7 +230,7 @@ static void test_diffusion_jacobi_matches(void)
             for (y = 0; y < n; ++y) hd_diffuse_row(&b.k, y, z, 0, 0, 1);
         t = b.phi; b.phi = phi2; phi2 = t; b.k.phi = b.phi; b.k.phi2 = phi2;
     }
-    for (i = 0; i < (int)nv; ++i) {
+    for (i = 0; i < (int)kfix_slots(n); ++i) { /* padding slots: 0 in both */
         if (fabs(a.phi[i] - b.phi[i]) > maxd) maxd = fabs(a.phi[i] - b.phi[i]);
         if (a.phi[i] > maxv) maxv = a.phi[i];
     }
@@ -257,7 +265,7 @@ static void test_diffusion_surface_boundary(void)
     for (z = 0; z < m; ++z)
         for (y = 0; y < m; ++y)
             for (x = 0; x < m; ++x) {
-                size_t ib = ((size_t)z * m + y) * m + x, ia = ((size_t)(z + o) * n + y + o) * n + x + o;
+                size_t ib = KAT(b, x, y, z), ia = KAT(a, x + o, y + o, z + o);
                 a.sig[ia] = b.sig[ib] = box.sig[ia] = 30.0f;
                 a.E[ia] = b.E[ib] = box.E[ia] = 1.0f;
             }
@@ -269,11 +277,11 @@ static void test_diffusion_surface_boundary(void)
     for (z = 0; z < n; ++z)
         for (y = 0; y < n; ++y)
             for (x = 0; x < n; ++x) {
-                size_t ia = ((size_t)z * n + y) * n + x;
+                size_t ia = KAT(a, x, y, z);
                 int in = x >= o && x < o + m && y >= o && y < o + m && z >= o && z < o + m;
                 if (!in) { if (fabs(a.phi[ia]) > maxair) maxair = fabs(a.phi[ia]); continue; }
                 {
-                    double v = b.phi[((size_t)(z - o) * m + y - o) * m + x - o];
+                    double v = b.phi[KAT(b, x - o, y - o, z - o)];
                     if (fabs(a.phi[ia] - v) > maxd) maxd = fabs(a.phi[ia] - v);
                     if (v > maxv) maxv = v;
                     sum_surf += a.phi[ia];
@@ -308,20 +316,20 @@ static void test_diffusion_surface_extrapolation(void)
     for (z = o; z < o + m; ++z)
         for (y = o; y < o + m; ++y)
             for (x = o; x < o + m; ++x) {
-                size_t i = ((size_t)z * n + y) * n + x;
+                size_t i = KAT(f, x, y, z);
                 f.sig[i] = 7.0f + (float)((x + 2 * y + 3 * z) % 6);
                 f.E[i] = 1.0f;
             }
-    f.sig[((size_t)o * n + o) * n + o] = 0.0f; /* a corner emptied */
-    f.E[((size_t)o * n + o) * n + o] = 0.0f;
-    f.sig[((size_t)(o + m - 1) * n + o + m - 1) * n + o + m - 1] = 60.0f; /* 1.5 sigma' h = 6.4: factor 0 */
+    f.sig[KAT(f, o, o, o)] = 0.0f; /* a corner emptied */
+    f.E[KAT(f, o, o, o)] = 0.0f;
+    f.sig[KAT(f, o + m - 1, o + m - 1, o + m - 1)] = 60.0f; /* 1.5 sigma' h = 6.4: factor 0 */
     solve(&f, 1e-6, 4000, &res);
     CHECK(res < 1e-6);
     for (z = 0; z < n; ++z)
         for (y = 0; y < n; ++y)
             for (x = 0; x < n; ++x) {
                 static const int d[6][3] = {{-1, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}};
-                size_t i = ((size_t)z * n + y) * n + x;
+                size_t i = KAT(f, x, y, z);
                 double sum = 0, cnt = 0, expect;
                 if (f.phi[i] > maxv) maxv = f.phi[i];
                 if (f.sig[i] > 0.0f) continue;
@@ -329,10 +337,10 @@ static void test_diffusion_surface_extrapolation(void)
                     int u = x + d[q][0], v = y + d[q][1], w = z + d[q][2];
                     double sp, g;
                     if (u < 0 || v < 0 || w < 0 || u >= n || v >= n || w >= n) continue;
-                    sp = f.sig[((size_t)w * n + v) * n + u]; /* g = 0: sigma' = sigma_t */
+                    sp = f.sig[KAT(f, u, v, w)]; /* g = 0: sigma' = sigma_t */
                     if (sp + sp < 1e-3) continue;
                     g = 1.5 * sp * h;
-                    sum += (g < 2 ? 2 - g : 0) / (2 + g) * f.phi[((size_t)w * n + v) * n + u];
+                    sum += (g < 2 ? 2 - g : 0) / (2 + g) * f.phi[KAT(f, u, v, w)];
                     cnt += 1;
                 }
                 expect = cnt > 0 ? sum / cnt : 0.0;
@@ -351,7 +359,7 @@ static void test_diffusion_surface_extrapolation(void)
         for (parity = 0; parity < 2; ++parity)
             for (z = 0; z < n; ++z)
                 for (y = 0; y < n; ++y) hd_diffuse_row(&f.k, y, z, 0, parity, 0);
-    for (x = 0; x < n * n * n; ++x)
+    for (x = 0; x < (int)kfix_slots(n); ++x) /* padding slots: sigma_t 0, phi 0 */
         if (f.sig[x] == 0.0f && fabs(f.phi[x]) > maxrhs) maxrhs = fabs(f.phi[x]);
     CHECK(maxrhs == 0.0);
     kfix_free(&f);

@@ -249,17 +249,19 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
     return num;
 }
 
-/* The surface boundary's update from loaded values, the arguments as hd_diffuse_box_of's: an
-   empty voxel gets its extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward
-   empty neighbours or the box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic,
-   so the CPU's row loop stays branch-free. */
-HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
-                                  float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
-                                  float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
-                                  int in_zp, HD_INOUT(float) den)
+/* The surface boundary's update from loaded values, the arguments as hd_diffuse_box_of's after
+   rhs (HD_FLAG_DIFFUSE_RHS: no extrapolation into empty voxels): an empty voxel gets its
+   extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward empty neighbours or the
+   box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic, so
+   the CPU's row loop stays branch-free; it passes rhs as a literal (with the flag loaded at run
+   time its loops took 11 against 3.4 ns per update, GCC 12). */
+HD_FN float hd_diffuse_surface_rhs_of(HD_KARGS int rhs, float num, float dn, float sp, float s_xm, float s_xp,
+                                      float s_ym, float s_yp, float s_zm, float s_zp, float p_xm, float p_xp,
+                                      float p_ym, float p_yp, float p_zm, float p_zp, int in_xm, int in_xp, int in_ym,
+                                      int in_yp, int in_zm, int in_zp, HD_INOUT(float) den)
 {
     float fl = HD_PRM(grid).w, cnt = 0.0f, self;
-    int extrap = (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) == 0 ? 1 : 0;
+    int extrap = rhs == 0 ? 1 : 0;
     num = hd_diffuse_surface_start(num, sp, fl, HD_REF(self));
     hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, self, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl,
                             HD_REF(num), HD_REF(dn), HD_REF(cnt));
@@ -268,6 +270,17 @@ HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float 
     hd_diffuse_surface_axis(HD_PRM(grid).z, HD_PRM(gridh).z, sp, self, s_zm, s_zp, p_zm, p_zp, in_zm, in_zp, fl,
                             HD_REF(num), HD_REF(dn), HD_REF(cnt));
     return hd_diffuse_surface_end(self, num, dn, cnt, extrap, den);
+}
+
+/* The same with rhs from the flags (HD_DIFFUSE_FLAGS). */
+HD_FN float hd_diffuse_surface_of(HD_KARGS float num, float dn, float sp, float s_xm, float s_xp, float s_ym,
+                                  float s_yp, float s_zm, float s_zp, float p_xm, float p_xp, float p_ym, float p_yp,
+                                  float p_zm, float p_zp, int in_xm, int in_xp, int in_ym, int in_yp, int in_zm,
+                                  int in_zp, HD_INOUT(float) den)
+{
+    return hd_diffuse_surface_rhs_of(HD_KPASS (HD_DIFFUSE_FLAGS & HD_FLAG_DIFFUSE_RHS) != 0 ? 1 : 0, num, dn, sp, s_xm,
+                                     s_xp, s_ym, s_yp, s_zm, s_zp, p_xm, p_xp, p_ym, p_yp, p_zm, p_zp, in_xm, in_xp,
+                                     in_ym, in_yp, in_zm, in_zp, den);
 }
 
 /* The update from loaded values under the configured boundary (HD_DIFFUSE_FLAGS). */
