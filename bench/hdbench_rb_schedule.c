@@ -5,7 +5,9 @@
      - "colour by colour": the schedule before it (466e1a8), rebuilt here: per colour, every block
        of 16 rows but its last row, then the blocks' last rows; each plane streams twice a sweep;
      - the same rows relaxed over and over (48 rows, L2-resident): the row code's own rate, what
-       a sweep would cost if the memory traffic were free.
+       a sweep would cost if the memory traffic were free;
+     - N sweeps as one call hd__cpu_red_black(be, N, 0) (walks of several sweeps, temporal
+       blocking) against N calls of one sweep, N = 2 and 4, walks of up to 2 and of up to 4 sweeps.
    Interleaved rounds from the same phi, best of each; the phi of both schedules is compared bit
    for bit. Head CT, one light, box and surface boundary. Both schedules run the library's current
    row code (since the colour layout, hd_prelude_c.h: unit-stride half-rows), so the ratio is the
@@ -116,6 +118,48 @@ static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
     free(start);
 }
 
+/* Seconds per sweep of N sweeps as N calls of one (best[0]) and as one call in walks of up to
+   `walk` sweeps (best[1]), interleaved rounds from the same phi, best of each; *same: phi equal
+   bit for bit after the first round. */
+static void measure_walks(hd__ctx *ctx, int N, int walk, double best[2], int *same)
+{
+    hd__backend *be = ctx->be;
+    hd__cpu_grid g;
+    size_t n = be->illum_slots;
+    float *start = (float *)malloc(n * sizeof(float));
+    unsigned long long hash[2] = {0, 0};
+    int r, i, s, reps = 8 / N;
+    if (!start) { fprintf(stderr, "hdbench_rb_schedule: out of memory\n"); exit(1); }
+    memcpy(start, be->phi, n * sizeof(float));
+    g.k = &be->k;
+    g.res = NULL;
+    be->grid = &g;
+    hd__fill_kparams(ctx);
+    best[0] = best[1] = 1e30;
+    for (r = 0; r < 12; ++r)
+        for (i = 0; i < 2; ++i) {
+            double t;
+            memcpy(be->phi, start, n * sizeof(float));
+            be->rb_walk_sweeps = walk;
+            t = now();
+            for (s = 0; s < reps; ++s) {
+                if (i) hd__cpu_red_black(be, N, 0);
+                else {
+                    int k;
+                    for (k = 0; k < N; ++k) hd__cpu_red_black(be, 1, 0);
+                }
+            }
+            t = (now() - t) / (reps * N);
+            if (t < best[i]) best[i] = t;
+            if (r == 0) hash[i] = phi_hash(be->phi, n);
+        }
+    *same = hash[0] == hash[1];
+    be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
+    memcpy(be->phi, start, n * sizeof(float));
+    be->grid = NULL;
+    free(start);
+}
+
 int main(int argc, char **argv)
 {
     const char *path = argc > 1 ? argv[1] : "data/head.nrrd";
@@ -156,6 +200,18 @@ int main(int argc, char **argv)
                "%.2f ns per voxel update in a sweep x threads, %.2f ns with the rows L2-resident (one thread)\n",
                boundary == HD_BOUNDARY_BOX ? "box" : "surface", best[0] * 1e3, best[1] * 1e3, best[0] / best[1],
                same ? "bit-identical" : "DIFFERENT", best[1] / nvox * threads * 1e9, l2 * 1e9);
+        {
+            static const int walks[][2] = {{2, 2}, {4, 2}, {4, 4}};
+            int w;
+            for (w = 0; w < 3; ++w) {
+                HD__GET_CTX(ctx, h);
+                measure_walks(ctx, walks[w][0], walks[w][1], best, &same);
+                printf("  %d sweeps: %d calls of one %.2f ms, one call (walks of up to %d) %.2f ms per sweep (%.2fx, phi %s); "
+                       "%.2f ns per voxel update x threads\n",
+                       walks[w][0], walks[w][0], best[0] * 1e3, walks[w][1], best[1] * 1e3, best[0] / best[1],
+                       same ? "bit-identical" : "DIFFERENT", best[1] / nvox * threads * 1e9);
+            }
+        }
         hd_destroy(h);
     }
     hd_volume_free(&vf);

@@ -562,9 +562,14 @@ static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
 {
     hd_result r;
     int s;
-    if (!ctx->params.disable_diffusion)
-        for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
-            if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
+    if (ctx->params.disable_diffusion) return HD_SUCCESS;
+#ifdef HD__BE_HAS_DIFFUSE_SWEEPS
+    /* all of them in one call: the CPU backend walks memory once for several red-black sweeps */
+    if (ctx->params.solver != HD_SOLVER_MULTIGRID)
+        return hd__be_diffuse_sweeps(ctx, ctx->params.solver == HD_SOLVER_JACOBI, ctx->params.diffusion_sweeps);
+#endif
+    for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
+        if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
     return HD_SUCCESS;
 }
 
