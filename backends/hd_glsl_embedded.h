@@ -1063,6 +1063,15 @@ static const char *const hd__gl_source[] = {
 "    return HD_GET(sig, j, x, y, z) < empty_below ? 0.0f : 1.0f;\n",
 "}\n",
 "\n",
+"/* hd_mg_medium of a voxel whose sigma_t the caller loaded (the CPU's row passes load a row once:\n",
+"   the colour layout makes a load by coordinates a gather). */\n",
+"HD_FN float hd_mg_medium_of(HD_KARGS float sig)\n",
+"{\n",
+"    float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);\n",
+"    if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0) return 1.0f;\n",
+"    return sig < empty_below ? 0.0f : 1.0f;\n",
+"}\n",
+"\n",
 "/* ---- restriction R = P^T / 8 (full weighting) ------------------------------------------------- */\n",
 "/* The full-weighting weight of fine index 2 C - 1 + t (t = 0..3) for coarse index C: 1/8 3/8 3/8\n",
 "   1/8, the transpose of the prolongation's 3/4, 1/4 halved (the 8 children's volume): a weighted\n",
@@ -1094,6 +1103,13 @@ static const char *const hd__gl_source[] = {
 "        }\n",
 "    }\n",
 "    return line;\n",
+"}\n",
+"\n",
+"/* hd_mg_restrict_line's step for fine row (a, b) on values the caller loaded: the residual res\n",
+"   and its voxel's hd_mg_medium m (the same operations in the same order: the same bits). */\n",
+"HD_FN float hd_mg_restrict_term(float line, int a, int b, float res, float m)\n",
+"{\n",
+"    return line + (hd_mg_fw(a) * hd_mg_fw(b)) * (res * m);\n",
 "}\n",
 "\n",
 "/* s plus the share of fine column 2 X - 1 + t (its hd_mg_restrict_line value `line`). */\n",
@@ -1138,6 +1154,13 @@ static const char *const hd__gl_source[] = {
 "        }\n",
 "    }\n",
 "    return v;\n",
+"}\n",
+"\n",
+"/* hd_mg_prolong's step for corner (a, b, t) inside the coarse grid on the coarse value u the\n",
+"   caller loaded (the same operations in the same order: the same bits). */\n",
+"HD_FN float hd_mg_prolong_term(float v, int a, int b, int t, float u)\n",
+"{\n",
+"    return v + hd_mg_pw(a) * hd_mg_pw(b) * hd_mg_pw(t) * u;\n",
 "}\n",
 "\n",
 "/* ---- conjugate gradients ---------------------------------------------------------------------- */\n",
@@ -1852,7 +1875,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1546 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1569 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])
