@@ -389,11 +389,15 @@ static HD__CPU_FLATTEN void hd__cpu_mg_residual_f64_into(const hd__backend *be, 
 }
 
 /* Row r (= zz * gy + y) of a grid in the colour layout of dims d: from row[] (x in order) into
-   buf's slots, and back. */
+   buf's slots, one unit-stride colour half-row at a time. */
 static void hd__cpu_mg_scatter_row(const hd__kparams *d, float *buf, int r, const float *row)
 {
-    int gx = d->gdims.x, gy = d->gdims.y, x;
-    for (x = 0; x < gx; ++x) buf[hd__split_slot(gx, gy, x, r % gy, r / gy)] = row[x];
+    int gx = d->gdims.x, gy = d->gdims.y, h, i, n;
+    for (h = 0; h < 2; ++h) {
+        float *dst = buf + hd__split_slot(gx, gy, h, r % gy, r / gy);
+        n = hd__cpu_half_len(gx, h);
+        for (i = 0; i < n; ++i) dst[i] = row[2 * i + h];
+    }
 }
 
 /* The residual of row r of be->grid into its res. */
@@ -405,15 +409,18 @@ static void hd__cpu_mg_residual_f64_row(hd__backend *be, int r)
 }
 
 /* ---- conjugate gradients' passes over the fine rows --------------------------------------------- */
-/* <a, b> of row r of level 0 (hd_mg_dot_row: in double, x in order). */
-static double hd__cpu_mg_dot(const hd__backend *be, int r, float *a, float *b)
+/* <a, b> of row r of level 0 (hd_mg_dot_row's terms, hd_mg_dot_term: in double, x in order) on
+   the two rows loaded once (loads by coordinates are gathers in the colour layout). */
+static double hd__cpu_mg_dot(const hd__backend *be, int r, const float *a, const float *b)
 {
-    const struct hd__cpu_mg *mg = be->mg;
-    hd__kctx k = mg->lv[0].k;
-    k.f16 = 0;
-    k.E = a;
-    k.phi = b;
-    return hd_mg_dot_row(&k, r % mg->lv[0].dims[1], r / mg->lv[0].dims[1]);
+    const int *d = be->mg->lv[0].dims;
+    float ra[HD__CPU_ROW_MAX], rb[HD__CPU_ROW_MAX];
+    double s = 0.0;
+    int x;
+    hd__cpu_mg_load_row(a, d[0], d[1], r % d[1], r / d[1], ra);
+    hd__cpu_mg_load_row(b, d[0], d[1], r % d[1], r / d[1], rb);
+    for (x = 0; x < d[0]; ++x) s = hd_mg_dot_term(s, ra[x], rb[x]);
+    return s;
 }
 
 /* The half-row of x parity h of fine row r (= zz * gy + y) of the colour layout: its first slot,

@@ -1255,6 +1255,13 @@ static const char *const hd__gl_source[] = {
 "    return d;\n",
 "}\n",
 "\n",
+"/* hd_mg_dot_row's step on values the caller loaded (the CPU loads a row once, as its two colour\n",
+"   half-rows): the same operations, so the same bits when x runs in order. */\n",
+"HD_FN double hd_mg_dot_term(double d, float a, float b)\n",
+"{\n",
+"    return d + HD_D(a) * HD_D(b);\n",
+"}\n",
+"\n",
 "/* phi + lo += alpha p in double: returns the new phi, the sum rounded to float (what the\n",
 "   projection reads), and leaves the rest in *lo. Why: with phi alone, every step's rounding (up\n",
 "   to half an ulp per voxel) added a fresh rough error one line search cannot remove (the head\n",
@@ -1875,7 +1882,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1569 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1576 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

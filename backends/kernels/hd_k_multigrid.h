@@ -279,6 +279,13 @@ HD_FN double hd_mg_dot_row(HD_KARGS int y, int zz)
     return d;
 }
 
+/* hd_mg_dot_row's step on values the caller loaded (the CPU loads a row once, as its two colour
+   half-rows): the same operations, so the same bits when x runs in order. */
+HD_FN double hd_mg_dot_term(double d, float a, float b)
+{
+    return d + HD_D(a) * HD_D(b);
+}
+
 /* phi + lo += alpha p in double: returns the new phi, the sum rounded to float (what the
    projection reads), and leaves the rest in *lo. Why: with phi alone, every step's rounding (up
    to half an ulp per voxel) added a fresh rough error one line search cannot remove (the head
