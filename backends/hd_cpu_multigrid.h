@@ -39,8 +39,11 @@
    perf: the prolongation 1.7x, the restriction 1.3-1.4x), so they load each row they read once,
    as its two unit-stride half-rows (hd__cpu_mg_load_row), and run the kernel's per-term
    functions on the values (hd_mg_prolong_term, hd_mg_restrict_term, hd_mg_medium_of: the same
-   operations in the same order, the same bits). Still through coordinates: the double residual
-   (1.2x) and the surface extrapolation (1.3x).
+   operations in the same order, the same bits), as do CG's dot products (hd_mg_dot_term): full
+   resolution box 211-213 ms against 212-236 before the colour layout and 274-278 with the
+   gathers, surface 267-277 against 261-266 and 304; half resolution 31-32 / 38 against 29 / 36
+   and 39 / 43 (two interleaved rounds, load 2.5-3). Still through coordinates: the double
+   residual (1.2x) and the surface extrapolation (1.3x; a literal f16 there gained nothing).
 
    The V-cycle is a symmetric positive definite preconditioner (M^-1 symmetric, what CG needs):
    - every level's smoothing and residual are the shared kernel's (hd_k_diffuse.h: the same
