@@ -33,12 +33,17 @@
    300 ms against 20.5 ms per sweep at 256x256x108, 47.8 against 3.23 at half resolution); the
    V-cycle is two thirds of it, the two double-summed residual passes most of the rest.
    Every level's buffers are in the colour layout (hd__mg_slots), so the smoothing runs the
-   sweep's unit-stride rows, but the transfers (hd_mg_prolong, hd_mg_restrict_line) and the
-   double residual load through coordinates, now gathers across the two colour halves: a step
-   went from 213 to 280 ms (box) and 268 to 316 ms (surface) at full resolution, 30 to 40 and 38
-   to 45 ms at half (one A/B pair, load 2; perf: the prolongation 1.7x, the restriction and the
-   extrapolation 1.3-1.4x, the double residual 1.2x). Not yet addressed: a pure
-   hd_mg_prolong_of on values the row loads once would undo most of it.
+   sweep's unit-stride rows. A load by coordinates alternates between the two colour halves of a
+   row (a gather): with the transfers loading so (hd_mg_prolong, hd_mg_restrict_line) a step went
+   from 213 to 280 ms (box) and 268 to 316 ms (surface) at full resolution (one A/B pair, load 2;
+   perf: the prolongation 1.7x, the restriction 1.3-1.4x), so they load each row they read once,
+   as its two unit-stride half-rows (hd__cpu_mg_load_row), and run the kernel's per-term
+   functions on the values (hd_mg_prolong_term, hd_mg_restrict_term, hd_mg_medium_of: the same
+   operations in the same order, the same bits), as do CG's dot products (hd_mg_dot_term): full
+   resolution box 211-213 ms against 212-236 before the colour layout and 274-278 with the
+   gathers, surface 267-277 against 261-266 and 304; half resolution 31-32 / 38 against 29 / 36
+   and 39 / 43 (two interleaved rounds, load 2.5-3). Still through coordinates: the double
+   residual (1.2x) and the surface extrapolation (1.3x; a literal f16 there gained nothing).
 
    The V-cycle is a symmetric positive definite preconditioner (M^-1 symmetric, what CG needs):
    - every level's smoothing and residual are the shared kernel's (hd_k_diffuse.h: the same
@@ -235,25 +240,49 @@ static HD__CPU_FLATTEN void hd__cpu_mg_sig_row(hd__backend *be, int r)
         C->sig[hd__split_slot(C->dims[0], C->dims[1], X, Y, Z + ch * C->dims[2])] = hd_mg_coarse_sig(&k, X, Y, Z, ch);
 }
 
+/* Row (y, zz) of a grid of dims gx, gy in the colour layout into out[] in x order: its two
+   colour half-rows, each unit-stride (a load by coordinates would alternate between them). */
+static void hd__cpu_mg_load_row(const float *buf, int gx, int gy, int y, int zz, float *out)
+{
+    int h, i, n;
+    for (h = 0; h < 2; ++h) {
+        const float *src = buf + hd__split_slot(gx, gy, h, y, zz);
+        n = hd__cpu_half_len(gx, h);
+        for (i = 0; i < n; ++i) out[2 * i + h] = src[i];
+    }
+}
+
 /* The right-hand side of level mg->cur: R = P^T / 8 of the residual of the level above
-   (hd_k_multigrid.h), each fine column's share of the row computed once (hd_mg_restrict_line, a
-   vector loop) and four of them combined per coarse voxel (hd_mg_restrict_x); its phi (the
-   correction) starts at 0. */
+   (hd_k_multigrid.h), each fine column's share of the row computed once (hd_mg_restrict_line's
+   terms, hd_mg_restrict_term, on each of the up to 16 fine rows loaded once, in its a, b order)
+   and four of them combined per coarse voxel (hd_mg_restrict_x); its phi (the correction)
+   starts at 0. */
 static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
     hd__cpu_level *C = &mg->lv[mg->cur], *F = &mg->lv[mg->cur - 1];
-    int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X, x, t;
+    int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X, x, t, a, b;
+    int gx = F->dims[0], gy = F->dims[1], gz = F->dims[2];
     hd__kctx k = F->k;
-    float line[HD__CPU_ROW_MAX];
+    float line[HD__CPU_ROW_MAX], res[HD__CPU_ROW_MAX], m[HD__CPU_ROW_MAX];
     k.f16 = 0;
-    k.phi = F->res;
-    for (x = 0; x < F->dims[0]; ++x) line[x] = hd_mg_restrict_line(&k, x, Y, Z, ch);
+    for (x = 0; x < gx; ++x) line[x] = 0.0f;
+    for (a = 0; a < 4; ++a) {
+        int z = 2 * Z - 1 + a;
+        if (z < 0 || z >= gz) continue;
+        for (b = 0; b < 4; ++b) {
+            int y = 2 * Y - 1 + b;
+            if (y < 0 || y >= gy) continue;
+            hd__cpu_mg_load_row(F->res, gx, gy, y, z + ch * gz, res);
+            hd__cpu_mg_load_row(k.sig, gx, gy, y, z, m);
+            for (x = 0; x < gx; ++x) line[x] = hd_mg_restrict_term(line[x], a, b, res[x], hd_mg_medium_of(&k, m[x]));
+        }
+    }
     for (X = 0; X < C->dims[0]; ++X) {
         float s = 0.0f;
         for (t = 0; t < 4; ++t) {
             x = 2 * X - 1 + t;
-            if (x >= 0 && x < F->dims[0]) s = hd_mg_restrict_x(s, t, line[x]);
+            if (x >= 0 && x < gx) s = hd_mg_restrict_x(s, t, line[x]);
         }
         size_t o = hd__split_slot(C->dims[0], C->dims[1], X, Y, Z + ch * C->dims[2]);
         C->rhs[o] = s;
@@ -261,20 +290,48 @@ static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
     }
 }
 
-/* Adds the prolonged correction of level mg->cur (hd_mg_prolong), masked to the medium
-   (hd_mg_medium of the level above's sigma_t), to row r of the level above. */
+/* Adds the prolonged correction of level mg->cur (hd_mg_prolong's terms, hd_mg_prolong_term, on
+   the up to 4 coarse rows loaded once), masked to the medium (hd_mg_medium_of the level above's
+   sigma_t), to row r of the level above. */
 static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
-    const hd__cpu_level *F = &mg->lv[mg->cur - 1];
-    hd__kctx k = mg->lv[mg->cur].k, kf = F->k;
-    int gx = F->dims[0], y = r % F->dims[1], z = (r / F->dims[1]) % F->dims[2], c = r / (F->dims[1] * F->dims[2]), x;
-    int j = (z * F->dims[1] + y) * gx;
-    float e[HD__CPU_ROW_MAX];
-    k.f16 = 0;
+    const hd__cpu_level *F = &mg->lv[mg->cur - 1], *C = &mg->lv[mg->cur];
+    hd__kctx kf = F->k;
+    int gx = F->dims[0], gy = F->dims[1], gz = F->dims[2], y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
+    int GX = C->dims[0], GY = C->dims[1], GZ = C->dims[2], x, a, b, t, h, i, n;
+    int zc[2], yc[2];
+    float e[HD__CPU_ROW_MAX], m[HD__CPU_ROW_MAX], u[2][2][HD__CPU_ROW_MAX / 2 + 1];
     kf.f16 = 0;
-    for (x = 0; x < gx; ++x) e[x] = hd_mg_prolong(&k, x, y, z, c) * hd_mg_medium(&kf, j + x, x, y, z);
-    for (x = 0; x < gx; ++x) F->phi[hd__split_slot(gx, F->dims[1], x, y, z + c * F->dims[2])] += e[x];
+    zc[0] = z >> 1;
+    zc[1] = hd_mg_far(z);
+    yc[0] = y >> 1;
+    yc[1] = hd_mg_far(y);
+    for (a = 0; a < 2; ++a)
+        for (b = 0; b < 2; ++b)
+            if (zc[a] >= 0 && zc[a] < GZ && yc[b] >= 0 && yc[b] < GY)
+                hd__cpu_mg_load_row(C->phi, GX, GY, yc[b], zc[a] + c * GZ, u[a][b]);
+    hd__cpu_mg_load_row(kf.sig, gx, gy, y, z, m);
+    for (x = 0; x < gx; ++x) {
+        int xc[2];
+        float v = 0.0f;
+        xc[0] = x >> 1;
+        xc[1] = hd_mg_far(x);
+        for (a = 0; a < 2; ++a) {
+            if (zc[a] < 0 || zc[a] >= GZ) continue;
+            for (b = 0; b < 2; ++b) {
+                if (yc[b] < 0 || yc[b] >= GY) continue;
+                for (t = 0; t < 2; ++t)
+                    if (xc[t] >= 0 && xc[t] < GX) v = hd_mg_prolong_term(v, a, b, t, u[a][b][xc[t]]);
+            }
+        }
+        e[x] = v * hd_mg_medium_of(&kf, m[x]);
+    }
+    for (h = 0; h < 2; ++h) {
+        float *dst = F->phi + hd__split_slot(gx, gy, h, y, z + c * gz);
+        n = hd__cpu_half_len(gx, h);
+        for (i = 0; i < n; ++i) dst[i] += e[2 * i + h];
+    }
 }
 
 /* ---- the V-cycle: z = M r ------------------------------------------------------------------------ */
@@ -335,11 +392,15 @@ static HD__CPU_FLATTEN void hd__cpu_mg_residual_f64_into(const hd__backend *be, 
 }
 
 /* Row r (= zz * gy + y) of a grid in the colour layout of dims d: from row[] (x in order) into
-   buf's slots, and back. */
+   buf's slots, one unit-stride colour half-row at a time. */
 static void hd__cpu_mg_scatter_row(const hd__kparams *d, float *buf, int r, const float *row)
 {
-    int gx = d->gdims.x, gy = d->gdims.y, x;
-    for (x = 0; x < gx; ++x) buf[hd__split_slot(gx, gy, x, r % gy, r / gy)] = row[x];
+    int gx = d->gdims.x, gy = d->gdims.y, h, i, n;
+    for (h = 0; h < 2; ++h) {
+        float *dst = buf + hd__split_slot(gx, gy, h, r % gy, r / gy);
+        n = hd__cpu_half_len(gx, h);
+        for (i = 0; i < n; ++i) dst[i] = row[2 * i + h];
+    }
 }
 
 /* The residual of row r of be->grid into its res. */
@@ -351,15 +412,18 @@ static void hd__cpu_mg_residual_f64_row(hd__backend *be, int r)
 }
 
 /* ---- conjugate gradients' passes over the fine rows --------------------------------------------- */
-/* <a, b> of row r of level 0 (hd_mg_dot_row: in double, x in order). */
-static double hd__cpu_mg_dot(const hd__backend *be, int r, float *a, float *b)
+/* <a, b> of row r of level 0 (hd_mg_dot_row's terms, hd_mg_dot_term: in double, x in order) on
+   the two rows loaded once (loads by coordinates are gathers in the colour layout). */
+static double hd__cpu_mg_dot(const hd__backend *be, int r, const float *a, const float *b)
 {
-    const struct hd__cpu_mg *mg = be->mg;
-    hd__kctx k = mg->lv[0].k;
-    k.f16 = 0;
-    k.E = a;
-    k.phi = b;
-    return hd_mg_dot_row(&k, r % mg->lv[0].dims[1], r / mg->lv[0].dims[1]);
+    const int *d = be->mg->lv[0].dims;
+    float ra[HD__CPU_ROW_MAX], rb[HD__CPU_ROW_MAX];
+    double s = 0.0;
+    int x;
+    hd__cpu_mg_load_row(a, d[0], d[1], r % d[1], r / d[1], ra);
+    hd__cpu_mg_load_row(b, d[0], d[1], r % d[1], r / d[1], rb);
+    for (x = 0; x < d[0]; ++x) s = hd_mg_dot_term(s, ra[x], rb[x]);
+    return s;
 }
 
 /* The half-row of x parity h of fine row r (= zz * gy + y) of the colour layout: its first slot,

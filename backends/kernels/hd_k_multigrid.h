@@ -87,6 +87,15 @@ HD_FN float hd_mg_medium(HD_KARGS int j, int x, int y, int z)
     return HD_GET(sig, j, x, y, z) < empty_below ? 0.0f : 1.0f;
 }
 
+/* hd_mg_medium of a voxel whose sigma_t the caller loaded (the CPU's row passes load a row once:
+   the colour layout makes a load by coordinates a gather). */
+HD_FN float hd_mg_medium_of(HD_KARGS float sig)
+{
+    float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);
+    if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0) return 1.0f;
+    return sig < empty_below ? 0.0f : 1.0f;
+}
+
 /* ---- restriction R = P^T / 8 (full weighting) ------------------------------------------------- */
 /* The full-weighting weight of fine index 2 C - 1 + t (t = 0..3) for coarse index C: 1/8 3/8 3/8
    1/8, the transpose of the prolongation's 3/4, 1/4 halved (the 8 children's volume): a weighted
@@ -118,6 +127,13 @@ HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
         }
     }
     return line;
+}
+
+/* hd_mg_restrict_line's step for fine row (a, b) on values the caller loaded: the residual res
+   and its voxel's hd_mg_medium m (the same operations in the same order: the same bits). */
+HD_FN float hd_mg_restrict_term(float line, int a, int b, float res, float m)
+{
+    return line + (hd_mg_fw(a) * hd_mg_fw(b)) * (res * m);
 }
 
 /* s plus the share of fine column 2 X - 1 + t (its hd_mg_restrict_line value `line`). */
@@ -162,6 +178,13 @@ HD_FN float hd_mg_prolong(HD_KARGS int x, int y, int z, int c)
         }
     }
     return v;
+}
+
+/* hd_mg_prolong's step for corner (a, b, t) inside the coarse grid on the coarse value u the
+   caller loaded (the same operations in the same order: the same bits). */
+HD_FN float hd_mg_prolong_term(float v, int a, int b, int t, float u)
+{
+    return v + hd_mg_pw(a) * hd_mg_pw(b) * hd_mg_pw(t) * u;
 }
 
 /* ---- conjugate gradients ---------------------------------------------------------------------- */
@@ -254,6 +277,13 @@ HD_FN double hd_mg_dot_row(HD_KARGS int y, int zz)
     double d = HD_D(0.0f);
     for (int x = 0; x < gx; ++x) d += HD_D(HD_GET(E, base + x, x, y, zz)) * HD_D(HD_GET(phi, base + x, x, y, zz));
     return d;
+}
+
+/* hd_mg_dot_row's step on values the caller loaded (the CPU loads a row once, as its two colour
+   half-rows): the same operations, so the same bits when x runs in order. */
+HD_FN double hd_mg_dot_term(double d, float a, float b)
+{
+    return d + HD_D(a) * HD_D(b);
 }
 
 /* phi + lo += alpha p in double: returns the new phi, the sum rounded to float (what the
