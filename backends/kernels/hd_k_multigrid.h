@@ -79,21 +79,19 @@ HD_FN float hd_mg_coarse_sig(HD_KARGS int X, int Y, int Z, int ch)
    the air beside it, an error of that much energy that CG's line search scaled every step down
    to nothing (24^3 sphere, max error after 12 steps 9.1e-3 unmasked, 3.8e-6 masked; the
    smoothers alone carry air's own correction). The surface boundary's empty voxels are identity
-   rows already, and its transfers keep their bits (a product by 1). */
-HD_FN float hd_mg_medium(HD_KARGS int j, int x, int y, int z)
-{
-    float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);
-    if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0) return 1.0f;
-    return HD_GET(sig, j, x, y, z) < empty_below ? 0.0f : 1.0f;
-}
-
-/* hd_mg_medium of a voxel whose sigma_t the caller loaded (the CPU's row passes load a row once:
-   the colour layout makes a load by coordinates a gather). */
+   rows already, and its transfers keep their bits (a product by 1). hd_mg_medium_of: the mask of a voxel whose sigma_t the caller loaded (the
+   CPU's row passes load a row once: in the colour layout a load by coordinates is a gather). */
 HD_FN float hd_mg_medium_of(HD_KARGS float sig)
 {
     float empty_below = 0.5f * HD_PRM(grid).w / (1.0f - HD_PRM(medium).y * HD_PRM(medium).z);
     if ((HD_PRM(counts).z & HD_FLAG_SURFACE_BOUNDARY) != 0) return 1.0f;
     return sig < empty_below ? 0.0f : 1.0f;
+}
+
+/* The mask loaded at grid voxel j (image coordinates x, y, z). */
+HD_FN float hd_mg_medium(HD_KARGS int j, int x, int y, int z)
+{
+    return hd_mg_medium_of(HD_KPASS HD_GET(sig, j, x, y, z));
 }
 
 /* ---- restriction R = P^T / 8 (full weighting) ------------------------------------------------- */
@@ -112,6 +110,13 @@ HD_FN float hd_mg_fw(int t)
    minutes apart, and the rows' tests are uniform along x anyway). A backend computes it once per fine x and
    coarse row (the CPU a vector loop per row, OpenCL a pass into a row buffer) and combines four
    of them per coarse voxel, in order, with hd_mg_restrict_x. */
+/* hd_mg_restrict_line's step for fine row (a, b) on values the caller loaded: the residual res
+   and its voxel's hd_mg_medium m (the same operations in the same order: the same bits). */
+HD_FN float hd_mg_restrict_term(float line, int a, int b, float res, float m)
+{
+    return line + (hd_mg_fw(a) * hd_mg_fw(b)) * (res * m);
+}
+
 HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
@@ -122,18 +127,11 @@ HD_FN float hd_mg_restrict_line(HD_KARGS int x, int Y, int Z, int c)
         for (int b = 0; b < 4; ++b) {
             int y = 2 * Y - 1 + b;
             if (y < 0 || y >= gy) continue;
-            line += (hd_mg_fw(a) * hd_mg_fw(b)) * (HD_GET(phi, ((c * gz + z) * gy + y) * gx + x, x, y, z + c * gz) *
-                                                    hd_mg_medium(HD_KPASS (z * gy + y) * gx + x, x, y, z));
+            line = hd_mg_restrict_term(line, a, b, HD_GET(phi, ((c * gz + z) * gy + y) * gx + x, x, y, z + c * gz),
+                                       hd_mg_medium(HD_KPASS (z * gy + y) * gx + x, x, y, z));
         }
     }
     return line;
-}
-
-/* hd_mg_restrict_line's step for fine row (a, b) on values the caller loaded: the residual res
-   and its voxel's hd_mg_medium m (the same operations in the same order: the same bits). */
-HD_FN float hd_mg_restrict_term(float line, int a, int b, float res, float m)
-{
-    return line + (hd_mg_fw(a) * hd_mg_fw(b)) * (res * m);
 }
 
 /* s plus the share of fine column 2 X - 1 + t (its hd_mg_restrict_line value `line`). */
@@ -161,6 +159,13 @@ HD_FN float hd_mg_pw(int t)
    0.83x (box) and 0.91x (surface boundary) of its time before (head CT, full resolution); skipping rather than adding a zero term
    keeps the CPU's bits (a zero term could flip the sign of a zero sum). The caller multiplies the
    value by the fine voxel's hd_mg_medium (the restriction's mask) before adding it. */
+/* hd_mg_prolong's step for corner (a, b, t) inside the coarse grid on the coarse value u the
+   caller loaded (the same operations in the same order: the same bits). */
+HD_FN float hd_mg_prolong_term(float v, int a, int b, int t, float u)
+{
+    return v + hd_mg_pw(a) * hd_mg_pw(b) * hd_mg_pw(t) * u;
+}
+
 HD_FN float hd_mg_prolong(HD_KARGS int x, int y, int z, int c)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
@@ -173,18 +178,11 @@ HD_FN float hd_mg_prolong(HD_KARGS int x, int y, int z, int c)
                 int xc = t == 0 ? x >> 1 : hd_mg_far(x), xk = hd_clampi(xc, 0, gx - 1);
                 float u = HD_GET(phi, ((c * gz + zk) * gy + yk) * gx + xk, xk, yk, zk + c * gz);
                 v = zc >= 0 && zc < gz && yc >= 0 && yc < gy && xc >= 0 && xc < gx
-                        ? v + hd_mg_pw(a) * hd_mg_pw(b) * hd_mg_pw(t) * u : v;
+                        ? hd_mg_prolong_term(v, a, b, t, u) : v;
             }
         }
     }
     return v;
-}
-
-/* hd_mg_prolong's step for corner (a, b, t) inside the coarse grid on the coarse value u the
-   caller loaded (the same operations in the same order: the same bits). */
-HD_FN float hd_mg_prolong_term(float v, int a, int b, int t, float u)
-{
-    return v + hd_mg_pw(a) * hd_mg_pw(b) * hd_mg_pw(t) * u;
 }
 
 /* ---- conjugate gradients ---------------------------------------------------------------------- */
@@ -271,19 +269,19 @@ HD_FN double hd_mg_res_f64_at(HD_KARGS int x, int y, int z, int c, int use_lo)
 /* <a, b> over row (y, zz) of a grid (zz = z + c * gz), a = K's E, b = K's phi: products and sum in
    double, x in order. Rows are then summed in row order (on the host or in one fixed-order pass),
    so a dot product has the same bits for any thread count and on any backend. */
-HD_FN double hd_mg_dot_row(HD_KARGS int y, int zz)
-{
-    int gx = HD_PRM(gdims).x, base = (zz * HD_PRM(gdims).y + y) * gx;
-    double d = HD_D(0.0f);
-    for (int x = 0; x < gx; ++x) d += HD_D(HD_GET(E, base + x, x, y, zz)) * HD_D(HD_GET(phi, base + x, x, y, zz));
-    return d;
-}
-
 /* hd_mg_dot_row's step on values the caller loaded (the CPU loads a row once, as its two colour
    half-rows): the same operations, so the same bits when x runs in order. */
 HD_FN double hd_mg_dot_term(double d, float a, float b)
 {
     return d + HD_D(a) * HD_D(b);
+}
+
+HD_FN double hd_mg_dot_row(HD_KARGS int y, int zz)
+{
+    int gx = HD_PRM(gdims).x, base = (zz * HD_PRM(gdims).y + y) * gx;
+    double d = HD_D(0.0f);
+    for (int x = 0; x < gx; ++x) d = hd_mg_dot_term(d, HD_GET(E, base + x, x, y, zz), HD_GET(phi, base + x, x, y, zz));
+    return d;
 }
 
 /* phi + lo += alpha p in double: returns the new phi, the sum rounded to float (what the
