@@ -71,37 +71,74 @@ static unsigned long long phi_hash(const float *phi, size_t n)
 static const float bench_tf[] = {0.0f, 0.0f, 0.0f, 0.0f,    0.0f, 0.0f, 0.0f, 0.0f,    0.93f, 0.73f, 0.62f, 0.02f,
                                  0.93f, 0.73f, 0.62f, 0.05f, 1.0f, 0.98f, 0.9f, 0.5f,   1.0f, 1.0f, 1.0f, 1.0f};
 
-/* Seconds per sweep of each schedule (best of interleaved rounds), and the L2-resident rows' time
-   per voxel update, on the context's grid from its current phi. */
-static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
+/* One timed run of `sweeps` sweeps: variant 0 or 1 of an A/B pair. */
+typedef void (*ab_run)(hd__backend *be, int variant, int sweeps);
+
+/* Best seconds per sweep of each variant of `run` (reps runs of `sweeps` sweeps per round, 12
+   interleaved rounds, each from the same phi) into best[], and into *same whether both left the
+   same phi bit for bit after the first round. Leaves phi as it found it; keeps be->grid set (the
+   caller's) until the end. */
+static void interleave(hd__ctx *ctx, ab_run run, int reps, int sweeps, double best[2], int *same)
 {
     hd__backend *be = ctx->be;
-    hd__cpu_grid g;
     size_t n = be->illum_slots; /* phi in the colour layout, padding slots included */
     float *start = (float *)malloc(n * sizeof(float));
     unsigned long long hash[2] = {0, 0};
-    int r, i, s, rep, y, z;
+    int r, i, s;
     if (!start) { fprintf(stderr, "hdbench_rb_schedule: out of memory\n"); exit(1); }
     memcpy(start, be->phi, n * sizeof(float));
-    g.k = &be->k;
-    g.res = NULL;
-    be->grid = &g;
-    hd__fill_kparams(ctx);
     best[0] = best[1] = 1e30;
     for (r = 0; r < 12; ++r)
         for (i = 0; i < 2; ++i) {
             double t;
             memcpy(be->phi, start, n * sizeof(float));
             t = now();
-            for (s = 0; s < 4; ++s) {
-                if (i) hd__cpu_red_black(be, 1, 0);
-                else old_sweep(be);
-            }
-            t = (now() - t) / 4;
+            for (s = 0; s < reps; ++s) run(be, i, sweeps);
+            t = (now() - t) / (reps * sweeps);
             if (t < best[i]) best[i] = t;
             if (r == 0) hash[i] = phi_hash(be->phi, n);
         }
     *same = hash[0] == hash[1];
+    memcpy(be->phi, start, n * sizeof(float));
+    free(start);
+}
+
+/* Points the backend at the context's own grid (what hd__be_diffuse does for a sweep). */
+static void use_fine_grid(hd__ctx *ctx, hd__cpu_grid *g)
+{
+    g->k = &ctx->be->k;
+    g->res = NULL;
+    ctx->be->grid = g;
+    hd__fill_kparams(ctx);
+}
+
+/* Variant 0: the colour-by-colour schedule, 1: the library's one walk, `sweeps` sweeps each. */
+static void run_schedules(hd__backend *be, int variant, int sweeps)
+{
+    int s;
+    for (s = 0; s < sweeps; ++s) {
+        if (variant) hd__cpu_red_black(be, 1, 0);
+        else old_sweep(be);
+    }
+}
+
+/* Variant 0: `sweeps` calls of one sweep, 1: one call of `sweeps` (walks of be->rb_walk_sweeps). */
+static void run_walks(hd__backend *be, int variant, int sweeps)
+{
+    int k;
+    if (variant) hd__cpu_red_black(be, sweeps, 0);
+    else for (k = 0; k < sweeps; ++k) hd__cpu_red_black(be, 1, 0);
+}
+
+/* Seconds per sweep of each schedule (best of interleaved rounds), and the L2-resident rows' time
+   per voxel update, on the context's grid from its current phi. */
+static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
+{
+    hd__backend *be = ctx->be;
+    hd__cpu_grid g;
+    int r, i, rep, y, z;
+    use_fine_grid(ctx, &g);
+    interleave(ctx, run_schedules, 1, 4, best, same);
     /* 48 rows in the middle of the head, both colours, 400 times: one thread, L2-resident */
     *l2_update = 1e30;
     for (r = 0; r < 5; ++r) {
@@ -113,9 +150,7 @@ static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
         t = (now() - t) / (400.0 * 48 * be->k.p->gdims.x);
         if (t < *l2_update) *l2_update = t;
     }
-    memcpy(be->phi, start, n * sizeof(float));
     be->grid = NULL;
-    free(start);
 }
 
 /* Seconds per sweep of N sweeps as N calls of one (best[0]) and as one call in walks of up to
@@ -123,41 +158,12 @@ static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
    bit for bit after the first round. */
 static void measure_walks(hd__ctx *ctx, int N, int walk, double best[2], int *same)
 {
-    hd__backend *be = ctx->be;
     hd__cpu_grid g;
-    size_t n = be->illum_slots;
-    float *start = (float *)malloc(n * sizeof(float));
-    unsigned long long hash[2] = {0, 0};
-    int r, i, s, reps = 8 / N;
-    if (!start) { fprintf(stderr, "hdbench_rb_schedule: out of memory\n"); exit(1); }
-    memcpy(start, be->phi, n * sizeof(float));
-    g.k = &be->k;
-    g.res = NULL;
-    be->grid = &g;
-    hd__fill_kparams(ctx);
-    best[0] = best[1] = 1e30;
-    for (r = 0; r < 12; ++r)
-        for (i = 0; i < 2; ++i) {
-            double t;
-            memcpy(be->phi, start, n * sizeof(float));
-            be->rb_walk_sweeps = walk;
-            t = now();
-            for (s = 0; s < reps; ++s) {
-                if (i) hd__cpu_red_black(be, N, 0);
-                else {
-                    int k;
-                    for (k = 0; k < N; ++k) hd__cpu_red_black(be, 1, 0);
-                }
-            }
-            t = (now() - t) / (reps * N);
-            if (t < best[i]) best[i] = t;
-            if (r == 0) hash[i] = phi_hash(be->phi, n);
-        }
-    *same = hash[0] == hash[1];
-    be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
-    memcpy(be->phi, start, n * sizeof(float));
-    be->grid = NULL;
-    free(start);
+    use_fine_grid(ctx, &g);
+    ctx->be->rb_walk_sweeps = walk;
+    interleave(ctx, run_walks, 8 / N, N, best, same);
+    ctx->be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
+    ctx->be->grid = NULL;
 }
 
 int main(int argc, char **argv)
