@@ -947,6 +947,30 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     return HD_SUCCESS;
 }
 
+/* The most sets one pool holds: the backend's (a set per light); the multigrid's fit too (checked
+   where HD__VK_MG_SETS is defined). */
+#define HD__VK_POOL_SETS_MAX HD_MAX_LIGHTS
+
+/* Empties `pool` and allocates n (<= HD__VK_POOL_SETS_MAX) sets of the backend's set layout from
+   it into sets[]; reset_name and alloc_name name the calls in a failure's log line. */
+static hd_result hd__vk_pool_sets(hd__ctx *ctx, VkDescriptorPool pool, int n, VkDescriptorSet *sets,
+                                  const char *reset_name, const char *alloc_name)
+{
+    hd__backend *be = ctx->be;
+    VkDescriptorSetLayout layouts[HD__VK_POOL_SETS_MAX];
+    VkDescriptorSetAllocateInfo ai;
+    int i;
+    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, pool, 0), reset_name);
+    for (i = 0; i < n; ++i) layouts[i] = be->set_layout;
+    memset(&ai, 0, sizeof ai);
+    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+    ai.descriptorPool = pool;
+    ai.descriptorSetCount = (uint32_t)n;
+    ai.pSetLayouts = layouts;
+    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, sets), alloc_name);
+    return HD_SUCCESS;
+}
+
 static hd_result hd__vk_pipelines(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1014,18 +1038,11 @@ static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, con
 static hd_result hd__vk_sets(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    VkDescriptorSetLayout layouts[HD_MAX_LIGHTS];
-    VkDescriptorSetAllocateInfo ai;
+    hd_result r;
     int n = be->nlv > 0 ? be->nlv : 1, s;
     if (be->sets_valid) return HD_SUCCESS;
-    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, be->dpool, 0), "vkResetDescriptorPool");
-    for (s = 0; s < n; ++s) layouts[s] = be->set_layout;
-    memset(&ai, 0, sizeof ai);
-    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    ai.descriptorPool = be->dpool;
-    ai.descriptorSetCount = (uint32_t)n;
-    ai.pSetLayouts = layouts;
-    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, be->sets), "vkAllocateDescriptorSets");
+    if ((r = hd__vk_pool_sets(ctx, be->dpool, n, be->sets, "vkResetDescriptorPool", "vkAllocateDescriptorSets")) != HD_SUCCESS)
+        return r;
     for (s = 0; s < n; ++s) {
         const hd__vk_image *im[HD__VK_BINDINGS];
         const hd__vk_buffer *bu[HD__VK_BINDINGS];
@@ -1592,6 +1609,7 @@ enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROL
 enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
        HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
 #define HD__VK_MG_SETS (4 * HD__VK_MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
+typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 typedef struct hd__vk_level {
     int dims[3];
@@ -1740,21 +1758,15 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = be->mg;
-    VkDescriptorSetLayout layouts[HD__VK_MG_SETS];
     VkDescriptorSet sets[HD__VK_MG_SETS];
-    VkDescriptorSetAllocateInfo ai;
     hd__vk_level *L0 = &mg->lv[0];
+    hd_result r;
     int n = 4 * mg->levels + HD__VK_MG_CG_SETS, i, l;
     if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
     mg->sets_valid = 0;
-    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, mg->pool, 0), "vkResetDescriptorPool (multigrid)");
-    for (i = 0; i < n; ++i) layouts[i] = be->set_layout;
-    memset(&ai, 0, sizeof ai);
-    ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-    ai.descriptorPool = mg->pool;
-    ai.descriptorSetCount = (uint32_t)n;
-    ai.pSetLayouts = layouts;
-    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, sets), "vkAllocateDescriptorSets (multigrid)");
+    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, sets, "vkResetDescriptorPool (multigrid)",
+                              "vkAllocateDescriptorSets (multigrid)")) != HD_SUCCESS)
+        return r;
     for (l = 0; l < mg->levels; ++l) {
         hd__vk_level *L = &mg->lv[l], *C = l + 1 < mg->levels ? &mg->lv[l + 1] : NULL;
         L->smooth = sets[4 * l];
