@@ -320,7 +320,12 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
    (hd_diffuse_own_of, hd_diffuse_box_of / _surface_rhs_of) with rgb, rhs and the boundary as
    literals and every in-grid flag 1, so each variant is a branch-free loop the compiler
    vectorises; the same operations in the same order as hd_diffuse_terms_loaded, so the same
-   bits as the per-voxel path (hd_diffuse_row), which edge rows take. The stride-2 loop over the
+   bits as the per-voxel path (hd_diffuse_row). Rows on the grid's faces in y or z (y = 0 or
+   gy - 1, z = 0 or gz - 1) take the same loop with their four y/z in-grid flags as run-time
+   values (a second copy of each variant; an outside neighbour's loads read the row's own other
+   colour instead, and the kernels ignore the values of an outside neighbour): through the
+   per-voxel path they cost 14 against 1.1 ns per update, and on the 256x256x108 head those 2.6 %
+   of the rows took a fifth of a sweep (bench/hdbench_rb_schedule.c). The stride-2 loop over the
    x-fastest layout this replaces needed permutes for every load: 1.77 against 1.06 ns per update
    for the whole row (Jacobi) with the rows in L2 (bench/hdbench_rb_schedule.c). The two end
    voxels go through hd_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
@@ -345,9 +350,11 @@ static int hd__cpu_row_variant(const hd__kctx *K)
 #if defined(__GNUC__) || defined(__clang__)
 #define HD__CPU_INLINE static inline __attribute__((always_inline))
 #define HD__CPU_FLATTEN __attribute__((flatten))
+#define HD__CPU_NOINLINE __attribute__((noinline))
 #else
 #define HD__CPU_INLINE static inline
 #define HD__CPU_FLATTEN
+#define HD__CPU_NOINLINE
 #endif
 
 /* Voxels of x parity xpar in a row of gx voxels: the length of that colour's half-row. */
@@ -374,6 +381,20 @@ static void hd__cpu_rows_of(const hd__kctx *K, int y, int z, int c, int x0, hd__
     }
 }
 
+/* An edge row's rows outside the grid (in[j - 2] == 0 for j = 2 .. 5: y - 1, y + 1, z - 1, z + 1)
+   read the row's other colour (j = 1) instead: valid memory, whose values the kernels ignore there. */
+static void hd__cpu_rows_clip(hd__cpu_rows *o, int iym, int iyp, int izm, int izp)
+{
+    const int in[4] = {iym, iyp, izm, izp};
+    int j;
+    for (j = 2; j < 6; ++j)
+        if (!in[j - 2]) {
+            o->s[j] = o->s[1];
+            o->a[j] = o->a[1];
+            o->p[j] = o->p[1];
+        }
+}
+
 /* E, phi or phi2 at slot o in K's storage precision (K->f16 a literal in the row loops). */
 #define HD__CPU_LD(buf, o) (K->f16 != 0 ? hd_h2f(K->buf##h[(o)]) : K->buf[(o)])
 
@@ -386,9 +407,11 @@ HD__CPU_INLINE float hd__cpu_nb_sigp(const hd__kctx *K, float st, float sc, int 
 
 /* The interior voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into
    out[id]: num / den, or with residual the residual num - den phi. rgb, rhs, surface and residual
-   are literals at every call (HD__CPU_COLOUR_VARIANTS), so the loop has no test. */
+   are literals at every call (HD__CPU_COLOUR_VARIANTS), so the loop has no test; so are the
+   in-grid flags iym, iyp, izm, izp of the y-1, y+1, z-1, z+1 rows (1) except in edge rows. */
 HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o, int lo, int hi, int cp, float *out,
-                                        int rgb, int rhs, int surface, int residual)
+                                        int rgb, int rhs, int surface, int residual, int iym, int iyp, int izm,
+                                        int izp)
 {
     const float *sg = K->sig;
     const size_t *s = o->s, *a = o->a, *p = o->p;
@@ -405,14 +428,15 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
                                             HD__CPU_NB(2, id), HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                             HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                             HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
-                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1,
-                                            &den);
+                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, iym, iyp,
+                                            izm, izp, &den);
         else
             num = hd_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
                                     HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                     HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                     HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
-                                    HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, 1, 1, 1, 1, &den);
+                                    HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, iym, iyp, izm,
+                                    izp, &den);
 #undef HD__CPU_NB
         out[id] = residual ? num - den * HD__CPU_LD(phi, p[0] + id) : num / den;
     }
@@ -420,52 +444,58 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
 
 /* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) of the colour with x parity x0
    into out[x >> 1], through `terms` with literal in-grid flags, so they take no branch either
-   (through hd_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep). */
-#define HD__CPU_ROW_ENDS(terms, rgb, rhs, residual)                                                   \
+   (through hd_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep); the y/z
+   flags iym .. izp as the loop's. */
+#define HD__CPU_ROW_ENDS(terms, rgb, rhs, residual, iym, iyp, izm, izp)                               \
     do {                                                                                            \
         float den_, num_;                                                                           \
         if (x0 == 0) {                                                                              \
-            num_ = terms(K, 0, y, z, c, 0, 1, 1, 1, 1, 1, rgb, rhs, &den_);                          \
+            num_ = terms(K, 0, y, z, c, 0, 1, iym, iyp, izm, izp, rgb, rhs, &den_);                  \
             out[0] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0]) : num_ / den_;               \
         }                                                                                           \
         if (((gx - 1 - x0) & 1) == 0) {                                                             \
-            num_ = terms(K, gx - 1, y, z, c, 1, 0, 1, 1, 1, 1, rgb, rhs, &den_);                     \
+            num_ = terms(K, gx - 1, y, z, c, 1, 0, iym, iyp, izm, izp, rgb, rhs, &den_);             \
             out[(gx - 1) >> 1] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0] + ((gx - 1) >> 1)) \
                                             : num_ / den_;                                          \
         }                                                                                           \
     } while (0)
 /* One case of the variant switch: the interior loop and the ends with rgb, rhs and the boundary
-   literal. */
-#define HD__CPU_COLOUR_CASE(rgb, rhs, surface, residual)                                              \
+   literal (and the y/z in-grid flags ym .. zp: literal 1s in interior rows). */
+#define HD__CPU_COLOUR_CASE(rgb, rhs, surface, residual, ym, yp, zm, zp)                             \
     do {                                                                                            \
-        hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual);  \
-        if (surface) HD__CPU_ROW_ENDS(hd_diffuse_terms_surface, rgb, rhs, residual);                  \
-        else HD__CPU_ROW_ENDS(hd_diffuse_terms_box, rgb, rhs, residual);                              \
+        hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual, ym, yp, \
+                            zm, zp);                                                                \
+        if (surface) HD__CPU_ROW_ENDS(hd_diffuse_terms_surface, rgb, rhs, residual, ym, yp, zm, zp);  \
+        else HD__CPU_ROW_ENDS(hd_diffuse_terms_box, rgb, rhs, residual, ym, yp, zm, zp);              \
     } while (0)
-#define HD__CPU_COLOUR_VARIANTS(residual)                                                            \
+#define HD__CPU_COLOUR_SWITCH(residual, ym, yp, zm, zp)                                              \
     switch (hd__cpu_row_variant(K)) {                                                               \
-    case 0: HD__CPU_COLOUR_CASE(0, 0, 0, residual); break;                                          \
-    case 1: HD__CPU_COLOUR_CASE(1, 0, 0, residual); break;                                          \
-    case 2: HD__CPU_COLOUR_CASE(0, 1, 0, residual); break;                                          \
-    case 3: HD__CPU_COLOUR_CASE(1, 1, 0, residual); break;                                          \
-    case 4: HD__CPU_COLOUR_CASE(0, 0, 1, residual); break;                                          \
-    case 5: HD__CPU_COLOUR_CASE(1, 0, 1, residual); break;                                          \
-    case 6: HD__CPU_COLOUR_CASE(0, 1, 1, residual); break;                                          \
-    default: HD__CPU_COLOUR_CASE(1, 1, 1, residual); break;                                         \
+    case 0: HD__CPU_COLOUR_CASE(0, 0, 0, residual, ym, yp, zm, zp); break;                         \
+    case 1: HD__CPU_COLOUR_CASE(1, 0, 0, residual, ym, yp, zm, zp); break;                         \
+    case 2: HD__CPU_COLOUR_CASE(0, 1, 0, residual, ym, yp, zm, zp); break;                         \
+    case 3: HD__CPU_COLOUR_CASE(1, 1, 0, residual, ym, yp, zm, zp); break;                         \
+    case 4: HD__CPU_COLOUR_CASE(0, 0, 1, residual, ym, yp, zm, zp); break;                         \
+    case 5: HD__CPU_COLOUR_CASE(1, 0, 1, residual, ym, yp, zm, zp); break;                         \
+    case 6: HD__CPU_COLOUR_CASE(0, 1, 1, residual, ym, yp, zm, zp); break;                         \
+    default: HD__CPU_COLOUR_CASE(1, 1, 1, residual, ym, yp, zm, zp); break;                        \
     }
+/* Interior rows (every y/z neighbour in the grid: literal flags) */
+#define HD__CPU_COLOUR_VARIANTS(residual) HD__CPU_COLOUR_SWITCH(residual, 1, 1, 1, 1)
 
-/* Relaxes the voxels of x parity x0 of interior row (y, z) of channel c (3 <= gx, 0 < y < gy - 1,
-   0 < z < gz - 1) into phi (red-black: in place, the colour reads only the other one) or phi2
-   (Jacobi): computed into a local half-row, then stored contiguously (a store through K's
-   pointers inside the loop might alias its loads, which would keep the compiler from
-   vectorising it). */
-HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c, int x0, int jacobi)
+/* Relaxes the voxels of x parity x0 of row (y, z) of channel c (3 <= gx) into phi (red-black: in
+   place, the colour reads only the other one) or phi2 (Jacobi): computed into a local half-row,
+   then stored contiguously (a store through K's pointers inside the loop might alias its loads,
+   which would keep the compiler from vectorising it). iym, iyp, izm, izp: whether the rows y - 1,
+   y + 1, z - 1, z + 1 lie in the grid (literal 1s for interior rows). */
+HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c, int x0, int jacobi, int iym, int iyp,
+                                         int izm, int izp)
 {
     int gx = K->p->gdims.x, n = hd__cpu_half_len(gx, x0), i;
     float out[HD__CPU_ROW_MAX / 2 + 1];
     hd__cpu_rows o;
     hd__cpu_rows_of(K, y, z, c, x0, &o);
-    HD__CPU_COLOUR_VARIANTS(0)
+    if (!(iym && iyp && izm && izp)) hd__cpu_rows_clip(&o, iym, iyp, izm, izp);
+    HD__CPU_COLOUR_SWITCH(0, iym, iyp, izm, izp)
     if (K->f16) {
         uint16_t *dst = (jacobi ? K->phi2h : K->phih) + o.p[0];
         for (i = 0; i < n; ++i) dst[i] = hd_f2h(out[i]);
@@ -475,30 +505,49 @@ HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c,
 }
 
 /* Relaxes row (y, z) of channel c: red-black its colour `parity` (voxels with x + y + z + parity
-   even), Jacobi (be->jacobi) both colours into phi2. */
-HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, int y, int z, int c, int parity)
+   even), Jacobi (be->jacobi) both colours into phi2; the in-grid flags as hd__cpu_relax_colour's. */
+HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, int y, int z, int c, int parity, int iym,
+                                          int iyp, int izm, int izp)
 {
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z;
-    if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
-        hd_diffuse_row(K, y, z, c, parity, be->jacobi);
-        return;
-    }
     if (be->jacobi) {
-        hd__cpu_relax_colour(K, y, z, c, 0, 1);
-        hd__cpu_relax_colour(K, y, z, c, 1, 1);
+        hd__cpu_relax_colour(K, y, z, c, 0, 1, iym, iyp, izm, izp);
+        hd__cpu_relax_colour(K, y, z, c, 1, 1, iym, iyp, izm, izp);
     } else {
-        hd__cpu_relax_colour(K, y, z, c, (y + z + parity) & 1, 0);
+        hd__cpu_relax_colour(K, y, z, c, (y + z + parity) & 1, 0, iym, iyp, izm, izp);
     }
 }
 
 /* The row on a copy of the grid's kernel context whose storage precision (f16) is a literal:
    the compiler drops the kernels' per-load precision test (hd_prelude_c.h's HD_GET) from each
    inlined copy, so the float32 loop is the loop it was and the binary16 one converts inline. */
+#define HD__CPU_ROW_ON_COPY(iym, iyp, izm, izp)                                                       \
+    do {                                                                                            \
+        hd__kctx k = *be->grid->k;                                                                  \
+        if (k.f16) { k.f16 = 1; hd__cpu_diffuse_row_k(be, &k, y, z, c, parity, iym, iyp, izm, izp); }  \
+        else { k.f16 = 0; hd__cpu_diffuse_row_k(be, &k, y, z, c, parity, iym, iyp, izm, izp); }        \
+    } while (0)
+
+/* A row on a face of the grid in y or z: the loops with run-time in-grid flags, out of line so
+   the interior rows' function keeps only the loops with literal ones. */
+static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_diffuse_edge_row(hd__backend *be, int y, int z, int c,
+                                                                      int parity)
+{
+    int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z;
+    HD__CPU_ROW_ON_COPY(y > 0, y < gy - 1, z > 0, z < gz - 1);
+}
+
 static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c, int parity)
 {
-    hd__kctx k = *be->grid->k;
-    if (k.f16) { k.f16 = 1; hd__cpu_diffuse_row_k(be, &k, y, z, c, parity); }
-    else { k.f16 = 0; hd__cpu_diffuse_row_k(be, &k, y, z, c, parity); }
+    const hd__kparams *p = be->grid->k->p;
+    if (p->gdims.x < 3) {
+        hd_diffuse_row(be->grid->k, y, z, c, parity, be->jacobi);
+        return;
+    }
+    if (y == 0 || y == p->gdims.y - 1 || z == 0 || z == p->gdims.z - 1) {
+        hd__cpu_diffuse_edge_row(be, y, z, c, parity);
+        return;
+    }
+    HD__CPU_ROW_ON_COPY(1, 1, 1, 1);
 }
 
 /* Jacobi's schedule: blocks of HD__CPU_BLOCK_ROWS rows (y) per work item, each walked through
