@@ -444,7 +444,7 @@ HD__CPU_INLINE float hd__cpu_nb_sigp(const hd__kctx *K, float st, float sc, int 
 
 /* The interior voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into
    out[id]: num / den, or with residual the residual num - den phi. rgb, rhs, surface and residual
-   are literals at every call (HD__CPU_COLOUR_VARIANTS), so the loop has no test; so are the
+   are literals at every call (HD__CPU_COLOUR_SWITCH), so the loop has no test; so are the
    in-grid flags iym, iyp, izm, izp of the y-1, y+1, z-1, z+1 rows (1) except in edge rows. */
 HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o, int lo, int hi, int cp, float *out,
                                         int rgb, int rhs, int surface, int residual, int iym, int iyp, int izm,
@@ -516,8 +516,6 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
     case 6: HD__CPU_COLOUR_CASE(0, 1, 1, residual, ym, yp, zm, zp); break;                         \
     default: HD__CPU_COLOUR_CASE(1, 1, 1, residual, ym, yp, zm, zp); break;                        \
     }
-/* Interior rows (every y/z neighbour in the grid: literal flags) */
-#define HD__CPU_COLOUR_VARIANTS(residual) HD__CPU_COLOUR_SWITCH(residual, 1, 1, 1, 1)
 
 /* Relaxes the voxels of x parity x0 of row (y, z) of channel c (3 <= gx) into phi (red-black: in
    place, the colour reads only the other one) or phi2 (Jacobi): computed into a local half-row,
@@ -785,29 +783,52 @@ static void hd__cpu_red_black(hd__backend *be, int sweeps, int first)
     }
 }
 
-/* The residual f - A phi of row r (= (c * gz + z) * gy + y) of be->grid into its res, in the
-   colour layout (float32 grids: multigrid's): each colour's half-row through the sweep's loop
+/* The residual f - A phi of row (y, z) of channel c of be->grid into its res, in the colour layout
+   (float32 grids: multigrid's): each colour's half-row through the sweep's loop
    (hd__cpu_colour_loop with residual), written to a local half-row first (stores through res
-   might alias the loads, which would keep the compiler from vectorising the loop). */
-static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
+   might alias the loads, which would keep the compiler from vectorising the loop); the in-grid
+   flags as hd__cpu_relax_colour's. */
+HD__CPU_INLINE void hd__cpu_residual_halves(hd__backend *be, int y, int z, int c, int iym, int iyp, int izm, int izp)
 {
     hd__kctx k = *be->grid->k; /* f16 a literal 0: no per-load precision test in the loop */
     const hd__kctx *K = &k;
-    float *res = be->grid->res;
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x, x0;
-    int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
-    float rhs;
+    int gx = K->p->gdims.x, x0;
     k.f16 = 0;
-    if (gx < 3 || y == 0 || y == gy - 1 || z == 0 || z == gz - 1) {
-        for (x = 0; x < gx; ++x) res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hd_diffuse_residual(K, x, y, z, c, &rhs);
-        return;
-    }
     for (x0 = 0; x0 < 2; ++x0) {
         float out[HD__CPU_ROW_MAX / 2 + 1];
         hd__cpu_rows o;
         hd__cpu_rows_of(K, y, z, c, x0, &o);
-        HD__CPU_COLOUR_VARIANTS(1)
-        memcpy(res + o.p[0], out, (size_t)hd__cpu_half_len(gx, x0) * sizeof(float));
+        if (!(iym && iyp && izm && izp)) hd__cpu_rows_clip(&o, iym, iyp, izm, izp);
+        HD__CPU_COLOUR_SWITCH(1, iym, iyp, izm, izp)
+        memcpy(be->grid->res + o.p[0], out, (size_t)hd__cpu_half_len(gx, x0) * sizeof(float));
+    }
+}
+
+/* An edge row's residual (a face of the grid in y or z), out of line as hd__cpu_diffuse_edge_row. */
+static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_residual_edge_row(hd__backend *be, int y, int z, int c)
+{
+    int gy = be->grid->k->p->gdims.y, gz = be->grid->k->p->gdims.z;
+    hd__cpu_residual_halves(be, y, z, c, y > 0, y < gy - 1, z > 0, z < gz - 1);
+}
+
+/* Row r = (c * gz + z) * gy + y. The per-voxel path (hd_diffuse_residual) where the loop does not
+   apply: rows under 3 voxels, and edge rows under the surface boundary without rhs, whose empty
+   voxels hd_diffuse_residual gives residual 0 (the V-cycle's grids all solve with rhs). */
+static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
+{
+    const hd__kctx *K = be->grid->k;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
+    int edge = y == 0 || y == gy - 1 || z == 0 || z == gz - 1;
+    int f = K->p->counts.z & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
+    if (gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
+        float rhs;
+        for (x = 0; x < gx; ++x)
+            be->grid->res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hd_diffuse_residual(K, x, y, z, c, &rhs);
+    } else if (edge) {
+        hd__cpu_residual_edge_row(be, y, z, c);
+    } else {
+        hd__cpu_residual_halves(be, y, z, c, 1, 1, 1, 1);
     }
 }
 
