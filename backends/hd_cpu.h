@@ -682,7 +682,7 @@ static void hd__cpu_rb_seam(hd__backend *be, int r)
 /* ---- red-black: several sweeps in one walk through z (temporal blocking) --------------------
    One walk of the schedule above streams sigma_t, E and phi once per sweep (16 B a voxel); a
    walk of T sweeps streams them once for T sweeps (1.02-1.11x on the head, whose grid fits this
-   CI machine's L3; more where it does not): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
+   CI machine's L3): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
    follow each other through z, phase k in plane z - k at step z. Phase k of a row reads the other
    colour (phase k - 1's) in rows y - 1 .. y + 1 of planes z - k - 1 .. z - k + 1 and must see
    exactly what the sweeps one after another give it: phase k - 1 done there, phase k + 1 not.
