@@ -544,12 +544,10 @@ HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c,
 HD__CPU_INLINE void hd__cpu_diffuse_row_k(hd__backend *be, const hd__kctx *K, int y, int z, int c, int parity, int iym,
                                           int iyp, int izm, int izp)
 {
-    if (be->jacobi) {
-        hd__cpu_relax_colour(K, y, z, c, 0, 1, iym, iyp, izm, izp);
-        hd__cpu_relax_colour(K, y, z, c, 1, 1, iym, iyp, izm, izp);
-    } else {
-        hd__cpu_relax_colour(K, y, z, c, (y + z + parity) & 1, 0, iym, iyp, izm, izp);
-    }
+    /* one call site: every inlined copy of the loops is compiled once per row function (with three,
+       the CPU backend took twice as long to compile) */
+    int first = be->jacobi ? 0 : (y + z + parity) & 1, last = be->jacobi ? 1 : first, x0;
+    for (x0 = first; x0 <= last; ++x0) hd__cpu_relax_colour(K, y, z, c, x0, be->jacobi, iym, iyp, izm, izp);
 }
 
 /* The row on a copy of the grid's kernel context whose storage precision (f16) is a literal:
