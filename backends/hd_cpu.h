@@ -50,12 +50,12 @@ struct hd__backend {
 
 static const char *hd__be_name(void) { return "cpu"; }
 
-/* Takes chunks of the current pass until none is left. */
 /* Denormals flushed to zero (x86 MXCSR FTZ and DAZ) while this backend's threads compute, as GPUs
    compute: a diffusion solve started from phi = 0 spreads through empty space as a front of
    values that underflow, and every operation on a denormal takes a microcode assist. On the head
    CT (box boundary) the first sweeps took 4.7 against 1.5 ns per update. The workers set it once;
-   the calling thread sets it for each pass and restores its own mode after (hd__cpu_parallel).
+   the calling thread sets it for each pass and restores its own mode after (hd__cpu_parallel,
+   through which every pass runs).
    Other architectures compute with denormals. */
 static unsigned hd__cpu_fp_enter(void)
 {
@@ -76,6 +76,7 @@ static void hd__cpu_fp_leave(unsigned m)
 #endif
 }
 
+/* Takes chunks of the current pass until none is left. */
 static void hd__cpu_work(hd__backend *be)
 {
     for (;;) {
@@ -432,6 +433,21 @@ static void hd__cpu_rows_clip(hd__cpu_rows *o, int iym, int iyp, int izm, int iz
         }
 }
 
+/* hd__cpu_rows_of with an edge row's outside rows clipped (the in-grid flags literal 1s in
+   interior rows, where the test folds away). */
+HD__CPU_INLINE void hd__cpu_rows_at(const hd__kctx *K, int y, int z, int c, int x0, int iym, int iyp, int izm, int izp,
+                                    hd__cpu_rows *o)
+{
+    hd__cpu_rows_of(K, y, z, c, x0, o);
+    if (!(iym && iyp && izm && izp)) hd__cpu_rows_clip(o, iym, iyp, izm, izp);
+}
+
+/* Whether row (y, z) lies on a face of the grid in y or z (an edge row). */
+static int hd__cpu_edge_row(const hd__kparams *p, int y, int z)
+{
+    return y == 0 || y == p->gdims.y - 1 || z == 0 || z == p->gdims.z - 1;
+}
+
 /* E, phi or phi2 at slot o in K's storage precision (K->f16 a literal in the row loops). */
 #define HD__CPU_LD(buf, o) (K->f16 != 0 ? hd_h2f(K->buf##h[(o)]) : K->buf[(o)])
 
@@ -528,8 +544,7 @@ HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c,
     int gx = K->p->gdims.x, n = hd__cpu_half_len(gx, x0), i;
     float out[HD__CPU_ROW_MAX / 2 + 1];
     hd__cpu_rows o;
-    hd__cpu_rows_of(K, y, z, c, x0, &o);
-    if (!(iym && iyp && izm && izp)) hd__cpu_rows_clip(&o, iym, iyp, izm, izp);
+    hd__cpu_rows_at(K, y, z, c, x0, iym, iyp, izm, izp, &o);
     HD__CPU_COLOUR_SWITCH(0, iym, iyp, izm, izp)
     if (K->f16) {
         uint16_t *dst = (jacobi ? K->phi2h : K->phih) + o.p[0];
@@ -576,7 +591,7 @@ static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z
         hd_diffuse_row(be->grid->k, y, z, c, parity, be->jacobi);
         return;
     }
-    if (y == 0 || y == p->gdims.y - 1 || z == 0 || z == p->gdims.z - 1) {
+    if (hd__cpu_edge_row(p, y, z)) {
         hd__cpu_diffuse_edge_row(be, y, z, c, parity);
         return;
     }
@@ -753,11 +768,21 @@ static void hd__cpu_rb_tseam(hd__backend *be, int r)
     hd__cpu_rb_phases(be, r / (nb - 1), lo, hi);
 }
 
+/* One sweep of a grid under 4 rows, colour by colour on one thread (item 0; no blocks). */
+static void hd__cpu_rb_small(hd__backend *be, int r)
+{
+    int h, c, z;
+    (void)r;
+    for (h = 0; h < 2; ++h)
+        for (c = 0; c < be->grid->k->p->gdims.w; ++c)
+            for (z = 0; z < be->grid->k->p->gdims.z; ++z) hd__cpu_rb_rows(be, be->parity ^ h, 0, 4, z, c);
+}
+
 /* Red-black sweeps on be->grid, the colour `first` first (multigrid's post-smoothing runs the
    adjoint order, black first): walks of up to be->rb_walk_sweeps sweeps, the rest one by one. */
 static void hd__cpu_red_black(hd__backend *be, int sweeps, int first)
 {
-    int nb = hd__cpu_rb_blocks(be), ch = be->grid->k->p->gdims.w, s = 0, h, c, z;
+    int nb = hd__cpu_rb_blocks(be), ch = be->grid->k->p->gdims.w, s = 0;
     be->jacobi = 0;
     be->parity = first;
     while (s < sweeps) {
@@ -770,12 +795,8 @@ static void hd__cpu_red_black(hd__backend *be, int sweeps, int first)
         } else if (nb > 0) {
             hd__cpu_parallel(be, hd__cpu_rb_block, nb * ch);
             hd__cpu_parallel(be, hd__cpu_rb_seam, (nb + 1) * ch);
-        } else { /* on the calling thread, in the workers' floating-point mode */
-            unsigned fp = hd__cpu_fp_enter();
-            for (h = 0; h < 2; ++h)
-                for (c = 0; c < ch; ++c)
-                    for (z = 0; z < be->grid->k->p->gdims.z; ++z) hd__cpu_rb_rows(be, first ^ h, 0, 4, z, c);
-            hd__cpu_fp_leave(fp);
+        } else {
+            hd__cpu_parallel(be, hd__cpu_rb_small, 1);
         }
         s += t;
     }
@@ -795,8 +816,7 @@ HD__CPU_INLINE void hd__cpu_residual_halves(hd__backend *be, int y, int z, int c
     for (x0 = 0; x0 < 2; ++x0) {
         float out[HD__CPU_ROW_MAX / 2 + 1];
         hd__cpu_rows o;
-        hd__cpu_rows_of(K, y, z, c, x0, &o);
-        if (!(iym && iyp && izm && izp)) hd__cpu_rows_clip(&o, iym, iyp, izm, izp);
+        hd__cpu_rows_at(K, y, z, c, x0, iym, iyp, izm, izp, &o);
         HD__CPU_COLOUR_SWITCH(1, iym, iyp, izm, izp)
         memcpy(be->grid->res + o.p[0], out, (size_t)hd__cpu_half_len(gx, x0) * sizeof(float));
     }
@@ -817,7 +837,7 @@ static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
     const hd__kctx *K = be->grid->k;
     int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
-    int edge = y == 0 || y == gy - 1 || z == 0 || z == gz - 1;
+    int edge = hd__cpu_edge_row(K->p, y, z);
     int f = K->p->counts.z & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
     if (gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
         float rhs;
