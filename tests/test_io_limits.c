@@ -609,26 +609,29 @@ static void lim_fail_free(void *p, void *user) { lim_free_fn(p, &((lim_fail *)us
 
 static void lim_alloc_fail(void)
 {
-    unsigned char d[4096], *b, *z;
+    enum { N = 48 }; /* N^3 > 64 Ki voxels: gzip output grows twice, so a failure can strand one */
+    const size_t bytes = (size_t)N * N * N;
+    unsigned char *d = (unsigned char *)malloc(bytes), *b, *z;
     size_t n, zn, i;
-    int k, dim[3] = {16, 16, 16};
+    int k, dim[3] = {N, N, N};
     float pix[3] = {1, 1, 1};
     static const char *names[3] = {"f.nii.gz", "f.nrrd", "f.mhd"};
-    for (i = 0; i < sizeof d; ++i) d[i] = lim_byte();
-    b = gen_nifti(0, 2, 8, 3, dim, pix, 352, 2.0f, 1.0f, d, sizeof d, &n); /* rescaled too */
+    for (i = 0; i < bytes; ++i) d[i] = lim_byte();
+    b = gen_nifti(0, 2, 8, 3, dim, pix, 352, 2.0f, 1.0f, d, bytes, &n); /* rescaled too */
     z = gen_deflate(b, n, 1, &zn);
     CHECK(lim_write(lim_path(names[0]), z, zn, NULL, 0));
     free(b);
     free(z);
-    b = gen_cat("NRRD0004\ntype: short\ndimension: 3\nsizes: 16 16 8\nencoding: raw\n\n", d,
-                sizeof d, &n);
+    b = gen_cat("NRRD0004\ntype: short\ndimension: 3\nsizes: 48 48 24\nencoding: raw\n\n", d,
+                bytes, &n);
     CHECK(lim_write(lim_path(names[1]), b, n, NULL, 0));
     free(b);
-    CHECK(lim_write(lim_path(names[2]), "NDims = 3\nDimSize = 16 16 16\nElementType = MET_UCHAR\n"
+    CHECK(lim_write(lim_path(names[2]), "NDims = 3\nDimSize = 48 48 48\nElementType = MET_UCHAR\n"
                     "CompressedData = True\nElementDataFile = f.zraw\n", 0, NULL, 0));
-    z = gen_deflate(d, sizeof d, 0, &zn);
+    z = gen_deflate(d, bytes, 0, &zn);
     CHECK(lim_write(lim_path("f.zraw"), z, zn, NULL, 0));
     free(z);
+    free(d);
     for (k = 0; k < 3; ++k) {
         lim_fail f;
         hd_load_options o;
