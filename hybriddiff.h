@@ -398,13 +398,14 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
    types are converted to F32.
    Every loader opens only regular files: a directory, device, FIFO or socket is
-   HD_ERROR_FILE_NOT_REGULAR, refused before it is read (a FIFO cannot block the call). A loader
-   reads the header, then at most the bytes the header says the data need (a file longer than
-   that is read no further). Raw data are allocated once the file is known to hold them; gzip
-   data are allocated as they inflate, never on the header's claim alone, so a short stream
-   claiming a huge volume fails without a large allocation. Peak allocation while loading is at
-   most twice the loaded volume (or its decompressed data, whichever is larger) plus 2 MiB
-   (tests/test_io_limits.c, io_peak_allocation). */
+   HD_ERROR_FILE_NOT_REGULAR, refused before it is read, so a FIFO cannot block the call
+   (tests/test_io_limits.c, io_not_regular). A loader reads the header (at most 1 MiB), then
+   only the bytes the header says the data need (io_data_length). Raw data are allocated once
+   the file is known to hold them; gzip data as they inflate, never on the header's claim alone,
+   so a short stream claiming a huge volume fails without a large allocation (io_gzip_claim).
+   Peak allocation while loading a file is at most twice the loaded volume (or its decompressed
+   data, whichever is larger) plus 1.25 MiB (io_peak_allocation). The memory parsers
+   (hd_volume_parse_*) allocate with malloc and have no limit but HD_MAX_DIM. */
 typedef struct hd_volume_file {
     hd_volume_desc desc; /* ready to be copied into hd_desc.volume */
     void *data;          /* what desc.data points to */
@@ -429,7 +430,8 @@ typedef enum hd_file_format {
    MetaImage detached data (ElementDataFile = name): by default the name must be relative and
    resolve (symbolic links followed, by realpath) to a regular file inside the header's folder;
    an absolute name, '..' leading out, or a link pointing out is HD_ERROR_FILE_OUTSIDE_FOLDER
-   (tests/test_io_limits.c, io_mhd_detached_policy). allow_outside_folder lifts that (the file
+   (tests/test_io_limits.c, io_mhd_detached_policy). The path is resolved once; its last component
+   is then opened without following a link. allow_outside_folder lifts the folder rule (the file
    must still be regular). max_bytes bounds the voxel data a header may declare, counted in the
    file's element type and in the loaded type, whichever is larger: more is
    HD_ERROR_FILE_TOO_LARGE before anything is allocated or inflated (io_max_bytes). */

@@ -1,7 +1,8 @@
 # mk/reliability.mk - hostile input, sanitizers and checkers (issue 8). Each job exits non-zero
 # on any report. Timings measured on the 2-core CI machine are in README.md, "Guarantees".
 #   make fuzz-smoke   libFuzzer, FUZZ_RUNS executions per loader from generated seeds plus
-#                     tests/fuzz/regressions/ (part of `make test`)
+#                     tests/fuzz/regressions/ (part of `make test`); every accepted volume of at
+#                     most 64^3 voxels is rendered (tests/fuzz/hd_fuzz_check.h)
 #   make fuzz-long    FUZZ_SECONDS per loader (local; keeps new corpus in build/fuzz/work_*)
 #   make asan         build/hdtest and the OpenCL conformance suite under ASan+UBSan+LSan
 #   make tsan         the CPU backend's threaded tests under TSan

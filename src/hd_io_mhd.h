@@ -9,7 +9,10 @@
    BinaryDataByteOrderMSB / ElementByteOrderMSB, CompressedData (zlib or gzip),
    CompressedDataSize, HeaderSize (bytes to skip in the data file; -1: the data are its last
    bytes). ElementDataFile: LOCAL (the bytes after that line) or a file name, relative to the
-   header's directory; LIST and slice patterns are HD_ERROR_UNSUPPORTED_ENCODING.
+   header's directory; LIST and slice patterns are HD_ERROR_UNSUPPORTED_ENCODING. A file name
+   must resolve (realpath) inside the header's folder, else HD_ERROR_FILE_OUTSIDE_FOLDER, unless
+   hd_load_options.allow_outside_folder; the data file must be regular (HD_ERROR_FILE_NOT_REGULAR)
+   and only the bytes the header needs are read from it.
    Errors as for NRRD: a data file shorter than the header claims is HD_ERROR_FILE_TRUNCATED,
    a DimSize product that overflows HD_ERROR_SIZE_OVERFLOW, negative/zero/NaN spacing
    HD_ERROR_INVALID_SPACING, unknown element types HD_ERROR_UNSUPPORTED_ENCODING, a corrupt or
