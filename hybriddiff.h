@@ -64,6 +64,10 @@
 #if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_POSIX_C_SOURCE) && !defined(_WIN32)
 #define _POSIX_C_SOURCE 200809L
 #endif
+/* realpath (the MetaImage loader's folder check) is X/Open. */
+#if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_XOPEN_SOURCE) && !defined(_WIN32)
+#define _XOPEN_SOURCE 700
+#endif
 
 #include <stddef.h>
 #include <stdint.h>
@@ -111,7 +115,10 @@ extern "C" {
     X(HD_ERROR_FILE_FORMAT, "the file header is malformed") \
     X(HD_ERROR_FILE_TRUNCATED, "the file is shorter than its header claims") \
     X(HD_ERROR_UNSUPPORTED_ENCODING, "the file's encoding or voxel type is not supported") \
-    X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated")
+    X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated") \
+    X(HD_ERROR_FILE_NOT_REGULAR, "the path is a directory, device, FIFO or socket, not a file") \
+    X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
+    X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -432,11 +439,22 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
-   types are converted to F32. */
+   types are converted to F32.
+   Every loader opens only regular files: a directory, device, FIFO or socket is
+   HD_ERROR_FILE_NOT_REGULAR, refused before it is read, so a FIFO cannot block the call
+   (tests/test_io_limits.c, io_not_regular). A loader reads the header (at most 1 MiB), then
+   only the bytes the header says the data need (io_data_length). Raw data are allocated once
+   the file is known to hold them; gzip data as they inflate, never on the header's claim alone,
+   so a short stream claiming a huge volume fails without a large allocation (io_gzip_claim).
+   Peak allocation while loading a file is at most twice the loaded volume (or its decompressed
+   data, whichever is larger) plus 1.25 MiB (io_peak_allocation). The memory parsers
+   (hd_volume_parse_*) allocate with malloc and have no limit but HD_MAX_DIM. */
 typedef struct hd_volume_file {
     hd_volume_desc desc; /* ready to be copied into hd_desc.volume */
     void *data;          /* what desc.data points to */
     float value_min, value_max; /* range of the values in the file */
+    hd_allocator allocator; /* what allocated data (hd_load_options.allocator); hd_volume_free
+                               uses it */
 } hd_volume_file;
 
 typedef enum hd_endian { HD_ENDIAN_LITTLE = 0, HD_ENDIAN_BIG } hd_endian;
@@ -445,6 +463,28 @@ typedef enum hd_raw_type {
     HD_RAW_U8 = 0, HD_RAW_I8, HD_RAW_U16, HD_RAW_I16, HD_RAW_U32, HD_RAW_I32, HD_RAW_F32,
     HD_RAW_F64, HD_RAW_TYPE_COUNT
 } hd_raw_type;
+
+typedef enum hd_file_format {
+    HD_FILE_AUTO = 0, /* by the file's first bytes (or a .mhd/.mha extension), as hd_volume_load */
+    HD_FILE_NRRD, HD_FILE_METAIMAGE, HD_FILE_NIFTI, HD_FILE_FORMAT_COUNT
+} hd_file_format;
+
+/* Options of hd_volume_load_ex; all zero is what the other loaders use.
+   MetaImage detached data (ElementDataFile = name): by default the name must be relative and
+   resolve (symbolic links followed, by realpath) to a regular file inside the header's folder;
+   an absolute name, '..' leading out, or a link pointing out is HD_ERROR_FILE_OUTSIDE_FOLDER
+   (tests/test_io_limits.c, io_mhd_detached_policy). The path is resolved once; its last component
+   is then opened without following a link. allow_outside_folder lifts the folder rule (the file
+   must still be regular). max_bytes bounds the voxel data a header may declare, counted in the
+   file's element type and in the loaded type, whichever is larger: more is
+   HD_ERROR_FILE_TOO_LARGE before anything is allocated or inflated (io_max_bytes). */
+typedef struct hd_load_options {
+    hd_file_format format;    /* HD_FILE_AUTO (0): detect */
+    int allow_outside_folder; /* MetaImage: ElementDataFile may name any regular file */
+    size_t max_bytes;         /* 0: no limit but HD_MAX_DIM per axis */
+    hd_allocator allocator;   /* every allocation of the loader (zlib's too) and the voxels;
+                                 all or none, {0}: malloc/free */
+} hd_load_options;
 
 /* NRRD (.nrrd, attached header; raw or gzip encoding). */
 HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out, const hd_logger *log);
@@ -466,6 +506,10 @@ HDDEF hd_result hd_volume_load_nifti(const char *path, hd_volume_file *out, cons
 HDDEF hd_result hd_volume_parse_nifti(const void *bytes, size_t size, hd_volume_file *out,
                                       const hd_logger *log);
 HDDEF hd_result hd_volume_load(const char *path, hd_volume_file *out, const hd_logger *log);
+/* Any format with options (NULL: all zero); an out-of-range format is HD_ERROR_INVALID_ENUM,
+   one of allocator.alloc/free without the other HD_ERROR_NULL_POINTER. */
+HDDEF hd_result hd_volume_load_ex(const char *path, const hd_load_options *options,
+                                  hd_volume_file *out, const hd_logger *log);
 HDDEF void hd_volume_free(hd_volume_file *vol);
 
 #ifdef __cplusplus
