@@ -294,7 +294,7 @@ typedef struct hd_params {
                                estimated relative error of E + phi, is below this for two light
                                iterations in a row: 0 -> 0.1 (head CT: 10-20 iterations, the
                                image within about 43 dB of one with 8x as many: the projection
-                               averages many voxels; docs/PERFORMANCE.md); finite and >= 0 */
+                               averages many voxels; docs/DESIGN-RENDER.md); finite and >= 0 */
     float render_budget;    /* seconds one hd_render call may spend refining light that has not
                                converged, before it projects its frame: 0 -> one light iteration
                                per call; must be finite and >= 0 */
