@@ -107,6 +107,52 @@ HDO_FN int hdo_scene_load(hdo_scene *s, const char *path, int size, const hd_log
     return 1;
 }
 
+/* Refines ctx's light until hd_stats.light_converged, at most max_iters iterations (progress on
+   stderr every 10). If it has not converged by then, light_tolerance is raised above the current
+   error estimate, so that hd_render does projections only from here on (benchmarks of frame
+   time), and the raise is reported. Returns 1 if it converged by itself, 0 if raised, -1 on error
+   (said). *seconds: the time spent. */
+HDO_FN int hdo_converge(hd_context ctx, int max_iters, const char *tag, double *seconds)
+{
+    hd_stats st;
+    hd_desc d;
+    hd_result r;
+    double t0 = hdo_now();
+    int it = 0, extra = 0;
+    do {
+        if ((r = hd_refine(ctx, 1)) != HD_SUCCESS || (r = hd_get_stats(ctx, &st)) != HD_SUCCESS) {
+            fprintf(stderr, "%s: hd_refine: %s\n", tag, hd_result_string(r));
+            return -1;
+        }
+        if (++it % 10 == 0)
+            fprintf(stderr, "%s: light iteration %d, light_error %.4g\n", tag, it, st.light_error);
+    } while (!st.light_converged && it < max_iters);
+    *seconds = hdo_now() - t0;
+    fprintf(stderr, "%s: light %s after %d iterations in %.1f s, light_error %.4g\n", tag,
+            st.light_converged ? "converged" : "not converged", it, *seconds, st.light_error);
+    if (st.light_converged) return 1;
+    if ((r = hd_query_desc(ctx, &d)) != HD_SUCCESS) {
+        fprintf(stderr, "%s: hd_query_desc: %s\n", tag, hd_result_string(r));
+        return -1;
+    }
+    d.params.light_tolerance = (float)(1.5 * st.light_error);
+    if ((r = hd_set_params(ctx, &d.params)) != HD_SUCCESS) {
+        fprintf(stderr, "%s: hd_set_params: %s\n", tag, hd_result_string(r));
+        return -1;
+    }
+    do {
+        if ((r = hd_refine(ctx, 1)) != HD_SUCCESS || (r = hd_get_stats(ctx, &st)) != HD_SUCCESS) {
+            fprintf(stderr, "%s: hd_refine: %s\n", tag, hd_result_string(r));
+            return -1;
+        }
+    } while (!st.light_converged && ++extra < 20);
+    *seconds = hdo_now() - t0;
+    fprintf(stderr, "%s: light_tolerance raised to %.4g (the iteration cap): converged %d after %d "
+            "more iterations, light_error %.4g\n", tag, (double)d.params.light_tolerance,
+            st.light_converged, extra + 1, st.light_error);
+    return st.light_converged ? 0 : -1;
+}
+
 HDO_FN double hdo_srgb(double x)
 {
     x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);

@@ -25,7 +25,7 @@
    Scripted (for tests): --frames N runs N frames and exits; --screenshot FILE saves the last
    one; --script FILE runs the commands in FILE, one a line: `orbit DEG_X DEG_Y`, `pan DX DY`,
    `zoom FACTOR`, `home` (the default camera), `key CHARS` (as typed), `restart`, `frames N`, `screenshot FILE`,
-   `converge N` (hd_refine until converged, at most N iterations), `expect-light-idle N` (N frames
+   `tolerance T` (light_tolerance), `converge N` (hd_refine until converged, at most N iterations), `expect-light-idle N` (N frames
    that must do no light work, else exit 1); with --script
    the window closes when the script ends. --size WxH sets the window (and image) size, --seed N
    the seed; the rest of the scene is hdrender's default (camera, 1 key light, ct-skin or ramp,
@@ -369,7 +369,7 @@ static void frame(viewer *v)
         if (st.method == HD_METHOD_HD || st.method == HD_METHOD_CD)
             snprintf(light, sizeof light, "light %s (error %.3g, %llu it)",
                      st.light_converged ? "converged" : "refining", st.light_error,
-                     (unsigned long long)st.light_iterations);
+                     (unsigned long long)st.iterations);
         else
             snprintf(light, sizeof light, "%llu paths/pixel", (unsigned long long)st.iterations);
         snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f",
@@ -394,6 +394,14 @@ static void run_frames(viewer *v, int n, int interactive)
     }
 }
 
+/* Script command: the light's convergence tolerance (hd_params.light_tolerance). */
+static void set_tolerance(viewer *v, float tol)
+{
+    hd_result r;
+    v->params.light_tolerance = tol;
+    if ((r = hd_set_params(v->ctx, &v->params)) != HD_SUCCESS) die("hd_set_params (tolerance)", r);
+}
+
 /* Script command: refines the light until it has converged (at most max iterations). */
 static void converge(viewer *v, int max)
 {
@@ -405,7 +413,7 @@ static void converge(viewer *v, int max)
         if ((r = hd_get_stats(v->ctx, &st)) != HD_SUCCESS) die("hd_get_stats", r);
     } while (!st.light_converged && ++i < max);
     fprintf(stderr, "hdview: light %s after %llu iterations (error %.3g)\n",
-            st.light_converged ? "converged" : "not converged", (unsigned long long)st.light_iterations,
+            st.light_converged ? "converged" : "not converged", (unsigned long long)st.iterations,
             st.light_error);
 }
 
@@ -418,10 +426,10 @@ static void expect_light_idle(viewer *v, int n)
     if (!a.light_converged) { fprintf(stderr, "hdview: expect-light-idle: the light has not converged\n"); exit(1); }
     run_frames(v, n, 0);
     if ((r = hd_get_stats(v->ctx, &b)) != HD_SUCCESS) die("hd_get_stats", r);
-    if (b.light_iterations != a.light_iterations || b.seconds_direct != a.seconds_direct ||
+    if (b.iterations != a.iterations || b.seconds_direct != a.seconds_direct ||
         b.seconds_diffusion != a.seconds_diffusion) {
         fprintf(stderr, "hdview: expect-light-idle: %d frames did light work (%llu -> %llu light iterations)\n",
-                n, (unsigned long long)a.light_iterations, (unsigned long long)b.light_iterations);
+                n, (unsigned long long)a.iterations, (unsigned long long)b.iterations);
         exit(1);
     }
     fprintf(stderr, "hdview: %d frames over converged light, no light work (%.1f ms/frame)\n", n, v->frame_ms);
@@ -456,6 +464,7 @@ static void run_script(viewer *v, const char *path)
         else if (strcmp(cmd, "restart") == 0) restart(v);
         else if (strcmp(cmd, "home") == 0) camera_default(v);
         else if (strcmp(cmd, "frames") == 0 && sscanf(arg, "%d", &n) == 1) run_frames(v, n, 0);
+        else if (strcmp(cmd, "tolerance") == 0 && sscanf(arg, "%f", &a) == 1) set_tolerance(v, a);
         else if (strcmp(cmd, "converge") == 0 && sscanf(arg, "%d", &n) == 1) converge(v, n);
         else if (strcmp(cmd, "expect-light-idle") == 0 && sscanf(arg, "%d", &n) == 1) expect_light_idle(v, n);
         else if (strcmp(cmd, "screenshot") == 0 && arg[0]) scripted_screenshot(v, arg);

@@ -1,7 +1,8 @@
 /* hdpeer - hybriddiff's side of the VTK side-by-side (bench/peer/vtk_peer.py drives it; make
    bench-peer). Loads the head CT with the orbit scene (bench/hd_orbit_scene.h), converges the
    light (hd_refine until hd_stats.light_converged, at most HDPEER_LIGHT_ITERS iterations, default
-   64), then answers commands on stdin, one a line, each answered by one line on stdout:
+   32; past the cap light_tolerance is raised so the frames stay projections, see hdo_converge),
+   then answers commands on stdin, one a line, each answered by one line on stdout:
      tf                    the TF the driver must mirror: "tf LO HI COUNT EXTINCTION STEP_WORLD
                            SX SY SZ DX DY DZ" then COUNT lines "R G B A" (SX.. the world box
                            sides, DX.. the dims)
@@ -71,10 +72,9 @@ int main(int argc, char **argv)
     static hdo_scene s;
     const char *path = argc > 1 ? argv[1] : "data/head.nrrd";
     const char *env = getenv("HDPEER_LIGHT_ITERS");
-    int max_light = env ? atoi(env) : 64, it = 0;
+    int max_light = env ? atoi(env) : 32;
     hd_logger log = {hd_log_stderr, NULL};
     char line[4096];
-    hd_stats st;
     double t0;
 
     if (argc > 2 || (argc == 2 && argv[1][0] == '-')) {
@@ -85,24 +85,7 @@ int main(int argc, char **argv)
     if (!hdo_scene_load(&s, path, 512, &log)) return 1;
     check(hd_create(&s.desc, &g_ctx), "hd_create");
 
-    t0 = hdo_now();
-    do {
-        check(hd_refine(g_ctx, 1), "hd_refine");
-        check(hd_get_stats(g_ctx, &st), "hd_get_stats");
-    } while (!st.light_converged && ++it < max_light);
-    fprintf(stderr, "hdpeer: light %s after %llu iterations (%.1f s), light_error %.4g\n",
-            st.light_converged ? "converged" : "NOT converged (HDPEER_LIGHT_ITERS)",
-            (unsigned long long)st.light_iterations, hdo_now() - t0, st.light_error);
-    if (!st.light_converged) {
-        /* hd_render would keep refining; the frames must be projections only */
-        hd_params p = s.desc.params;
-        p.light_tolerance = (float)(st.light_error * 1.01 + 1e-12);
-        check(hd_set_params(g_ctx, &p), "hd_set_params");
-        check(hd_refine(g_ctx, 1), "hd_refine");
-        check(hd_get_stats(g_ctx, &st), "hd_get_stats");
-        fprintf(stderr, "hdpeer: light_tolerance raised to %.4g: converged %d\n",
-                (double)p.light_tolerance, st.light_converged);
-    }
+    if (hdo_converge(g_ctx, max_light, "hdpeer", &t0) < 0) return 1;
 
     while (fgets(line, sizeof line, stdin)) {
         char cmd[32], arg[4000];
