@@ -14,7 +14,8 @@
            chosen light per iteration (progressive mean; memory independent of the light count);
         2. multiple scattering phi, by a diffusion solve on the grid, warm-started each iteration;
         3. an emission-absorption ray-marched projection of sigma_s * c * (E + phi) / (4 pi).
-      Only stage 3 depends on the camera: moving the camera keeps the converged illumination.
+      Only stage 3 depends on the camera: moving the camera keeps the converged illumination, and
+      hd_render stops all light work once the light has converged (hd_stats.light_converged).
 
    Quick start
       hd_desc desc = {0};
@@ -23,8 +24,10 @@
       desc.volume.data = voxels;                 // copied; may be freed after hd_create
       hd_context ctx;
       if (hd_create(&desc, &ctx) != HD_SUCCESS) { ... }
-      hd_iterate(ctx, 64);                       // progressive: call again to refine
-      hd_read_image_rgba8(ctx, pixels, w * h * 4);
+      while (app_running) {                      // one call per displayed frame
+          hd_render(ctx);                        // light work only until it converges
+          hd_read_image_rgba8(ctx, pixels, w * h * 4);
+      }
       hd_destroy(ctx);
 
    Configuration macros (define before including the implementation)
@@ -280,6 +283,14 @@ typedef struct hd_params {
                                device lacks them HD_ERROR_UNSUPPORTED at the next render); the
                                multigrid solver returns HD_ERROR_UNSUPPORTED. hd_read_illumination
                                still returns floats. */
+    float light_tolerance;  /* hd_render stops refining the light once hd_stats.light_error, the
+                               estimated relative error of E + phi, is below this for two light
+                               iterations in a row: 0 -> 0.1 (head CT: 10-20 iterations, the
+                               image within about 43 dB of one with 8x as many: the projection
+                               averages many voxels; docs/PERFORMANCE.md); finite and >= 0 */
+    float render_budget;    /* seconds one hd_render call may spend refining light that has not
+                               converged, before it projects its frame: 0 -> one light iteration
+                               per call; must be finite and >= 0 */
 } hd_params;
 
 typedef struct hd_desc {
@@ -325,6 +336,13 @@ typedef struct hd_stats {
     double seconds_direct;    /* accumulated wall time per stage since creation */
     double seconds_diffusion;
     double seconds_projection;
+    /* Light convergence (HD and CD; 0 for the path tracers). After each light iteration the
+       change of E and phi on the medium's voxels gives an estimate of their relative RMS error:
+       sqrt(n) |E_n - E_n-1| for E's Monte Carlo mean, |phi_n - phi_n-1| q / (1 - q) for the
+       solver (q: the change's observed contraction, at most 0.9), over |E_n + phi_n|; 1 before
+       two iterations. */
+    double light_error;
+    int light_converged;      /* light_error < params.light_tolerance twice in a row */
 } hd_stats;
 
 typedef struct hd_context {
@@ -353,14 +371,39 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering,
      illumination_precision                    -> E, phi, image (new grids)
-     solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
+     solver, sweeps, tracking, exposure,
+     light_tolerance, render_budget            -> nothing (same solution, estimator or encoding) */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);
 HDDEF hd_result hd_set_camera(hd_context ctx, const hd_camera *camera);
 HDDEF hd_result hd_set_params(hd_context ctx, const hd_params *params);
 
-/* Runs n >= 1 iterations of the current method. */
+/* Runs n >= 1 iterations of the current method, each refining the light (HD, CD) and projecting
+   one frame; it refines even light that has converged (hd_stats.light_converged). */
 HDDEF hd_result hd_iterate(hd_context ctx, int n);
+
+/* n >= 1 light iterations (HD: direct light and diffusion; CD: convection and diffusion) with no
+   projection: the image is left as it was. For a single view, refine until
+   hd_stats.light_converged, then project with hd_render. The path tracers have no light to
+   refine: HD_ERROR_UNSUPPORTED. */
+HDDEF hd_result hd_refine(hd_context ctx, int n);
+
+/* One frame for a per-frame loop: call it once per displayed frame.
+     HD, CD: while the light has not converged, one light iteration (or as many as
+             params.render_budget seconds allow), then one projection frame from the current E
+             and phi into the image's running mean. Once the light has converged, no light work:
+             the projection alone, and when the frame_window frames since the convergence are in
+             the image (it is done), nothing at all until a setter invalidates something.
+     PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
+   A camera move (hd_set_camera) keeps converged light: the next call projects at once.
+
+      for (;;) {                              // the application's frame loop
+          if (camera_moved) hd_set_camera(ctx, &cam);
+          hd_render(ctx);                     // cheap once hd_stats.light_converged
+          hd_read_image_rgba8(ctx, px, n);    // or hd_gl_render_to_texture
+      }
+*/
+HDDEF hd_result hd_render(hd_context ctx);
 
 /* The image, top row first. RGBA8: sRGB-encoded radiance * exposure, alpha = opacity.
    Float: linear RGB radiance and opacity. Sizes are in bytes / in floats. */
