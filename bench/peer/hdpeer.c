@@ -7,8 +7,9 @@
                            SX SY SZ DX DY DZ" then COUNT lines "R G B A" (SX.. the world box
                            sides, DX.. the dims)
      frames SIZE N         N orbit frames at SIZE x SIZE (azimuth 360 i / N), one hd_render
-                           each: "ms MEAN_MS LIGHT_SECONDS" (LIGHT_SECONDS: direct + diffusion
-                           time spent during them, 0 once the light has converged)
+                           each: "ms MEAN_MS LIGHT_SECONDS CPU_MS" (LIGHT_SECONDS: direct +
+                           diffusion time spent during them, 0 once the light has converged;
+                           CPU_MS: this process's CPU time per frame)
      picture SIZE PATH     azimuth 0 at SIZE x SIZE, frame_window frames averaged, PNG: "ok"
      quit
    Usage: hdpeer [FILE]   (default data/head.nrrd) */
@@ -36,6 +37,13 @@ static double light_seconds(void)
     hd_stats st;
     check(hd_get_stats(g_ctx, &st), "hd_get_stats");
     return st.seconds_direct + st.seconds_diffusion;
+}
+
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static void set_view(double deg, int size)
@@ -119,18 +127,20 @@ int main(int argc, char **argv)
                        (double)d.transfer_function.rgba[4 * i + 3]);
         } else if (strcmp(cmd, "frames") == 0 && sscanf(line, "%*s %d %d", &size, &n) == 2 &&
                    size >= 16 && size <= 4096 && n >= 1) {
-            double l0, ts, te;
+            double l0, ts, te, cs;
             int i;
             set_view(0.0, size);
             check(hd_render(g_ctx), "hd_render"); /* the image at this size exists */
             l0 = light_seconds();
             ts = hdo_now();
+            cs = cpu_seconds();
             for (i = 0; i < n; ++i) {
                 set_view(360.0 * i / n, size);
                 check(hd_render(g_ctx), "hd_render");
             }
             te = hdo_now();
-            printf("ms %.3f %.6f\n", 1e3 * (te - ts) / n, light_seconds() - l0);
+            printf("ms %.3f %.6f %.3f\n", 1e3 * (te - ts) / n, light_seconds() - l0,
+                   1e3 * (cpu_seconds() - cs) / n);
         } else if (strcmp(cmd, "picture") == 0 && sscanf(line, "%*s %d %3999s", &size, arg) == 2 &&
                    size >= 16 && size <= 4096) {
             picture(size, arg);
