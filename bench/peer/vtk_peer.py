@@ -14,7 +14,8 @@
 # Every frame of a timed run moves the camera along the orbit (azimuth 360 i / N).
 #
 # Usage: pvpython vtk_peer.py [--hdpeer build/hdpeer] [--data data/head.nrrd] [--sizes 512,1024]
-#          [--frames 3] [--gi-frames 2] [--rounds 2] [--pictures docs/peer]
+#          [--frames 3] [--gi-frames 2] [--rounds 2] [--pictures docs/peer|none]
+# (pvpython cannot take an empty argument: --pictures none, not --pictures '')
 import argparse
 import math
 import os
@@ -89,7 +90,7 @@ def main():
     ap.add_argument("--frames", type=int, default=3, help="orbit frames per engine and round")
     ap.add_argument("--gi-frames", type=int, default=2, help="frames of vtk-gi (slow)")
     ap.add_argument("--rounds", type=int, default=2)
-    ap.add_argument("--pictures", default="docs/peer", help="'' for none")
+    ap.add_argument("--pictures", default="docs/peer", help="directory, or 'none'")
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",") if s]
 
@@ -236,7 +237,7 @@ def main():
                 s, med["hd"], med["vtk-fp"], med["vtk-gpu"], med["vtk-gi"],
                 med["hd"] / med["vtk-fp"], med["hd"] / med["vtk-gpu"]))
 
-    if a.pictures:
+    if a.pictures and a.pictures != "none":
         os.makedirs(a.pictures, exist_ok=True)
         for s in sizes[:1]:
             files = []
