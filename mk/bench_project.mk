@@ -19,6 +19,7 @@ PROJECT_LIB_vulkan := -lvulkan
 PROJECT_ITERS ?= 24
 PROJECT_SIZES ?= 512 1024
 PROJECT_REPS ?= 2
+PROJECT_FRAMES ?= 5
 
 .PHONY: bench-project
 
@@ -40,6 +41,6 @@ bench-project: $(foreach b,$(PROJECT_BACKENDS),$(B)/hdbench_project_$(b) $(B)/hd
 	@mkdir -p $(B)/bench_project
 	@for size in $(PROJECT_SIZES); do for be in $(PROJECT_BACKENDS); do for rep in $$(seq $(PROJECT_REPS)); do \
 	  o=$(B)/bench_project/$$be-$$size; \
-	  $(B)/hdbench_project_old_$$be --tag old --size $$size --save $$o-old.f32 --png $$o-old.png || exit 1; \
-	  $(B)/hdbench_project_$$be --tag new --size $$size --compare $$o-old.f32 --png $$o-new.png || exit 1; \
+	  $(B)/hdbench_project_old_$$be --tag old --size $$size --frames $(PROJECT_FRAMES) --save $$o-old.f32 --png $$o-old.png || exit 1; \
+	  $(B)/hdbench_project_$$be --tag new --size $$size --frames $(PROJECT_FRAMES) --compare $$o-old.f32 --png $$o-new.png || exit 1; \
 	done; done; done
