@@ -850,10 +850,19 @@ static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
     }
 }
 
-static void hd__cpu_project_row(hd__backend *be, int py)
+/* An image row on a copy of the kernel context whose storage precision (f16) is a literal, every
+   call inlined: the sample's 16 loads of E and phi lose their precision test. */
+static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 {
     int px, w = be->ctx->kp.image.x;
-    for (px = 0; px < w; ++px) hd_project_pixel(&be->k, px, py);
+    hd__kctx k = be->k;
+    if (k.f16) {
+        k.f16 = 1;
+        for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
+    } else {
+        k.f16 = 0;
+        for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
+    }
 }
 
 static hd_result hd__be_classify(hd__ctx *ctx)

@@ -53,6 +53,36 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
     HD_SET1(img, b + 3, HD_GET1(img, b + 3) + (v.w - HD_GET1(img, b + 3)) * w);
 }
 
+/* Adds one sample's emission to (r, g, b) and its absorption to T: colour and extinction from
+   the TF at the volume sample, the light from hd_sample_light. */
+HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_INOUT(float) r,
+                             HD_INOUT(float) g, HD_INOUT(float) b)
+{
+    hd_v4 c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
+    float st = c.w * HD_PRM(medium).x;
+    if (st > 0.0f) {
+        float a = 1.0f - hd_exp(-st * dt);
+        float e = HD_DEREF(T) * a * HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
+        if (HD_PRM(gdims).w == 1) {
+            float l0 = hd_sample_light(HD_KPASS u, 0) * e;
+            HD_DEREF(r) += c.x * l0 * HD_PRM(chan_color).x;
+            HD_DEREF(g) += c.y * l0 * HD_PRM(chan_color).y;
+            HD_DEREF(b) += c.z * l0 * HD_PRM(chan_color).z;
+        } else {
+            HD_DEREF(r) += c.x * hd_sample_light(HD_KPASS u, 0) * e;
+            HD_DEREF(g) += c.y * hd_sample_light(HD_KPASS u, 1) * e;
+            HD_DEREF(b) += c.z * hd_sample_light(HD_KPASS u, 2) * e;
+        }
+        HD_DEREF(T) *= 1.0f - a;
+    }
+}
+
+/* The samples sit at t0 + (jitter + k) dt along the camera ray. Empty space is skipped through
+   the majorant grid (cells of mdims.w voxels, each majorant bounding every trilinear sample
+   inside the cell with a one-voxel halo, hd_context.h): in a cell whose majorant is 0 every
+   sample has sigma_t = 0 and adds nothing, so the march jumps to the first sample past the
+   cell's exit; the samples taken are the same as without the skip. The march stops once the
+   transmittance falls below march.z. */
 HD_FN void hd_project_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
@@ -63,28 +93,34 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
     float dt = HD_PRM(march).x;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
-    int nch = HD_PRM(gdims).w;
-    float k = HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
-    float t;
-    for (t = t0 + hd_rand(key, 2u) * dt; t < t1; t += dt) {
-        hd_v3 u = hd_world_to_tex(HD_KPASS hd_madd(o, d, t));
-        hd_v4 c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
-        float st = c.w * HD_PRM(medium).x;
-        if (st > 0.0f) {
-            float a = 1.0f - hd_exp(-st * dt);
-            float e = T * a * k;
-            if (nch == 1) {
-                float l0 = hd_sample_light(HD_KPASS u, 0) * e;
-                r += c.x * l0 * HD_PRM(chan_color).x;
-                g += c.y * l0 * HD_PRM(chan_color).y;
-                b += c.z * l0 * HD_PRM(chan_color).z;
-            } else {
-                r += c.x * hd_sample_light(HD_KPASS u, 0) * e;
-                g += c.y * hd_sample_light(HD_KPASS u, 1) * e;
-                b += c.z * hd_sample_light(HD_KPASS u, 2) * e;
-            }
-            T *= 1.0f - a;
+    float t = t0 + hd_rand(key, 2u) * dt;
+    /* the ray in majorant-cell coordinates: q(t) = q0 + t * qd; iq: 1 / qd (0 where qd is 0) */
+    float cell = HD_F(HD_PRM(mdims).w);
+    hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);
+    hd_v3 q0 = hd_vmul(hd_world_to_tex(HD_KPASS o), cs);
+    hd_v3 qd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);
+    hd_v3 iq = HD_V3(qd.x != 0.0f ? 1.0f / qd.x : 0.0f, qd.y != 0.0f ? 1.0f / qd.y : 0.0f,
+                     qd.z != 0.0f ? 1.0f / qd.z : 0.0f);
+    hd_i4 md = HD_PRM(mdims);
+    while (t < t1) {
+        hd_v3 q = hd_madd(q0, qd, t);
+        int cx = hd_clampi(HD_I(hd_floor(q.x)), 0, md.x - 1);
+        int cy = hd_clampi(HD_I(hd_floor(q.y)), 0, md.y - 1);
+        int cz = hd_clampi(HD_I(hd_floor(q.z)), 0, md.z - 1);
+        /* where the ray leaves the cell (or the box) */
+        float tc = t1;
+        if (qd.x != 0.0f) tc = hd_minf(tc, (HD_F(qd.x > 0.0f ? cx + 1 : cx) - q0.x) * iq.x);
+        if (qd.y != 0.0f) tc = hd_minf(tc, (HD_F(qd.y > 0.0f ? cy + 1 : cy) - q0.y) * iq.y);
+        if (qd.z != 0.0f) tc = hd_minf(tc, (HD_F(qd.z > 0.0f ? cz + 1 : cz) - q0.z) * iq.z);
+        if (HD_GET1(maj, (cz * md.y + cy) * md.x + cx) > 0.0f) {
+            do {
+                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(o, d, t)), dt, HD_REF(T),
+                                  HD_REF(r), HD_REF(g), HD_REF(b));
+                t += dt;
+            } while (t < tc && T >= HD_PRM(march).z);
             if (T < HD_PRM(march).z) { T = 0.0f; break; }
+        } else {
+            t += hd_maxf(hd_floor((tc - t) / dt) + 1.0f, 1.0f) * dt; /* the first sample past tc */
         }
     }
     hd_accumulate_pixel(HD_KPASS i, HD_V4(r + T * HD_PRM(background).x, g + T * HD_PRM(background).y,
