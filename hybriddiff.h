@@ -202,6 +202,17 @@ typedef struct hd_allocator {
 #define HD_MAX_LIGHTS 64
 #define HD_MAX_DIM 8192           /* per axis */
 #define HD_MAX_IMAGE_DIM 16384
+/* Finite limits that keep every intermediate value finite and every loop short (hd_create and
+   the setters reject beyond them; README "Guarantees"):
+   - the volume's extent (dims * spacing) over its smallest spacing, per axis pair, is at most
+     HD_MAX_SPACING_RATIO, so a voxel spans enough float steps of the box for the march;
+   - the sum over the lights of intensity * max(colour) is at most HD_MAX_LIGHT_POWER;
+   - point-light positions and camera eye/target components are at most HD_MAX_LIGHT_DISTANCE
+     and HD_MAX_CAMERA_DISTANCE in magnitude (world units: the box's largest side is 1). */
+#define HD_MAX_SPACING_RATIO 65536.0f
+#define HD_MAX_LIGHT_POWER 1e6f
+#define HD_MAX_LIGHT_DISTANCE 1e15f
+#define HD_MAX_CAMERA_DISTANCE 1e4f
 
 typedef struct hd_volume_desc {
     hd_voxel_type type;   /* required */

@@ -84,14 +84,14 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
     float lo = v->value_range[0], hi = v->value_range[1], scale;
     size_t i, ncell;
     int d, x, y, z;
-    float extent[3], emax = 0.0f;
+    double extent[3], emax = 0.0; /* double: dims * spacing may pass FLT_MAX (hd__check_extent) */
     for (d = 0; d < 3; ++d) {
         ctx->dims[d] = v->dims[d];
-        extent[d] = (float)v->dims[d] * v->spacing[d];
+        extent[d] = (double)v->dims[d] * (double)v->spacing[d];
         if (extent[d] > emax) emax = extent[d];
         ctx->mdims[d] = (v->dims[d] + HD__MAJORANT_CELL - 1) / HD__MAJORANT_CELL;
     }
-    for (d = 0; d < 3; ++d) ctx->box[d] = extent[d] / emax;
+    for (d = 0; d < 3; ++d) ctx->box[d] = (float)(extent[d] / emax);
     ctx->nvox = (size_t)ctx->dims[0] * ctx->dims[1] * ctx->dims[2];
     ctx->vol = (float *)hd__alloc(ctx, ctx->nvox * sizeof(float));
     ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
@@ -300,8 +300,9 @@ static void hd__fill_kparams(hd__ctx *ctx)
         const hd_light *l = &ctx->lights[i];
         hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];
         if (l->type == HD_LIGHT_DIRECTIONAL) {
-            float n = sqrtf(l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] + l->direction[2] * l->direction[2]);
-            a->x = l->direction[0] / n; a->y = l->direction[1] / n; a->z = l->direction[2] / n; a->w = 0.0f;
+            float n[3];
+            hd__unit3(l->direction, n); /* nonzero: hd__check_lights */
+            a->x = n[0]; a->y = n[1]; a->z = n[2]; a->w = 0.0f;
         } else {
             a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
         }

@@ -65,11 +65,20 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
     int nch = HD_PRM(gdims).w;
     float k = HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
-    float t;
-    for (t = t0 + hd_rand(key, 2u) * dt; t < t1; t += dt) {
-        hd_v3 u = hd_world_to_tex(HD_KPASS hd_madd(o, d, t));
-        hd_v4 c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
-        float st = c.w * HD_PRM(medium).x;
+    /* samples at s0 + n dt from the entry point, n counted: the step advances however far the
+       eye is, the chord is at most the box diagonal, and n < HD_MAX_MARCH_STEPS */
+    hd_v3 pe = hd_madd(o, d, t0);
+    float len = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
+    float s0 = hd_rand(key, 2u) * dt;
+    int n;
+    for (n = 0; n < HD_MAX_MARCH_STEPS; ++n) {
+        float s = s0 + HD_F(n) * dt;
+        hd_v3 u = hd_world_to_tex(HD_KPASS hd_madd(pe, d, s));
+        hd_v4 c;
+        float st;
+        if (!(s < len)) break;
+        c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
+        st = c.w * HD_PRM(medium).x;
         if (st > 0.0f) {
             float a = 1.0f - hd_exp(-st * dt);
             float e = T * a * k;
