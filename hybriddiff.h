@@ -108,7 +108,8 @@ extern "C" {
     X(HD_ERROR_FILE_FORMAT, "the file header is malformed") \
     X(HD_ERROR_FILE_TRUNCATED, "the file is shorter than its header claims") \
     X(HD_ERROR_UNSUPPORTED_ENCODING, "the file's encoding or voxel type is not supported") \
-    X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated")
+    X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated") \
+    X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -317,7 +318,10 @@ typedef struct hd_desc {
         int enable_validation;
     } vulkan;
     struct {
-        int use_current_context; /* 1: use the caller's current GL context */
+        int use_current_context; /* 1: use the caller's current GL context; it must be current
+                                    at every later call that reaches GL (iterate, read, render,
+                                    destroy), else HD_ERROR_GL_CONTEXT_NOT_CURRENT (the one current
+                                    at hd_create, where EGL or GLX can tell) */
         void *(*get_proc_address)(const char *name); /* NULL -> eglGetProcAddress */
     } gl;
 } hd_desc;

@@ -53,7 +53,7 @@ static const char *const hd__gl_source[] = {
 "#define HD_GLSL_CUSTOM_BUFFERS 1\n",
 "#ifdef HD_ILLUM_R16F\n",
 "#define HD_ILLUM_FMT r16f\n",
-"#define HD_ILLUM_ROUND(v) hd_f16_round(v) /* the store rounds to nearest even (hd_prelude_glsl.h) */\n",
+"#define HD_ILLUM_ROUND(v) hd_f16_round(min((v), 65504.0)) /* nearest even (hd_prelude_glsl.h), saturated as hd_f2h_sat */\n",
 "#else\n",
 "#define HD_ILLUM_FMT r32f\n",
 "#define HD_ILLUM_ROUND(v) (v)\n",
