@@ -1,6 +1,6 @@
 /* fuzz_api.c - libFuzzer target over the API's inputs (mk/reliability.mk: make fuzz-smoke, run
    with -timeout so a hang is a finding; regressions in regressions/api/). The bytes become an
-   hd_desc (a volume of at most 4x4x4 voxels, its spacing and value range, a transfer function,
+   hd_desc (a volume of at most 5x5x5 voxels, its spacing and value range, a transfer function,
    up to 3 lights, a camera of at most 4x4 pixels, every hd_params field) whose floats are drawn
    mostly from finite extremes (0, +-1e+-30, denormals, FLT_MIN, FLT_MAX, 1e6, ...) and otherwise
    from raw bits (NaN, Inf). hd_create must either fail with one logged error naming its code or
@@ -43,6 +43,13 @@ static int fz_small(fz_in *in, int range)
     return b % range;
 }
 
+/* an image side: 1..4, or out of range (0 would be the default 512) */
+static int fz_size(fz_in *in)
+{
+    uint8_t b = fz_u8(in);
+    return b == 255 ? -1 : b == 254 ? HD_MAX_IMAGE_DIM + 1 : 1 + b % 4;
+}
+
 static int fz_errors;
 static hd_result fz_code;
 static void fz_log(void *u, hd_log_level level, hd_result code, const char *msg, const char *file, int line)
@@ -75,8 +82,8 @@ static void fz_camera(fz_in *in, hd_camera *c)
     if (fz_u8(in) & 1) { fz_float3(in, c->eye); fz_float3(in, c->target); }
     if (fz_u8(in) & 1) fz_float3(in, c->up);
     if (fz_u8(in) & 1) c->fov_y = fz_float(in);
-    c->width = 1 + fz_small(in, 4);
-    c->height = 1 + fz_small(in, 4);
+    c->width = fz_size(in);
+    c->height = fz_size(in);
 }
 
 static void fz_params(fz_in *in, hd_params *p)
@@ -114,7 +121,7 @@ static int fz_finite(const float *v, size_t n)
 /* One iteration, then the image and both illumination volumes must be finite. */
 static void fz_run(hd_context ctx)
 {
-    static float buf[4 * 4 * 4 * 3 + 4 * 4 * 4];
+    static float buf[5 * 5 * 5 * 3]; /* the illumination (dims <= 5, 3 channels) or 4x4 RGBA */
     hd_stats st;
     hd_desc q;
     hd_result r;
@@ -142,7 +149,7 @@ static void fz_run(hd_context ctx)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static uint8_t vox[4 * 4 * 4 * 4];
+    static uint8_t vox[5 * 5 * 5 * 4]; /* dims 1 + fz_small(4): 0..5, or rejected */
     static float tf[4 * 4];
     hd_light lights[3];
     fz_in in;
@@ -156,13 +163,14 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (i = 0; i < 3; ++i) d.volume.dims[i] = 1 + fz_small(&in, 4);
     if (fz_u8(&in) & 1) fz_float3(&in, d.volume.spacing);
     if (fz_u8(&in) & 1) { d.volume.value_range[0] = fz_float(&in); d.volume.value_range[1] = fz_float(&in); }
-    nvox = d.volume.dims[0] > 0 && d.volume.dims[0] <= 4 && d.volume.dims[1] > 0 && d.volume.dims[1] <= 4 &&
-           d.volume.dims[2] > 0 && d.volume.dims[2] <= 4 ? d.volume.dims[0] * d.volume.dims[1] * d.volume.dims[2] : 0;
+    nvox = d.volume.dims[0] > 0 && d.volume.dims[0] <= 5 && d.volume.dims[1] > 0 && d.volume.dims[1] <= 5 &&
+           d.volume.dims[2] > 0 && d.volume.dims[2] <= 5 ? d.volume.dims[0] * d.volume.dims[1] * d.volume.dims[2] : 0;
+    memset(vox, 0, sizeof vox);
     if (d.volume.type == HD_VOXEL_F32) {
         float *f = (float *)(void *)vox;
         for (i = 0; i < nvox; ++i) f[i] = fz_float(&in);
     } else {
-        for (i = 0; i < (int)sizeof vox; ++i) vox[i] = fz_u8(&in);
+        for (i = 0; i < nvox * (d.volume.type == HD_VOXEL_U16 ? 2 : 1); ++i) vox[i] = fz_u8(&in);
     }
     d.volume.data = vox;
     d.transfer_function.count = fz_small(&in, 5);
