@@ -211,8 +211,8 @@ typedef struct hd_allocator {
    - point-light positions and camera eye/target components are at most HD_MAX_LIGHT_DISTANCE
      and HD_MAX_CAMERA_DISTANCE in magnitude (world units: the box's largest side is 1). */
 /* Loop bounds, the same on every backend (backends/kernels/hd_k_common.h): one transmittance or
-   free-flight walk ends after 2^22 collisions and majorant cells (a valid input expects at most
-   1.74e6) with transmittance 0; one projection ray after 2^24 samples (a valid one needs at most
+   free-flight walk ends after 2^16 collisions and majorant cells with transmittance 0 (reached
+   only with an extinction or majorant above about 3.8e4 per world unit); one projection ray after 2^24 samples (a valid one needs at most
    1.13e7); a path after max_bounces vertices. Float16 illumination (illumination_precision)
    saturates at 65504, the largest half. */
 #define HD_MAX_SPACING_RATIO 65536.0f
@@ -266,7 +266,8 @@ typedef struct hd_params {
     float anisotropy;       /* Henyey-Greenstein g in (-1, 1): reduces the diffusion's sigma_s
                                to sigma_s (1 - g); used by PT_MS as its phase; default 0 */
     float majorant;         /* 0 -> a coarse grid of local majorants (empty space is skipped);
-                               > 0 -> this global majorant (must be >= max sigma_t and <= 1e6) */
+                               > 0 -> this global majorant: >= max sigma_t, <= 16 max sigma_t
+                               (and <= max(16, 1e6)); a TF that breaks that drops it (grid) */
     int diffusion_sweeps;   /* solver sweeps per iteration, 0 -> 4 (multigrid: CG steps, 0 -> 1) */
     int disable_diffusion;  /* 1: phi stays 0 (direct light only, the PT_SS equivalent) */
     hd_solver solver;

@@ -224,14 +224,17 @@ static const char *const hd__gl_source[] = {
 "/* Ratio tracking stops by Russian roulette below this transmittance (unbiased). */\n",
 "#define HD_RR_THRESHOLD 0.1f\n",
 "/* Loop bounds, the same on every backend, so no input can hang a kernel (README \"Guarantees\").\n",
-"   HD_MAX_TRACK_STEPS: collisions plus majorant cells of one hd_track walk. A valid input expects\n",
-"   at most majorant (<= 1e6 per world unit) * the box diagonal (<= sqrt 3) = 1.74e6 collisions\n",
-"   and 3 * 2048 cells, so the bound (2.4x that) ends only walks whose free path no longer\n",
-"   advances t; such a walk is taken as absorbed: T = 0, and the collision at the current t.\n",
+"   HD_MAX_TRACK_STEPS: collisions plus majorant cells of one hd_track walk, so an iteration costs\n",
+"   at most that per voxel (per path vertex for the path tracers). A walk expects the majorant's\n",
+"   optical depth along it (majorant * distance, <= 1.74 * majorant per world unit) plus the\n",
+"   cells it crosses (<= 3 * 2048); the bound is reached only beyond about 3.8e4 per world unit\n",
+"   (extinction, or a global majorant, which hd_create keeps within 16x the largest sigma_t), or\n",
+"   where the free path no longer advances t. Such a walk is taken as absorbed: T = 0, and the\n",
+"   collision at the current t.\n",
 "   HD_MAX_MARCH_STEPS: samples of one projection ray. The chord is at most the diagonal and a\n",
 "   step at least 0.01 voxel of at least 1 / HD_MAX_SPACING_RATIO (1.13e7 steps), so the bound\n",
 "   (2^24, where step indices stay exact in float) never shortens a valid march. */\n",
-"#define HD_MAX_TRACK_STEPS 4194304\n",
+"#define HD_MAX_TRACK_STEPS 65536\n",
 "#define HD_MAX_MARCH_STEPS 16777216\n",
 "#define HD_BOX_DIAGONAL 1.7320509f\n",
 "\n",
@@ -1909,7 +1912,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1603 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1606 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

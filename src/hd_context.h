@@ -208,12 +208,21 @@ static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
     ctx->desc.light_count = count;
 }
 
+/* A global majorant above HD__MAJORANT_SLACK times the largest sigma_t (at least 1 per world
+   unit) only adds null collisions: each walk would cost majorant * distance of them. */
+#define HD__MAJORANT_SLACK 16.0f
+static float hd__majorant_cap(float max_sigma) { return HD__MAJORANT_SLACK * (max_sigma > 1.0f ? max_sigma : 1.0f); }
 static hd_result hd__check_majorant(hd__ctx *ctx, const hd_params *p)
 {
-    if (p->majorant > 0.0f && p->majorant < ctx->max_sigma / (1.0f + 1e-5f) * (p->extinction / ctx->params.extinction))
+    float max_sigma = ctx->max_sigma * (p->extinction / ctx->params.extinction);
+    if (p->majorant > 0.0f && p->majorant < max_sigma / (1.0f + 1e-5f))
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
                        "params.majorant = %g is below the largest extinction %g: tracking would be biased",
-                       (double)p->majorant, (double)(ctx->max_sigma * p->extinction / ctx->params.extinction));
+                       (double)p->majorant, (double)max_sigma);
+    if (p->majorant > hd__majorant_cap(max_sigma))
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
+                       "params.majorant = %g is above %g x the largest extinction %g (at least 1): only null collisions",
+                       (double)p->majorant, (double)HD__MAJORANT_SLACK, (double)max_sigma);
     return HD_SUCCESS;
 }
 
@@ -426,8 +435,9 @@ HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_functio
     if ((r = hd__check_tf(tf, &ctx->log)) != HD_SUCCESS) return r;
     if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
     hd__build_majorants(ctx);
-    if (ctx->params.majorant > 0.0f && ctx->params.majorant < ctx->max_sigma / (1.0f + 1e-5f)) {
-        HD__INFO(&ctx->log, "params.majorant %g is below the new TF's largest extinction %g: using the majorant grid",
+    if (ctx->params.majorant > 0.0f &&
+        (ctx->params.majorant < ctx->max_sigma / (1.0f + 1e-5f) || ctx->params.majorant > hd__majorant_cap(ctx->max_sigma))) {
+        HD__INFO(&ctx->log, "params.majorant %g is outside 1..16x the new TF's largest extinction %g: using the majorant grid",
                  (double)ctx->params.majorant, (double)ctx->max_sigma);
         ctx->params.majorant = 0.0f;
     }

@@ -76,6 +76,7 @@ static hd_result c_li_power_sum(void) { hd_light l[2]; l[0] = l[1] = L0; l[0].in
 static hd_result c_cam_far(void) { hd_camera c = CAM0; c.eye[2] = 1e30f; return hd_set_camera(C, &c); }
 static hd_result c_p_maj_max(void) { hd_params p = P0; p.majorant = FLT_MAX; return hd_set_params(C, &p); }
 static hd_result c_p_maj_1e30(void) { hd_params p = P0; p.majorant = 1e30f; return hd_set_params(C, &p); }
+static hd_result c_p_maj_1e6(void) { hd_params p = P0; p.majorant = 1e6f; return hd_set_params(C, &p); }
 static hd_result c_cam_null(void) { return hd_set_camera(C, NULL); }
 static hd_result c_cam_inf(void) { hd_camera c = CAM0; c.target[2] = hs_inf(); return hd_set_camera(C, &c); }
 static hd_result c_cam_fov_nan(void) { hd_camera c = CAM0; c.fov_y = hs_nan(); return hd_set_camera(C, &c); }
@@ -145,6 +146,7 @@ static const hs_case hs_cases[] = {
     {"camera eye at 1e30", HD_ERROR_INVALID_CAMERA, c_cam_far},
     {"majorant FLT_MAX", HD_ERROR_INVALID_PARAMETER, c_p_maj_max},
     {"majorant 1e30", HD_ERROR_INVALID_PARAMETER, c_p_maj_1e30},
+    {"majorant 1e6 (> 16 x max sigma_t)", HD_ERROR_INVALID_PARAMETER, c_p_maj_1e6},
     {"camera NULL", HD_ERROR_NULL_POINTER, c_cam_null},
     {"camera Inf target", HD_ERROR_INVALID_CAMERA, c_cam_inf},
     {"camera NaN fov", HD_ERROR_INVALID_CAMERA, c_cam_fov_nan},

@@ -19,14 +19,17 @@
 /* Ratio tracking stops by Russian roulette below this transmittance (unbiased). */
 #define HD_RR_THRESHOLD 0.1f
 /* Loop bounds, the same on every backend, so no input can hang a kernel (README "Guarantees").
-   HD_MAX_TRACK_STEPS: collisions plus majorant cells of one hd_track walk. A valid input expects
-   at most majorant (<= 1e6 per world unit) * the box diagonal (<= sqrt 3) = 1.74e6 collisions
-   and 3 * 2048 cells, so the bound (2.4x that) ends only walks whose free path no longer
-   advances t; such a walk is taken as absorbed: T = 0, and the collision at the current t.
+   HD_MAX_TRACK_STEPS: collisions plus majorant cells of one hd_track walk, so an iteration costs
+   at most that per voxel (per path vertex for the path tracers). A walk expects the majorant's
+   optical depth along it (majorant * distance, <= 1.74 * majorant per world unit) plus the
+   cells it crosses (<= 3 * 2048); the bound is reached only beyond about 3.8e4 per world unit
+   (extinction, or a global majorant, which hd_create keeps within 16x the largest sigma_t), or
+   where the free path no longer advances t. Such a walk is taken as absorbed: T = 0, and the
+   collision at the current t.
    HD_MAX_MARCH_STEPS: samples of one projection ray. The chord is at most the diagonal and a
    step at least 0.01 voxel of at least 1 / HD_MAX_SPACING_RATIO (1.13e7 steps), so the bound
    (2^24, where step indices stay exact in float) never shortens a valid march. */
-#define HD_MAX_TRACK_STEPS 4194304
+#define HD_MAX_TRACK_STEPS 65536
 #define HD_MAX_MARCH_STEPS 16777216
 #define HD_BOX_DIAGONAL 1.7320509f
 
