@@ -183,12 +183,16 @@ static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
 
 /* Lights of one colour and grey scattering need one illumination channel; lights of different
    colours or RGB scattering need three (and RGB scattering the TF colour beside sigma_t). */
+static float hd__max3(const float v[3]) { return v[0] > v[1] ? (v[0] > v[2] ? v[0] : v[2]) : (v[1] > v[2] ? v[1] : v[2]); }
 static void hd__set_channels(hd__ctx *ctx)
 {
     int i, grey = ctx->lights_one_colour && !ctx->params.rgb_scattering;
+    /* one channel: E carries intensity * max colour (the quantity hd__check_lights limits) and the
+       projection the colour over its maximum, so neither factor alone can overflow */
+    float cmax = hd__max3(ctx->lights[0].color);
     ctx->channels = grey ? 1 : 3;
     ctx->sig_channels = ctx->params.rgb_scattering ? 4 : 1;
-    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] : 1.0f;
+    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] / cmax : 1.0f;
 }
 
 static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
@@ -241,7 +245,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
 {
     hd__kparams *k = &ctx->kp;
     const hd_camera *c = &ctx->camera;
-    float w[3], u[3], v[3], len, th, aspect;
+    float w[3], u[3], v[3], th, aspect;
     int i;
     memset(k, 0, sizeof *k);
     k->dims.x = ctx->dims[0]; k->dims.y = ctx->dims[1]; k->dims.z = ctx->dims[2]; k->dims.w = ctx->tf_count;
@@ -283,15 +287,15 @@ static void hd__fill_kparams(hd__ctx *ctx)
         k->march.y = (float)(1.0 / (double)(f < win ? f : win));
     }
     k->march.z = 1e-4f; /* stop marching below this transmittance */
-    /* camera basis */
-    for (i = 0; i < 3; ++i) w[i] = c->target[i] - c->eye[i];
-    len = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    for (i = 0; i < 3; ++i) w[i] /= len;
-    u[0] = w[1] * c->up[2] - w[2] * c->up[1];
-    u[1] = w[2] * c->up[0] - w[0] * c->up[2];
-    u[2] = w[0] * c->up[1] - w[1] * c->up[0];
-    len = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    for (i = 0; i < 3; ++i) u[i] /= len;
+    /* camera basis, through unit vectors (hd__unit3: a tiny up must not underflow the cross
+       product; hd__check_camera keeps it away from parallel) */
+    for (i = 0; i < 3; ++i) v[i] = c->target[i] - c->eye[i];
+    hd__unit3(v, w);
+    hd__unit3(c->up, u);
+    v[0] = w[1] * u[2] - w[2] * u[1];
+    v[1] = w[2] * u[0] - w[0] * u[2];
+    v[2] = w[0] * u[1] - w[1] * u[0];
+    hd__unit3(v, u);
     v[0] = u[1] * w[2] - u[2] * w[1];
     v[1] = u[2] * w[0] - u[0] * w[2];
     v[2] = u[0] * w[1] - u[1] * w[0];
@@ -316,7 +320,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
             a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
         }
         if (ctx->channels == 1) {
-            b->x = b->y = b->z = l->intensity;
+            b->x = b->y = b->z = l->intensity * hd__max3(l->color); /* the colour is chan_color */
         } else {
             b->x = l->color[0] * l->intensity; b->y = l->color[1] * l->intensity; b->z = l->color[2] * l->intensity;
         }

@@ -147,7 +147,7 @@ static void hd__camera_defaults(hd_camera *c)
 /* Checks a camera whose defaults are filled in. */
 static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
 {
-    float f[3], cr[3], lf, lu, lc;
+    float f[3], fu[3], uu[3], cr[3], lf, lc;
     int i;
     if (!hd__finite3(c->eye) || !hd__finite3(c->target) || !hd__finite3(c->up) || !hd__finite(c->fov_y))
         return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera has a NaN or infinite value");
@@ -160,14 +160,17 @@ static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
     if (c->width < 1 || c->height < 1 || c->width > HD_MAX_IMAGE_DIM || c->height > HD_MAX_IMAGE_DIM)
         return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "image size %dx%d is outside 1..%d", c->width, c->height, HD_MAX_IMAGE_DIM);
     f[0] = c->target[0] - c->eye[0]; f[1] = c->target[1] - c->eye[1]; f[2] = c->target[2] - c->eye[2];
-    cr[0] = f[1] * c->up[2] - f[2] * c->up[1];
-    cr[1] = f[2] * c->up[0] - f[0] * c->up[2];
-    cr[2] = f[0] * c->up[1] - f[1] * c->up[0];
     lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    lu = sqrtf(c->up[0] * c->up[0] + c->up[1] * c->up[1] + c->up[2] * c->up[2]);
-    lc = sqrtf(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
     if (!(lf > 1e-6f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye and target coincide");
-    if (!(lc > 1e-4f * lf * lu)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is parallel to the view direction (or zero)");
+    /* unit vectors first (hd__unit3), so a tiny or huge up neither underflows nor overflows the
+       cross product hd__fill_kparams normalises */
+    if (!hd__unit3(f, fu) || !hd__unit3(c->up, uu))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is zero");
+    cr[0] = fu[1] * uu[2] - fu[2] * uu[1];
+    cr[1] = fu[2] * uu[0] - fu[0] * uu[2];
+    cr[2] = fu[0] * uu[1] - fu[1] * uu[0];
+    lc = sqrtf(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    if (!(lc > 1e-4f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is parallel to the view direction");
     return HD_SUCCESS;
 }
 

@@ -306,6 +306,8 @@ static void x_col_max(hd_desc *d, hd_light *l) { l->intensity = 2.0f; l->color[0
 static void x_power_limit(hd_desc *d, hd_light *l) { l->intensity = HD_MAX_LIGHT_POWER; d->light_count = 1; d->params.albedo = 1.0f; }
 static void x_eye_far(hd_desc *d, hd_light *l) { (void)l; d->camera.eye[2] = 1e30f; }
 static void x_target_far(hd_desc *d, hd_light *l) { (void)l; d->camera.eye[2] = 2.5f; d->camera.target[0] = -1e30f; }
+static void x_int_max_col_min(hd_desc *d, hd_light *l) { l->intensity = FLT_MAX; l->color[2] = FLT_MIN; d->light_count = 1; }
+static void x_up_tiny(hd_desc *d, hd_light *l) { (void)l; d->camera.up[0] = 1e-24f; }
 static void x_bg_max(hd_desc *d, hd_light *l) { (void)l; d->params.background[0] = FLT_MAX; d->params.background[2] = 1e30f; }
 
 static const hx_case hx_cases[] = {
@@ -330,6 +332,8 @@ static const hx_case hx_cases[] = {
     {"camera eye at 1e30", HD_ERROR_INVALID_CAMERA, x_eye_far},
     {"camera target at -1e30", HD_ERROR_INVALID_CAMERA, x_target_far},
     {"background FLT_MAX", HD_SUCCESS, x_bg_max},
+    {"intensity FLT_MAX, colour {0, 0, FLT_MIN}", HD_SUCCESS, x_int_max_col_min},
+    {"camera up {1e-24, 0, 0}", HD_SUCCESS, x_up_tiny},
 };
 
 static int hx_image_finite(hd_context ctx)
