@@ -14,7 +14,8 @@
            chosen light per iteration (progressive mean; memory independent of the light count);
         2. multiple scattering phi, by a diffusion solve on the grid, warm-started each iteration;
         3. an emission-absorption ray-marched projection of sigma_s * c * (E + phi) / (4 pi).
-      Only stage 3 depends on the camera: moving the camera keeps the converged illumination.
+      Only stage 3 depends on the camera: moving the camera keeps the converged illumination, and
+      hd_render stops all light work once the light has converged (hd_stats.light_converged).
 
    Quick start
       hd_desc desc = {0};
@@ -23,8 +24,10 @@
       desc.volume.data = voxels;                 // copied; may be freed after hd_create
       hd_context ctx;
       if (hd_create(&desc, &ctx) != HD_SUCCESS) { ... }
-      hd_iterate(ctx, 64);                       // progressive: call again to refine
-      hd_read_image_rgba8(ctx, pixels, w * h * 4);
+      while (app_running) {                      // one call per displayed frame
+          hd_render(ctx);                        // light work only until it converges
+          hd_read_image_rgba8(ctx, pixels, w * h * 4);
+      }
       hd_destroy(ctx);
 
    Configuration macros (define before including the implementation)
@@ -60,6 +63,10 @@
    (or build with -D_POSIX_C_SOURCE=200809L, or -std=gnu99). */
 #if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_POSIX_C_SOURCE) && !defined(_WIN32)
 #define _POSIX_C_SOURCE 200809L
+#endif
+/* realpath (the MetaImage loader's folder check) is X/Open. */
+#if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_XOPEN_SOURCE) && !defined(_WIN32)
+#define _XOPEN_SOURCE 700
 #endif
 
 #include <stddef.h>
@@ -109,6 +116,9 @@ extern "C" {
     X(HD_ERROR_FILE_TRUNCATED, "the file is shorter than its header claims") \
     X(HD_ERROR_UNSUPPORTED_ENCODING, "the file's encoding or voxel type is not supported") \
     X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated") \
+    X(HD_ERROR_FILE_NOT_REGULAR, "the path is a directory, device, FIFO or socket, not a file") \
+    X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
+    X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes") \
     X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current")
 
 typedef enum hd_result {
@@ -303,6 +313,14 @@ typedef struct hd_params {
                                device lacks them HD_ERROR_UNSUPPORTED at the next render); the
                                multigrid solver returns HD_ERROR_UNSUPPORTED. hd_read_illumination
                                still returns floats. */
+    float light_tolerance;  /* hd_render stops refining the light once hd_stats.light_error, the
+                               estimated relative error of E + phi, is below this for two light
+                               iterations in a row: 0 -> 0.1 (head CT: 10-20 iterations, the
+                               image within about 43 dB of one with 8x as many: the projection
+                               averages many voxels; docs/DESIGN-RENDER.md); finite and >= 0 */
+    float render_budget;    /* seconds one hd_render call may spend refining light that has not
+                               converged, before it projects its frame: 0 -> one light iteration
+                               per call; must be finite and >= 0 */
 } hd_params;
 
 typedef struct hd_desc {
@@ -351,6 +369,13 @@ typedef struct hd_stats {
     double seconds_direct;    /* accumulated wall time per stage since creation */
     double seconds_diffusion;
     double seconds_projection;
+    /* Light convergence (HD and CD; 0 for the path tracers). After each light iteration the
+       change of E and phi on the medium's voxels gives an estimate of their relative RMS error:
+       sqrt(n) |E_n - E_n-1| for E's Monte Carlo mean, |phi_n - phi_n-1| q / (1 - q) for the
+       solver (q: the change's observed contraction, at most 0.9), over |E_n + phi_n|; 1 before
+       two iterations. */
+    double light_error;
+    int light_converged;      /* light_error < params.light_tolerance twice in a row */
 } hd_stats;
 
 typedef struct hd_context {
@@ -379,14 +404,39 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering,
      illumination_precision                    -> E, phi, image (new grids)
-     solver, sweeps, tracking, exposure        -> nothing (same solution, estimator or encoding) */
+     solver, sweeps, tracking, exposure,
+     light_tolerance, render_budget            -> nothing (same solution, estimator or encoding) */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);
 HDDEF hd_result hd_set_camera(hd_context ctx, const hd_camera *camera);
 HDDEF hd_result hd_set_params(hd_context ctx, const hd_params *params);
 
-/* Runs n >= 1 iterations of the current method. */
+/* Runs n >= 1 iterations of the current method, each refining the light (HD, CD) and projecting
+   one frame; it refines even light that has converged (hd_stats.light_converged). */
 HDDEF hd_result hd_iterate(hd_context ctx, int n);
+
+/* n >= 1 light iterations (HD: direct light and diffusion; CD: convection and diffusion) with no
+   projection: the image is left as it was. For a single view, refine until
+   hd_stats.light_converged, then project with hd_render. The path tracers have no light to
+   refine: HD_ERROR_UNSUPPORTED. */
+HDDEF hd_result hd_refine(hd_context ctx, int n);
+
+/* One frame for a per-frame loop: call it once per displayed frame.
+     HD, CD: while the light has not converged, one light iteration (or as many as
+             params.render_budget seconds allow), then one projection frame from the current E
+             and phi into the image's running mean. Once the light has converged, no light work:
+             the projection alone, and when the frame_window frames since the convergence are in
+             the image (it is done), nothing at all until a setter invalidates something.
+     PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
+   A camera move (hd_set_camera) keeps converged light: the next call projects at once.
+
+      for (;;) {                              // the application's frame loop
+          if (camera_moved) hd_set_camera(ctx, &cam);
+          hd_render(ctx);                     // cheap once hd_stats.light_converged
+          hd_read_image_rgba8(ctx, px, n);    // or hd_gl_render_to_texture
+      }
+*/
+HDDEF hd_result hd_render(hd_context ctx);
 
 /* The image, top row first. RGBA8: sRGB-encoded radiance * exposure, alpha = opacity.
    Float: linear RGB radiance and opacity. Sizes are in bytes / in floats. */
@@ -415,11 +465,22 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer
-   types are converted to F32. */
+   types are converted to F32.
+   Every loader opens only regular files: a directory, device, FIFO or socket is
+   HD_ERROR_FILE_NOT_REGULAR, refused before it is read, so a FIFO cannot block the call
+   (tests/test_io_limits.c, io_not_regular). A loader reads the header (at most 1 MiB), then
+   only the bytes the header says the data need (io_data_length). Raw data are allocated once
+   the file is known to hold them; gzip data as they inflate, never on the header's claim alone,
+   so a short stream claiming a huge volume fails without a large allocation (io_gzip_claim).
+   Peak allocation while loading a file is at most twice the loaded volume (or its decompressed
+   data, whichever is larger) plus 1.25 MiB (io_peak_allocation). The memory parsers
+   (hd_volume_parse_*) allocate with malloc and have no limit but HD_MAX_DIM. */
 typedef struct hd_volume_file {
     hd_volume_desc desc; /* ready to be copied into hd_desc.volume */
     void *data;          /* what desc.data points to */
     float value_min, value_max; /* range of the values in the file */
+    hd_allocator allocator; /* what allocated data (hd_load_options.allocator); hd_volume_free
+                               uses it */
 } hd_volume_file;
 
 typedef enum hd_endian { HD_ENDIAN_LITTLE = 0, HD_ENDIAN_BIG } hd_endian;
@@ -428,6 +489,28 @@ typedef enum hd_raw_type {
     HD_RAW_U8 = 0, HD_RAW_I8, HD_RAW_U16, HD_RAW_I16, HD_RAW_U32, HD_RAW_I32, HD_RAW_F32,
     HD_RAW_F64, HD_RAW_TYPE_COUNT
 } hd_raw_type;
+
+typedef enum hd_file_format {
+    HD_FILE_AUTO = 0, /* by the file's first bytes (or a .mhd/.mha extension), as hd_volume_load */
+    HD_FILE_NRRD, HD_FILE_METAIMAGE, HD_FILE_NIFTI, HD_FILE_FORMAT_COUNT
+} hd_file_format;
+
+/* Options of hd_volume_load_ex; all zero is what the other loaders use.
+   MetaImage detached data (ElementDataFile = name): by default the name must be relative and
+   resolve (symbolic links followed, by realpath) to a regular file inside the header's folder;
+   an absolute name, '..' leading out, or a link pointing out is HD_ERROR_FILE_OUTSIDE_FOLDER
+   (tests/test_io_limits.c, io_mhd_detached_policy). The path is resolved once; its last component
+   is then opened without following a link. allow_outside_folder lifts the folder rule (the file
+   must still be regular). max_bytes bounds the voxel data a header may declare, counted in the
+   file's element type and in the loaded type, whichever is larger: more is
+   HD_ERROR_FILE_TOO_LARGE before anything is allocated or inflated (io_max_bytes). */
+typedef struct hd_load_options {
+    hd_file_format format;    /* HD_FILE_AUTO (0): detect */
+    int allow_outside_folder; /* MetaImage: ElementDataFile may name any regular file */
+    size_t max_bytes;         /* 0: no limit but HD_MAX_DIM per axis */
+    hd_allocator allocator;   /* every allocation of the loader (zlib's too) and the voxels;
+                                 all or none, {0}: malloc/free */
+} hd_load_options;
 
 /* NRRD (.nrrd, attached header; raw or gzip encoding). */
 HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out, const hd_logger *log);
@@ -449,6 +532,10 @@ HDDEF hd_result hd_volume_load_nifti(const char *path, hd_volume_file *out, cons
 HDDEF hd_result hd_volume_parse_nifti(const void *bytes, size_t size, hd_volume_file *out,
                                       const hd_logger *log);
 HDDEF hd_result hd_volume_load(const char *path, hd_volume_file *out, const hd_logger *log);
+/* Any format with options (NULL: all zero); an out-of-range format is HD_ERROR_INVALID_ENUM,
+   one of allocator.alloc/free without the other HD_ERROR_NULL_POINTER. */
+HDDEF hd_result hd_volume_load_ex(const char *path, const hd_load_options *options,
+                                  hd_volume_file *out, const hd_logger *log);
 HDDEF void hd_volume_free(hd_volume_file *vol);
 
 #ifdef __cplusplus

@@ -1070,7 +1070,7 @@ static hd_result hd__vk_ring(hd__ctx *ctx, uint32_t slots)
     be->slots = 0;
     be->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
     if (slots > (1u << 20))
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "vulkan: %u parameter slots (recorded iterations) are too many; record at most 2^20 at a time", slots);
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "vulkan: %u parameter slots (recorded iterations) are too many; record at most 2^19 iterations at a time", slots);
     {
         hd_result r = hd__vk_buffer_create(ctx, &be->params, be->slot_bytes * slots, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1,
                                            "the parameter ring");
@@ -2042,12 +2042,14 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
        recorded, each with its own parameter slot */
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_ring(ctx, (uint32_t)n + 2u)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_ring(ctx, 2u * (uint32_t)n + 2u)) != HD_SUCCESS) return r; /* light and frame */
     if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
     be->next_slot = 0;
     be->have_slot = 0;
     be->rec = (VkCommandBuffer)command_buffer;
+    ctx->no_measure = 1;
     for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__iterate_method(ctx);
+    ctx->no_measure = 0;
     if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
     be->rec = VK_NULL_HANDLE;
     return r;

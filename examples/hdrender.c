@@ -32,6 +32,7 @@
 #define DEFAULT_INPUT "data/head.nrrd"
 #define DEFAULT_OUTPUT "out/head.png"
 #define DEFAULT_EXPOSURE 8.0f
+#define HDR_MAX_LIGHT "2000"
 
 static const char *usage_text =
     "usage: hdrender [options] [FILE]               (default input: " DEFAULT_INPUT ")\n"
@@ -75,8 +76,12 @@ static const char *usage_text =
 static const char *usage_text_method =
     "method\n"
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
-    "  --iterations N          progressive iterations (default 24; 256 for pt_ss, pt_ms,\n"
-    "                          whose iteration is one path per pixel)\n"
+    "  --iterations N          hd, cd: N full iterations, each projecting a frame (default:\n"
+    "                          refine the light without frames until it converges, at most\n"
+    "                          " HDR_MAX_LIGHT " iterations, then project --frame-window frames);\n"
+    "                          pt_ss, pt_ms: paths per pixel (default 256)\n"
+    "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
+    "                          as converged (default 0.1)\n"
     "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"
     "  --albedo F              sigma_s / sigma_t in (0,1] (default 0.9)\n"
     "  --anisotropy G          Henyey-Greenstein g in (-1,1) (default 0)\n"
@@ -416,7 +421,7 @@ int main(int argc, char **argv)
     hd_stats stats;
     uint8_t *rgba, *rgb;
     double t0, t_end;
-    int done = 0, chunk = 1;
+    int done = 0, chunk = 1, pt;
     size_t npix;
     char err[512];
 
@@ -506,6 +511,8 @@ int main(int argc, char **argv)
             else if (strcmp(v, "pt_ss") == 0) desc.params.method = HD_METHOD_PT_SS;
             else if (strcmp(v, "pt_ms") == 0) desc.params.method = HD_METHOD_PT_MS;
             else fail(2, "--method: '%s' is not hd, cd, pt_ss or pt_ms", v);
+        } else if (IS("--tolerance")) {
+            desc.params.light_tolerance = parse_float(a, VAL(), 0.0f, 10.0f, 1, 0);
         } else if (IS("--iterations")) {
             iterations = (int)parse_int(a, VAL(), 1, 1000000);
         } else if (IS("--extinction")) {
@@ -585,9 +592,8 @@ int main(int argc, char **argv)
     if (raw && (!have_dims || raw_type < 0)) fail(2, "--raw needs --dims X,Y,Z and --type T");
     if (light_count && lights_n) fail(2, "give either --light (one or more) or --lights N");
 
-    if (!iterations)
-        iterations = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS
-                         ? 256 : 24;
+    pt = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS;
+    if (!iterations && pt) iterations = 256;
 
     /* ---- transfer function ---- */
     if (tf_arg) {
@@ -649,17 +655,44 @@ int main(int argc, char **argv)
     }
     if (!g_quiet)
         fprintf(stderr, "hdrender: %s %dx%dx%d %s, values %g..%g, tf %s, %d light%s, %s on %s, "
-                "%dx%d, %d iteration%s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
+                "%dx%d, %s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
                 vol.desc.dims[2], voxel_type_name(vol.desc.type), (double)vol.value_min,
                 (double)vol.value_max, tf.name, light_count, light_count == 1 ? "" : "s",
                 hd_method_name(desc.params.method == HD_METHOD_DEFAULT ? HD_METHOD_HD
                                                                         : desc.params.method),
-                hd_backend_name(), desc.camera.width, desc.camera.height, iterations,
-                iterations == 1 ? "" : "s");
+                hd_backend_name(), desc.camera.width, desc.camera.height,
+                iterations ? "fixed iterations" : "light refined to convergence");
     hd_volume_free(&vol);
 
-    /* ---- iterate, in chunks of about 0.2 s ---- */
     t0 = now_seconds();
+    if (!iterations) {
+        /* the single-view schedule: light without frames until it converges, then the frames */
+        int max_light = atoi(HDR_MAX_LIGHT);
+        while (done < max_light) {
+            ls.last[0] = 0;
+            if ((r = hd_refine(ctx, 1)) != HD_SUCCESS) {
+                if (!g_quiet && isatty(2)) fputc('\n', stderr);
+                fail_lib(1, &ls, r, "hd_refine", NULL);
+            }
+            ++done;
+            hd_get_stats(ctx, &stats);
+            if (!g_quiet && isatty(2))
+                fprintf(stderr, "\r  light: %d iterations, estimated error %.4f (converged below %g), %.1f s ", done,
+                        stats.light_error, (double)desc.params.light_tolerance, now_seconds() - t0);
+            if (stats.light_converged) break;
+        }
+        if (!g_quiet && isatty(2)) fputc('\n', stderr);
+        if (!stats.light_converged && !g_quiet)
+            fprintf(stderr, "hdrender: the light did not converge in %d iterations (estimated error %.4f)\n", done,
+                    stats.light_error);
+        do {
+            ls.last[0] = 0;
+            if ((r = hd_render(ctx)) != HD_SUCCESS) fail_lib(1, &ls, r, "hd_render", NULL);
+            hd_get_stats(ctx, &stats);
+        } while (stats.frames < (uint64_t)desc.params.frame_window + (desc.params.frame_window ? 0 : 8));
+        done = iterations = (int)stats.iterations;
+    }
+    /* ---- fixed iterations, in chunks of about 0.2 s ---- */
     while (done < iterations) {
         int n = chunk < iterations - done ? chunk : iterations - done;
         double ts = now_seconds(), te, per;

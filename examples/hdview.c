@@ -1,13 +1,14 @@
 /* hdview - the interactive viewer: a GLFW window with an OpenGL 4.3+ core context, and
    hybriddiff's GL backend computing in that same context (desc.gl.use_current_context); each
-   frame is one iteration drawn straight from the GPU (hd_gl_render_to_texture, then a blit), no
-   CPU round trip.
+   frame is one hd_render drawn straight from the GPU (hd_gl_render_to_texture, then a blit), no
+   CPU round trip. hd_render refines the light only until it has converged; after that a frame is
+   one projection, and once the image holds frame_window frames the viewer waits for input.
 
      make hdview && build/hdview [FILE]          (default data/head.nrrd; make data fetches it)
 
    Mouse: left drag orbits, right (or shift + left) drag pans, the wheel zooms. The illumination
-   (E, phi) does not depend on the camera, so it keeps converging while the camera moves; only
-   the image restarts. Keys:
+   (E, phi) does not depend on the camera, so moving the camera restarts only the image: over
+   converged light orbiting, panning and zooming do no light work. Keys:
      1 2 3 4   method HD, CD, PT_SS, PT_MS        T   next transfer function preset
      L         1 / 3 lights                        E / shift+E   extinction x1.25 / /1.25
      A / shift+A  albedo +0.05 / -0.05             R   restart     S   screenshot (hdview-N.png)
@@ -18,11 +19,14 @@
      M         diffusion solver: red-black sweeps / multigrid (a backend without multigrid logs
                why and the viewer stays at red-black)
      Esc / Q   quit
-   The title shows the method, iterations, iterations/s and the bytes the method holds.
+   The title shows the method, whether the light has converged (its error estimate and
+   iterations; paths per pixel for PT), the frame time and the bytes the method holds.
 
    Scripted (for tests): --frames N runs N frames and exits; --screenshot FILE saves the last
    one; --script FILE runs the commands in FILE, one a line: `orbit DEG_X DEG_Y`, `pan DX DY`,
-   `zoom FACTOR`, `home` (the default camera), `key CHARS` (as typed), `restart`, `frames N`, `screenshot FILE`; with --script
+   `zoom FACTOR`, `home` (the default camera), `key CHARS` (as typed), `restart`, `frames N`, `screenshot FILE`,
+   `tolerance T` (light_tolerance), `converge N` (hd_refine until converged, at most N iterations), `expect-light-idle N` (N frames
+   that must do no light work, else exit 1); with --script
    the window closes when the script ends. --size WxH sets the window (and image) size, --seed N
    the seed; the rest of the scene is hdrender's default (camera, 1 key light, ct-skin or ramp,
    exposure 8), so `hdrender --size WxH --iterations N` renders what hdview shows after a
@@ -65,7 +69,8 @@ typedef struct viewer {
     int camera_dirty;
     double last_x, last_y;
     int dragging, panning;
-    double t_title, it_at_title;
+    double t_title, frame_ms; /* frame_ms: smoothed wall time of frame() */
+    int idle, idle_titled;    /* idle: light converged and the image final (hd_render is a no-op) */
     int shots;
 } viewer;
 
@@ -336,43 +341,98 @@ static void on_resize(GLFWwindow *w, int width, int height)
     resize((viewer *)glfwGetWindowUserPointer(w), width, height);
 }
 
-/* One frame: one iteration, the image into the texture, the texture onto the window. */
+/* One frame: hd_render (HD/CD refine the light only while it has not converged, so moving the
+   camera over converged light costs one projection), the image into the texture, the texture
+   onto the window. */
 static void frame(viewer *v)
 {
     hd_result r;
     hd_stats st;
-    double t;
+    double t, t0 = now_seconds();
     if (v->camera_dirty) {
         if ((r = hd_set_camera(v->ctx, &v->cam)) != HD_SUCCESS) die("hd_set_camera", r);
         v->camera_dirty = 0;
     }
-    if ((r = hd_iterate(v->ctx, 1)) != HD_SUCCESS) die("hd_iterate", r);
+    if ((r = hd_render(v->ctx)) != HD_SUCCESS) die("hd_render", r);
     if ((r = hd_gl_render_to_texture(v->ctx, v->tex)) != HD_SUCCESS) die("hd_gl_render_to_texture", r);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, v->fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glBlitFramebuffer(0, 0, v->width, v->height, 0, 0, v->width, v->height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    glFinish(); /* the frame time includes the GPU's work */
     t = now_seconds();
-    if (hd_get_stats(v->ctx, &st) == HD_SUCCESS && t - v->t_title > 0.5) {
-        char title[256];
-        double rate = (double)st.iterations >= v->it_at_title ? ((double)st.iterations - v->it_at_title) / (t - v->t_title) : 0.0;
-        snprintf(title, sizeof title, "hdview - %s | %llu it | %.1f it/s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f",
-                 hd_method_name(st.method), (unsigned long long)st.iterations, rate, (double)st.method_bytes / 1048576.0,
-                 v->tf.name, v->light_count, v->light_count == 1 ? "" : "s", (double)v->params.extinction, (double)v->params.albedo);
+    v->frame_ms = v->frame_ms > 0.0 ? 0.8 * v->frame_ms + 0.2 * 1e3 * (t - t0) : 1e3 * (t - t0);
+    if (hd_get_stats(v->ctx, &st) != HD_SUCCESS) return;
+    v->idle = st.light_converged && st.frames >= (uint64_t)v->params.frame_window;
+    if (t - v->t_title > 0.5 || v->idle != v->idle_titled) {
+        char title[320], light[96];
+        if (st.method == HD_METHOD_HD || st.method == HD_METHOD_CD)
+            snprintf(light, sizeof light, "light %s (error %.3g, %llu it)",
+                     st.light_converged ? "converged" : "refining", st.light_error,
+                     (unsigned long long)st.iterations);
+        else
+            snprintf(light, sizeof light, "%llu paths/pixel", (unsigned long long)st.iterations);
+        snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f",
+                 hd_method_name(st.method), light, v->frame_ms, v->idle ? " (idle: image final)" : "",
+                 (double)st.method_bytes / 1048576.0, v->tf.name, v->light_count, v->light_count == 1 ? "" : "s",
+                 (double)v->params.extinction, (double)v->params.albedo);
         glfwSetWindowTitle(v->win, title);
         v->t_title = t;
-        v->it_at_title = (double)st.iterations;
+        v->idle_titled = v->idle;
     }
 }
 
-static void run_frames(viewer *v, int n)
+/* n frames; interactive: once the image is final, wait for input instead of spinning. */
+static void run_frames(viewer *v, int n, int interactive)
 {
     int i;
     for (i = 0; i < n && !glfwWindowShouldClose(v->win); ++i) {
         frame(v);
         glfwSwapBuffers(v->win);
-        glfwPollEvents();
+        if (interactive && v->idle && !v->camera_dirty) glfwWaitEventsTimeout(0.5);
+        else glfwPollEvents();
     }
+}
+
+/* Script command: the light's convergence tolerance (hd_params.light_tolerance). */
+static void set_tolerance(viewer *v, float tol)
+{
+    hd_result r;
+    v->params.light_tolerance = tol;
+    if ((r = hd_set_params(v->ctx, &v->params)) != HD_SUCCESS) die("hd_set_params (tolerance)", r);
+}
+
+/* Script command: refines the light until it has converged (at most max iterations). */
+static void converge(viewer *v, int max)
+{
+    hd_stats st;
+    hd_result r;
+    int i = 0;
+    do {
+        if ((r = hd_refine(v->ctx, 1)) != HD_SUCCESS) die("hd_refine", r);
+        if ((r = hd_get_stats(v->ctx, &st)) != HD_SUCCESS) die("hd_get_stats", r);
+    } while (!st.light_converged && ++i < max);
+    fprintf(stderr, "hdview: light %s after %llu iterations (error %.3g)\n",
+            st.light_converged ? "converged" : "not converged", (unsigned long long)st.iterations,
+            st.light_error);
+}
+
+/* Script command: n frames over converged light must do no light work (exit 1 otherwise). */
+static void expect_light_idle(viewer *v, int n)
+{
+    hd_stats a, b;
+    hd_result r;
+    if ((r = hd_get_stats(v->ctx, &a)) != HD_SUCCESS) die("hd_get_stats", r);
+    if (!a.light_converged) { fprintf(stderr, "hdview: expect-light-idle: the light has not converged\n"); exit(1); }
+    run_frames(v, n, 0);
+    if ((r = hd_get_stats(v->ctx, &b)) != HD_SUCCESS) die("hd_get_stats", r);
+    if (b.iterations != a.iterations || b.seconds_direct != a.seconds_direct ||
+        b.seconds_diffusion != a.seconds_diffusion) {
+        fprintf(stderr, "hdview: expect-light-idle: %d frames did light work (%llu -> %llu light iterations)\n",
+                n, (unsigned long long)a.iterations, (unsigned long long)b.iterations);
+        exit(1);
+    }
+    fprintf(stderr, "hdview: %d frames over converged light, no light work (%.1f ms/frame)\n", n, v->frame_ms);
 }
 
 /* The screenshot is read from the back buffer: draw the current image once more first. */
@@ -403,7 +463,10 @@ static void run_script(viewer *v, const char *path)
         else if (strcmp(cmd, "key") == 0) { for (n = 0; arg[n]; ++n) if (arg[n] != ' ') key_char(v, arg[n]); }
         else if (strcmp(cmd, "restart") == 0) restart(v);
         else if (strcmp(cmd, "home") == 0) camera_default(v);
-        else if (strcmp(cmd, "frames") == 0 && sscanf(arg, "%d", &n) == 1) run_frames(v, n);
+        else if (strcmp(cmd, "frames") == 0 && sscanf(arg, "%d", &n) == 1) run_frames(v, n, 0);
+        else if (strcmp(cmd, "tolerance") == 0 && sscanf(arg, "%f", &a) == 1) set_tolerance(v, a);
+        else if (strcmp(cmd, "converge") == 0 && sscanf(arg, "%d", &n) == 1) converge(v, n);
+        else if (strcmp(cmd, "expect-light-idle") == 0 && sscanf(arg, "%d", &n) == 1) expect_light_idle(v, n);
         else if (strcmp(cmd, "screenshot") == 0 && arg[0]) scripted_screenshot(v, arg);
         else { fprintf(stderr, "hdview: %s:%d: cannot read '%s'\n", path, lineno, line); exit(2); }
     }
@@ -488,8 +551,8 @@ int main(int argc, char **argv)
     glfwSetFramebufferSizeCallback(v.win, on_resize);
     v.t_title = now_seconds();
     if (script) run_script(&v, script);
-    else if (frames >= 0) run_frames(&v, frames);
-    else run_frames(&v, 0x7fffffff);
+    else if (frames >= 0) run_frames(&v, frames, 0);
+    else run_frames(&v, 0x7fffffff, 1);
     if (shot) scripted_screenshot(&v, shot);
     hd_destroy(v.ctx);
     glDeleteTextures(1, &v.tex);

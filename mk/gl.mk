@@ -53,7 +53,7 @@ $(B)/pngcmp: tests/gl/pngcmp.c | $(B)
 # `data` first: make test (and so CI) fetches the head CT, so this test runs rather than skips.
 test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	@if [ ! -f data/head.nrrd ]; then echo "test-hdview SKIPPED: no data/head.nrrd (make data)"; exit 0; fi; \
-	mkdir -p $(B)/gl && rm -f $(B)/gl/hdview.png $(B)/gl/hdview-moved.png && \
+	mkdir -p $(B)/gl && rm -f $(B)/gl/hdview.png $(B)/gl/hdview-moved.png $(B)/gl/hdview-orbit.png && \
 	{ xvfb-run -a -s "-screen 0 640x480x24" $(B)/hdview --size 256x256 --script tests/gl/hdview.script data/head.nrrd \
 	      2> $(B)/gl/hdview.log || { cat $(B)/gl/hdview.log; echo "test-hdview: hdview failed"; exit 1; }; } && \
 	grep -v " info: " $(B)/gl/hdview.log; \
@@ -61,6 +61,11 @@ test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	$(B)/pngcmp --nonblank $(B)/gl/hdview-moved.png && \
 	$(B)/pngcmp --nonblank $(B)/gl/hdview.png && \
 	$(B)/pngcmp $(B)/gl/hdview.png $(B)/gl/hdrender-cpu.png
+	@if [ -f data/head.nrrd ]; then \
+	{ xvfb-run -a -s "-screen 0 640x480x24" $(B)/hdview --size 256x256 --script tests/gl/hdview-orbit.script data/head.nrrd \
+	      2> $(B)/gl/hdview-orbit.log || { cat $(B)/gl/hdview-orbit.log; echo "test-hdview: hdview-orbit.script failed"; exit 1; }; } && \
+	{ grep -v " info: " $(B)/gl/hdview-orbit.log || true; } && \
+	$(B)/pngcmp --nonblank $(B)/gl/hdview-orbit.png; fi
 
 test: test-hdview
 

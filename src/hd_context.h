@@ -329,8 +329,11 @@ static void hd__fill_kparams(hd__ctx *ctx)
 }
 
 /* ---- life cycle ---------------------------------------------------------------------------- */
+static void hd__conv_free(hd__ctx *ctx);
+
 static void hd__ctx_free(hd__ctx *ctx)
 {
+    hd__conv_free(ctx);
     if (ctx->be) hd__be_destroy(ctx);
     hd__free(ctx, ctx->vol);
     hd__free(ctx, ctx->cell_range);
@@ -522,6 +525,128 @@ static size_t hd__illum_floats(const hd__ctx *ctx)
     return (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2] * (size_t)ctx->channels;
 }
 
+/* ---- light convergence ------------------------------------------------------------------------ */
+static void hd__conv_reset(hd__ctx *ctx)
+{
+    ctx->conv_have_prev = 0;
+    ctx->conv_below = 0;
+    ctx->conv_dphi = 0.0;
+    ctx->conv_q = 0.0;
+    ctx->light_error = 1.0;
+    ctx->converged_frames = 0;
+}
+
+static void hd__conv_free(hd__ctx *ctx)
+{
+    hd__free(ctx, ctx->conv_idx);
+    hd__free(ctx, ctx->conv_prev);
+    hd__free(ctx, ctx->conv_tmp);
+    ctx->conv_idx = NULL;
+    ctx->conv_prev = ctx->conv_tmp = NULL;
+    ctx->conv_count = 0;
+    hd__conv_reset(ctx);
+}
+
+/* The illumination-grid voxels the estimate is taken over: those whose majorant cell holds
+   medium (the projection reads E and phi only there; light in air is exact and would dilute
+   the relative error). */
+static int hd__mini_c(int a, int b) { return a < b ? a : b; }
+
+static int hd__conv_in_medium(const hd__ctx *ctx, int x, int y, int z)
+{
+    int f = ctx->params.illumination_downsample, c = HD__MAJORANT_CELL;
+    int vx = hd__mini_c(x * f + f / 2, ctx->dims[0] - 1);
+    int vy = hd__mini_c(y * f + f / 2, ctx->dims[1] - 1);
+    int vz = hd__mini_c(z * f + f / 2, ctx->dims[2] - 1);
+    return ctx->majorant[((size_t)(vz / c) * ctx->mdims[1] + (size_t)(vy / c)) * ctx->mdims[0] + (size_t)(vx / c)] > 0.0f;
+}
+
+static hd_result hd__conv_alloc(hd__ctx *ctx)
+{
+    size_t n = 0, i = 0, gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    int x, y, z;
+    if (ctx->conv_tmp) return HD_SUCCESS;
+    for (z = 0; z < ctx->gdims[2]; ++z)
+        for (y = 0; y < ctx->gdims[1]; ++y)
+            for (x = 0; x < ctx->gdims[0]; ++x) n += (size_t)hd__conv_in_medium(ctx, x, y, z);
+    ctx->conv_idx = (uint32_t *)hd__alloc(ctx, (n ? n : 1) * sizeof(uint32_t));
+    ctx->conv_prev = (float *)hd__calloc(ctx, (n ? n : 1) * 2 * (size_t)ctx->channels, sizeof(float));
+    ctx->conv_tmp = (float *)hd__alloc(ctx, gvox * (size_t)ctx->channels * sizeof(float));
+    if (!ctx->conv_idx || !ctx->conv_prev || !ctx->conv_tmp) {
+        hd__conv_free(ctx);
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the light's convergence estimate (%zu voxels)", n);
+    }
+    for (z = 0; z < ctx->gdims[2]; ++z)
+        for (y = 0; y < ctx->gdims[1]; ++y)
+            for (x = 0; x < ctx->gdims[0]; ++x)
+                if (hd__conv_in_medium(ctx, x, y, z))
+                    ctx->conv_idx[i++] = (uint32_t)(((size_t)z * ctx->gdims[1] + (size_t)y) * ctx->gdims[0] + (size_t)x);
+    ctx->conv_count = n;
+    return HD_SUCCESS;
+}
+
+/* Reads one illumination volume back into the measured voxels' copies: *dsq gets the sum of
+   squared changes; for phi (read after E) *lsq gets the sum of squares of E + phi. */
+static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq, double *lsq)
+{
+    hd_result r;
+    size_t i, c, gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], n = ctx->conv_count;
+    size_t m = n * (size_t)ctx->channels;
+    float *prev = ctx->conv_prev + (which == HD_ILLUMINATION_DIRECT ? 0 : m);
+    double d = 0.0, l = 0.0;
+    if ((r = hd__be_read_illumination(ctx, which, ctx->conv_tmp)) != HD_SUCCESS) return r;
+    for (c = 0; c < (size_t)ctx->channels; ++c)
+        for (i = 0; i < n; ++i) {
+            float v = ctx->conv_tmp[c * gvox + ctx->conv_idx[i]];
+            float e = v - prev[c * n + i];
+            d += (double)e * e;
+            prev[c * n + i] = v;
+            if (which == HD_ILLUMINATION_SCATTERED) {
+                double t = (double)ctx->conv_prev[c * n + i] + v;
+                l += t * t;
+            }
+        }
+    *dsq = d;
+    *lsq = l;
+    return HD_SUCCESS;
+}
+
+/* After a light iteration: the estimate of E + phi's relative RMS error (hd_stats.light_error).
+   E is a Monte Carlo mean of n samples, whose change is (s_n - E_n-1) / n: its RMS times sqrt(n)
+   estimates the standard error. phi follows a fixed-point iteration, whose remaining error is
+   about its change times q / (1 - q) for a contraction q, taken from successive changes.
+   CD's E is deterministic and counted with phi. */
+static hd_result hd__light_measure(hd__ctx *ctx)
+{
+    hd_result r;
+    double de = 0.0, dp = 0.0, ls = 0.0, err, q;
+    if ((r = hd__conv_alloc(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__conv_fold(ctx, HD_ILLUMINATION_DIRECT, &de, &ls)) != HD_SUCCESS) return r;
+    if ((r = hd__conv_fold(ctx, HD_ILLUMINATION_SCATTERED, &dp, &ls)) != HD_SUCCESS) return r;
+    if (!ctx->conv_have_prev) {
+        ctx->conv_have_prev = 1;
+        ctx->light_error = 1.0;
+        return HD_SUCCESS;
+    }
+    if (ctx->params.method == HD_METHOD_HD) {
+        err = sqrt((double)ctx->iterations * de);
+    } else {
+        err = 0.0;
+        dp += de;
+    }
+    dp = sqrt(dp);
+    q = ctx->conv_dphi > 0.0 ? dp / ctx->conv_dphi : 0.0;
+    ctx->conv_q = q > 0.9 ? 0.9 : q;
+    ctx->conv_dphi = dp;
+    err += dp * ctx->conv_q / (1.0 - ctx->conv_q);
+    /* no light reaches the medium: nothing left to refine */
+    ctx->light_error = ls > 0.0 ? err / sqrt(ls) : 0.0;
+    ctx->conv_below = ctx->light_error < (double)ctx->params.light_tolerance ? ctx->conv_below + 1 : 0;
+    return HD_SUCCESS;
+}
+
+static int hd__light_converged(const hd__ctx *ctx) { return ctx->conv_below >= 2; }
+
 /* Brings the device state up to date with what the setters changed, in dependency order. */
 static hd_result hd__prepare(hd__ctx *ctx)
 {
@@ -551,7 +676,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
     }
     ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
     if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
-    if (dirty & HD__DIRTY_IMAGE) ctx->frames = 0;
+    if (dirty & HD__DIRTY_IMAGE) ctx->frames = ctx->converged_frames = 0;
+    /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
+    if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) hd__conv_reset(ctx);
     hd__fill_kparams(ctx);
     if (dirty & HD__DIRTY_SIGMA) {
         if ((r = hd__be_upload_inputs(ctx)) != HD_SUCCESS) return r;
@@ -588,49 +716,55 @@ static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* One HD iteration: a direct-light sample per voxel, the diffusion sweeps, one frame. */
-static hd_result hd__iterate_hd(hd__ctx *ctx)
+/* One light iteration, no projection. HD: a direct-light sample per voxel and the diffusion
+   sweeps; CD: one convection step per light, their sum into E, and the sweeps (convection and
+   sum count as the direct stage). Then the convergence estimate, counted with the diffusion. */
+static hd_result hd__light_iteration(hd__ctx *ctx)
 {
     hd_result r;
     double t0 = hd__now(), t1, t2;
     ctx->iterations++;
-    ctx->frames++;
     hd__fill_kparams(ctx);
+#ifdef HD__BE_HAS_CD
+    if (ctx->params.method == HD_METHOD_CD) {
+        int l;
+        for (l = 0; l < ctx->light_count; ++l)
+            if ((r = hd__be_convect(ctx, l)) != HD_SUCCESS) return r;
+        if ((r = hd__be_sum_lights(ctx)) != HD_SUCCESS) return r;
+    } else
+#endif
     if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
     t1 = hd__now();
     if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
+    /* iterations recorded into a caller's command buffer have not run yet: nothing to measure */
+    if (ctx->no_measure) hd__conv_reset(ctx);
+    else r = hd__light_measure(ctx);
     t2 = hd__now();
-    if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
     ctx->seconds[0] += t1 - t0;
     ctx->seconds[1] += t2 - t1;
-    ctx->seconds[2] += hd__now() - t2;
-    return HD_SUCCESS;
+    if (!hd__light_converged(ctx)) ctx->converged_frames = 0;
+    return r;
 }
 
-#ifdef HD__BE_HAS_CD
-/* One CD iteration: one convection step per light and their sum into E, the diffusion sweeps,
-   one frame. Time of the convection and the sum counts as the direct stage. */
-static hd_result hd__iterate_cd(hd__ctx *ctx)
+/* One projection frame from the current E and phi into the image's running mean. */
+static hd_result hd__project_frame(hd__ctx *ctx)
 {
     hd_result r;
-    double t0 = hd__now(), t1, t2;
-    int l;
-    ctx->iterations++;
+    double t0 = hd__now();
     ctx->frames++;
     hd__fill_kparams(ctx);
-    for (l = 0; l < ctx->light_count; ++l)
-        if ((r = hd__be_convect(ctx, l)) != HD_SUCCESS) return r;
-    if ((r = hd__be_sum_lights(ctx)) != HD_SUCCESS) return r;
-    t1 = hd__now();
-    if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
-    t2 = hd__now();
-    if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
-    ctx->seconds[0] += t1 - t0;
-    ctx->seconds[1] += t2 - t1;
-    ctx->seconds[2] += hd__now() - t2;
-    return HD_SUCCESS;
+    r = hd__be_project(ctx);
+    ctx->seconds[2] += hd__now() - t0;
+    return r;
 }
-#endif
+
+/* One HD or CD iteration: a light iteration and one frame. */
+static hd_result hd__iterate_light(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__light_iteration(ctx)) != HD_SUCCESS) return r;
+    return hd__project_frame(ctx);
+}
 
 #ifdef HD__BE_HAS_PT
 /* One PT_SS / PT_MS iteration: one full path per pixel into the image's plain running mean.
@@ -653,13 +787,13 @@ static hd_result hd__iterate_method(hd__ctx *ctx)
 {
     switch (ctx->params.method) {
 #ifdef HD__BE_HAS_CD
-    case HD_METHOD_CD: return hd__iterate_cd(ctx);
+    case HD_METHOD_CD: return hd__iterate_light(ctx);
 #endif
 #ifdef HD__BE_HAS_PT
     case HD_METHOD_PT_SS:
     case HD_METHOD_PT_MS: return hd__iterate_pt(ctx);
 #endif
-    case HD_METHOD_HD: return hd__iterate_hd(ctx);
+    case HD_METHOD_HD: return hd__iterate_light(ctx);
     default:
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
                        hd_method_name(ctx->params.method), hd__be_name());
@@ -679,6 +813,70 @@ HDDEF hd_result hd_iterate(hd_context h, int n)
         if ((r = hd__iterate_method(ctx)) != HD_SUCCESS) return r;
     }
     return HD_SUCCESS;
+}
+
+/* A light iteration of hd_refine or hd_render. When the light converges, the frames in the
+   image saw light that was still changing: the image starts afresh. */
+static hd_result hd__refine_once(hd__ctx *ctx)
+{
+    int before = hd__light_converged(ctx);
+    hd_result r = hd__light_iteration(ctx);
+    if (r == HD_SUCCESS && !before && hd__light_converged(ctx)) {
+        ctx->frames = 0;
+        ctx->converged_frames = 0;
+        HD__INFO(&ctx->log, "light converged after %llu iterations (estimated error %.3g)",
+                 (unsigned long long)ctx->iterations, ctx->light_error);
+    }
+    return r;
+}
+
+HDDEF hd_result hd_refine(hd_context h, int n)
+{
+    hd_result r;
+    int i;
+    HD__GET_CTX(ctx, h);
+    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_refine: n = %d, must be >= 1", n);
+    if (hd__method_is_pt(ctx->params.method))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd_refine: method %s has no light volume to refine; use hd_iterate or hd_render",
+                       hd_method_name(ctx->params.method));
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_refine: more than 2^31 iterations; reset with a new seed");
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    for (i = 0; i < n; ++i)
+        if ((r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_render(hd_context h)
+{
+    hd_result r;
+    double t0, last = 0.0, budget;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    t0 = hd__now();
+    budget = (double)ctx->params.render_budget;
+    if (hd__method_is_pt(ctx->params.method)) {
+        /* the image is the path tracers' state: each call adds at least one path per pixel */
+        do {
+            double ti = hd__now();
+            if (ctx->iterations >= 0x7fffffffu) break;
+            if ((r = hd__iterate_method(ctx)) != HD_SUCCESS) return r;
+            last = hd__now() - ti;
+        } while (hd__now() - t0 + last <= budget);
+        return HD_SUCCESS;
+    }
+    /* refine while not converged: at least once, then while the budget has room for another */
+    while (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu) {
+        double ti = hd__now();
+        if ((r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
+        last = hd__now() - ti;
+        if (hd__now() - t0 + last > budget) break;
+    }
+    if (hd__light_converged(ctx)) {
+        if (ctx->converged_frames >= (uint64_t)ctx->params.frame_window) return HD_SUCCESS; /* the image is done */
+        ctx->converged_frames++;
+    }
+    return hd__project_frame(ctx);
 }
 
 #if !defined(HYBRIDDIFF_BACKEND_GL)
@@ -797,5 +995,10 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->seconds_direct = ctx->seconds[0];
     out->seconds_diffusion = ctx->seconds[1];
     out->seconds_projection = ctx->seconds[2];
+    if (!hd__method_is_pt(ctx->params.method)) {
+        int fresh = (ctx->dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) != 0;
+        out->light_error = fresh ? 1.0 : ctx->light_error;
+        out->light_converged = !fresh && hd__light_converged(ctx);
+    }
     return HD_SUCCESS;
 }

@@ -71,6 +71,19 @@ typedef struct hd__ctx {
     uint64_t frames;
     hd__kparams kp;
     double seconds[3];       /* direct (or convection / paths), diffusion, projection */
+    /* light convergence (hd__light_measure): E and phi of the medium's voxels after the
+       previous light iteration, to estimate the error from their change */
+    uint32_t *conv_idx;      /* illumination-grid indices of the voxels measured */
+    size_t conv_count;
+    float *conv_prev;        /* conv_count * channels values of E, then the same of phi */
+    float *conv_tmp;         /* one illumination volume read back */
+    int conv_have_prev;      /* conv_prev holds the previous iteration */
+    int conv_below;          /* light iterations in a row with light_error below the tolerance */
+    double conv_dphi;        /* |phi_n - phi_n-1| of the previous iteration */
+    double conv_q;           /* the solver's observed contraction of that change */
+    double light_error;
+    uint64_t converged_frames; /* projection frames since the light converged */
+    int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     hd__backend *be;
 } hd__ctx;
 

@@ -1,10 +1,14 @@
-/* hd_io.h - the file loaders: NRRD (attached header, raw or gzip) and headerless raw volumes.
-   Part of the implementation of hybriddiff.h; included once, after the public declarations.
+/* hd_io.h - the file loaders: NRRD (attached header, raw or gzip) and headerless raw volumes,
+   and what every loader shares: opening a file, reading it in bounded chunks, inflating gzip,
+   converting voxels. Part of the implementation of hybriddiff.h; included once, after the
+   public declarations.
 
-   One parser works on a memory buffer (hd_volume_parse_nrrd, what the fuzzers drive); the file
-   loaders only read the file and hand the bytes over. Nothing is allocated before the header has
-   been checked against the bytes that are really there, so a hostile header cannot make the
-   parser allocate more than a small multiple of its input.
+   The parsers read from a source, a memory buffer (hd_volume_parse_*, what the fuzzers drive) or
+   an open regular file. A file loader reads the header (at most HD__IO_HEADER_MAX bytes), then
+   only the bytes the header says the data need, in HD__IO_CHUNK pieces converted as they
+   arrive. Raw data are allocated once the source is known to hold them; gzip data grow with
+   what really inflates. So the peak allocation is the loaded volume (twice it while a growing
+   buffer is copied) plus the header and one chunk, whatever the header claims.
 
    Output types: u8 stays HD_VOXEL_U8, u16 stays HD_VOXEL_U16, every other type is converted to
    HD_VOXEL_F32 (non-finite values become 0, with a warning). desc.value_range is the range of the
@@ -13,7 +17,8 @@
    Order of the size checks (NRRD sizes and raw dims alike): a size <= 0 is
    HD_ERROR_INVALID_DIMENSIONS; then the product of the sizes and the bytes per voxel must fit in
    a size_t (HD_ERROR_SIZE_OVERFLOW); then each size must be <= HD_MAX_DIM
-   (HD_ERROR_INVALID_DIMENSIONS). */
+   (HD_ERROR_INVALID_DIMENSIONS); then the bytes must be <= hd_load_options.max_bytes
+   (HD_ERROR_FILE_TOO_LARGE). */
 #ifndef HD_IO_H
 #define HD_IO_H
 
@@ -25,6 +30,10 @@
 #include <limits.h>
 #include <stdint.h>
 #include <math.h>
+#include <sys/types.h>
+#include <sys/stat.h>
+#include <fcntl.h>
+#include <unistd.h>
 #ifndef HYBRIDDIFF_NO_ZLIB
 #include <zlib.h>
 #endif
@@ -107,6 +116,51 @@ static const hd_logger *hd__io_wrap_logger(const hd_logger *outer, const char *p
     wrapped->func = hd__io_path_log;
     wrapped->user_data = pl;
     return wrapped;
+}
+
+/* ---- options and allocation ------------------------------------------------------------------ */
+typedef struct hd__io_opt {
+    hd_allocator al;  /* never empty: malloc/free unless the caller gave one */
+    size_t max_bytes; /* SIZE_MAX: no limit */
+    int allow_outside;
+} hd__io_opt;
+
+static void hd__io_opt_init(hd__io_opt *o, const hd_load_options *lo)
+{
+    memset(o, 0, sizeof *o);
+    o->al.alloc = hd__malloc_default;
+    o->al.free = hd__free_default;
+    o->max_bytes = SIZE_MAX;
+    if (!lo) return;
+    if (lo->allocator.alloc) o->al = lo->allocator;
+    if (lo->max_bytes) o->max_bytes = lo->max_bytes;
+    o->allow_outside = lo->allow_outside_folder != 0;
+}
+
+static void *hd__io_alloc(const hd__io_opt *o, size_t n)
+{
+    return o->al.alloc(n ? n : 1, o->al.user_data);
+}
+
+static void hd__io_free(const hd__io_opt *o, void *p)
+{
+    if (p) o->al.free(p, o->al.user_data);
+}
+
+/* Bytes a voxel takes once loaded: u8 and u16 stay, the rest becomes f32. */
+static size_t hd__io_out_size(int type) { return type == HD__IO_U8 ? 1 : type == HD__IO_U16 ? 2 : 4; }
+
+/* hd_load_options.max_bytes: the data as stored and as loaded, whichever is larger. */
+static hd_result hd__io_check_limit(size_t count, int type, const hd__io_opt *o, const char *what,
+                                    const hd_logger *logger)
+{
+    size_t es = hd__io_type_size(type), os = hd__io_out_size(type);
+    size_t bytes = count * (es > os ? es : os); /* fits: hd__io_check_dims checked it */
+    if (bytes > o->max_bytes)
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_TOO_LARGE,
+                           "%s: the volume takes %zu bytes, more than max_bytes %zu", what, bytes,
+                           o->max_bytes);
+    return HD_SUCCESS;
 }
 
 /* ---- sizes ----------------------------------------------------------------------------------- */
@@ -206,68 +260,162 @@ static void hd__io_set_range(hd_volume_file *out, double lo, double hi)
         else out->desc.value_range[0] = v - d;
     }
 }
+/* Conversion as the bytes arrive: count elements of type, fed in pieces of any length (an
+   element split between pieces is carried over). The output is allocated whole at the start
+   when the source is known to hold the data (grow = 0), else as elements arrive, doubling from
+   HD__IO_GROW_FIRST voxels up to count. */
+#define HD__IO_GROW_FIRST ((size_t)1 << 16)
 
-/* Converts count elements of type at src into out->data (allocated here) and fills out->desc
-   (but dims and spacing), value_min and value_max. */
-static hd_result hd__io_convert(const unsigned char *src, size_t count, int type, int big,
-                                hd_volume_file *out, const char *what, const hd_logger *logger)
+typedef struct hd__io_conv {
+    int type, big, grow, any;
+    size_t esize, osize;
+    size_t count, done, cap; /* voxels: expected, converted, allocated */
+    unsigned char *out;
+    double lo, hi;
+    size_t bad;              /* non-finite values replaced by 0 */
+    unsigned char carry[8];
+    size_t carry_n;
+} hd__io_conv;
+
+static hd_result hd__io_conv_reserve(hd__io_conv *c, size_t need, const hd__io_opt *o,
+                                     const char *what, const hd_logger *logger)
 {
-    size_t i, esize = hd__io_type_size(type), bad = 0;
-    double lo = 0.0, hi = 0.0;
-    int any = 0;
-    if (count == 0) count = 1; /* never: dims are >= 1 */
-    if (type == HD__IO_U8) {
-        unsigned char *d = (unsigned char *)malloc(count);
-        if (!d) goto oom;
-        memcpy(d, src, count);
-        lo = hi = d[0];
-        for (i = 1; i < count; ++i) {
-            if (d[i] < lo) lo = d[i];
-            if (d[i] > hi) hi = d[i];
+    size_t ncap;
+    unsigned char *n;
+    if (need <= c->cap) return HD_SUCCESS;
+    ncap = c->cap ? c->cap : HD__IO_GROW_FIRST;
+    while (ncap < need) ncap = ncap > c->count / 2 ? c->count : ncap * 2;
+    if (ncap > c->count) ncap = c->count;
+    n = (unsigned char *)hd__io_alloc(o, ncap * c->osize);
+    if (!n)
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu voxels", what,
+                           ncap);
+    if (c->done) memcpy(n, c->out, c->done * c->osize);
+    hd__io_free(o, c->out);
+    c->out = n;
+    c->cap = ncap;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__io_conv_begin(hd__io_conv *c, size_t count, int type, int big, int grow,
+                                   const hd__io_opt *o, const char *what,
+                                   const hd_logger *logger)
+{
+    memset(c, 0, sizeof *c);
+    c->type = type;
+    c->big = big;
+    c->grow = grow;
+    c->esize = hd__io_type_size(type);
+    c->osize = hd__io_out_size(type);
+    c->count = count ? count : 1; /* never 0: dims are >= 1 */
+    return grow ? HD_SUCCESS : hd__io_conv_reserve(c, c->count, o, what, logger);
+}
+
+/* k whole elements at src into the output (room for them reserved). */
+static void hd__io_conv_elems(hd__io_conv *c, const unsigned char *src, size_t k)
+{
+    size_t i;
+    double lo = c->any ? c->lo : HUGE_VAL, hi = c->any ? c->hi : -HUGE_VAL;
+    if (c->type == HD__IO_U8) {
+        unsigned char *d = c->out + c->done;
+        unsigned vlo = 255, vhi = 0;
+        memcpy(d, src, k);
+        for (i = 0; i < k; ++i) {
+            if (d[i] < vlo) vlo = d[i];
+            if (d[i] > vhi) vhi = d[i];
         }
-        out->data = d;
-        out->desc.type = HD_VOXEL_U8;
-    } else if (type == HD__IO_U16) {
-        uint16_t *d = (uint16_t *)malloc(count * 2);
+        if (vlo < lo) lo = vlo;
+        if (vhi > hi) hi = vhi;
+    } else if (c->type == HD__IO_U16) {
+        uint16_t *d = (uint16_t *)(void *)c->out + c->done;
         unsigned vlo = 65535, vhi = 0;
-        if (!d) goto oom;
-        for (i = 0; i < count; ++i) {
+        for (i = 0; i < k; ++i) {
             const unsigned char *p = src + 2 * i;
-            unsigned v = big ? (unsigned)(p[0] << 8 | p[1]) : (unsigned)(p[1] << 8 | p[0]);
+            unsigned v = c->big ? (unsigned)(p[0] << 8 | p[1]) : (unsigned)(p[1] << 8 | p[0]);
             d[i] = (uint16_t)v;
             if (v < vlo) vlo = v;
             if (v > vhi) vhi = v;
         }
-        lo = vlo;
-        hi = vhi;
-        out->data = d;
-        out->desc.type = HD_VOXEL_U16;
+        if (vlo < lo) lo = vlo;
+        if (vhi > hi) hi = vhi;
     } else {
-        float *d = (float *)malloc(count * sizeof(float));
-        if (!d) goto oom;
-        for (i = 0; i < count; ++i) {
-            double v = hd__io_value(src + esize * i, type, big);
+        float *d = (float *)(void *)c->out + c->done;
+        for (i = 0; i < k; ++i) {
+            double v = hd__io_value(src + c->esize * i, c->type, c->big);
             float f = (float)v;
             if (!(v == v) || !isfinite(f)) { /* NaN, Inf, or a double beyond float range */
                 f = 0.0f;
-                ++bad;
+                ++c->bad;
             }
             d[i] = f;
-            if (!any || f < lo) lo = f;
-            if (!any || f > hi) hi = f;
-            any = 1;
+            if (f < lo) lo = f;
+            if (f > hi) hi = f;
         }
-        if (bad)
-            HD__IO_WARN(logger, "%s: %zu non-finite voxel values were replaced by 0", what, bad);
-        out->data = d;
-        out->desc.type = HD_VOXEL_F32;
     }
-    out->desc.data = out->data;
-    hd__io_set_range(out, lo, hi);
+    c->lo = lo;
+    c->hi = hi;
+    c->any = 1;
+    c->done += k;
+}
+
+/* Bytes still wanted. */
+static size_t hd__io_conv_left(const hd__io_conv *c)
+{
+    return (c->count - c->done) * c->esize - c->carry_n;
+}
+
+/* Feeds n bytes (beyond the last element they are ignored). */
+static hd_result hd__io_conv_feed(hd__io_conv *c, const unsigned char *p, size_t n,
+                                  const hd__io_opt *o, const char *what, const hd_logger *logger)
+{
+    size_t k, left = hd__io_conv_left(c);
+    hd_result r;
+    if (n > left) n = left;
+    if (c->carry_n) {
+        size_t t = c->esize - c->carry_n;
+        if (t > n) t = n;
+        memcpy(c->carry + c->carry_n, p, t);
+        c->carry_n += t;
+        p += t;
+        n -= t;
+        if (c->carry_n < c->esize) return HD_SUCCESS;
+        if ((r = hd__io_conv_reserve(c, c->done + 1, o, what, logger)) != HD_SUCCESS) return r;
+        hd__io_conv_elems(c, c->carry, 1);
+        c->carry_n = 0;
+    }
+    k = n / c->esize;
+    if (k) {
+        if ((r = hd__io_conv_reserve(c, c->done + k, o, what, logger)) != HD_SUCCESS) return r;
+        hd__io_conv_elems(c, p, k);
+        p += k * c->esize;
+        n -= k * c->esize;
+    }
+    if (n) {
+        memcpy(c->carry, p, n);
+        c->carry_n = n;
+    }
     return HD_SUCCESS;
-oom:
-    return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu voxels", what,
-                       count);
+}
+
+/* Hands the complete output to out (desc.type, data, value range; not dims or spacing). */
+static void hd__io_conv_end(hd__io_conv *c, hd_volume_file *out, const hd__io_opt *o,
+                            const char *what, const hd_logger *logger)
+{
+    if (c->bad)
+        HD__IO_WARN(logger, "%s: %zu non-finite voxel values were replaced by 0", what, c->bad);
+    out->data = c->out;
+    out->desc.data = c->out;
+    out->desc.type = c->type == HD__IO_U8 ? HD_VOXEL_U8
+                     : c->type == HD__IO_U16 ? HD_VOXEL_U16 : HD_VOXEL_F32;
+    out->allocator = o->al;
+    hd__io_set_range(out, c->lo, c->hi);
+    c->out = NULL;
+}
+
+static void hd__io_conv_drop(hd__io_conv *c, const hd__io_opt *o)
+{
+    hd__io_free(o, c->out);
+    c->out = NULL;
 }
 
 /* ---- text helpers ---------------------------------------------------------------------------- */
@@ -613,38 +761,252 @@ static hd_result hd__io_nrrd_field(hd__io_nrrd *h, const char *name, const char 
     return HD_SUCCESS;
 }
 
-#ifndef HYBRIDDIFF_NO_ZLIB
-/* Inflates into out[0..out_len) (out may be NULL with a scratch buffer: discard). Returns a zlib
-   code: Z_OK (out full), Z_STREAM_END, Z_BUF_ERROR (input ended early), or an error. */
-static int hd__io_inflate(z_stream *zs, const unsigned char **in, size_t *in_left,
-                          unsigned char *out, size_t out_len, size_t *produced)
+/* ---- sources: a memory buffer or an open regular file ---------------------------------------- */
+#define HD__IO_CHUNK ((size_t)1 << 16)       /* bytes read from a file at a time */
+#define HD__IO_HEADER_MAX ((size_t)1 << 20)  /* longest text header a file loader reads */
+
+typedef struct hd__io_src {
+    const unsigned char *mem; /* the buffer, or NULL: the file fd */
+    int fd;
+    uint64_t size;            /* bytes in the source (a file: its size when opened) */
+    uint64_t pos;             /* next byte to read */
+    unsigned char *buf;       /* a file's read buffer, HD__IO_CHUNK bytes */
+    const hd__io_opt *o;
+} hd__io_src;
+
+static void hd__io_src_mem(hd__io_src *s, const void *p, size_t n, const hd__io_opt *o)
 {
-    unsigned char scratch[4096];
-    *produced = 0;
-    while (*produced < out_len) {
-        size_t want = out_len - *produced;
-        uInt chunk;
+    memset(s, 0, sizeof *s);
+    s->mem = (const unsigned char *)p;
+    s->fd = -1;
+    s->size = n;
+    s->o = o;
+}
+
+static void hd__io_src_close(hd__io_src *s)
+{
+    hd__io_free(s->o, s->buf);
+    s->buf = NULL;
+    if (!s->mem && s->fd >= 0) close(s->fd);
+    s->fd = -1;
+}
+
+static const char *hd__io_kind(mode_t m)
+{
+    return S_ISDIR(m) ? "a directory" : S_ISCHR(m) ? "a character device"
+           : S_ISBLK(m) ? "a block device" : S_ISFIFO(m) ? "a FIFO"
+           : S_ISSOCK(m) ? "a socket" : "not a regular file";
+}
+
+/* Opens path if it is a regular file. stat comes first, so a FIFO or a device is refused before
+   open (which could block or have effects); the opened file must be the one stat saw.
+   nofollow: path has no symbolic links (a realpath result); a link appearing in its last
+   component since is refused. */
+static hd_result hd__io_open(const char *path, int nofollow, hd__io_src *s, const hd__io_opt *o,
+                             const hd_logger *logger)
+{
+    struct stat st, st2;
+    int fd, flags = O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC;
+    memset(s, 0, sizeof *s);
+    s->fd = -1;
+    s->o = o;
+    if ((nofollow ? lstat(path, &st) : stat(path, &st)) != 0)
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "cannot open: %s", strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_NOT_REGULAR, "%s: refused (only regular files "
+                           "are read)", hd__io_kind(st.st_mode));
+    if (nofollow) flags |= O_NOFOLLOW;
+    fd = open(path, flags);
+    if (fd < 0) return HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "cannot open: %s", strerror(errno));
+    if (fstat(fd, &st2) != 0 || !S_ISREG(st2.st_mode) || st2.st_dev != st.st_dev ||
+        st2.st_ino != st.st_ino) {
+        close(fd);
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_NOT_REGULAR,
+                           "the file changed between stat and open: refused");
+    }
+    s->fd = fd;
+    s->size = st2.st_size > 0 ? (uint64_t)st2.st_size : 0;
+    return HD_SUCCESS;
+}
+
+/* Up to max bytes from pos on, *n == 0 at the end; *p points into the buffer or into the read
+   buffer (valid until the next call). A file that shrank since it was opened ends early. */
+static hd_result hd__io_src_next(hd__io_src *s, size_t max, const unsigned char **p, size_t *n,
+                                 const hd_logger *logger)
+{
+    uint64_t left = s->pos < s->size ? s->size - s->pos : 0;
+    size_t want = left < (uint64_t)max ? (size_t)left : max;
+    *p = NULL;
+    *n = 0;
+    if (!want) return HD_SUCCESS;
+    if (s->mem) {
+        *p = s->mem + s->pos;
+        *n = want;
+        s->pos += want;
+        return HD_SUCCESS;
+    }
+    if (want > HD__IO_CHUNK) want = HD__IO_CHUNK;
+    if (!s->buf && !(s->buf = (unsigned char *)hd__io_alloc(s->o, HD__IO_CHUNK)))
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "cannot allocate a read buffer");
+    for (;;) {
+        ssize_t got = pread(s->fd, s->buf, want, (off_t)s->pos);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0)
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "read error: %s", strerror(errno));
+        if (got == 0) s->size = s->pos;
+        *p = s->buf;
+        *n = (size_t)got;
+        s->pos += (uint64_t)got;
+        return HD_SUCCESS;
+    }
+}
+
+/* Copies up to n bytes from pos on into dst; *got says how many there were. */
+static hd_result hd__io_src_read(hd__io_src *s, unsigned char *dst, size_t n, size_t *got,
+                                 const hd_logger *logger)
+{
+    *got = 0;
+    while (*got < n) {
+        const unsigned char *p;
+        size_t m;
+        hd_result r = hd__io_src_next(s, n - *got, &p, &m, logger);
+        if (r != HD_SUCCESS) return r;
+        if (!m) break;
+        memcpy(dst + *got, p, m);
+        *got += m;
+    }
+    return HD_SUCCESS;
+}
+
+/* Returns the offset just past the header's end in b[0..n), 0 if it is not there yet. */
+typedef size_t (*hd__io_end_fn)(const unsigned char *b, size_t n);
+
+/* A text header: the first bytes of a file, read until end() finds its end, the file ends, or
+   HD__IO_HEADER_MAX bytes (HD_ERROR_FILE_FORMAT). *out is allocated through s's options. */
+static hd_result hd__io_read_header(hd__io_src *s, hd__io_end_fn end, unsigned char **out,
+                                    size_t *out_n, const char *what, const hd_logger *logger)
+{
+    size_t cap = 4096, n = 0, got;
+    unsigned char *b = NULL;
+    hd_result r;
+    *out = NULL;
+    *out_n = 0;
+    s->pos = 0;
+    for (;;) {
+        unsigned char *nb = (unsigned char *)hd__io_alloc(s->o, cap);
+        if (!nb) {
+            hd__io_free(s->o, b);
+            return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "cannot allocate %zu bytes for "
+                               "the header", cap);
+        }
+        if (n) memcpy(nb, b, n);
+        hd__io_free(s->o, b);
+        b = nb;
+        r = hd__io_src_read(s, b + n, cap - n, &got, logger);
+        if (r != HD_SUCCESS) {
+            hd__io_free(s->o, b);
+            return r;
+        }
+        n += got;
+        if (n < cap || end(b, n)) break; /* the file ended, or the header did */
+        if (cap >= HD__IO_HEADER_MAX) {
+            hd__io_free(s->o, b);
+            return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                               "%s: no end of the header in the first %zu bytes", what, cap);
+        }
+        cap *= 2;
+    }
+    *out = b;
+    *out_n = n;
+    return HD_SUCCESS;
+}
+
+/* ---- gzip ------------------------------------------------------------------------------------- */
+#ifndef HYBRIDDIFF_NO_ZLIB
+/* A gzip or zlib stream of in_left bytes of a source, from its current position on; zlib's own
+   memory comes from the loader's allocator. */
+typedef struct hd__io_gz {
+    z_stream zs;
+    hd__io_src *src;
+    uint64_t in_left;  /* bytes of the source not yet given to zlib */
+    int ended;         /* Z_STREAM_END seen (its check value verified) */
+    hd_result src_err; /* a read error, when hd__io_gz_read returns Z_ERRNO */
+    const hd_logger *logger;
+} hd__io_gz;
+
+static voidpf hd__io_zalloc(voidpf opaque, uInt items, uInt size)
+{
+    if (size && items > SIZE_MAX / size) return Z_NULL;
+    return hd__io_alloc((const hd__io_opt *)opaque, (size_t)items * size);
+}
+
+static void hd__io_zfree(voidpf opaque, voidpf p)
+{
+    hd__io_free((const hd__io_opt *)opaque, p);
+}
+
+static hd_result hd__io_gzip_error(int r, const hd__io_gz *g, const char *stage,
+                                   const char *what, const hd_logger *logger)
+{
+    if (r == Z_ERRNO) return g->src_err; /* logged by the source */
+    if (r == Z_MEM_ERROR)
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: zlib is out of memory", what);
+    if (r == Z_BUF_ERROR)
+        return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is truncated (%s)", what,
+                           stage);
+    return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is corrupt (%s): %s", what, stage,
+                       g->zs.msg ? g->zs.msg : "zlib error");
+}
+
+static hd_result hd__io_gz_init(hd__io_gz *g, hd__io_src *src, uint64_t in_len,
+                                const char *what, const hd_logger *logger)
+{
+    int r;
+    memset(g, 0, sizeof *g);
+    g->src = src;
+    g->in_left = in_len;
+    g->logger = logger;
+    g->zs.zalloc = hd__io_zalloc;
+    g->zs.zfree = hd__io_zfree;
+    g->zs.opaque = (voidpf)src->o;
+    r = inflateInit2(&g->zs, 15 + 32); /* gzip or zlib header */
+    if (r != Z_OK) return hd__io_gzip_error(r, g, "init", what, logger);
+    return HD_SUCCESS;
+}
+
+/* Inflates up to n bytes into dst; *got: how many. Returns Z_OK (dst full), Z_STREAM_END,
+   Z_BUF_ERROR (the input ended first), Z_ERRNO (a read error, in src_err) or a zlib error. */
+static int hd__io_gz_read(hd__io_gz *g, unsigned char *dst, size_t n, size_t *got)
+{
+    *got = 0;
+    while (*got < n) {
+        size_t want = n - *got;
+        uInt chunk = want > (size_t)UINT_MAX ? UINT_MAX : (uInt)want;
         int r;
-        if (zs->avail_in == 0 && *in_left > 0) {
-            uInt c = *in_left > (size_t)UINT_MAX ? UINT_MAX : (uInt)*in_left;
-            zs->next_in = (Bytef *)*in;
-            zs->avail_in = c;
-            *in += c;
-            *in_left -= c;
+        if (g->zs.avail_in == 0 && g->in_left > 0) {
+            const unsigned char *p;
+            size_t m;
+            hd_result e = hd__io_src_next(g->src, g->in_left < (uint64_t)UINT_MAX
+                                                      ? (size_t)g->in_left : (size_t)UINT_MAX,
+                                          &p, &m, g->logger);
+            if (e != HD_SUCCESS) {
+                g->src_err = e;
+                return Z_ERRNO;
+            }
+            g->in_left = m ? g->in_left - m : 0;
+            g->zs.next_in = (Bytef *)p;
+            g->zs.avail_in = (uInt)m;
         }
-        if (out) {
-            chunk = want > (size_t)UINT_MAX ? UINT_MAX : (uInt)want;
-            zs->next_out = out + *produced;
-        } else {
-            chunk = want > sizeof scratch ? (uInt)sizeof scratch : (uInt)want;
-            zs->next_out = scratch;
+        g->zs.next_out = dst + *got;
+        g->zs.avail_out = chunk;
+        r = inflate(&g->zs, Z_NO_FLUSH);
+        *got += chunk - g->zs.avail_out;
+        if (r == Z_STREAM_END) {
+            g->ended = 1;
+            return r;
         }
-        zs->avail_out = chunk;
-        r = inflate(zs, Z_NO_FLUSH);
-        *produced += chunk - zs->avail_out;
-        if (r == Z_STREAM_END) return r;
-        if (r == Z_BUF_ERROR || r == Z_OK) {
-            if (zs->avail_out != 0 && zs->avail_in == 0 && *in_left == 0) return Z_BUF_ERROR;
+        if (r == Z_OK || r == Z_BUF_ERROR) {
+            if (g->zs.avail_out != 0 && g->zs.avail_in == 0 && g->in_left == 0) return Z_BUF_ERROR;
             continue;
         }
         return r;
@@ -652,101 +1014,128 @@ static int hd__io_inflate(z_stream *zs, const unsigned char **in, size_t *in_lef
     return Z_OK;
 }
 
-static hd_result hd__io_gzip_error(int r, const z_stream *zs, const char *stage,
-                                   const char *what, const hd_logger *logger)
+/* From the stream's current position: drops skip bytes, converts count elements of type
+   (allocated as they inflate), then inflates the rest of the stream to check it. */
+static hd_result hd__io_gz_data(hd__io_gz *g, uint64_t skip, size_t count, int type, int big,
+                                hd_volume_file *out, const char *what, const hd_logger *logger)
 {
-    if (r == Z_MEM_ERROR)
-        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: zlib is out of memory", what);
-    if (r == Z_BUF_ERROR)
-        return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is truncated (%s)", what,
-                           stage);
-    return HD__IO_FAIL(logger, HD_ERROR_GZIP, "%s: gzip stream is corrupt (%s): %s", what, stage,
-                       zs->msg ? zs->msg : "zlib error");
-}
-
-/* Decompresses skip + bytes bytes of a gzip or zlib stream; returns the last bytes of them in
-   *out (malloc'd). what: "nrrd", "mhd", "nifti", for the messages. */
-static hd_result hd__io_gunzip(const unsigned char *in, size_t in_len, size_t skip, size_t bytes,
-                               unsigned char **out, const char *what, const hd_logger *logger)
-{
-    z_stream zs;
-    size_t got = 0;
-    unsigned char *buf;
+    const hd__io_opt *o = g->src->o;
+    unsigned char *scratch = (unsigned char *)hd__io_alloc(o, HD__IO_CHUNK);
+    uint64_t skipped = 0;
+    size_t got, total = 0;
+    hd__io_conv c;
     hd_result res = HD_SUCCESS;
-    int r;
-    *out = NULL;
-    /* deflate cannot expand more than 1032:1: a header claiming more is lying, and we refuse it
-       before allocating anything. */
-    if (skip > SIZE_MAX - bytes || (skip + bytes) / 1032 > in_len + 64)
-        return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                           "%s: header claims %zu bytes of data, a gzip stream of %zu bytes "
-                           "cannot hold that many", what, bytes, in_len);
-    buf = (unsigned char *)malloc(bytes);
-    if (!buf)
-        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes",
-                           what, bytes);
-    memset(&zs, 0, sizeof zs);
-    r = inflateInit2(&zs, 15 + 32); /* gzip or zlib header */
-    if (r != Z_OK) {
-        free(buf);
-        return hd__io_gzip_error(r, &zs, "init", what, logger);
+    int r = Z_OK;
+    memset(&c, 0, sizeof c);
+    if (!scratch)
+        return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate %zu bytes", what,
+                           HD__IO_CHUNK);
+    while (skipped < skip) {
+        uint64_t left = skip - skipped;
+        r = hd__io_gz_read(g, scratch, left < HD__IO_CHUNK ? (size_t)left : HD__IO_CHUNK, &got);
+        skipped += got;
+        if (r == Z_STREAM_END && skipped < skip) {
+            res = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                              "%s: gzip stream holds %llu bytes, less than the %llu to skip",
+                              what, (unsigned long long)skipped, (unsigned long long)skip);
+            goto done;
+        }
+        if (r != Z_OK && r != Z_STREAM_END) {
+            res = hd__io_gzip_error(r, g, "in the skipped bytes", what, logger);
+            goto done;
+        }
     }
-    r = hd__io_inflate(&zs, &in, &in_len, NULL, skip, &got);
-    if (r == Z_OK) {
-        r = hd__io_inflate(&zs, &in, &in_len, buf, bytes, &got);
-        if (r == Z_STREAM_END && got == bytes) {
-            /* the stream ended right after the data: inflate has checked its CRC */
-        } else if (r == Z_OK) { /* data complete: check the rest of the stream (CRC) */
-            size_t rest;
-            do r = hd__io_inflate(&zs, &in, &in_len, NULL, (size_t)1 << 30, &rest);
-            while (r == Z_OK);
-            if (r != Z_STREAM_END)
-                res = hd__io_gzip_error(r, &zs, "after the data", what, logger);
-        } else if (r == Z_STREAM_END) {
+    res = hd__io_conv_begin(&c, count, type, big, 1, o, what, logger);
+    while (res == HD_SUCCESS && hd__io_conv_left(&c) > 0) {
+        size_t left = hd__io_conv_left(&c);
+        r = hd__io_gz_read(g, scratch, left < HD__IO_CHUNK ? left : HD__IO_CHUNK, &got);
+        total += got;
+        if (r != Z_OK && r != Z_STREAM_END) {
+            res = hd__io_gzip_error(r, g, "in the data", what, logger);
+            break;
+        }
+        res = hd__io_conv_feed(&c, scratch, got, o, what, logger);
+        if (res == HD_SUCCESS && r == Z_STREAM_END && hd__io_conv_left(&c) > 0)
             res = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
                               "%s: header claims %zu bytes of data, gzip stream holds %zu",
-                              what, bytes, got);
-        } else {
-            res = hd__io_gzip_error(r, &zs, "in the data", what, logger);
-        }
-    } else if (r == Z_STREAM_END) {
-        res = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                          "%s: gzip stream holds %zu bytes, less than the byte skip %zu", what,
-                          got, skip);
-    } else {
-        res = hd__io_gzip_error(r, &zs, "in the skipped bytes", what, logger);
+                              what, count * c.esize, total);
     }
-    inflateEnd(&zs);
-    if (res != HD_SUCCESS) {
-        free(buf);
-        return res;
+    while (res == HD_SUCCESS && !g->ended) { /* the rest of the stream, for its check value */
+        r = hd__io_gz_read(g, scratch, HD__IO_CHUNK, &got);
+        if (r != Z_OK && r != Z_STREAM_END)
+            res = hd__io_gzip_error(r, g, "after the data", what, logger);
     }
-    *out = buf;
-    return HD_SUCCESS;
+    if (res == HD_SUCCESS) hd__io_conv_end(&c, out, o, what, logger);
+done:
+    hd__io_conv_drop(&c, o);
+    hd__io_free(o, scratch);
+    return res;
 }
 #endif
+
+/* ---- voxel data -------------------------------------------------------------------------------- */
+/* count elements of type at offset of s, raw (the caller has checked that the source holds
+   them) or, gzip != 0, a stream of in_len bytes there whose first skip inflated bytes are
+   dropped. Fills out's data, type and value range. */
+static hd_result hd__io_data(hd__io_src *s, uint64_t offset, int gzip, uint64_t in_len,
+                             uint64_t skip, size_t count, int type, int big, hd_volume_file *out,
+                             const char *what, const hd_logger *logger)
+{
+    hd__io_conv c;
+    hd_result r;
+    s->pos = offset;
+    if (gzip) {
+#ifdef HYBRIDDIFF_NO_ZLIB
+        (void)in_len; (void)skip; (void)count; (void)type; (void)big; (void)out;
+        return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                           "%s: gzip encoding needs zlib (built with HYBRIDDIFF_NO_ZLIB)", what);
+#else
+        hd__io_gz g;
+        r = hd__io_gz_init(&g, s, in_len, what, logger);
+        if (r != HD_SUCCESS) return r;
+        r = hd__io_gz_data(&g, skip, count, type, big, out, what, logger);
+        inflateEnd(&g.zs);
+        return r;
+#endif
+    }
+    r = hd__io_conv_begin(&c, count, type, big, 0, s->o, what, logger);
+    while (r == HD_SUCCESS && hd__io_conv_left(&c) > 0) {
+        const unsigned char *p;
+        size_t n, left = hd__io_conv_left(&c);
+        r = hd__io_src_next(s, left, &p, &n, logger);
+        if (r == HD_SUCCESS && n == 0)
+            r = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                            "%s: the file ended %zu bytes before the end of the data", what,
+                            left);
+        if (r == HD_SUCCESS) r = hd__io_conv_feed(&c, p, n, s->o, what, logger);
+    }
+    if (r == HD_SUCCESS) hd__io_conv_end(&c, out, s->o, what, logger);
+    hd__io_conv_drop(&c, s->o);
+    return r;
+}
 
 HDDEF void hd_volume_free(hd_volume_file *vol)
 {
     if (!vol) return;
-    free(vol->data);
+    if (vol->data) {
+        if (vol->allocator.free) vol->allocator.free(vol->data, vol->allocator.user_data);
+        else free(vol->data);
+    }
     memset(vol, 0, sizeof *vol);
 }
 
-HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_file *out,
-                                     const hd_logger *logger)
+/* The NRRD header in buf[0..size) (a memory source's bytes, or a file's first bytes up to the
+   blank line at least), then the data from s, where the header's offsets point. */
+static hd_result hd__io_nrrd_load(const unsigned char *buf, size_t size, hd__io_src *s,
+                             hd_volume_file *out, const hd__io_opt *o, const hd_logger *logger)
 {
-    const unsigned char *buf = (const unsigned char *)bytes;
-    size_t pos, count = 0, data_bytes = 0, avail;
+    size_t pos, count = 0, data_bytes = 0;
+    uint64_t avail;
     int64_t dims[3];
     int line = 1, ended = 0, overflow = 0, i;
     hd__io_nrrd h;
     hd_result r;
 
-    if (out) memset(out, 0, sizeof *out);
-    if (!bytes || !out)
-        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "nrrd: %s is NULL",
-                           !out ? "out" : "bytes");
     if (size < 8 || memcmp(buf, "NRRD000", 7) != 0 || buf[7] < '1' || buf[7] > '9')
         return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
                            "nrrd: no 'NRRD000x' magic at the start: not a NRRD file");
@@ -759,7 +1148,7 @@ HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_f
     if (pos < size) ++pos;
     while (pos < size) {
         size_t start = pos, end, len, colon;
-        const char *s = (const char *)buf + start;
+        const char *t = (const char *)buf + start;
         char name[64];
         size_t nl = 0, k;
         ++line;
@@ -772,14 +1161,14 @@ HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_f
             ended = 1;
             break;
         }
-        if (s[0] == '#') continue;
-        for (colon = 0; colon < len && s[colon] != ':'; ++colon) {}
+        if (t[0] == '#') continue;
+        for (colon = 0; colon < len && t[colon] != ':'; ++colon) {}
         if (colon == len)
             return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
                                "nrrd: line %d is not 'field: value' (no ':')", line);
-        if (colon + 1 < len && s[colon + 1] == '=') continue; /* 'key:=value' pair */
+        if (colon + 1 < len && t[colon + 1] == '=') continue; /* 'key:=value' pair */
         for (k = 0; k < colon; ++k) { /* the name, lower case, without spaces */
-            int c = (unsigned char)s[k];
+            int c = (unsigned char)t[k];
             if (hd__io_space(c)) continue;
             if (nl + 1 >= sizeof name || c < 32 || c > 126)
                 return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
@@ -790,7 +1179,7 @@ HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_f
         if (nl == 0)
             return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT, "nrrd: line %d: empty field name",
                                line);
-        r = hd__io_nrrd_field(&h, name, s + colon + 1, len - colon - 1, line, logger);
+        r = hd__io_nrrd_field(&h, name, t + colon + 1, len - colon - 1, line, logger);
         if (r != HD_SUCCESS) return r;
     }
 
@@ -804,161 +1193,138 @@ HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_f
     r = hd__io_check_dims(dims, hd__io_type_size(h.type), overflow, &count, &data_bytes, "nrrd",
                           logger);
     if (r != HD_SUCCESS) return r;
-    for (i = 0; i < 3; ++i) out->desc.dims[i] = (int)dims[i];
+    r = hd__io_check_limit(count, h.type, o, "nrrd", logger);
+    if (r != HD_SUCCESS) return r;
     r = hd__io_nrrd_spacing(&h, out->desc.spacing, logger);
-    if (r != HD_SUCCESS) {
-        memset(out, 0, sizeof *out);
-        return r;
-    }
+    if (r != HD_SUCCESS) return r;
     if (!h.have_endian && hd__io_type_size(h.type) > 1)
         HD__IO_WARN(logger, "nrrd: no 'endian' field for a multi-byte type; assuming little");
 
     /* line skip: whole lines of the file after the header */
+    s->pos = pos;
     for (i = 0; (int64_t)i < h.line_skip; ++i) {
-        while (pos < size && buf[pos] != '\n') ++pos;
-        if (pos >= size) {
-            memset(out, 0, sizeof *out);
-            return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                               "nrrd: file ends inside the %lld lines to skip",
-                               (long long)h.line_skip);
+        for (;;) {
+            const unsigned char *p, *nl;
+            size_t n;
+            r = hd__io_src_next(s, HD__IO_CHUNK, &p, &n, logger);
+            if (r != HD_SUCCESS) return r;
+            if (n == 0)
+                return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                                   "nrrd: file ends inside the %lld lines to skip",
+                                   (long long)h.line_skip);
+            nl = (const unsigned char *)memchr(p, '\n', n);
+            if (nl) {
+                s->pos -= n - (size_t)(nl - p) - 1; /* back to just past the '\n' */
+                break;
+            }
         }
-        ++pos;
     }
-    avail = size - pos;
+    avail = s->size - s->pos;
 
     if (h.encoding == 1) {
-        const unsigned char *data;
+        uint64_t at;
         if (h.byte_skip == -1) { /* the data are the last bytes of the file */
             if (avail < data_bytes) goto truncated;
-            data = buf + size - data_bytes;
+            at = s->size - data_bytes;
         } else {
-            if ((uint64_t)h.byte_skip > (uint64_t)avail ||
-                avail - (size_t)h.byte_skip < data_bytes) {
-                if ((uint64_t)h.byte_skip > (uint64_t)avail) {
-                    memset(out, 0, sizeof *out);
-                    return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                                       "nrrd: byte skip %lld is past the end of the file "
-                                       "(%zu bytes after the header)",
-                                       (long long)h.byte_skip, avail);
-                }
-                avail -= (size_t)h.byte_skip;
-                goto truncated;
-            }
-            data = buf + pos + (size_t)h.byte_skip;
+            if ((uint64_t)h.byte_skip > avail)
+                return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                                   "nrrd: byte skip %lld is past the end of the file "
+                                   "(%llu bytes after the header)",
+                                   (long long)h.byte_skip, (unsigned long long)avail);
+            avail -= (uint64_t)h.byte_skip;
+            if (avail < data_bytes) goto truncated;
+            at = s->pos + (uint64_t)h.byte_skip;
         }
-        r = hd__io_convert(data, count, h.type, h.big, out, "nrrd", logger);
-        if (r != HD_SUCCESS) {
-            memset(out, 0, sizeof *out);
-            return r;
-        }
-        return HD_SUCCESS;
-    }
-#ifdef HYBRIDDIFF_NO_ZLIB
-    memset(out, 0, sizeof *out);
-    return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
-                       "nrrd: gzip encoding needs zlib (built with HYBRIDDIFF_NO_ZLIB)");
-#else
-    {
-        unsigned char *raw = NULL;
-        if (h.byte_skip < 0) {
-            memset(out, 0, sizeof *out);
+        r = hd__io_data(s, at, 0, 0, 0, count, h.type, h.big, out, "nrrd", logger);
+    } else {
+        if (h.byte_skip < 0)
             return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
                                "nrrd: byte skip -1 is only allowed with raw encoding");
-        }
-        if ((uint64_t)h.byte_skip > (uint64_t)SIZE_MAX) {
-            memset(out, 0, sizeof *out);
-            return HD__IO_FAIL(logger, HD_ERROR_SIZE_OVERFLOW, "nrrd: byte skip is too large");
-        }
-        r = hd__io_gunzip(buf + pos, avail, (size_t)h.byte_skip, data_bytes, &raw, "nrrd",
-                          logger);
-        if (r == HD_SUCCESS) r = hd__io_convert(raw, count, h.type, h.big, out, "nrrd", logger);
-        free(raw);
-        if (r != HD_SUCCESS) memset(out, 0, sizeof *out);
-        return r;
+        r = hd__io_data(s, s->pos, 1, avail, (uint64_t)h.byte_skip, count, h.type, h.big, out,
+                        "nrrd", logger);
     }
-#endif
-truncated:
-    memset(out, 0, sizeof *out);
-    return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                       "nrrd: header claims %zu bytes of data, file has %zu", data_bytes, avail);
-}
-
-/* Reads a whole file into memory. */
-static hd_result hd__io_read_file(const char *path, unsigned char **out, size_t *out_size,
-                                  const hd_logger *logger)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *buf = NULL;
-    size_t cap = 0, n = 0;
-    *out = NULL;
-    *out_size = 0;
-    if (!f)
-        return HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "cannot open: %s", strerror(errno));
-    for (;;) {
-        size_t got;
-        if (n == cap) {
-            size_t ncap = cap ? cap * 2 : (size_t)1 << 16;
-            unsigned char *nb;
-            if (ncap < cap) { /* cannot happen before memory runs out */
-                free(buf);
-                fclose(f);
-                return HD__IO_FAIL(logger, HD_ERROR_SIZE_OVERFLOW, "file is too large");
-            }
-            nb = (unsigned char *)realloc(buf, ncap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY,
-                                   "cannot allocate %zu bytes to read the file", ncap);
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) break;
-    }
-    if (ferror(f)) {
-        int e = errno;
-        free(buf);
-        fclose(f);
-        return HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "read error: %s", strerror(e));
-    }
-    fclose(f);
-    *out = buf;
-    *out_size = n;
+    if (r != HD_SUCCESS) return r;
+    for (i = 0; i < 3; ++i) out->desc.dims[i] = (int)dims[i];
     return HD_SUCCESS;
+truncated:
+    return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                       "nrrd: header claims %zu bytes of data, file has %llu", data_bytes,
+                       (unsigned long long)avail);
 }
 
-/* A loader of a one-file format: the whole file in memory, then its parser, with the path in
-   front of every logged message. */
-typedef hd_result (*hd__io_parse_fn)(const void *bytes, size_t size, hd_volume_file *out,
-                                     const hd_logger *logger);
-static hd_result hd__io_load_whole(const char *path, hd_volume_file *out, const hd_logger *logger,
-                                   const char *format, hd__io_parse_fn parse)
+HDDEF hd_result hd_volume_parse_nrrd(const void *bytes, size_t size, hd_volume_file *out,
+                                     const hd_logger *logger)
+{
+    hd__io_opt o;
+    hd__io_src s;
+    hd_result r;
+    if (out) memset(out, 0, sizeof *out);
+    if (!bytes || !out)
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "nrrd: %s is NULL",
+                           !out ? "out" : "bytes");
+    hd__io_opt_init(&o, NULL);
+    hd__io_src_mem(&s, bytes, size, &o);
+    r = hd__io_nrrd_load((const unsigned char *)bytes, size, &s, out, &o, logger);
+    if (r != HD_SUCCESS) hd_volume_free(out);
+    return r;
+}
+
+/* A NRRD header ends at its first empty line. */
+static size_t hd__io_nrrd_end(const unsigned char *b, size_t n)
+{
+    size_t i;
+    for (i = 1; i < n; ++i)
+        if (b[i] == '\n' && (b[i - 1] == '\n' || (i >= 2 && b[i - 1] == '\r' && b[i - 2] == '\n')))
+            return i + 1;
+    return 0;
+}
+
+/* A loader of one file: opened (regular files only), then fn on it, with the path in front of
+   every logged message; out is empty after an error. */
+typedef hd_result (*hd__io_file_fn)(hd__io_src *s, const char *path, hd_volume_file *out,
+                                    const hd__io_opt *o, const hd_logger *logger);
+
+static hd_result hd__io_nrrd_file(hd__io_src *s, const char *path, hd_volume_file *out,
+                                  const hd__io_opt *o, const hd_logger *logger)
+{
+    unsigned char *head;
+    size_t n;
+    hd_result r = hd__io_read_header(s, hd__io_nrrd_end, &head, &n, "nrrd", logger);
+    (void)path;
+    if (r != HD_SUCCESS) return r;
+    r = hd__io_nrrd_load(head, n, s, out, o, logger);
+    hd__io_free(o, head);
+    return r;
+}
+
+static hd_result hd__io_load_file(const char *path, const hd__io_opt *o, hd_volume_file *out,
+                                  const hd_logger *logger, const char *format, hd__io_file_fn fn)
 {
     hd__io_path_logger pl;
     hd_logger wrapped;
     const hd_logger *lg;
-    unsigned char *bytes;
-    size_t size;
+    hd__io_src s;
     hd_result r;
     if (out) memset(out, 0, sizeof *out);
     if (!path || !out)
         return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "%s: %s is NULL", format,
                            !path ? "path" : "out");
     lg = hd__io_wrap_logger(logger, path, &pl, &wrapped);
-    r = hd__io_read_file(path, &bytes, &size, lg);
+    r = hd__io_open(path, 0, &s, o, lg);
     if (r != HD_SUCCESS) return r;
-    r = parse(bytes, size, out, lg);
-    free(bytes);
+    r = fn(&s, path, out, o, lg);
+    hd__io_src_close(&s);
+    if (r != HD_SUCCESS) hd_volume_free(out);
     return r;
 }
 
 HDDEF hd_result hd_volume_load_nrrd(const char *path, hd_volume_file *out,
                                     const hd_logger *logger)
 {
-    return hd__io_load_whole(path, out, logger, "nrrd", hd_volume_parse_nrrd);
+    hd__io_opt o;
+    hd__io_opt_init(&o, NULL);
+    return hd__io_load_file(path, &o, out, logger, "nrrd", hd__io_nrrd_file);
 }
 
 HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_type type,
@@ -969,10 +1335,9 @@ HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_t
     hd_logger wrapped;
     const hd_logger *lg;
     int64_t d[3];
-    size_t count, bytes, got;
-    long fsize;
-    unsigned char *buf;
-    FILE *f;
+    size_t count, bytes;
+    hd__io_opt o;
+    hd__io_src s;
     hd_result r;
     int i;
     if (out) memset(out, 0, sizeof *out);
@@ -992,42 +1357,23 @@ HDDEF hd_result hd_volume_load_raw(const char *path, const int dims[3], hd_raw_t
     if (offset > SIZE_MAX - bytes)
         return HD__IO_FAIL(lg, HD_ERROR_SIZE_OVERFLOW, "raw: offset %zu + %zu bytes overflow",
                            offset, bytes);
-    f = fopen(path, "rb");
-    if (!f) return HD__IO_FAIL(lg, HD_ERROR_FILE_IO, "cannot open: %s", strerror(errno));
-    /* Check the size before allocating: dims from a typo must not allocate gigabytes. */
-    if (fseek(f, 0, SEEK_END) == 0 && (fsize = ftell(f)) >= 0 &&
-        (uint64_t)fsize < (uint64_t)(offset + bytes)) {
-        fclose(f);
-        return HD__IO_FAIL(lg, HD_ERROR_FILE_TRUNCATED,
-                           "raw: %d x %d x %d voxels of %u bytes at offset %zu need %zu bytes, "
-                           "file has %ld", dims[0], dims[1], dims[2],
-                           (unsigned)hd__io_type_size((int)type), offset, offset + bytes, fsize);
+    hd__io_opt_init(&o, NULL);
+    r = hd__io_open(path, 0, &s, &o, lg);
+    if (r != HD_SUCCESS) return r;
+    /* the size before allocating: dims from a typo must not allocate gigabytes */
+    if (s.size < (uint64_t)(offset + bytes)) {
+        r = HD__IO_FAIL(lg, HD_ERROR_FILE_TRUNCATED,
+                        "raw: %d x %d x %d voxels of %u bytes at offset %zu need %zu bytes, "
+                        "file has %llu", dims[0], dims[1], dims[2],
+                        (unsigned)hd__io_type_size((int)type), offset, offset + bytes,
+                        (unsigned long long)s.size);
+    } else {
+        r = hd__io_data(&s, offset, 0, 0, 0, count, (int)type, endian == HD_ENDIAN_BIG, out,
+                        "raw", lg);
     }
-    if (offset > (size_t)LONG_MAX || fseek(f, (long)offset, SEEK_SET) != 0) {
-        fclose(f);
-        return HD__IO_FAIL(lg, HD_ERROR_FILE_TRUNCATED, "raw: cannot seek to offset %zu",
-                           offset);
-    }
-    buf = (unsigned char *)malloc(bytes);
-    if (!buf) {
-        fclose(f);
-        return HD__IO_FAIL(lg, HD_ERROR_OUT_OF_MEMORY, "raw: cannot allocate %zu bytes", bytes);
-    }
-    got = fread(buf, 1, bytes, f);
-    if (got < bytes) {
-        int e = errno, err = ferror(f);
-        free(buf);
-        fclose(f);
-        if (err) return HD__IO_FAIL(lg, HD_ERROR_FILE_IO, "raw: read error: %s", strerror(e));
-        return HD__IO_FAIL(lg, HD_ERROR_FILE_TRUNCATED,
-                           "raw: need %zu bytes at offset %zu, file has %zu", bytes, offset,
-                           offset + got);
-    }
-    fclose(f);
-    r = hd__io_convert(buf, count, (int)type, endian == HD_ENDIAN_BIG, out, "raw", lg);
-    free(buf);
+    hd__io_src_close(&s);
     if (r != HD_SUCCESS) {
-        memset(out, 0, sizeof *out);
+        hd_volume_free(out);
         return r;
     }
     for (i = 0; i < 3; ++i) {

@@ -9,7 +9,10 @@
    BinaryDataByteOrderMSB / ElementByteOrderMSB, CompressedData (zlib or gzip),
    CompressedDataSize, HeaderSize (bytes to skip in the data file; -1: the data are its last
    bytes). ElementDataFile: LOCAL (the bytes after that line) or a file name, relative to the
-   header's directory; LIST and slice patterns are HD_ERROR_UNSUPPORTED_ENCODING.
+   header's directory; LIST and slice patterns are HD_ERROR_UNSUPPORTED_ENCODING. A file name
+   must resolve (realpath) inside the header's folder, else HD_ERROR_FILE_OUTSIDE_FOLDER, unless
+   hd_load_options.allow_outside_folder; the data file must be regular (HD_ERROR_FILE_NOT_REGULAR)
+   and only the bytes the header needs are read from it.
    Errors as for NRRD: a data file shorter than the header claims is HD_ERROR_FILE_TRUNCATED,
    a DimSize product that overflows HD_ERROR_SIZE_OVERFLOW, negative/zero/NaN spacing
    HD_ERROR_INVALID_SPACING, unknown element types HD_ERROR_UNSUPPORTED_ENCODING, a corrupt or
@@ -194,13 +197,16 @@ static hd_result hd__io_mhd_header(const unsigned char *buf, size_t size, hd__io
     return HD_SUCCESS;
 }
 
-/* DimSize and spacing, then the data from data[0..data_size) (the whole data file). */
-static hd_result hd__io_mhd_data(const hd__io_mhd *h, const unsigned char *data, size_t data_size,
-                                 hd_volume_file *out, const hd_logger *logger)
+/* DimSize and spacing, then the data: the bytes of s from base on (the data file, or what
+   follows the ElementDataFile = LOCAL line). */
+static hd_result hd__io_mhd_data(const hd__io_mhd *h, hd__io_src *s, uint64_t base,
+                                 hd_volume_file *out, const hd__io_opt *o,
+                                 const hd_logger *logger)
 {
     int64_t dims[3] = {1, 1, 1};
     int overflow = 0, i;
-    size_t count, bytes, skip;
+    size_t count, bytes;
+    uint64_t data_size = s->size > base ? s->size - base : 0, skip;
     const char *p = h->dim_size;
     hd_result r;
     for (i = 0; i < h->ndims; ++i) {
@@ -215,70 +221,63 @@ static hd_result hd__io_mhd_data(const hd__io_mhd *h, const unsigned char *data,
     r = hd__io_check_dims(dims, hd__io_type_size(h->type), overflow, &count, &bytes, "mhd",
                           logger);
     if (r != HD_SUCCESS) return r;
+    r = hd__io_check_limit(count, h->type, o, "mhd", logger);
+    if (r != HD_SUCCESS) return r;
     out->desc.spacing[0] = out->desc.spacing[1] = out->desc.spacing[2] = 1.0f;
     p = h->spacing[0] ? h->spacing : h->element_size[0] ? h->element_size : NULL;
     if (p) {
         for (i = 0; i < h->ndims; ++i) {
-            double s;
-            p = hd__io_parse_double(p, &s);
+            double sp;
+            p = hd__io_parse_double(p, &sp);
             if (!p || (*p && !hd__io_space((unsigned char)*p)))
                 return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
                                    "mhd: ElementSpacing needs %d numbers", h->ndims);
-            if (!hd__io_spacing_valid(s))
+            if (!hd__io_spacing_valid(sp))
                 return HD__IO_FAIL(logger, HD_ERROR_INVALID_SPACING,
                                    "mhd: spacing of axis %d is %g (must be finite and > 0)", i,
-                                   s);
-            out->desc.spacing[i] = (float)s;
+                                   sp);
+            out->desc.spacing[i] = (float)sp;
         }
     }
     if (h->compressed) {
-#ifdef HYBRIDDIFF_NO_ZLIB
-        (void)data; (void)data_size;
-        return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
-                           "mhd: compressed data need zlib (built with HYBRIDDIFF_NO_ZLIB)");
-#else
-        unsigned char *raw = NULL;
-        size_t len = data_size;
+        uint64_t len;
         if (h->header_size < 0)
             return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
                                "mhd: HeaderSize -1 is only allowed for uncompressed data");
-        if ((uint64_t)h->header_size > (uint64_t)data_size)
+        if ((uint64_t)h->header_size > data_size)
             return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                               "mhd: HeaderSize %lld is past the end of the data (%zu bytes)",
-                               (long long)h->header_size, data_size);
-        skip = (size_t)h->header_size;
-        len -= skip;
+                               "mhd: HeaderSize %lld is past the end of the data (%llu bytes)",
+                               (long long)h->header_size, (unsigned long long)data_size);
+        skip = (uint64_t)h->header_size;
+        len = data_size - skip;
         if (h->compressed_size >= 0) {
-            if ((uint64_t)h->compressed_size > (uint64_t)len)
+            if ((uint64_t)h->compressed_size > len)
                 return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                                   "mhd: CompressedDataSize %lld, the file holds %zu bytes",
-                                   (long long)h->compressed_size, len);
-            len = (size_t)h->compressed_size;
+                                   "mhd: CompressedDataSize %lld, the file holds %llu bytes",
+                                   (long long)h->compressed_size, (unsigned long long)len);
+            len = (uint64_t)h->compressed_size;
         }
-        r = hd__io_gunzip(data + skip, len, 0, bytes, &raw, "mhd", logger);
-        if (r == HD_SUCCESS) r = hd__io_convert(raw, count, h->type, h->big, out, "mhd", logger);
-        free(raw);
-        if (r != HD_SUCCESS) return r;
-#endif
+        r = hd__io_data(s, base + skip, 1, len, 0, count, h->type, h->big, out, "mhd", logger);
     } else {
         if (h->header_size < 0) {
             if (data_size < bytes) goto truncated;
             skip = data_size - bytes;
         } else {
-            if ((uint64_t)h->header_size > (uint64_t)data_size ||
-                data_size - (size_t)h->header_size < bytes)
+            if ((uint64_t)h->header_size > data_size ||
+                data_size - (uint64_t)h->header_size < bytes)
                 goto truncated;
-            skip = (size_t)h->header_size;
+            skip = (uint64_t)h->header_size;
         }
-        r = hd__io_convert(data + skip, count, h->type, h->big, out, "mhd", logger);
-        if (r != HD_SUCCESS) return r;
+        r = hd__io_data(s, base + skip, 0, 0, 0, count, h->type, h->big, out, "mhd", logger);
     }
+    if (r != HD_SUCCESS) return r;
     for (i = 0; i < 3; ++i) out->desc.dims[i] = (int)dims[i];
     return HD_SUCCESS;
 truncated:
     return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
                        "mhd: header claims %zu bytes of data after a HeaderSize of %lld, the data "
-                       "hold %zu", bytes, (long long)h->header_size, data_size);
+                       "hold %llu", bytes, (long long)h->header_size,
+                       (unsigned long long)data_size);
 }
 
 HDDEF hd_result hd_volume_parse_mhd(const void *header, size_t header_size, const void *data,
@@ -286,6 +285,8 @@ HDDEF hd_result hd_volume_parse_mhd(const void *header, size_t header_size, cons
                                     const hd_logger *logger)
 {
     hd__io_mhd h;
+    hd__io_opt o;
+    hd__io_src s;
     hd_result r;
     if (out) memset(out, 0, sizeof *out);
     if (!header || !out)
@@ -293,60 +294,137 @@ HDDEF hd_result hd_volume_parse_mhd(const void *header, size_t header_size, cons
                            !out ? "out" : "header");
     r = hd__io_mhd_header((const unsigned char *)header, header_size, &h, logger);
     if (r != HD_SUCCESS) return r;
+    hd__io_opt_init(&o, NULL);
     if (h.local) {
-        data = (const unsigned char *)header + h.data_pos;
-        data_size = header_size - h.data_pos;
+        hd__io_src_mem(&s, header, header_size, &o);
+        r = hd__io_mhd_data(&h, &s, h.data_pos, out, &o, logger);
     } else if (!data) {
         return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER,
                            "mhd: the data are in '%s' and no data buffer was given", h.data_file);
+    } else {
+        hd__io_src_mem(&s, data, data_size, &o);
+        r = hd__io_mhd_data(&h, &s, 0, out, &o, logger);
     }
-    r = hd__io_mhd_data(&h, (const unsigned char *)data, data_size, out, logger);
     if (r != HD_SUCCESS) hd_volume_free(out);
     return r;
 }
 
-HDDEF hd_result hd_volume_load_mhd(const char *path, hd_volume_file *out, const hd_logger *logger)
+/* A MetaImage header ends with the line of its ElementDataFile key. */
+static size_t hd__io_mhd_end(const unsigned char *b, size_t n)
 {
-    hd__io_path_logger pl;
-    hd_logger wrapped;
-    const hd_logger *lg;
-    unsigned char *bytes = NULL, *data = NULL;
-    size_t size = 0, data_size = 0;
-    hd__io_mhd h;
-    hd_result r;
-    if (out) memset(out, 0, sizeof *out);
-    if (!path || !out)
-        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "mhd: %s is NULL",
-                           !path ? "path" : "out");
-    lg = hd__io_wrap_logger(logger, path, &pl, &wrapped);
-    r = hd__io_read_file(path, &bytes, &size, lg);
-    if (r != HD_SUCCESS) return r;
-    r = hd__io_mhd_header(bytes, size, &h, lg);
-    if (r == HD_SUCCESS && h.local) {
-        r = hd__io_mhd_data(&h, bytes + h.data_pos, size - h.data_pos, out, lg);
-    } else if (r == HD_SUCCESS) {
-        /* the data file: absolute, or relative to the header's directory */
-        const char *slash = strrchr(path, '/');
-        size_t dir = (h.data_file[0] == '/' || !slash) ? 0 : (size_t)(slash - path) + 1;
-        size_t n = dir + strlen(h.data_file) + 1;
-        char *dpath = (char *)malloc(n);
-        if (!dpath) {
-            r = HD__IO_FAIL(lg, HD_ERROR_OUT_OF_MEMORY, "mhd: cannot allocate a path");
+    size_t pos = 0;
+    while (pos < n) {
+        const unsigned char *nl = (const unsigned char *)memchr(b + pos, '\n', n - pos);
+        size_t end = nl ? (size_t)(nl - b) : n, k;
+        const char *key = "elementdatafile";
+        for (k = pos; k < end && *key; ++k) {
+            if (hd__io_space(b[k])) continue;
+            if (hd__io_lower(b[k]) != *key++) break;
+        }
+        if (!*key) {
+            while (k < end && hd__io_space(b[k])) ++k;
+            if (k < end && b[k] == '=') return nl ? end + 1 : 0;
+        }
+        if (!nl) break;
+        pos = end + 1;
+    }
+    return 0;
+}
+
+/* The path of the detached data file name (relative to the folder of the header at path). Unless
+   o->allow_outside, name must be relative and its real path (symbolic links resolved) must lie
+   in the folder's real path; *out is then that real path. *out is freed with hd__io_free. */
+static hd_result hd__io_mhd_data_path(const char *path, const char *name, const hd__io_opt *o,
+                                      char **out, const hd_logger *logger)
+{
+    const char *slash = strrchr(path, '/');
+    size_t dir = slash ? (size_t)(slash - path) + 1 : 0, n;
+    int absolute = name[0] == '/';
+    char *joined, *rdir = NULL, *rfile = NULL;
+    hd_result r = HD_SUCCESS;
+    *out = NULL;
+    if (absolute && !o->allow_outside)
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_OUTSIDE_FOLDER,
+                           "mhd: ElementDataFile '%s' is an absolute path: refused "
+                           "(hd_load_options.allow_outside_folder allows it)", name);
+    if (absolute) dir = 0;
+    n = dir + strlen(name) + 1;
+    joined = (char *)hd__io_alloc(o, n);
+    if (!joined) return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "mhd: cannot allocate a path");
+    memcpy(joined, path, dir);
+    memcpy(joined + dir, name, n - dir);
+    if (o->allow_outside) {
+        *out = joined;
+        return HD_SUCCESS;
+    }
+    rfile = realpath(joined, NULL);
+    if (!rfile) {
+        r = HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "mhd: data file %s: cannot open: %s", joined,
+                        strerror(errno));
+    } else {
+        joined[dir] = 0; /* the header's folder */
+        rdir = realpath(dir ? joined : ".", NULL);
+        if (!rdir) {
+            r = HD__IO_FAIL(logger, HD_ERROR_FILE_IO, "mhd: the header's folder: %s",
+                            strerror(errno));
         } else {
-            hd__io_path_logger pl2;
-            hd_logger wrapped2;
-            memcpy(dpath, path, dir);
-            memcpy(dpath + dir, h.data_file, n - dir);
-            r = hd__io_read_file(dpath, &data, &data_size,
-                                 hd__io_wrap_logger(logger, dpath, &pl2, &wrapped2));
-            if (r == HD_SUCCESS) r = hd__io_mhd_data(&h, data, data_size, out, lg);
-            free(dpath);
+            size_t len = strlen(rdir);
+            if (len > 1 && (strncmp(rfile, rdir, len) != 0 || rfile[len] != '/'))
+                r = HD__IO_FAIL(logger, HD_ERROR_FILE_OUTSIDE_FOLDER,
+                                "mhd: ElementDataFile '%s' is %s, outside the header's folder "
+                                "%s: refused (hd_load_options.allow_outside_folder allows it)",
+                                name, rfile, rdir);
         }
     }
-    free(bytes);
-    free(data);
-    if (r != HD_SUCCESS) hd_volume_free(out);
+    if (r == HD_SUCCESS) {
+        n = strlen(rfile) + 1;
+        if ((*out = (char *)hd__io_alloc(o, n)) != NULL) memcpy(*out, rfile, n);
+        else r = HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "mhd: cannot allocate a path");
+    }
+    free(rfile); /* realpath's, from malloc */
+    free(rdir);
+    hd__io_free(o, joined);
     return r;
+}
+
+static hd_result hd__io_mhd_file(hd__io_src *s, const char *path, hd_volume_file *out,
+                                 const hd__io_opt *o, const hd_logger *logger)
+{
+    unsigned char *head;
+    size_t n;
+    hd__io_mhd h;
+    hd_result r = hd__io_read_header(s, hd__io_mhd_end, &head, &n, "mhd", logger);
+    if (r != HD_SUCCESS) return r;
+    r = hd__io_mhd_header(head, n, &h, logger);
+    hd__io_free(o, head);
+    if (r != HD_SUCCESS) return r;
+    if (h.local) return hd__io_mhd_data(&h, s, h.data_pos, out, o, logger);
+    {
+        char *dpath;
+        hd__io_src ds;
+        r = hd__io_mhd_data_path(path, h.data_file, o, &dpath, logger);
+        if (r != HD_SUCCESS) return r;
+        {
+            hd__io_path_logger pl;
+            hd_logger wrapped;
+            /* messages about the data file name it after the header's path */
+            const hd_logger *dl = hd__io_wrap_logger(logger, dpath, &pl, &wrapped);
+            r = hd__io_open(dpath, !o->allow_outside, &ds, o, dl);
+        }
+        if (r == HD_SUCCESS) {
+            r = hd__io_mhd_data(&h, &ds, 0, out, o, logger);
+            hd__io_src_close(&ds);
+        }
+        hd__io_free(o, dpath);
+        return r;
+    }
+}
+
+HDDEF hd_result hd_volume_load_mhd(const char *path, hd_volume_file *out, const hd_logger *logger)
+{
+    hd__io_opt o;
+    hd__io_opt_init(&o, NULL);
+    return hd__io_load_file(path, &o, out, logger, "mhd", hd__io_mhd_file);
 }
 
 #endif /* HD_IO_MHD_H */

@@ -27,7 +27,7 @@ static float hd__io_f32(const unsigned char *p, int big)
 
 /* value * slope + inter, in place: out becomes F32 (converted from U8/U16 when needed). */
 static hd_result hd__io_rescale(hd_volume_file *out, size_t count, double slope, double inter,
-                                const hd_logger *logger)
+                                const hd__io_opt *o, const hd_logger *logger)
 {
     float *d;
     double lo = 0.0, hi = 0.0;
@@ -35,14 +35,14 @@ static hd_result hd__io_rescale(hd_volume_file *out, size_t count, double slope,
     if (out->desc.type == HD_VOXEL_F32) {
         d = (float *)out->data;
     } else {
-        d = (float *)malloc(count * sizeof(float));
+        d = (float *)hd__io_alloc(o, count * sizeof(float));
         if (!d)
             return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "nifti: cannot allocate %zu voxels",
                                count);
         for (i = 0; i < count; ++i)
             d[i] = out->desc.type == HD_VOXEL_U8 ? (float)((const unsigned char *)out->data)[i]
                                                  : (float)((const uint16_t *)out->data)[i];
-        free(out->data);
+        hd__io_free(o, out->data);
         out->data = d;
         out->desc.type = HD_VOXEL_F32;
         out->desc.data = d;
@@ -73,7 +73,8 @@ typedef struct hd__io_nii {
 } hd__io_nii;
 
 /* Checks a 348-byte header; fills h. */
-static hd_result hd__io_nii_header(const unsigned char *p, hd__io_nii *h, const hd_logger *logger)
+static hd_result hd__io_nii_header(const unsigned char *p, hd__io_nii *h, const hd__io_opt *o,
+                                   const hd_logger *logger)
 {
     static const struct { int code, type; } types[] = {
         {2, HD__IO_U8}, {4, HD__IO_I16}, {8, HD__IO_I32}, {16, HD__IO_F32}, {64, HD__IO_F64},
@@ -124,6 +125,8 @@ static hd_result hd__io_nii_header(const unsigned char *p, hd__io_nii *h, const 
     r = hd__io_check_dims(h->dims, hd__io_type_size(h->type), 0, &h->count, &h->bytes, "nifti",
                           logger);
     if (r != HD_SUCCESS) return r;
+    r = hd__io_check_limit(h->count, h->type, o, "nifti", logger);
+    if (r != HD_SUCCESS) return r;
     if (extra)
         HD__IO_WARN(logger, "nifti: %d-dimensional image: only the first 3D volume is loaded",
                     ndim);
@@ -157,13 +160,13 @@ static hd_result hd__io_nii_header(const unsigned char *p, hd__io_nii *h, const 
     return HD_SUCCESS;
 }
 
-static hd_result hd__io_nii_finish(const hd__io_nii *h, const unsigned char *data,
-                                   hd_volume_file *out, const hd_logger *logger)
+static hd_result hd__io_nii_finish(const hd__io_nii *h, hd_volume_file *out, const hd__io_opt *o,
+                                   const hd_logger *logger)
 {
     int i;
-    hd_result r = hd__io_convert(data, h->count, h->type, h->big, out, "nifti", logger);
-    if (r == HD_SUCCESS && h->slope != 0.0 && !(h->slope == 1.0 && h->inter == 0.0))
-        r = hd__io_rescale(out, h->count, h->slope, h->inter, logger);
+    hd_result r = HD_SUCCESS;
+    if (h->slope != 0.0 && !(h->slope == 1.0 && h->inter == 0.0))
+        r = hd__io_rescale(out, h->count, h->slope, h->inter, o, logger);
     if (r != HD_SUCCESS) return r;
     for (i = 0; i < 3; ++i) {
         out->desc.dims[i] = (int)h->dims[i];
@@ -172,92 +175,141 @@ static hd_result hd__io_nii_finish(const hd__io_nii *h, const unsigned char *dat
     return HD_SUCCESS;
 }
 
+/* A .nii (raw) or .nii.gz (one gzip stream of the same bytes) from s. */
+static hd_result hd__io_nii_load(hd__io_src *s, hd_volume_file *out, const hd__io_opt *o,
+                            const hd_logger *logger)
+{
+    unsigned char hdr[HD__NII_HDR];
+    size_t got;
+    hd__io_nii h;
+    hd_result r;
+    s->pos = 0;
+    r = hd__io_src_read(s, hdr, 2, &got, logger);
+    if (r != HD_SUCCESS) return r;
+    if (got == 2 && hdr[0] == 0x1f && hdr[1] == 0x8b) {
+#ifdef HYBRIDDIFF_NO_ZLIB
+        return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
+                           "nifti: .nii.gz needs zlib (built with HYBRIDDIFF_NO_ZLIB)");
+#else
+        /* one pass: the header, the bytes up to vox_offset, the data, the rest of the stream */
+        hd__io_gz g;
+        int z;
+        s->pos = 0;
+        r = hd__io_gz_init(&g, s, s->size, "nifti", logger);
+        if (r != HD_SUCCESS) return r;
+        z = hd__io_gz_read(&g, hdr, HD__NII_HDR, &got);
+        if (z == Z_STREAM_END && got < HD__NII_HDR)
+            r = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                            "nifti: gzip stream holds %zu bytes, less than the 348-byte header",
+                            got);
+        else if (z != Z_OK && z != Z_STREAM_END)
+            r = hd__io_gzip_error(z, &g, "in the header", "nifti", logger);
+        if (r == HD_SUCCESS) r = hd__io_nii_header(hdr, &h, o, logger);
+        if (r == HD_SUCCESS)
+            r = hd__io_gz_data(&g, h.offset - HD__NII_HDR, h.count, h.type, h.big, out, "nifti",
+                               logger);
+        inflateEnd(&g.zs);
+        return r == HD_SUCCESS ? hd__io_nii_finish(&h, out, o, logger) : r;
+#endif
+    }
+    if (s->size < HD__NII_HDR)
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                           "nifti: %llu bytes, shorter than the 348-byte header",
+                           (unsigned long long)s->size);
+    s->pos = 0;
+    r = hd__io_src_read(s, hdr, HD__NII_HDR, &got, logger);
+    if (r == HD_SUCCESS && got < HD__NII_HDR)
+        r = HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED, "nifti: the file ended inside the "
+                        "header");
+    if (r == HD_SUCCESS) r = hd__io_nii_header(hdr, &h, o, logger);
+    if (r != HD_SUCCESS) return r;
+    if ((uint64_t)h.offset > s->size || s->size - h.offset < (uint64_t)h.bytes)
+        return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
+                           "nifti: header claims %zu bytes of data at offset %zu, file has %llu",
+                           h.bytes, h.offset, (unsigned long long)s->size);
+    r = hd__io_data(s, h.offset, 0, 0, 0, h.count, h.type, h.big, out, "nifti", logger);
+    return r == HD_SUCCESS ? hd__io_nii_finish(&h, out, o, logger) : r;
+}
+
 HDDEF hd_result hd_volume_parse_nifti(const void *bytes, size_t size, hd_volume_file *out,
                                       const hd_logger *logger)
 {
-    const unsigned char *b = (const unsigned char *)bytes;
-    hd__io_nii h;
+    hd__io_opt o;
+    hd__io_src s;
     hd_result r;
     if (out) memset(out, 0, sizeof *out);
     if (!bytes || !out)
         return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "nifti: %s is NULL",
                            !out ? "out" : "bytes");
-    if (size >= 2 && b[0] == 0x1f && b[1] == 0x8b) {
-#ifdef HYBRIDDIFF_NO_ZLIB
-        return HD__IO_FAIL(logger, HD_ERROR_UNSUPPORTED_ENCODING,
-                           "nifti: .nii.gz needs zlib (built with HYBRIDDIFF_NO_ZLIB)");
-#else
-        unsigned char *hdr = NULL, *data = NULL;
-        /* the header first (this also checks the whole stream and its CRC), then the data */
-        r = hd__io_gunzip(b, size, 0, HD__NII_HDR, &hdr, "nifti", logger);
-        if (r != HD_SUCCESS) return r;
-        r = hd__io_nii_header(hdr, &h, logger);
-        free(hdr);
-        if (r == HD_SUCCESS)
-            r = hd__io_gunzip(b, size, h.offset, h.bytes, &data, "nifti", logger);
-        if (r == HD_SUCCESS) r = hd__io_nii_finish(&h, data, out, logger);
-        free(data);
-        if (r != HD_SUCCESS) hd_volume_free(out);
-        return r;
-#endif
-    }
-    if (size < HD__NII_HDR)
-        return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
-                           "nifti: %zu bytes, shorter than the 348-byte header", size);
-    r = hd__io_nii_header(b, &h, logger);
-    if (r != HD_SUCCESS) return r;
-    if (h.offset > size || size - h.offset < h.bytes)
-        return HD__IO_FAIL(logger, HD_ERROR_FILE_TRUNCATED,
-                           "nifti: header claims %zu bytes of data at offset %zu, file has %zu",
-                           h.bytes, h.offset, size);
-    r = hd__io_nii_finish(&h, b + h.offset, out, logger);
+    hd__io_opt_init(&o, NULL);
+    hd__io_src_mem(&s, bytes, size, &o);
+    r = hd__io_nii_load(&s, out, &o, logger);
     if (r != HD_SUCCESS) hd_volume_free(out);
     return r;
+}
+
+static hd_result hd__io_nii_file(hd__io_src *s, const char *path, hd_volume_file *out,
+                                 const hd__io_opt *o, const hd_logger *logger)
+{
+    (void)path;
+    return hd__io_nii_load(s, out, o, logger);
 }
 
 HDDEF hd_result hd_volume_load_nifti(const char *path, hd_volume_file *out,
                                      const hd_logger *logger)
 {
-    return hd__io_load_whole(path, out, logger, "nifti", hd_volume_parse_nifti);
+    hd__io_opt o;
+    hd__io_opt_init(&o, NULL);
+    return hd__io_load_file(path, &o, out, logger, "nifti", hd__io_nii_file);
 }
 
 /* ---- any format -------------------------------------------------------------------------- */
 /* By the first bytes: "NRRD000", a gzip stream or sizeof_hdr 348 (NIfTI-1), "NDims" or
    "Object..." (MetaImage), else MetaImage if the extension is .mhd or .mha. */
-HDDEF hd_result hd_volume_load(const char *path, hd_volume_file *out, const hd_logger *logger)
+static hd_result hd__io_any_file(hd__io_src *s, const char *path, hd_volume_file *out,
+                                 const hd__io_opt *o, const hd_logger *logger)
 {
     unsigned char m[8] = {0};
-    size_t n = 0, len;
-    int opened = 0;
-    FILE *f;
-    if (out) memset(out, 0, sizeof *out);
-    if (!path || !out)
-        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER, "load: %s is NULL",
-                           !path ? "path" : "out");
-    f = fopen(path, "rb");
-    if (f) {
-        opened = 1;
-        n = fread(m, 1, sizeof m, f);
-        fclose(f);
-    }
-    len = strlen(path);
-    if (n >= 7 && memcmp(m, "NRRD000", 7) == 0) return hd_volume_load_nrrd(path, out, logger);
+    size_t n, len = strlen(path);
+    hd_result r;
+    s->pos = 0;
+    r = hd__io_src_read(s, m, sizeof m, &n, logger);
+    if (r != HD_SUCCESS) return r;
+    if (n >= 7 && memcmp(m, "NRRD000", 7) == 0) return hd__io_nrrd_file(s, path, out, o, logger);
     if ((n >= 2 && m[0] == 0x1f && m[1] == 0x8b) ||
         (n >= 4 && (hd__io_get(m, 4, 0) == HD__NII_HDR || hd__io_get(m, 4, 1) == HD__NII_HDR)))
-        return hd_volume_load_nifti(path, out, logger);
+        return hd__io_nii_load(s, out, o, logger);
     if ((n >= 5 && (hd__io_match_word((const char *)m, "ndims") ||
                     hd__io_match_word((const char *)m, "object"))) ||
         (len >= 4 && (hd__io_match_word(path + len - 4, ".mhd") ||
-                     hd__io_match_word(path + len - 4, ".mha"))))
-        return hd_volume_load_mhd(path, out, logger);
-    if (!opened) return hd_volume_load_nrrd(path, out, logger); /* reports why it cannot be opened */
-    {
-        hd__io_path_logger pl;
-        hd_logger wrapped;
-        return HD__IO_FAIL(hd__io_wrap_logger(logger, path, &pl, &wrapped), HD_ERROR_FILE_FORMAT,
-                           "load: not a NRRD, NIfTI-1 or (by its extension .mhd/.mha) "
-                           "MetaImage file");
-    }
+                      hd__io_match_word(path + len - 4, ".mha"))))
+        return hd__io_mhd_file(s, path, out, o, logger);
+    return HD__IO_FAIL(logger, HD_ERROR_FILE_FORMAT,
+                       "load: not a NRRD, NIfTI-1 or (by its extension .mhd/.mha) MetaImage file");
+}
+
+HDDEF hd_result hd_volume_load(const char *path, hd_volume_file *out, const hd_logger *logger)
+{
+    return hd_volume_load_ex(path, NULL, out, logger);
+}
+
+HDDEF hd_result hd_volume_load_ex(const char *path, const hd_load_options *options,
+                                  hd_volume_file *out, const hd_logger *logger)
+{
+    static const hd__io_file_fn fns[HD_FILE_FORMAT_COUNT] = {
+        hd__io_any_file, hd__io_nrrd_file, hd__io_mhd_file, hd__io_nii_file,
+    };
+    static const char *const names[HD_FILE_FORMAT_COUNT] = {"load", "nrrd", "mhd", "nifti"};
+    hd__io_opt o;
+    int f = options ? (int)options->format : 0;
+    if (out) memset(out, 0, sizeof *out);
+    if (f < 0 || f >= (int)HD_FILE_FORMAT_COUNT)
+        return HD__IO_FAIL(logger, HD_ERROR_INVALID_ENUM, "load: format %d is out of range", f);
+    if (options && !options->allocator.alloc != !options->allocator.free)
+        return HD__IO_FAIL(logger, HD_ERROR_NULL_POINTER,
+                           "load: allocator needs both alloc and free, or neither");
+    hd__io_opt_init(&o, options);
+    return hd__io_load_file(path, &o, out, logger, names[f], fns[f]);
 }
 
 #endif /* HD_IO_NIFTI_H */

@@ -187,6 +187,7 @@ static void hd__params_defaults(hd_params *p)
     if (p->exposure == 0.0f) p->exposure = 1.0f;
     if (p->max_bounces == 0) p->max_bounces = 64;
     if (p->illumination_downsample == 0) p->illumination_downsample = 1;
+    if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
 }
 
 /* Checks parameters whose defaults are filled in. */
@@ -228,6 +229,10 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
     if ((int)p->illumination_precision < 0 || (int)p->illumination_precision >= (int)HD_PRECISION_COUNT)
         return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.illumination_precision = %d is not an hd_precision",
                        (int)p->illumination_precision);
+    if (!hd__finite(p->light_tolerance) || p->light_tolerance < 0.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.light_tolerance = %g must be >= 0 and finite", (double)p->light_tolerance);
+    if (!hd__finite(p->render_budget) || p->render_budget < 0.0f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_budget = %g s must be >= 0 and finite", (double)p->render_budget);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
 #ifndef HD__BE_HAS_CD

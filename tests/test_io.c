@@ -451,9 +451,9 @@ static void io_error_file_io(void)
     r = hd_volume_load_raw(io_path("does-not-exist.raw"), dims, HD_RAW_U8, HD_ENDIAN_LITTLE, 0, &v,
                            &lg);
     IO_EXPECT(r, HD_ERROR_FILE_IO, l);
-    lg = io_logger(&l); /* a directory opens but cannot be read */
+    lg = io_logger(&l); /* a directory is refused before it is opened */
     r = hd_volume_load_nrrd(io_tmpdir(), &v, &lg);
-    IO_EXPECT(r, HD_ERROR_FILE_IO, l);
+    IO_EXPECT(r, HD_ERROR_FILE_NOT_REGULAR, l);
     /* silent without a logger, still the same code */
     CHECK(hd_volume_load_nrrd(io_path("does-not-exist.nrrd"), &v, NULL) == HD_ERROR_FILE_IO);
 }

@@ -67,6 +67,8 @@ VK_WRAP(set_lights, (hd_context c, const hd_light *l, int n), (c, l, n))
 VK_WRAP(set_camera, (hd_context c, const hd_camera *cam), (c, cam))
 VK_WRAP(set_params, (hd_context c, const hd_params *p), (c, p))
 VK_WRAP(iterate, (hd_context c, int n), (c, n))
+VK_WRAP(refine, (hd_context c, int n), (c, n))
+VK_WRAP(render, (hd_context c), (c))
 VK_WRAP(read_image_rgba8, (hd_context c, uint8_t *dst, size_t n), (c, dst, n))
 VK_WRAP(read_image_f32, (hd_context c, float *dst, size_t n), (c, dst, n))
 VK_WRAP(read_illumination, (hd_context c, hd_illumination w, float *dst, size_t n), (c, w, dst, n))
@@ -82,4 +84,5 @@ const hd_api hd_api_backend = {hd_backend_name, hd_result_string, hd_method_name
                                vk_set_params, vk_iterate, vk_read_image_rgba8, vk_read_image_f32,
                                vk_read_illumination, hd_get_stats, hd_volume_load_nrrd, hd_volume_load_raw,
                                hd_volume_parse_nrrd, hd_volume_free, vk_test_prepare, vk_test_direct,
-                               vk_test_diffuse, vk_test_project, vk_test_write_illumination, vk_test_finish};
+                               vk_test_diffuse, vk_test_project, vk_test_write_illumination, vk_test_finish,
+                               vk_refine, vk_render};

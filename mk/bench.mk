@@ -1,0 +1,46 @@
+# mk/bench.mk - the interactive-use benchmarks (none of them is part of `make test`):
+#   make bench-peer     hybriddiff's projection frame over converged light (CPU backend) against
+#                       VTK's fixed-point CPU ray caster, its GPU ray caster (Mesa llvmpipe) and
+#                       its volumetric-scattering mode, head CT, 512^2 and 1024^2, interleaved in
+#                       one run (bench/peer/); pictures -> docs/peer/. Needs ParaView's pvpython
+#                       (Debian python3-paraview) and xvfb-run (xvfb): installed by apt-get here,
+#                       on demand, when missing (root). Knobs: PEER_ARGS (see vtk_peer.py),
+#                       HDPEER_LIGHT_ITERS (light iteration cap, default 64).
+#   make bench-orbit    bench/hdbench_orbit.c: converge HD's light once, then an orbit of K views:
+#                       ms per orbit frame on every backend (CPU, OpenCL, Vulkan, GL), and on the
+#                       CPU backend HD's and PT_MS's PSNR per per-view time budget against PT_MS
+#                       references -> docs/orbit/ (CSV, gnuplot PNG), the crossover budget.
+#                       Default ~10 min on 2 cores (256^2 PSNR part, references cached in
+#                       build/orbit-cache); ORBIT_ARGS for the full run, e.g.
+#                       ORBIT_ARGS="--size 512 --ref-iters 1024 --views 16".
+#                       ORBIT_BACKENDS picks the frame-time builds (default opencl vulkan gl).
+.PHONY: bench-peer bench-orbit
+
+$(B)/hdpeer: bench/peer/hdpeer.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_png.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+PEER_ARGS ?=
+bench-peer: $(B)/hdpeer
+	@test -f data/head.nrrd || scripts/fetch-data
+	@command -v pvpython >/dev/null && command -v xvfb-run >/dev/null || \
+	    { echo "bench-peer: installing python3-paraview and xvfb (apt-get)"; \
+	      DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends python3-paraview xvfb xauth; }
+	xvfb-run -a -s "-screen 0 1280x1280x24" pvpython bench/peer/vtk_peer.py --hdpeer $(B)/hdpeer $(PEER_ARGS)
+
+ORBIT_SRC := bench/hdbench_orbit.c bench/hd_orbit_scene.h examples/hd_tf.h $(LIB_SRC)
+ORBIT_CC = $(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+$(B)/hdbench_orbit: $(ORBIT_SRC) | $(B)
+	$(ORBIT_CC) -DHYBRIDDIFF_BACKEND_CPU
+$(B)/hdbench_orbit_opencl: $(ORBIT_SRC) | $(B)
+	$(ORBIT_CC) -DHYBRIDDIFF_BACKEND_OPENCL -lOpenCL
+$(B)/hdbench_orbit_vulkan: $(ORBIT_SRC) | $(B)
+	$(ORBIT_CC) -DHYBRIDDIFF_BACKEND_VULKAN -lvulkan
+$(B)/hdbench_orbit_gl: $(ORBIT_SRC) | $(B)
+	$(ORBIT_CC) -DHYBRIDDIFF_BACKEND_GL -lEGL
+
+ORBIT_ARGS ?=
+ORBIT_BACKENDS ?= opencl vulkan gl
+bench-orbit: $(B)/hdbench_orbit $(patsubst %,$(B)/hdbench_orbit_%,$(ORBIT_BACKENDS))
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdbench_orbit $(ORBIT_ARGS)
+	@for b in $(ORBIT_BACKENDS); do echo "== $$b"; $(B)/hdbench_orbit_$$b --no-psnr $(ORBIT_ARGS) || exit 1; done

@@ -1,0 +1,230 @@
+/* test_render.c - the per-frame API on the CPU backend: hd_refine refines the light without
+   projecting, the convergence estimate falls as the light converges, hd_render stops all light
+   work once it has, a camera move costs one projection, setters restart the light, bad input. */
+#include "hybriddiff.h"
+#include "hd_test.h"
+#include <stdlib.h>
+
+/* A 20^3 blob with a dense core, one light, a 32x32 image. */
+#define N 20
+#define W 32
+static uint8_t vox[N * N * N];
+static const float tf3[12] = {0, 0, 0, 0, 1.0f, 0.6f, 0.4f, 0.3f, 1, 1, 1, 1};
+
+static void make_desc(hd_desc *d, hd_test_log *log)
+{
+    int x, y, z;
+    for (z = 0; z < N; ++z)
+        for (y = 0; y < N; ++y)
+            for (x = 0; x < N; ++x) {
+                float dx = x - 9.5f, dy = y - 9.5f, dz = z - 9.5f;
+                float r = sqrtf(dx * dx + dy * dy + dz * dz);
+                vox[(z * N + y) * N + x] = (uint8_t)(r < 8 ? (r < 4 ? 255 : 128) : 0);
+            }
+    memset(d, 0, sizeof *d);
+    d->volume.type = HD_VOXEL_U8;
+    d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = N;
+    d->volume.data = vox;
+    d->transfer_function.rgba = tf3;
+    d->transfer_function.count = 3;
+    d->camera.width = d->camera.height = W;
+    d->params.extinction = 40.0f;
+    if (log) d->logger = hd_test_logger(log);
+}
+
+static void read_light(hd_context ctx, float *e, float *p)
+{
+    CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e, (size_t)N * N * N) == HD_SUCCESS);
+    CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_SCATTERED, p, (size_t)N * N * N) == HD_SUCCESS);
+}
+
+/* The light of hd_refine(n) is bit for bit that of hd_iterate(n), and it projects nothing. */
+static void test_refine_is_iterate_without_frames(void)
+{
+    size_t n = (size_t)N * N * N;
+    float *e0 = (float *)malloc(n * 4), *p0 = (float *)malloc(n * 4), *e1 = (float *)malloc(n * 4), *p1 = (float *)malloc(n * 4);
+    hd_desc d;
+    hd_context a, b;
+    hd_stats s;
+    make_desc(&d, NULL);
+    CHECK(hd_create(&d, &a) == HD_SUCCESS && hd_create(&d, &b) == HD_SUCCESS);
+    CHECK(hd_iterate(a, 6) == HD_SUCCESS);
+    CHECK(hd_refine(b, 6) == HD_SUCCESS);
+    read_light(a, e0, p0);
+    read_light(b, e1, p1);
+    CHECK(memcmp(e0, e1, n * 4) == 0 && memcmp(p0, p1, n * 4) == 0);
+    CHECK(hd_get_stats(b, &s) == HD_SUCCESS && s.iterations == 6 && s.frames == 0 && s.seconds_projection == 0.0);
+    CHECK(s.seconds_direct > 0.0 && s.seconds_diffusion > 0.0);
+    hd_destroy(a);
+    hd_destroy(b);
+    free(e0); free(p0); free(e1); free(p1);
+}
+
+/* The estimate starts at 1 and falls as the light converges, for HD and for CD. */
+static void test_light_error_falls(void)
+{
+    hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_CD};
+    int m;
+    for (m = 0; m < 2; ++m) {
+        hd_desc d;
+        hd_context ctx;
+        hd_stats s;
+        double e4, e64;
+        make_desc(&d, NULL);
+        d.params.method = methods[m];
+        CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.light_error == 1.0 && !s.light_converged);
+        CHECK(hd_refine(ctx, 1) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.light_error == 1.0);
+        CHECK(hd_refine(ctx, 3) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+        e4 = s.light_error;
+        CHECK(hd_refine(ctx, 60) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+        e64 = s.light_error;
+        CHECK_MSG(e4 > 0.0 && e64 < 0.5 * e4, "%s: error %g after 4, %g after 64 iterations",
+                  hd_method_name(methods[m]), e4, e64);
+        hd_destroy(ctx);
+    }
+}
+
+/* A per-frame loop: light work until the light converges, then projections only, then nothing
+   once the frame window is full; a camera move costs one projection and keeps the light. */
+static void test_render_loop(void)
+{
+    size_t n = (size_t)N * N * N;
+    float *e0 = (float *)malloc(n * 4), *p0 = (float *)malloc(n * 4), *e1 = (float *)malloc(n * 4), *p1 = (float *)malloc(n * 4);
+    float *img0 = (float *)malloc(W * W * 16), *img1 = (float *)malloc(W * W * 16);
+    hd_desc d;
+    hd_context ctx;
+    hd_stats s, c;
+    hd_camera cam;
+    int i;
+    double sum = 0.0;
+    make_desc(&d, NULL);
+    d.params.light_tolerance = 0.05f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    for (i = 0; i < 2000; ++i) {
+        CHECK(hd_render(ctx) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+        if (s.light_converged) break;
+        CHECK(s.iterations == (uint64_t)i + 1); /* one light iteration per call, budget 0 */
+    }
+    CHECK_MSG(s.light_converged && s.light_error < 0.05, "not converged after %d calls (error %g)", i, s.light_error);
+    CHECK(s.frames == 1); /* the image restarted with the converged light */
+    read_light(ctx, e0, p0);
+    for (i = 0; i < 20; ++i) CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &c) == HD_SUCCESS);
+    CHECK(c.iterations == s.iterations && c.seconds_direct == s.seconds_direct && c.seconds_diffusion == s.seconds_diffusion);
+    CHECK(c.frames == 8 && c.light_converged); /* frame_window frames, then nothing */
+    CHECK(c.seconds_projection > s.seconds_projection);
+    read_light(ctx, e1, p1);
+    CHECK(memcmp(e0, e1, n * 4) == 0 && memcmp(p0, p1, n * 4) == 0);
+    CHECK(hd_read_image_f32(ctx, img0, W * W * 4) == HD_SUCCESS);
+    /* the image is done: more calls leave it and the timers alone */
+    s = c;
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &c) == HD_SUCCESS && c.seconds_projection == s.seconds_projection && c.frames == 8);
+
+    cam = d.camera;
+    cam.eye[0] = 2.0f; cam.eye[1] = 0.7f; cam.eye[2] = 1.2f;
+    CHECK(hd_set_camera(ctx, &cam) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &c) == HD_SUCCESS);
+    CHECK(c.frames == 1 && c.iterations == s.iterations && c.light_converged);
+    CHECK(c.seconds_direct == s.seconds_direct && c.seconds_diffusion == s.seconds_diffusion);
+    CHECK(hd_read_image_f32(ctx, img1, W * W * 4) == HD_SUCCESS);
+    for (i = 0; i < W * W * 4; ++i) sum += fabsf(img1[i] - img0[i]);
+    CHECK(sum > 0.0); /* a new view */
+
+    /* a setter that invalidates the light restarts the refinement */
+    {
+        hd_light l;
+        memset(&l, 0, sizeof l);
+        l.direction[0] = 1.0f;
+        CHECK(hd_set_lights(ctx, &l, 1) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &c) == HD_SUCCESS && !c.light_converged && c.light_error == 1.0);
+        CHECK(hd_render(ctx) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &c) == HD_SUCCESS && c.iterations == 1 && c.frames == 1 && !c.light_converged);
+        CHECK(c.seconds_direct > s.seconds_direct);
+    }
+    hd_destroy(ctx);
+    free(e0); free(p0); free(e1); free(p1); free(img0); free(img1);
+}
+
+/* render_budget: one call may run several light iterations; the path tracers add paths. */
+static void test_render_budget(void)
+{
+    hd_desc d;
+    hd_context ctx;
+    hd_stats s;
+    make_desc(&d, NULL);
+    d.params.render_budget = 30.0f;
+    d.params.light_tolerance = 0.05f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+    CHECK_MSG(s.light_converged && s.iterations > 2 && s.frames == 1, "one call with a 30 s budget: %llu iterations, converged %d",
+              (unsigned long long)s.iterations, s.light_converged);
+    hd_destroy(ctx);
+
+    make_desc(&d, NULL);
+    d.params.method = HD_METHOD_PT_MS;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS && hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 2 && s.frames == 2 && s.light_error == 0.0);
+    hd_destroy(ctx);
+}
+
+/* Bad input: each a specific hd_result and one logged line; nothing changes. */
+static void test_render_bad_input(void)
+{
+    hd_test_log log;
+    hd_desc d;
+    hd_context ctx, stale;
+    hd_params p;
+    hd_stats s;
+    float bad[3] = {-1.0f, NAN, INFINITY};
+    int i;
+    for (i = 0; i < 3; ++i) {
+        make_desc(&d, &log);
+        d.params.light_tolerance = bad[i];
+        CHECK(hd_create(&d, &ctx) == HD_ERROR_INVALID_PARAMETER && log.errors == 1 && strstr(log.last, "light_tolerance"));
+        make_desc(&d, &log);
+        d.params.render_budget = bad[i];
+        CHECK(hd_create(&d, &ctx) == HD_ERROR_INVALID_PARAMETER && log.errors == 1 && strstr(log.last, "render_budget"));
+    }
+    make_desc(&d, &log);
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
+    p = d.params;
+    CHECK(p.light_tolerance == 0.1f && p.render_budget == 0.0f); /* the defaults */
+    p.light_tolerance = NAN;
+    CHECK(hd_set_params(ctx, &p) == HD_ERROR_INVALID_PARAMETER && log.errors == 1);
+    p.light_tolerance = 0.05f;
+    p.render_budget = -1.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_ERROR_INVALID_PARAMETER && log.errors == 2);
+    CHECK(hd_refine(ctx, 0) == HD_ERROR_INVALID_PARAMETER && log.errors == 3);
+    CHECK(hd_refine(ctx, -5) == HD_ERROR_INVALID_PARAMETER && log.errors == 4);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 0 && s.frames == 0);
+    /* before any light: a render does the first light iteration itself */
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 1 && s.frames == 1);
+    p.method = HD_METHOD_PT_SS;
+    p.render_budget = 0.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK(hd_refine(ctx, 1) == HD_ERROR_UNSUPPORTED && log.errors == 5 && strstr(log.last, "PT_SS"));
+    stale = ctx;
+    hd_destroy(ctx);
+    CHECK(hd_refine(stale, 1) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_render(stale) == HD_ERROR_INVALID_HANDLE);
+}
+
+const hd_test_case hd_tests_render[] = {
+    {"render_refine_is_iterate_without_frames", test_refine_is_iterate_without_frames},
+    {"render_light_error_falls", test_light_error_falls},
+    {"render_loop", test_render_loop},
+    {"render_budget", test_render_budget},
+    {"render_bad_input", test_render_bad_input},
+};
+const int hd_tests_render_count = sizeof hd_tests_render / sizeof hd_tests_render[0];
