@@ -118,7 +118,8 @@ extern "C" {
     X(HD_ERROR_GZIP, "the gzip stream is corrupt or truncated") \
     X(HD_ERROR_FILE_NOT_REGULAR, "the path is a directory, device, FIFO or socket, not a file") \
     X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
-    X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes")
+    X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes") \
+    X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -212,11 +213,28 @@ typedef struct hd_allocator {
 #define HD_MAX_LIGHTS 64
 #define HD_MAX_DIM 8192           /* per axis */
 #define HD_MAX_IMAGE_DIM 16384
+/* Finite limits that keep every intermediate value finite and every loop short (hd_create and
+   the setters reject beyond them; README "Guarantees"):
+   - the volume's extent (dims * spacing) over its smallest spacing, per axis pair, is at most
+     HD_MAX_SPACING_RATIO, so a voxel spans enough float steps of the box for the march;
+   - the sum over the lights of intensity * max(colour) is at most HD_MAX_LIGHT_POWER;
+   - point-light positions and camera eye/target components are at most HD_MAX_LIGHT_DISTANCE
+     and HD_MAX_CAMERA_DISTANCE in magnitude (world units: the box's largest side is 1). */
+/* Loop bounds, the same on every backend (backends/kernels/hd_k_common.h): one transmittance or
+   free-flight walk ends after 2^16 collisions and majorant cells with transmittance 0 (reached
+   only with an extinction or majorant above about 3.8e4 per world unit); one projection ray after 2^24 samples (a valid one needs at most
+   1.13e7); a path after max_bounces vertices. Float16 illumination (illumination_precision)
+   saturates at 65504, the largest half. */
+#define HD_MAX_SPACING_RATIO 65536.0f
+#define HD_MAX_LIGHT_POWER 1e6f
+#define HD_MAX_LIGHT_DISTANCE 1e15f
+#define HD_MAX_CAMERA_DISTANCE 1e4f
 
 typedef struct hd_volume_desc {
     hd_voxel_type type;   /* required */
     int dims[3];          /* x, y, z; x varies fastest in data. Each in 1..HD_MAX_DIM */
-    float spacing[3];     /* physical voxel size; {0,0,0} -> {1,1,1}; must be finite and > 0 */
+    float spacing[3];     /* physical voxel size; {0,0,0} -> {1,1,1}; must be finite and > 0,
+                             each >= the largest extent (dims * spacing) / HD_MAX_SPACING_RATIO */
     const void *data;     /* dims[0]*dims[1]*dims[2] voxels; copied by hd_create */
     float value_range[2]; /* raw value mapped to TF coordinate 0 and 1; {0,0} -> {0,255} for U8,
                              {0,65535} for U16, {0,1} for F32. Values outside are clamped. */
@@ -231,15 +249,19 @@ typedef struct hd_transfer_function {
 
 typedef struct hd_light {
     hd_light_type type;
-    float direction[3]; /* DIRECTIONAL: the direction the light travels in (need not be unit) */
-    float position[3];  /* POINT: position in world space (the volume box is centred at 0) */
+    float direction[3]; /* DIRECTIONAL: the direction the light travels in (need not be unit;
+                           any nonzero finite vector) */
+    float position[3];  /* POINT: position in world space (the volume box is centred at 0),
+                           components within +-HD_MAX_LIGHT_DISTANCE */
     float color[3];     /* linear RGB, >= 0; {0,0,0} -> {1,1,1} */
-    float intensity;    /* >= 0; 0 -> 1 */
+    float intensity;    /* >= 0; 0 -> 1. Over all lights, sum of intensity * max(color) <=
+                           HD_MAX_LIGHT_POWER */
     int inverse_square; /* POINT: 1 = intensity / r^2 falloff (r in world units), 0 = none */
 } hd_light;
 
 typedef struct hd_camera {
-    float eye[3];    /* {0,0,0} together with target {0,0,0} -> eye {0,0,2.5} */
+    float eye[3];    /* {0,0,0} together with target {0,0,0} -> eye {0,0,2.5}; eye and target
+                        components within +-HD_MAX_CAMERA_DISTANCE */
     float target[3]; /* looked-at point */
     float up[3];     /* {0,0,0} -> {0,1,0}; must not be parallel to target - eye */
     float fov_y;     /* vertical field of view in degrees, 0 -> 40; must be in (0, 180) */
@@ -254,7 +276,8 @@ typedef struct hd_params {
     float anisotropy;       /* Henyey-Greenstein g in (-1, 1): reduces the diffusion's sigma_s
                                to sigma_s (1 - g); used by PT_MS as its phase; default 0 */
     float majorant;         /* 0 -> a coarse grid of local majorants (empty space is skipped);
-                               > 0 -> this global majorant (must be >= max sigma_t) */
+                               > 0 -> this global majorant: >= max sigma_t, <= 16 max sigma_t
+                               (and <= max(16, 1e6)); a TF that breaks that drops it (grid) */
     int diffusion_sweeps;   /* solver sweeps per iteration, 0 -> 4 (multigrid: CG steps, 0 -> 1) */
     int disable_diffusion;  /* 1: phi stays 0 (direct light only, the PT_SS equivalent) */
     hd_solver solver;
@@ -324,7 +347,10 @@ typedef struct hd_desc {
         int enable_validation;
     } vulkan;
     struct {
-        int use_current_context; /* 1: use the caller's current GL context */
+        int use_current_context; /* 1: use the caller's current GL context; it must be current
+                                    at every later call that reaches GL (iterate, read, render,
+                                    destroy), else HD_ERROR_GL_CONTEXT_NOT_CURRENT (the one current
+                                    at hd_create, where EGL or GLX can tell) */
         void *(*get_proc_address)(const char *name); /* NULL -> eglGetProcAddress */
     } gl;
 } hd_desc;

@@ -548,7 +548,7 @@ HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c,
     HD__CPU_COLOUR_SWITCH(0, iym, iyp, izm, izp)
     if (K->f16) {
         uint16_t *dst = (jacobi ? K->phi2h : K->phih) + o.p[0];
-        for (i = 0; i < n; ++i) dst[i] = hd_f2h(out[i]);
+        for (i = 0; i < n; ++i) dst[i] = hd_f2h_sat(out[i]);
     } else {
         memcpy((jacobi ? K->phi2 : K->phi) + o.p[0], out, (size_t)n * sizeof(float));
     }

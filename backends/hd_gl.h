@@ -149,6 +149,11 @@ struct hd__backend {
     int own;                    /* 1: the EGL context is the backend's */
     EGLDisplay dpy;
     EGLContext egl;
+    /* the caller's context (use_current_context), as current at hd_create: EGL, else GLX
+       (glXGetCurrentContext through get_proc_address), else neither (only "some context") */
+    EGLContext caller_egl;
+    void *(*glx_current)(void);
+    void *caller_glx;
     int version;                /* major * 10 + minor */
     int depth;                  /* nesting of hd__gl_enter */
     hd__gl_state saved;
@@ -261,6 +266,33 @@ static void hd__gl_restore_indexed(hd__backend *be, GLenum target, GLuint index,
     else be->gl.BindBufferBase(target, index, (GLuint)name);
 }
 
+/* The caller's context (use_current_context) must be current at every call that reaches GL:
+   the one current at hd_create where EGL or GLX can tell, else any (GL_VERSION answers). A GL
+   call without a current context does nothing, so without this check iterations would count
+   as run and the image would be stale. */
+static hd_result hd__gl_check_current(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    if (be->caller_egl != EGL_NO_CONTEXT) {
+        EGLContext cur = eglGetCurrentContext();
+        if (cur == be->caller_egl) return HD_SUCCESS;
+        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == EGL_NO_CONTEXT
+                       ? "gl: no EGL context is current; make the one given at hd_create (use_current_context) current"
+                       : "gl: another EGL context is current than the one given at hd_create (use_current_context)");
+    }
+    if (be->glx_current) {
+        void *cur = be->glx_current();
+        if (cur == be->caller_glx) return HD_SUCCESS;
+        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == NULL
+                       ? "gl: no GLX context is current; make the one given at hd_create (use_current_context) current"
+                       : "gl: another GLX context is current than the one given at hd_create (use_current_context)");
+    }
+    if (!be->gl.GetString(GL_VERSION))
+        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT,
+                       "gl: no GL context is current (use_current_context: the caller's must be current at every call)");
+    return HD_SUCCESS;
+}
+
 /* Makes the context current (own context) and saves the host's bindings. Nested calls (a stage
    inside hd_gl_render_to_texture's prepare) save once. Pending GL errors are not ours. */
 static hd_result hd__gl_enter(hd__ctx *ctx)
@@ -281,6 +313,9 @@ static hd_result hd__gl_enter(hd__ctx *ctx)
             return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)eglGetError());
         }
         s->switched = 1;
+    } else if (!be->own) {
+        hd_result r = hd__gl_check_current(ctx);
+        if (r != HD_SUCCESS) { be->depth--; return r; }
     }
     while ((e = be->gl.GetError()) != GL_NO_ERROR)
         HD__INFO(&ctx->log, "gl: %s was pending before this call (not hybriddiff's; cleared)", hd__gl_error_name(e));
@@ -745,8 +780,17 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->own = !ctx->desc.gl.use_current_context;
     if (be->own) {
         if ((r = hd__gl_egl_context(ctx)) != HD_SUCCESS) return r;
-    } else if (!be->gpa && eglGetCurrentContext() == EGL_NO_CONTEXT) {
-        HD__INFO(&ctx->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
+    } else {
+        be->caller_egl = eglGetCurrentContext();
+        if (be->caller_egl == EGL_NO_CONTEXT && be->gpa) {
+            /* a GLX caller: its loader knows glXGetCurrentContext; a NULL answer tells nothing */
+            void *p = be->gpa("glXGetCurrentContext");
+            memcpy(&be->glx_current, &p, sizeof p); /* void* -> function pointer: a cast is not ISO C */
+            be->caller_glx = be->glx_current ? be->glx_current() : NULL;
+            if (!be->caller_glx) be->glx_current = NULL;
+        }
+        if (!be->gpa && be->caller_egl == EGL_NO_CONTEXT)
+            HD__INFO(&ctx->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
     }
     if ((r = hd__gl_load_fns(ctx)) != HD_SUCCESS) {
         be->gl.GetError = NULL; /* hd__be_destroy must not call into GL */

@@ -89,6 +89,10 @@ HD_FN uint16_t hd_f2h(float f)
     uint32_t h = a >= 0x477ff000u ? special : (a >= 0x38800000u ? normal : sub);
     return (uint16_t)(sign | h);
 }
+/* The illumination's float16 store: saturates at the largest half, 65504, so a bright E or phi
+   is clipped instead of becoming inf (and NaN in the image); every backend stores this. */
+#define HD_HALF_MAX 65504.0f
+HD_FN uint16_t hd_f2h_sat(float f) { return hd_f2h(f > HD_HALF_MAX ? HD_HALF_MAX : f); }
 
 /* The colour-separated layout of the buffers the diffusion reads (sigma_t with its RGB channels,
    E, phi, phi2; also the CPU multigrid's vectors), the same on the CPU and OpenCL backends
@@ -179,7 +183,7 @@ typedef struct hd__kctx {
 #define HD__ST_sig(i, x, y, z, v) ((void)(i), K->sig[HD__C_AT(x, y, z)] = (v))
 #define HD__LD_HALF(buf, x, y, z) (K->f16 != 0 ? hd_h2f(K->buf##h[HD__C_AT(x, y, z)]) : K->buf[HD__C_AT(x, y, z)])
 #define HD__ST_HALF(buf, x, y, z, v) \
-    (K->f16 != 0 ? (void)(K->buf##h[HD__C_AT(x, y, z)] = hd_f2h(v)) : (void)(K->buf[HD__C_AT(x, y, z)] = (v)))
+    (K->f16 != 0 ? (void)(K->buf##h[HD__C_AT(x, y, z)] = hd_f2h_sat(v)) : (void)(K->buf[HD__C_AT(x, y, z)] = (v)))
 #define HD__LD_E(i, x, y, z) ((void)(i), HD__LD_HALF(E, x, y, z))
 #define HD__LD_phi(i, x, y, z) ((void)(i), HD__LD_HALF(phi, x, y, z))
 #define HD__LD_phi2(i, x, y, z) ((void)(i), HD__LD_HALF(phi2, x, y, z))

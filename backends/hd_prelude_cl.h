@@ -148,12 +148,13 @@ typedef struct hd__kctx {
 #define HD__ST_lv2(i, x, y, z, v) (K->lv2[(i)] = (v))
 #define HD__LD_sig(i, x, y, z) HD__CL_COL(sig, x, y, z)
 #define HD__ST_sig(i, x, y, z, v) (HD__CL_COL(sig, x, y, z) = (v))
-/* The illumination buffers: float, or binary16 rounded to nearest even (as the C prelude's
-   hd_f2h, so both backends store the same bits for the same float). */
+/* The illumination buffers: float, or binary16 rounded to nearest even and saturated at 65504
+   (as the C prelude's hd_f2h_sat, so both backends store the same bits for the same float). */
 #define HD__LD_HALF(buf, x, y, z) \
     (K->f16 != 0 ? vload_half((size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) : HD__CL_COL(buf, x, y, z))
 #define HD__ST_HALF(buf, x, y, z, v) \
-    (K->f16 != 0 ? vstore_half_rte((v), (size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) : (void)(HD__CL_COL(buf, x, y, z) = (v)))
+    (K->f16 != 0 ? vstore_half_rte(fmin((v), 65504.0f), (size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) \
+                 : (void)(HD__CL_COL(buf, x, y, z) = (v)))
 #define HD__LD_E(i, x, y, z) HD__LD_HALF(E, x, y, z)
 #define HD__LD_phi(i, x, y, z) HD__LD_HALF(phi, x, y, z)
 #define HD__LD_phi2(i, x, y, z) HD__LD_HALF(phi2, x, y, z)

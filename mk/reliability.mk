@@ -4,6 +4,8 @@
 #                     tests/fuzz/regressions/ (part of `make test`); every accepted volume of at
 #                     most 64^3 voxels is rendered (tests/fuzz/hd_fuzz_check.h)
 #   make fuzz-long    FUZZ_SECONDS per loader (local; keeps new corpus in build/fuzz/work_*)
+#   make fuzz-smoke-api / fuzz-long-api   the same for the API fuzzer (tests/fuzz/fuzz_api.c;
+#                     fuzz-smoke runs fuzz-smoke-api)
 #   make asan         build/hdtest and the OpenCL conformance suite under ASan+UBSan+LSan
 #   make tsan         the CPU backend's threaded tests under TSan
 #   make valgrind     build/hdtest's API/loader/error-path suites (CPU) under memcheck, built
@@ -115,3 +117,22 @@ soak: $(B)/hdsoak
 soak-short: $(B)/hdsoak
 	$(B)/hdsoak 500 24
 test: soak-short
+
+# ---- the API fuzzer (tests/fuzz/fuzz_api.c): hd_desc / hd_params / lights / camera bytes with
+# finite extremes, one context and iterations per input; -timeout makes a hang a finding. It
+# starts from its regressions only (no generated seeds). FUZZ_API_RUNS in make test; the README
+# ("Guarantees") gives the 200,000-run figure.
+FUZZ_API_RUNS ?= 20000
+FUZZ_API_ARGS := -seed=1 -max_len=1024 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+.PHONY: fuzz-smoke-api fuzz-long-api
+fuzz-smoke-api: $(FZ)/fuzz_api
+	@rm -rf $(FZ)/work_api; mkdir -p $(FZ)/work_api; start=$$(date +%s); \
+	if ! $(FZ)/fuzz_api -runs=$(FUZZ_API_RUNS) $(FUZZ_API_ARGS) -artifact_prefix=$(FZ)/crash-api- \
+	     $(FZ)/work_api tests/fuzz/regressions/api > $(FZ)/fuzz_api.log 2>&1; then \
+	  tail -n 60 $(FZ)/fuzz_api.log; echo "fuzz-smoke: api FAILED (input in $(FZ)/crash-api-*)"; exit 1; fi; \
+	echo "fuzz-smoke: api: $(FUZZ_API_RUNS) runs, nothing found ($$(( $$(date +%s) - start )) s)"
+fuzz-smoke: fuzz-smoke-api
+fuzz-long-api: $(FZ)/fuzz_api
+	mkdir -p $(FZ)/work_api
+	$(FZ)/fuzz_api -max_total_time=$(FUZZ_SECONDS) $(FUZZ_API_ARGS) \
+	  -artifact_prefix=tests/fuzz/regressions/api/crash- $(FZ)/work_api tests/fuzz/regressions/api 2>&1 | tail -n 3

@@ -84,14 +84,14 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
     float lo = v->value_range[0], hi = v->value_range[1], scale;
     size_t i, ncell;
     int d, x, y, z;
-    float extent[3], emax = 0.0f;
+    double extent[3], emax = 0.0; /* double: dims * spacing may pass FLT_MAX (hd__check_extent) */
     for (d = 0; d < 3; ++d) {
         ctx->dims[d] = v->dims[d];
-        extent[d] = (float)v->dims[d] * v->spacing[d];
+        extent[d] = (double)v->dims[d] * (double)v->spacing[d];
         if (extent[d] > emax) emax = extent[d];
         ctx->mdims[d] = (v->dims[d] + HD__MAJORANT_CELL - 1) / HD__MAJORANT_CELL;
     }
-    for (d = 0; d < 3; ++d) ctx->box[d] = extent[d] / emax;
+    for (d = 0; d < 3; ++d) ctx->box[d] = (float)(extent[d] / emax);
     ctx->nvox = (size_t)ctx->dims[0] * ctx->dims[1] * ctx->dims[2];
     ctx->vol = (float *)hd__alloc(ctx, ctx->nvox * sizeof(float));
     ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
@@ -183,12 +183,16 @@ static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
 
 /* Lights of one colour and grey scattering need one illumination channel; lights of different
    colours or RGB scattering need three (and RGB scattering the TF colour beside sigma_t). */
+static float hd__max3(const float v[3]) { return v[0] > v[1] ? (v[0] > v[2] ? v[0] : v[2]) : (v[1] > v[2] ? v[1] : v[2]); }
 static void hd__set_channels(hd__ctx *ctx)
 {
     int i, grey = ctx->lights_one_colour && !ctx->params.rgb_scattering;
+    /* one channel: E carries intensity * max colour (the quantity hd__check_lights limits) and the
+       projection the colour over its maximum, so neither factor alone can overflow */
+    float cmax = hd__max3(ctx->lights[0].color);
     ctx->channels = grey ? 1 : 3;
     ctx->sig_channels = ctx->params.rgb_scattering ? 4 : 1;
-    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] : 1.0f;
+    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] / cmax : 1.0f;
 }
 
 static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
@@ -208,12 +212,21 @@ static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)
     ctx->desc.light_count = count;
 }
 
+/* A global majorant above HD__MAJORANT_SLACK times the largest sigma_t (at least 1 per world
+   unit) only adds null collisions: each walk would cost majorant * distance of them. */
+#define HD__MAJORANT_SLACK 16.0f
+static float hd__majorant_cap(float max_sigma) { return HD__MAJORANT_SLACK * (max_sigma > 1.0f ? max_sigma : 1.0f); }
 static hd_result hd__check_majorant(hd__ctx *ctx, const hd_params *p)
 {
-    if (p->majorant > 0.0f && p->majorant < ctx->max_sigma / (1.0f + 1e-5f) * (p->extinction / ctx->params.extinction))
+    float max_sigma = ctx->max_sigma * (p->extinction / ctx->params.extinction);
+    if (p->majorant > 0.0f && p->majorant < max_sigma / (1.0f + 1e-5f))
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
                        "params.majorant = %g is below the largest extinction %g: tracking would be biased",
-                       (double)p->majorant, (double)(ctx->max_sigma * p->extinction / ctx->params.extinction));
+                       (double)p->majorant, (double)max_sigma);
+    if (p->majorant > hd__majorant_cap(max_sigma))
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
+                       "params.majorant = %g is above %g x the largest extinction %g (at least 1): only null collisions",
+                       (double)p->majorant, (double)HD__MAJORANT_SLACK, (double)max_sigma);
     return HD_SUCCESS;
 }
 
@@ -232,7 +245,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
 {
     hd__kparams *k = &ctx->kp;
     const hd_camera *c = &ctx->camera;
-    float w[3], u[3], v[3], len, th, aspect;
+    float w[3], u[3], v[3], th, aspect;
     int i;
     memset(k, 0, sizeof *k);
     k->dims.x = ctx->dims[0]; k->dims.y = ctx->dims[1]; k->dims.z = ctx->dims[2]; k->dims.w = ctx->tf_count;
@@ -274,15 +287,15 @@ static void hd__fill_kparams(hd__ctx *ctx)
         k->march.y = (float)(1.0 / (double)(f < win ? f : win));
     }
     k->march.z = 1e-4f; /* stop marching below this transmittance */
-    /* camera basis */
-    for (i = 0; i < 3; ++i) w[i] = c->target[i] - c->eye[i];
-    len = sqrtf(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
-    for (i = 0; i < 3; ++i) w[i] /= len;
-    u[0] = w[1] * c->up[2] - w[2] * c->up[1];
-    u[1] = w[2] * c->up[0] - w[0] * c->up[2];
-    u[2] = w[0] * c->up[1] - w[1] * c->up[0];
-    len = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-    for (i = 0; i < 3; ++i) u[i] /= len;
+    /* camera basis, through unit vectors (hd__unit3: a tiny up must not underflow the cross
+       product; hd__check_camera keeps it away from parallel) */
+    for (i = 0; i < 3; ++i) v[i] = c->target[i] - c->eye[i];
+    hd__unit3(v, w);
+    hd__unit3(c->up, u);
+    v[0] = w[1] * u[2] - w[2] * u[1];
+    v[1] = w[2] * u[0] - w[0] * u[2];
+    v[2] = w[0] * u[1] - w[1] * u[0];
+    hd__unit3(v, u);
     v[0] = u[1] * w[2] - u[2] * w[1];
     v[1] = u[2] * w[0] - u[0] * w[2];
     v[2] = u[0] * w[1] - u[1] * w[0];
@@ -300,13 +313,14 @@ static void hd__fill_kparams(hd__ctx *ctx)
         const hd_light *l = &ctx->lights[i];
         hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];
         if (l->type == HD_LIGHT_DIRECTIONAL) {
-            float n = sqrtf(l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] + l->direction[2] * l->direction[2]);
-            a->x = l->direction[0] / n; a->y = l->direction[1] / n; a->z = l->direction[2] / n; a->w = 0.0f;
+            float n[3];
+            hd__unit3(l->direction, n); /* nonzero: hd__check_lights */
+            a->x = n[0]; a->y = n[1]; a->z = n[2]; a->w = 0.0f;
         } else {
             a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
         }
         if (ctx->channels == 1) {
-            b->x = b->y = b->z = l->intensity;
+            b->x = b->y = b->z = l->intensity * hd__max3(l->color); /* the colour is chan_color */
         } else {
             b->x = l->color[0] * l->intensity; b->y = l->color[1] * l->intensity; b->z = l->color[2] * l->intensity;
         }
@@ -428,8 +442,9 @@ HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_functio
     if ((r = hd__check_tf(tf, &ctx->log)) != HD_SUCCESS) return r;
     if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
     hd__build_majorants(ctx);
-    if (ctx->params.majorant > 0.0f && ctx->params.majorant < ctx->max_sigma / (1.0f + 1e-5f)) {
-        HD__INFO(&ctx->log, "params.majorant %g is below the new TF's largest extinction %g: using the majorant grid",
+    if (ctx->params.majorant > 0.0f &&
+        (ctx->params.majorant < ctx->max_sigma / (1.0f + 1e-5f) || ctx->params.majorant > hd__majorant_cap(ctx->max_sigma))) {
+        HD__INFO(&ctx->log, "params.majorant %g is outside 1..16x the new TF's largest extinction %g: using the majorant grid",
                  (double)ctx->params.majorant, (double)ctx->max_sigma);
         ctx->params.majorant = 0.0f;
     }

@@ -11,6 +11,10 @@
 #ifndef HD_MAX_CONTEXTS
 #define HD_MAX_CONTEXTS 64
 #endif
+/* A handle keeps its slot in 8 bits (hd__lookup): more slots would alias each other's handles. */
+#if HD_MAX_CONTEXTS < 1 || HD_MAX_CONTEXTS > 255
+#error "hybriddiff: HD_MAX_CONTEXTS must be in 1..255 (a context handle holds its slot in 8 bits)"
+#endif
 /* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
 #define HD__MAX_VOXELS (1u << 30)
 #define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: on the head CT 4 tracks 12% faster

@@ -1,12 +1,38 @@
 /* hd_validate.h - checks every input and fills the documented defaults, before anything is
    allocated or dispatched. Each check returns its own hd_result and logs what was wrong. */
+#include <float.h>
 
 static int hd__finite3(const float v[3]) { return hd__finite(v[0]) && hd__finite(v[1]) && hd__finite(v[2]); }
+
+/* The derived geometry, in double (dims * spacing may pass FLT_MAX): the box's largest side is
+   1, so a voxel's world size along axis i is spacing[i] / max extent. Below 1 / HD_MAX_SPACING_RATIO
+   a ray position no longer resolves the voxel in float and the march and DDA step counts grow
+   without use; the all-zero spacing (the default {1,1,1}) passes. */
+static hd_result hd__check_extent(const hd_volume_desc *v, const hd_logger *log)
+{
+    double ext[3], emax = 0.0;
+    int i;
+    if (v->spacing[0] == 0.0f && v->spacing[1] == 0.0f && v->spacing[2] == 0.0f) return HD_SUCCESS;
+    for (i = 0; i < 3; ++i) {
+        ext[i] = (double)v->dims[i] * (double)v->spacing[i];
+        if (ext[i] > emax) emax = ext[i];
+    }
+    for (i = 0; i < 3; ++i) {
+        double voxel = (double)v->spacing[i] / emax;
+        if (!(voxel * (double)HD_MAX_SPACING_RATIO >= 1.0) || !((float)(ext[i] / emax) > 0.0f))
+            return HD__ERR(log, HD_ERROR_INVALID_SPACING,
+                           "volume.spacing {%g, %g, %g}: a voxel along axis %d is %g of the largest extent, "
+                           "below 1/%g", (double)v->spacing[0], (double)v->spacing[1], (double)v->spacing[2],
+                           i, voxel, (double)HD_MAX_SPACING_RATIO);
+    }
+    return HD_SUCCESS;
+}
 
 static hd_result hd__check_volume(const hd_volume_desc *v, const hd_logger *log)
 {
     size_t nvox = 1;
     int i;
+    hd_result r;
     if (v->type <= HD_VOXEL_INVALID || v->type >= HD_VOXEL_COUNT)
         return HD__ERR(log, HD_ERROR_INVALID_ENUM, "volume.type %d is not a hd_voxel_type", (int)v->type);
     for (i = 0; i < 3; ++i) {
@@ -24,6 +50,7 @@ static hd_result hd__check_volume(const hd_volume_desc *v, const hd_logger *log)
         if (!hd__finite(v->spacing[i]) || !(v->spacing[i] > 0.0f))
             return HD__ERR(log, HD_ERROR_INVALID_SPACING, "volume.spacing[%d] = %g must be finite and > 0", i, (double)v->spacing[i]);
     }
+    if ((r = hd__check_extent(v, log)) != HD_SUCCESS) return r;
     if (!hd__finite(v->value_range[0]) || !hd__finite(v->value_range[1]) ||
         (v->value_range[0] == v->value_range[1] && v->value_range[0] != 0.0f))
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "volume.value_range {%g, %g} must be finite and not empty",
@@ -47,24 +74,61 @@ static hd_result hd__check_tf(const hd_transfer_function *tf, const hd_logger *l
     return HD_SUCCESS;
 }
 
+/* The unit vector along v, scaled by its largest component first so the squared length neither
+   overflows nor underflows; 0 (and out zeroed) when v is zero or the result is not finite. */
+static int hd__unit3(const float v[3], float out[3])
+{
+    double m = 0.0, a[3], n;
+    int i;
+    for (i = 0; i < 3; ++i) { double c = fabs((double)v[i]); if (c > m) m = c; }
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!(m > 0.0) || !(m <= (double)FLT_MAX)) return 0;
+    for (i = 0; i < 3; ++i) a[i] = (double)v[i] / m;
+    n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (i = 0; i < 3; ++i) out[i] = (float)(a[i] / n);
+    return hd__finite(out[0]) && hd__finite(out[1]) && hd__finite(out[2]) &&
+           out[0] * out[0] + out[1] * out[1] + out[2] * out[2] > 0.5f;
+}
+
+/* Lights as given, before the defaults (zero colour -> white, zero intensity -> 1), which the
+   power limit applies after: sum of intensity * max(colour) <= HD_MAX_LIGHT_POWER keeps E, phi
+   and the image finite (a sample is at most HD_MAX_LIGHTS * power * 1e12, the point lights'
+   1/r^2 floor; README "Guarantees"). */
 static hd_result hd__check_lights(const hd_light *lights, int count, const hd_logger *log)
 {
     int i;
+    double power = 0.0;
     if (count == 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "no lights: give at least one");
     if (count < 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "light count %d is negative", count);
     if (count > HD_MAX_LIGHTS) return HD__ERR(log, HD_ERROR_TOO_MANY_LIGHTS, "%d lights, at most %d", count, HD_MAX_LIGHTS);
     if (!lights) return HD__ERR(log, HD_ERROR_NULL_POINTER, "lights is NULL with count %d", count);
     for (i = 0; i < count; ++i) {
         const hd_light *l = &lights[i];
+        float unit[3];
+        double cmax, inten;
         if ((int)l->type < 0 || l->type >= HD_LIGHT_TYPE_COUNT)
             return HD__ERR(log, HD_ERROR_INVALID_ENUM, "light %d: type %d is not a hd_light_type", i, (int)l->type);
         if (!hd__finite3(l->direction) || !hd__finite3(l->position) || !hd__finite3(l->color) || !hd__finite(l->intensity))
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d has a NaN or infinite value", i);
         if (l->color[0] < 0.0f || l->color[1] < 0.0f || l->color[2] < 0.0f || l->intensity < 0.0f)
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d has a negative colour or intensity", i);
-        if (l->type == HD_LIGHT_DIRECTIONAL &&
-            l->direction[0] * l->direction[0] + l->direction[1] * l->direction[1] + l->direction[2] * l->direction[2] < 1e-20f)
+        if (l->type == HD_LIGHT_DIRECTIONAL && !hd__unit3(l->direction, unit))
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: directional light with a zero direction", i);
+        if (l->type == HD_LIGHT_POINT &&
+            (fabsf(l->position[0]) > HD_MAX_LIGHT_DISTANCE || fabsf(l->position[1]) > HD_MAX_LIGHT_DISTANCE ||
+             fabsf(l->position[2]) > HD_MAX_LIGHT_DISTANCE))
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: point light at {%g, %g, %g}, beyond %g world units",
+                           i, (double)l->position[0], (double)l->position[1], (double)l->position[2],
+                           (double)HD_MAX_LIGHT_DISTANCE);
+        cmax = l->color[0] > l->color[1] ? l->color[0] : l->color[1];
+        if (l->color[2] > cmax) cmax = l->color[2];
+        if (cmax == 0.0) cmax = 1.0;
+        inten = l->intensity == 0.0f ? 1.0 : (double)l->intensity;
+        power += inten * cmax;
+        if (!(power <= (double)HD_MAX_LIGHT_POWER))
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT,
+                           "light %d: intensity * colour summed over lights 0..%d is %g, above HD_MAX_LIGHT_POWER %g",
+                           i, i, power, (double)HD_MAX_LIGHT_POWER);
     }
     return HD_SUCCESS;
 }
@@ -83,22 +147,30 @@ static void hd__camera_defaults(hd_camera *c)
 /* Checks a camera whose defaults are filled in. */
 static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
 {
-    float f[3], cr[3], lf, lu, lc;
+    float f[3], fu[3], uu[3], cr[3], lf, lc;
+    int i;
     if (!hd__finite3(c->eye) || !hd__finite3(c->target) || !hd__finite3(c->up) || !hd__finite(c->fov_y))
         return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera has a NaN or infinite value");
+    for (i = 0; i < 3; ++i)
+        if (fabsf(c->eye[i]) > HD_MAX_CAMERA_DISTANCE || fabsf(c->target[i]) > HD_MAX_CAMERA_DISTANCE)
+            return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye or target component beyond %g world units",
+                           (double)HD_MAX_CAMERA_DISTANCE);
     if (!(c->fov_y > 0.0f && c->fov_y < 180.0f))
         return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera fov_y = %g degrees is outside (0, 180)", (double)c->fov_y);
     if (c->width < 1 || c->height < 1 || c->width > HD_MAX_IMAGE_DIM || c->height > HD_MAX_IMAGE_DIM)
         return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "image size %dx%d is outside 1..%d", c->width, c->height, HD_MAX_IMAGE_DIM);
     f[0] = c->target[0] - c->eye[0]; f[1] = c->target[1] - c->eye[1]; f[2] = c->target[2] - c->eye[2];
-    cr[0] = f[1] * c->up[2] - f[2] * c->up[1];
-    cr[1] = f[2] * c->up[0] - f[0] * c->up[2];
-    cr[2] = f[0] * c->up[1] - f[1] * c->up[0];
     lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
-    lu = sqrtf(c->up[0] * c->up[0] + c->up[1] * c->up[1] + c->up[2] * c->up[2]);
-    lc = sqrtf(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
     if (!(lf > 1e-6f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye and target coincide");
-    if (!(lc > 1e-4f * lf * lu)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is parallel to the view direction (or zero)");
+    /* unit vectors first (hd__unit3), so a tiny or huge up neither underflows nor overflows the
+       cross product hd__fill_kparams normalises */
+    if (!hd__unit3(f, fu) || !hd__unit3(c->up, uu))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is zero");
+    cr[0] = fu[1] * uu[2] - fu[2] * uu[1];
+    cr[1] = fu[2] * uu[0] - fu[0] * uu[2];
+    cr[2] = fu[0] * uu[1] - fu[1] * uu[0];
+    lc = sqrtf(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
+    if (!(lc > 1e-4f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera up is parallel to the view direction");
     return HD_SUCCESS;
 }
 
@@ -133,8 +205,9 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.albedo = %g is outside (0, 1]", (double)p->albedo);
     if (!hd__finite(p->anisotropy) || !(p->anisotropy > -1.0f && p->anisotropy < 1.0f))
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.anisotropy = %g is outside (-1, 1)", (double)p->anisotropy);
-    if (!hd__finite(p->majorant) || p->majorant < 0.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.majorant = %g must be >= 0 and finite", (double)p->majorant);
+    /* above the largest extinction a majorant only adds null collisions (1e6 per world unit) */
+    if (!hd__finite(p->majorant) || p->majorant < 0.0f || p->majorant > 1e6f)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.majorant = %g is outside [0, 1e6]", (double)p->majorant);
     if (p->diffusion_sweeps < 0 || p->diffusion_sweeps > 100000)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_sweeps = %d is outside 1..100000", p->diffusion_sweeps);
     if (!hd__finite3(p->background) || p->background[0] < 0.0f || p->background[1] < 0.0f || p->background[2] < 0.0f)

@@ -8,6 +8,8 @@
 #include "hd_test.h"
 #include <stdlib.h>
 #include <limits.h>
+#include <float.h>
+#include <unistd.h>
 #ifndef HD_MAX_CONTEXTS
 #define HD_MAX_CONTEXTS 64 /* the implementation's default */
 #endif
@@ -66,6 +68,15 @@ static hd_result c_li_nan(void) { hd_light l = L0; l.direction[1] = hs_nan(); re
 static hd_result c_li_inf(void) { hd_light l = L0; l.intensity = hs_inf(); return hd_set_lights(C, &l, 1); }
 static hd_result c_li_negcol(void) { hd_light l = L0; l.color[2] = -0.1f; return hd_set_lights(C, &l, 1); }
 static hd_result c_li_pos_inf(void) { hd_light l = L0; l.type = HD_LIGHT_POINT; l.position[0] = hs_inf(); return hd_set_lights(C, &l, 1); }
+/* finite extremes: each would hang the tracking, overflow a product or lose the ray */
+static hd_result c_li_pos_far(void) { hd_light l = L0; l.type = HD_LIGHT_POINT; l.position[0] = 1e30f; return hd_set_lights(C, &l, 1); }
+static hd_result c_li_power_max(void) { hd_light l = L0; l.intensity = FLT_MAX; return hd_set_lights(C, &l, 1); }
+static hd_result c_li_colour_max(void) { hd_light l = L0; l.intensity = 1e20f; l.color[0] = l.color[1] = l.color[2] = 1e20f; return hd_set_lights(C, &l, 1); }
+static hd_result c_li_power_sum(void) { hd_light l[2]; l[0] = l[1] = L0; l[0].intensity = l[1].intensity = 0.6f * HD_MAX_LIGHT_POWER; return hd_set_lights(C, l, 2); }
+static hd_result c_cam_far(void) { hd_camera c = CAM0; c.eye[2] = 1e30f; return hd_set_camera(C, &c); }
+static hd_result c_p_maj_max(void) { hd_params p = P0; p.majorant = FLT_MAX; return hd_set_params(C, &p); }
+static hd_result c_p_maj_1e30(void) { hd_params p = P0; p.majorant = 1e30f; return hd_set_params(C, &p); }
+static hd_result c_p_maj_1e6(void) { hd_params p = P0; p.majorant = 1e6f; return hd_set_params(C, &p); }
 static hd_result c_cam_null(void) { return hd_set_camera(C, NULL); }
 static hd_result c_cam_inf(void) { hd_camera c = CAM0; c.target[2] = hs_inf(); return hd_set_camera(C, &c); }
 static hd_result c_cam_fov_nan(void) { hd_camera c = CAM0; c.fov_y = hs_nan(); return hd_set_camera(C, &c); }
@@ -73,7 +84,8 @@ static hd_result c_cam_fov_neg(void) { hd_camera c = CAM0; c.fov_y = -10.0f; ret
 static hd_result c_cam_huge(void) { hd_camera c = CAM0; c.width = HD_MAX_IMAGE_DIM + 1; return hd_set_camera(C, &c); }
 static hd_result c_cam_int_max(void) { hd_camera c = CAM0; c.height = INT_MAX; return hd_set_camera(C, &c); }
 static hd_result c_cam_neg(void) { hd_camera c = CAM0; c.height = -1; return hd_set_camera(C, &c); }
-static hd_result c_cam_up0(void) { hd_camera c = CAM0; c.up[0] = c.up[1] = c.up[2] = 0; c.up[0] = 1e-30f; return hd_set_camera(C, &c); }
+/* a tiny up is normalised (any nonzero one works); a tiny one along the view is still parallel */
+static hd_result c_cam_up0(void) { hd_camera c = CAM0; c.up[0] = c.up[1] = c.up[2] = 0; c.up[2] = 1e-30f; return hd_set_camera(C, &c); }
 static hd_result c_p_null(void) { return hd_set_params(C, NULL); }
 static hd_result c_p_method(void) { hd_params p = P0; p.method = HD_METHOD_COUNT; return hd_set_params(C, &p); }
 static hd_result c_p_method_neg(void) { hd_params p = P0; p.method = (hd_method)-3; return hd_set_params(C, &p); }
@@ -128,6 +140,14 @@ static const hs_case hs_cases[] = {
     {"light Inf intensity", HD_ERROR_INVALID_LIGHT, c_li_inf},
     {"light negative colour", HD_ERROR_INVALID_LIGHT, c_li_negcol},
     {"point light Inf position", HD_ERROR_INVALID_LIGHT, c_li_pos_inf},
+    {"point light at 1e30", HD_ERROR_INVALID_LIGHT, c_li_pos_far},
+    {"light intensity FLT_MAX", HD_ERROR_INVALID_LIGHT, c_li_power_max},
+    {"light intensity * colour 1e40", HD_ERROR_INVALID_LIGHT, c_li_colour_max},
+    {"lights' summed power > limit", HD_ERROR_INVALID_LIGHT, c_li_power_sum},
+    {"camera eye at 1e30", HD_ERROR_INVALID_CAMERA, c_cam_far},
+    {"majorant FLT_MAX", HD_ERROR_INVALID_PARAMETER, c_p_maj_max},
+    {"majorant 1e30", HD_ERROR_INVALID_PARAMETER, c_p_maj_1e30},
+    {"majorant 1e6 (> 16 x max sigma_t)", HD_ERROR_INVALID_PARAMETER, c_p_maj_1e6},
     {"camera NULL", HD_ERROR_NULL_POINTER, c_cam_null},
     {"camera Inf target", HD_ERROR_INVALID_CAMERA, c_cam_inf},
     {"camera NaN fov", HD_ERROR_INVALID_CAMERA, c_cam_fov_nan},
@@ -135,7 +155,7 @@ static const hs_case hs_cases[] = {
     {"camera width > max", HD_ERROR_INVALID_DIMENSIONS, c_cam_huge},
     {"camera height INT_MAX", HD_ERROR_INVALID_DIMENSIONS, c_cam_int_max},
     {"camera height -1", HD_ERROR_INVALID_DIMENSIONS, c_cam_neg},
-    {"camera up ~0", HD_ERROR_INVALID_CAMERA, c_cam_up0},
+    {"camera up 1e-30 along the view", HD_ERROR_INVALID_CAMERA, c_cam_up0},
     {"params NULL", HD_ERROR_NULL_POINTER, c_p_null},
     {"method COUNT", HD_ERROR_INVALID_ENUM, c_p_method},
     {"method -3", HD_ERROR_INVALID_ENUM, c_p_method_neg},
@@ -261,6 +281,112 @@ static void test_hostile_handles(void)
     CHECK(hs.live == 0);
 }
 
+/* ---- finite extremes through hd_create: 1e+-30, denormals, FLT_MAX ---- */
+/* Each case edits a valid desc; want HD_SUCCESS means the context must iterate (HD, then PT_MS)
+   and give a finite image; an error must be that code with one logged line. A hang is caught by
+   alarm(): SIGALRM ends the run. */
+typedef struct hx_case { const char *name; hd_result expect; void (*edit)(hd_desc *d, hd_light *l); } hx_case;
+static float hx_denormal(void) { volatile float f = FLT_MIN; return f / 1024.0f; }
+static void x_sp_mixed(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = 1e-30f; d->volume.spacing[1] = 1.0f; d->volume.spacing[2] = 1e30f; }
+static void x_sp_tiny(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = 1e-30f; d->volume.spacing[1] = d->volume.spacing[2] = 1.0f; }
+static void x_sp_denormal_one(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = hx_denormal(); d->volume.spacing[1] = d->volume.spacing[2] = 1.0f; }
+static void x_sp_max_one(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = d->volume.spacing[1] = FLT_MAX; d->volume.spacing[2] = 1.0f; }
+static void x_sp_max_all(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = d->volume.spacing[1] = d->volume.spacing[2] = FLT_MAX; }
+static void x_sp_denormal_all(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = d->volume.spacing[1] = d->volume.spacing[2] = hx_denormal(); }
+static void x_sp_1e30_all(hd_desc *d, hd_light *l) { (void)l; d->volume.spacing[0] = d->volume.spacing[1] = d->volume.spacing[2] = 1e30f; }
+static void x_maj_max(hd_desc *d, hd_light *l) { (void)l; d->params.majorant = FLT_MAX; }
+static void x_dir_huge(hd_desc *d, hd_light *l) { l->direction[0] = 1e30f; l->direction[1] = -3e30f; l->direction[2] = 2e30f; d->light_count = 1; }
+static void x_dir_max(hd_desc *d, hd_light *l) { l->direction[0] = FLT_MAX; l->direction[1] = FLT_MAX; l->direction[2] = -FLT_MAX; d->light_count = 1; }
+static void x_dir_tiny(hd_desc *d, hd_light *l) { l->direction[0] = 0.0f; l->direction[1] = 1e-30f; l->direction[2] = -1e-30f; d->light_count = 1; }
+static void x_dir_denormal(hd_desc *d, hd_light *l) { l->direction[0] = 0.0f; l->direction[1] = 0.0f; l->direction[2] = -hx_denormal(); d->light_count = 1; }
+static void x_pt_far(hd_desc *d, hd_light *l) { l->type = HD_LIGHT_POINT; l->position[0] = 1e30f; d->light_count = 1; }
+static void x_pt_far_ok(hd_desc *d, hd_light *l) { l->type = HD_LIGHT_POINT; l->position[0] = 1e14f; l->inverse_square = 1; d->light_count = 1; }
+static void x_pt_at_voxel(hd_desc *d, hd_light *l) { l->type = HD_LIGHT_POINT; l->position[0] = 0.05f; l->position[1] = 0.05f; l->position[2] = 0.05f; l->inverse_square = 1; l->intensity = HD_MAX_LIGHT_POWER; d->light_count = 1; }
+static void x_int_max(hd_desc *d, hd_light *l) { l->intensity = FLT_MAX; d->light_count = 1; }
+static void x_col_max(hd_desc *d, hd_light *l) { l->intensity = 2.0f; l->color[0] = FLT_MAX; l->color[1] = 1.0f; d->light_count = 1; }
+static void x_power_limit(hd_desc *d, hd_light *l) { l->intensity = HD_MAX_LIGHT_POWER; d->light_count = 1; d->params.albedo = 1.0f; }
+static void x_eye_far(hd_desc *d, hd_light *l) { (void)l; d->camera.eye[2] = 1e30f; }
+static void x_target_far(hd_desc *d, hd_light *l) { (void)l; d->camera.eye[2] = 2.5f; d->camera.target[0] = -1e30f; }
+static void x_int_max_col_min(hd_desc *d, hd_light *l) { l->intensity = FLT_MAX; l->color[2] = FLT_MIN; d->light_count = 1; }
+static void x_up_tiny(hd_desc *d, hd_light *l) { (void)l; d->camera.up[0] = 1e-24f; }
+static void x_bg_max(hd_desc *d, hd_light *l) { (void)l; d->params.background[0] = FLT_MAX; d->params.background[2] = 1e30f; }
+
+static const hx_case hx_cases[] = {
+    {"spacing 1e-30, 1, 1e30", HD_ERROR_INVALID_SPACING, x_sp_mixed},
+    {"spacing 1e-30, 1, 1", HD_ERROR_INVALID_SPACING, x_sp_tiny},
+    {"spacing denormal, 1, 1", HD_ERROR_INVALID_SPACING, x_sp_denormal_one},
+    {"spacing FLT_MAX, FLT_MAX, 1", HD_ERROR_INVALID_SPACING, x_sp_max_one},
+    {"spacing FLT_MAX x3", HD_SUCCESS, x_sp_max_all},
+    {"spacing denormal x3", HD_SUCCESS, x_sp_denormal_all},
+    {"spacing 1e30 x3", HD_SUCCESS, x_sp_1e30_all},
+    {"majorant FLT_MAX", HD_ERROR_INVALID_PARAMETER, x_maj_max},
+    {"direction 1e30", HD_SUCCESS, x_dir_huge},
+    {"direction FLT_MAX", HD_SUCCESS, x_dir_max},
+    {"direction 1e-30", HD_SUCCESS, x_dir_tiny},
+    {"direction denormal", HD_SUCCESS, x_dir_denormal},
+    {"point light at 1e30", HD_ERROR_INVALID_LIGHT, x_pt_far},
+    {"point light at 1e14, 1/r^2", HD_SUCCESS, x_pt_far_ok},
+    {"point light in the volume, 1/r^2, max power", HD_SUCCESS, x_pt_at_voxel},
+    {"intensity FLT_MAX", HD_ERROR_INVALID_LIGHT, x_int_max},
+    {"colour FLT_MAX", HD_ERROR_INVALID_LIGHT, x_col_max},
+    {"power at the limit, albedo 1", HD_SUCCESS, x_power_limit},
+    {"camera eye at 1e30", HD_ERROR_INVALID_CAMERA, x_eye_far},
+    {"camera target at -1e30", HD_ERROR_INVALID_CAMERA, x_target_far},
+    {"background FLT_MAX", HD_SUCCESS, x_bg_max},
+    {"intensity FLT_MAX, colour {0, 0, FLT_MIN}", HD_SUCCESS, x_int_max_col_min},
+    {"camera up {1e-24, 0, 0}", HD_SUCCESS, x_up_tiny},
+};
+
+static int hx_image_finite(hd_context ctx)
+{
+    static float img[8 * 8 * 4];
+    int i;
+    if (hd_read_image_f32(ctx, img, 8 * 8 * 4) != HD_SUCCESS) return 0;
+    for (i = 0; i < 8 * 8 * 4; ++i)
+        if (!(img[i] - img[i] == 0.0f)) return 0;
+    return 1;
+}
+
+static void test_hostile_extremes(void)
+{
+    size_t i;
+    alarm(300); /* every case takes milliseconds; a hang ends the run */
+    for (i = 0; i < sizeof hx_cases / sizeof hx_cases[0]; ++i) {
+        hd_desc d;
+        hd_light l;
+        hd_context ctx;
+        hd_result r;
+        hs_desc(&d);
+        memset(&l, 0, sizeof l);
+        l.direction[2] = -1.0f;
+        d.lights = &l;
+        d.light_count = 1;
+        hx_cases[i].edit(&d, &l);
+        memset(&hs, 0, sizeof hs);
+        r = hd_create(&d, &ctx);
+        CHECK_MSG(r == hx_cases[i].expect, "%s: got %s, want %s", hx_cases[i].name, hd_result_string(r),
+                  hd_result_string(hx_cases[i].expect));
+        if (r != HD_SUCCESS) {
+            CHECK_MSG(hs.errors == 1 && hs.last == r, "%s: %d errors logged", hx_cases[i].name, hs.errors);
+        } else {
+            hd_params p;
+            hd_desc q;
+            CHECK_MSG(hd_iterate(ctx, 2) == HD_SUCCESS, "%s: HD iterate", hx_cases[i].name);
+            CHECK_MSG(hx_image_finite(ctx), "%s: HD image not finite", hx_cases[i].name);
+            CHECK(hd_query_desc(ctx, &q) == HD_SUCCESS);
+            p = q.params;
+            p.method = HD_METHOD_PT_MS;
+            CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+            CHECK_MSG(hd_iterate(ctx, 2) == HD_SUCCESS, "%s: PT_MS iterate", hx_cases[i].name);
+            CHECK_MSG(hx_image_finite(ctx), "%s: PT_MS image not finite", hx_cases[i].name);
+            CHECK_MSG(hs.errors == 0, "%s: %d errors logged", hx_cases[i].name, hs.errors);
+            CHECK(hd_destroy(ctx) == HD_SUCCESS);
+        }
+        CHECK(hs.live == 0);
+    }
+    alarm(0);
+}
+
 /* Names of out-of-range enums and the context limit. */
 static void test_hostile_misc(void)
 {
@@ -290,5 +416,6 @@ const hd_test_case hd_tests_hostile[] = {
     {"hostile_args_table", test_hostile_args},
     {"hostile_handles", test_hostile_handles},
     {"hostile_misc", test_hostile_misc},
+    {"hostile_extremes", test_hostile_extremes},
 };
 const int hd_tests_hostile_count = sizeof hd_tests_hostile / sizeof hd_tests_hostile[0];

@@ -18,6 +18,20 @@
 #define HD_INV_4PI 0.0795774715f
 /* Ratio tracking stops by Russian roulette below this transmittance (unbiased). */
 #define HD_RR_THRESHOLD 0.1f
+/* Loop bounds, the same on every backend, so no input can hang a kernel (README "Guarantees").
+   HD_MAX_TRACK_STEPS: collisions plus majorant cells of one hd_track walk, so an iteration costs
+   at most that per voxel (per path vertex for the path tracers). A walk expects the majorant's
+   optical depth along it (majorant * distance, <= 1.74 * majorant per world unit) plus the
+   cells it crosses (<= 3 * 2048); the bound is reached only beyond about 3.8e4 per world unit
+   (extinction, or a global majorant, which hd_create keeps within 16x the largest sigma_t), or
+   where the free path no longer advances t. Such a walk is taken as absorbed: T = 0, and the
+   collision at the current t.
+   HD_MAX_MARCH_STEPS: samples of one projection ray. The chord is at most the diagonal and a
+   step at least 0.01 voxel of at least 1 / HD_MAX_SPACING_RATIO (1.13e7 steps), so the bound
+   (2^24, where step indices stay exact in float) never shortens a valid march. */
+#define HD_MAX_TRACK_STEPS 65536
+#define HD_MAX_MARCH_STEPS 16777216
+#define HD_BOX_DIAGONAL 1.7320509f
 
 /* ---- random numbers: a stateless hash of 32-bit integers, bit-identical everywhere -------- */
 /* lowbias32 (C. Wellons): full avalanche with two multiplies. */
@@ -141,7 +155,8 @@ HD_FN float hd_box_entry(HD_KARGS hd_v3 o, hd_v3 d, HD_INOUT(float) t_exit)
    Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim.
    hd_track is the shared walker: with HD_TRACK_DELTA it also reports in *t_hit the distance of
    the real collision that ended the walk (tmax when the ray got through), which makes it the
-   free-flight sampler of the path tracers (hd_free_flight); hd_transmittance wraps it. */
+   free-flight sampler of the path tracers (hd_free_flight); hd_transmittance wraps it.
+   At most HD_MAX_TRACK_STEPS collisions and cells; a walk that reaches it returns T = 0. */
 HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0, int mode,
                      HD_INOUT(hd_u32) next_dim, HD_INOUT(float) t_hit)
 {
@@ -169,6 +184,7 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
     float dy = gd.y != 0.0f ? hd_absf(1.0f / gd.y) : inf;
     float dz = gd.z != 0.0f ? hd_absf(1.0f / gd.z) : inf;
     int global_majorant = (HD_PRM(counts).z & HD_FLAG_GLOBAL_MAJORANT) != 0 ? 1 : 0;
+    int steps = 0; /* collisions and cells, at most HD_MAX_TRACK_STEPS */
     while (done == 0 && t < tmax) {
         float t_end = global_majorant != 0 ? tmax : hd_minf(hd_minf(nx, ny), hd_minf(nz, tmax));
         float mu = global_majorant != 0 ? HD_PRM(medium).w
@@ -181,6 +197,8 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
                 dim += 1u;
                 t -= hd_log(1.0f - xi) * inv_mu;
                 if (t >= t_end) break;
+                steps += 1;
+                if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; done = 1; hit = t; break; }
                 sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
                 ratio = hd_minf(sig * inv_mu, 1.0f);
                 if (mode == HD_TRACK_DELTA) {
@@ -198,8 +216,11 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
                 if (done != 0) break;
             }
         }
+        if (done != 0) break;
         t = t_end;
         if (global_majorant != 0) break;
+        steps += 1;
+        if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; hit = t; break; }
         /* step into the next cell along the axis whose boundary comes first */
         if (nx <= ny && nx <= nz) { cx += sx; nx += dx; if (cx < 0 || cx >= HD_PRM(mdims).x) break; }
         else if (ny <= nz) { cy += sy; ny += dy; if (cy < 0 || cy >= HD_PRM(mdims).y) break; }

@@ -14,6 +14,8 @@
        after Russian roulette from HD_PT_RR_BOUNCES vertices on, until counts.w vertices.
    PT_SS is this kernel with counts.w = 1 and g = 0 (set by the host): one collision, one shadow
    ray, isotropic phase; so PT_MS with max_bounces = 1 and g = 0 is the same estimator.
+   Every loop is bounded: at most counts.w (max_bounces <= 100000) vertices per path, each
+   free flight and shadow ray at most HD_MAX_TRACK_STEPS (hd_track).
    A camera ray that leaves the box unscattered sees the background; scattered rays that leave
    add nothing (the background is a backdrop, not a light, as in HD's projection). Alpha is 1 if
    the camera ray collides, so its mean is 1 - T_cam as in the projection.

@@ -77,12 +77,13 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
     }
 }
 
-/* The samples sit at t0 + (jitter + k) dt along the camera ray. Empty space is skipped through
-   the majorant grid (cells of mdims.w voxels, each majorant bounding every trilinear sample
-   inside the cell with a one-voxel halo, hd_context.h): in a cell whose majorant is 0 every
-   sample has sigma_t = 0 and adds nothing, so the march jumps to the first sample past the
-   cell's exit; the samples taken are the same as without the skip. The march stops once the
-   transmittance falls below march.z. */
+/* The samples sit at s0 + n dt from the ray's entry into the box, n counted (s0: the jitter), so
+   the step advances however far the eye is; the chord is at most the box diagonal and n stays
+   below HD_MAX_MARCH_STEPS. Empty space is skipped through the majorant grid (cells of mdims.w
+   voxels, each majorant bounding every trilinear sample inside the cell with a one-voxel halo,
+   hd_context.h): in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing, so
+   the march jumps to the first sample past the cell's exit; the samples taken are the same as
+   without the skip. The march stops once the transmittance falls below march.z. */
 HD_FN void hd_project_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
@@ -93,34 +94,42 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
     float dt = HD_PRM(march).x;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
-    float t = t0 + hd_rand(key, 2u) * dt;
-    /* the ray in majorant-cell coordinates: q(t) = q0 + t * qd; iq: 1 / qd (0 where qd is 0) */
+    hd_v3 pe = hd_madd(o, d, t0);
+    float len = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
+    float s0 = hd_rand(key, 2u) * dt;
+    /* the ray in majorant-cell coordinates: q(s) = q0 + s * qd; iq: 1 / qd (0 where qd is 0) */
     float cell = HD_F(HD_PRM(mdims).w);
     hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);
-    hd_v3 q0 = hd_vmul(hd_world_to_tex(HD_KPASS o), cs);
+    hd_v3 q0 = hd_vmul(hd_world_to_tex(HD_KPASS pe), cs);
     hd_v3 qd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);
     hd_v3 iq = HD_V3(qd.x != 0.0f ? 1.0f / qd.x : 0.0f, qd.y != 0.0f ? 1.0f / qd.y : 0.0f,
                      qd.z != 0.0f ? 1.0f / qd.z : 0.0f);
     hd_i4 md = HD_PRM(mdims);
-    while (t < t1) {
-        hd_v3 q = hd_madd(q0, qd, t);
+    int n = 0;
+    float s = s0;
+    while (s < len && n < HD_MAX_MARCH_STEPS) {
+        hd_v3 q = hd_madd(q0, qd, s);
         int cx = hd_clampi(HD_I(hd_floor(q.x)), 0, md.x - 1);
         int cy = hd_clampi(HD_I(hd_floor(q.y)), 0, md.y - 1);
         int cz = hd_clampi(HD_I(hd_floor(q.z)), 0, md.z - 1);
         /* where the ray leaves the cell (or the box) */
-        float tc = t1;
-        if (qd.x != 0.0f) tc = hd_minf(tc, (HD_F(qd.x > 0.0f ? cx + 1 : cx) - q0.x) * iq.x);
-        if (qd.y != 0.0f) tc = hd_minf(tc, (HD_F(qd.y > 0.0f ? cy + 1 : cy) - q0.y) * iq.y);
-        if (qd.z != 0.0f) tc = hd_minf(tc, (HD_F(qd.z > 0.0f ? cz + 1 : cz) - q0.z) * iq.z);
+        float sc = len;
+        if (qd.x != 0.0f) sc = hd_minf(sc, (HD_F(qd.x > 0.0f ? cx + 1 : cx) - q0.x) * iq.x);
+        if (qd.y != 0.0f) sc = hd_minf(sc, (HD_F(qd.y > 0.0f ? cy + 1 : cy) - q0.y) * iq.y);
+        if (qd.z != 0.0f) sc = hd_minf(sc, (HD_F(qd.z > 0.0f ? cz + 1 : cz) - q0.z) * iq.z);
         if (HD_GET1(maj, (cz * md.y + cy) * md.x + cx) > 0.0f) {
             do {
-                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(o, d, t)), dt, HD_REF(T),
+                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T),
                                   HD_REF(r), HD_REF(g), HD_REF(b));
-                t += dt;
-            } while (t < tc && T >= HD_PRM(march).z);
+                ++n;
+                s = s0 + HD_F(n) * dt;
+            } while (s < sc && T >= HD_PRM(march).z && n < HD_MAX_MARCH_STEPS);
             if (T < HD_PRM(march).z) { T = 0.0f; break; }
         } else {
-            t += hd_maxf(hd_floor((tc - t) / dt) + 1.0f, 1.0f) * dt; /* the first sample past tc */
+            /* the first sample past sc */
+            float m = hd_floor((sc - s0) / dt) + 1.0f;
+            n = m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n + 1) : HD_MAX_MARCH_STEPS;
+            s = s0 + HD_F(n) * dt;
         }
     }
     hd_accumulate_pixel(HD_KPASS i, HD_V4(r + T * HD_PRM(background).x, g + T * HD_PRM(background).y,

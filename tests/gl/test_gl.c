@@ -16,6 +16,9 @@
       both signs, the midpoint above it (a tie) and the floats either side of that midpoint,
       and for overflow (>= 65520: inf) and inf; the same store without hd_f16_round is counted
       and printed (llvmpipe truncates), not checked: a driver may round.
+   5. the caller's context (use_current_context) not current, or another one current: hd_iterate
+      and hd_read_image_f32 return HD_ERROR_GL_CONTEXT_NOT_CURRENT with one logged error and count
+      no iteration; with it current again the context goes on from the iterations that ran.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -333,6 +336,57 @@ static void check_f16_round(void)
            n - bad, n, n - raw);
 }
 
+static int nc_errors;
+static hd_result nc_last;
+static void nc_log(void *u, hd_log_level level, hd_result code, const char *msg, const char *f, int l)
+{
+    (void)u; (void)msg; (void)f; (void)l;
+    if (level == HD_LOG_ERROR) { ++nc_errors; nc_last = code; }
+}
+
+/* Check 5: calls on a caller's-context backend whose context is not current. */
+static void check_not_current(EGLDisplay dpy, EGLConfig cfg, const EGLint *attrs, EGLContext host)
+{
+    static uint8_t vox[16 * 16 * 16];
+    static float img[48 * 40 * 4];
+    EGLContext other = eglCreateContext(dpy, cfg, EGL_NO_CONTEXT, attrs);
+    hd_desc d;
+    hd_context c;
+    hd_stats st;
+    hd_result r;
+    int k;
+    make_desc(&d, vox, 16);
+    d.gl.use_current_context = 1;
+    d.logger.func = nc_log;
+    CHECK(other != EGL_NO_CONTEXT, "not current: a second EGL context");
+    r = hd_create(&d, &c);
+    CHECK(r == HD_SUCCESS, "not current: hd_create: %s", hd_result_string(r));
+    if (r != HD_SUCCESS) return;
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS, "not current: first iterate");
+    for (k = 0; k < 2; ++k) { /* none current, then another one */
+        const char *what = k == 0 ? "no context current" : "another context current";
+        eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, k == 0 ? EGL_NO_CONTEXT : other);
+        nc_errors = 0;
+        r = hd_iterate(c, 2);
+        CHECK(r == HD_ERROR_GL_CONTEXT_NOT_CURRENT && nc_errors == 1 && nc_last == r, "%s: hd_iterate: %s, %d errors",
+              what, hd_result_string(r), nc_errors);
+        nc_errors = 0;
+        r = hd_read_image_f32(c, img, sizeof img / sizeof img[0]);
+        CHECK(r == HD_ERROR_GL_CONTEXT_NOT_CURRENT && nc_errors == 1, "%s: hd_read_image_f32: %s, %d errors", what,
+              hd_result_string(r), nc_errors);
+        CHECK(hd_get_stats(c, &st) == HD_SUCCESS && st.iterations == 1, "%s: %llu iterations counted, 1 ran", what,
+              (unsigned long long)st.iterations);
+    }
+    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, host);
+    nc_errors = 0;
+    CHECK(hd_iterate(c, 2) == HD_SUCCESS && nc_errors == 0, "not current: iterate with the context current again");
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS && st.iterations == 3, "not current: %llu iterations after 3 ran",
+          (unsigned long long)st.iterations);
+    CHECK(hd_read_image_f32(c, img, sizeof img / sizeof img[0]) == HD_SUCCESS, "not current: read with the context current");
+    hd_destroy(c);
+    if (other != EGL_NO_CONTEXT) eglDestroyContext(dpy, other);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -353,6 +407,7 @@ int main(void)
     printf("host context: %s\n", (const char *)glGetString(GL_RENDERER));
     check_f16_round();
     run_calls(1, "caller's context");
+    check_not_current(dpy, cfg, ctx_attrs, host);
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
     {
