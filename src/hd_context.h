@@ -679,7 +679,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
     if (dirty & HD__DIRTY_IMAGE) ctx->frames = ctx->converged_frames = 0;
     /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
     if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
-    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) hd__conv_reset(ctx);
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) {
+        hd__conv_reset(ctx);
+        ctx->light_gen++;
+    }
     hd__fill_kparams(ctx);
     if (dirty & HD__DIRTY_SIGMA) {
         if ((r = hd__be_upload_inputs(ctx)) != HD_SUCCESS) return r;

@@ -84,6 +84,7 @@ typedef struct hd__ctx {
     double light_error;
     uint64_t converged_frames; /* projection frames since the light converged */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
+    unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     hd__backend *be;
 } hd__ctx;
 

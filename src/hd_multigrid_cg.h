@@ -15,6 +15,7 @@ typedef struct hd__mg_cg {
     hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
     int have_dir;            /* the backend's p holds a direction of the current CG run */
     double rz;               /* <r, z> of the previous step (beta's denominator) */
+    unsigned light_gen;      /* the context's light_gen of the current CG run */
 } hd__mg_cg;
 
 /* A new state for a backend whose sigma_t generation is sig_gen: the first step restricts. */
@@ -26,7 +27,7 @@ HD__MAYBE_UNUSED static void hd__mg_cg_init(hd__mg_cg *cg, unsigned sig_gen)
 
 /* The start of a step, for a backend at sigma_t generation sig_gen. *restart: CG restarts (a new
    HD iteration brought a new E, or A changed); *stale: besides, the iterate's low part belongs to
-   another phi (A changed, or phi was reset: the iteration count went back; it is at most half an
+   another phi (A changed, or E and phi were reset: ctx->light_gen moved on; it is at most half an
    ulp of phi, so a stale one would only perturb the start) and the backend zeroes it. Returns
    whether the coarse sigma_t must be restricted again (sigma_t or the boundary changed): the
    backend does so, then calls hd__mg_cg_restricted. */
@@ -40,10 +41,12 @@ HD__MAYBE_UNUSED static int hd__mg_cg_begin(hd__mg_cg *cg, const hd__ctx *ctx, u
     key.medium = ctx->kp.medium;
     key.grid = ctx->kp.grid;
     key.gridh = ctx->kp.gridh;
-    *stale = resig || memcmp(&key, &cg->akey, sizeof key) != 0 || ctx->iterations < cg->iteration;
+    *stale = resig || memcmp(&key, &cg->akey, sizeof key) != 0 || ctx->iterations < cg->iteration ||
+             cg->light_gen != ctx->light_gen;
     *restart = *stale || !cg->have_dir || cg->iteration != ctx->iterations;
     cg->akey = key;
     cg->iteration = ctx->iterations;
+    cg->light_gen = ctx->light_gen;
     return resig;
 }
 
@@ -54,10 +57,12 @@ HD__MAYBE_UNUSED static void hd__mg_cg_restricted(hd__mg_cg *cg, const hd__ctx *
     cg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
 }
 
-/* beta = <r, z> / the previous <r, z>, 0 at a restart (or without a positive previous one). */
+/* beta = <r, z> / the previous <r, z>, 0 at a restart (or without a positive previous one, or
+   where the ratio is not a finite float: the run restarts rather than carry an overflow). */
 HD__MAYBE_UNUSED static float hd__mg_cg_beta(hd__mg_cg *cg, double rz, int restart)
 {
-    float beta = restart || !(cg->rz > 0.0) ? 0.0f : (float)(rz / cg->rz);
+    double q = restart || !(cg->rz > 0.0) ? 0.0 : rz / cg->rz;
+    float beta = q >= 0.0 && q <= 3.4e38 ? (float)q : 0.0f;
     cg->rz = rz;
     return beta;
 }
