@@ -47,7 +47,8 @@ static void test_refine_is_iterate_without_frames(void)
     hd_context a, b;
     hd_stats s;
     make_desc(&d, NULL);
-    CHECK(hd_create(&d, &a) == HD_SUCCESS && hd_create(&d, &b) == HD_SUCCESS);
+    CHECK(hd_create(&d, &a) == HD_SUCCESS);
+    CHECK(hd_create(&d, &b) == HD_SUCCESS);
     CHECK(hd_iterate(a, 6) == HD_SUCCESS);
     CHECK(hd_refine(b, 6) == HD_SUCCESS);
     read_light(a, e0, p0);
