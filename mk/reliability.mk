@@ -92,7 +92,7 @@ $(SAN)/hdtest-vg: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SA
 	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(VG_CFLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
 # The suites that exercise the API, the loaders and the error paths; the numeric suites
 # (kernels_, methods_) take >10 min under memcheck and run under ASan instead.
-VG_SUITES ?= core_ io hostile alloc_fail tf_ render_
+VG_SUITES ?= core_ io_ hostile alloc_fail tf_ render_
 valgrind: $(SAN)/hdtest-vg
 	@set -e; for s in $(VG_SUITES); do echo "valgrind: hdtest $$s"; \
 	  valgrind -q --error-exitcode=9 --leak-check=full --errors-for-leak-kinds=definite,indirect \
