@@ -550,14 +550,12 @@ static void hd__conv_free(hd__ctx *ctx)
 /* The illumination-grid voxels the estimate is taken over: those whose majorant cell holds
    medium (the projection reads E and phi only there; light in air is exact and would dilute
    the relative error). */
-static int hd__mini_c(int a, int b) { return a < b ? a : b; }
-
 static int hd__conv_in_medium(const hd__ctx *ctx, int x, int y, int z)
 {
     int f = ctx->params.illumination_downsample, c = HD__MAJORANT_CELL;
-    int vx = hd__mini_c(x * f + f / 2, ctx->dims[0] - 1);
-    int vy = hd__mini_c(y * f + f / 2, ctx->dims[1] - 1);
-    int vz = hd__mini_c(z * f + f / 2, ctx->dims[2] - 1);
+    int vx = hd_mini(x * f + f / 2, ctx->dims[0] - 1);
+    int vy = hd_mini(y * f + f / 2, ctx->dims[1] - 1);
+    int vz = hd_mini(z * f + f / 2, ctx->dims[2] - 1);
     return ctx->majorant[((size_t)(vz / c) * ctx->mdims[1] + (size_t)(vy / c)) * ctx->mdims[0] + (size_t)(vx / c)] > 0.0f;
 }
 
