@@ -17,11 +17,8 @@ GL_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
 $(B)/conf_impl_gl.o: $(GL_CONF)/impl_backend.c $(GL_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conf_impl_cpu_gl.o: $(GL_CONF)/impl_cpu.c $(GL_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conformance_gl.o: $(GL_CONF)/conformance.c $(GL_CONF)/hd_api.h hybriddiff.h | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conformance-gl: $(B)/conformance_gl.o $(B)/conf_impl_cpu_gl.o $(B)/conf_impl_gl.o
+# The driver and the CPU reference are the OpenCL suite's objects (mk/opencl.mk): one compile each.
+$(B)/conformance-gl: $(B)/conformance.o $(B)/conf_impl_cpu.o $(B)/conf_impl_gl.o
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(GL_LDLIBS)
 
 conformance-gl: $(B)/conformance-gl

@@ -34,9 +34,12 @@ $(FZ) $(SAN):
 	mkdir -p $@
 
 # ---- fuzzing ----
-$(FZ)/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/hd_fuzz_check.h $(LIB_SRC) | $(FZ)
-	$(SAN_CC) $(CPPFLAGS) $(WARN) $(SAN_COMMON) -fsanitize=fuzzer,address,undefined \
-		-fno-sanitize-recover=all $< -o $@ $(LDLIBS)
+FUZZ_SAN := $(SAN_COMMON) -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all
+# The implementation is compiled once (tests/fuzz/hd_impl_fuzz.c) and linked into every target.
+$(FZ)/hd_impl_fuzz.o: tests/fuzz/hd_impl_fuzz.c $(LIB_SRC) | $(FZ)
+	$(SAN_CC) $(CPPFLAGS) $(WARN) $(FUZZ_SAN) -c $< -o $@
+$(FZ)/fuzz_%: tests/fuzz/fuzz_%.c tests/fuzz/hd_fuzz_check.h $(FZ)/hd_impl_fuzz.o $(LIB_SRC) | $(FZ)
+	$(SAN_CC) $(CPPFLAGS) $(WARN) $(FUZZ_SAN) $< $(FZ)/hd_impl_fuzz.o -o $@ $(LDLIBS)
 $(FZ)/make_seeds: tests/fuzz/make_seeds.c tests/fuzz/hd_fuzz_gen.h | $(FZ)
 	$(CC) $(CPPFLAGS) $(WARN) -O1 $< -o $@ -lz
 $(FZ)/seeds.stamp: $(FZ)/make_seeds

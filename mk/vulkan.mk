@@ -26,11 +26,8 @@ VK_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
 $(B)/conf_impl_vk.o: $(VK_CONF)/impl_vk.c $(VK_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conf_impl_cpu_vk.o: $(VK_CONF)/impl_cpu.c $(VK_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conformance_vk.o: $(VK_CONF)/conformance.c $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/conformance-vulkan: $(B)/conformance_vk.o $(B)/conf_impl_cpu_vk.o $(B)/conf_impl_vk.o
+# The driver and the CPU reference are the OpenCL suite's objects (mk/opencl.mk): one compile each.
+$(B)/conformance-vulkan: $(B)/conformance.o $(B)/conf_impl_cpu.o $(B)/conf_impl_vk.o
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)
 
 conformance-vulkan: $(B)/conformance-vulkan
@@ -60,7 +57,7 @@ bench-vulkan: $(B)/hdbench_vulkan data
 
 $(B)/hdbench_mg_vulkan.o: bench/hdbench_mg_vulkan.c $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu_vk.o $(B)/conf_impl_vk.o
+$(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu.o $(B)/conf_impl_vk.o
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)
 
 bench-vulkan-multigrid: $(B)/hdbench_mg_vulkan data

@@ -7,9 +7,7 @@
    give a context that runs one iteration, and a second after hd_set_lights / hd_set_camera /
    hd_set_params with more of the bytes, with a finite image and finite illumination; anything
    else aborts, which keeps the input. */
-#define HYBRIDDIFF_IMPLEMENTATION
-#define HYBRIDDIFF_BACKEND_CPU
-#include "hybriddiff.h"
+#include "hybriddiff.h" /* the implementation: tests/fuzz/hd_impl_fuzz.c */
 #include <float.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,8 +1,6 @@
 /* fuzz_mhd.c - libFuzzer target: hd_volume_parse_mhd; the input is both the header and the
    detached data file's bytes (so LOCAL and detached paths both run). */
-#define HYBRIDDIFF_IMPLEMENTATION
-#define HYBRIDDIFF_BACKEND_CPU
-#include "hybriddiff.h"
+#include "hybriddiff.h" /* the implementation: tests/fuzz/hd_impl_fuzz.c */
 #include "tests/fuzz/hd_fuzz_check.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -1,7 +1,5 @@
 /* fuzz_nifti.c - libFuzzer target: hd_volume_parse_nifti (.nii and .nii.gz bytes). */
-#define HYBRIDDIFF_IMPLEMENTATION
-#define HYBRIDDIFF_BACKEND_CPU
-#include "hybriddiff.h"
+#include "hybriddiff.h" /* the implementation: tests/fuzz/hd_impl_fuzz.c */
 #include "tests/fuzz/hd_fuzz_check.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
