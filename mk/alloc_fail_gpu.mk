@@ -25,4 +25,5 @@ alloc-fail-opencl: $(AFG)/alloc-fail-opencl
 device-oom-opencl: $(AFG)/device-oom-opencl
 	POCL_MEMORY_LIMIT=1 $(AFG)/device-oom-opencl
 
+TEST_PROGRAMS += $(AFG)/alloc-fail-opencl $(AFG)/device-oom-opencl
 test: alloc-fail-opencl device-oom-opencl

@@ -33,6 +33,7 @@ test-gl: $(B)/test_gl
 compile-gl-cxx: | $(B)
 	$(CXX) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(GL_CXXWARN) -O1 -x c++ -c $(GL_CONF)/impl_backend.c -o $(B)/conf_impl_gl_cxx.o
 
+TEST_PROGRAMS += $(B)/conformance-gl $(B)/test_gl
 test: conformance-gl test-gl compile-gl-cxx
 
 # ---- the viewer -------------------------------------------------------------------------------
@@ -64,6 +65,7 @@ test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	{ grep -v " info: " $(B)/gl/hdview-orbit.log || true; } && \
 	$(B)/pngcmp --nonblank $(B)/gl/hdview-orbit.png; fi
 
+TEST_PROGRAMS += $(B)/hdview $(B)/hdrender $(B)/pngcmp
 test: test-hdview
 
 $(B)/hdbench_gl: bench/hdbench_gl.c $(LIB_SRC) | $(B)

@@ -44,4 +44,5 @@ valgrind-opencl: $(B)/conformance-opencl
 bench-opencl: $(B)/hdbench_opencl
 	$(B)/hdbench_opencl
 
+TEST_PROGRAMS += $(B)/conformance-opencl
 test: conformance-opencl compile-opencl-cxx

@@ -109,6 +109,8 @@ valgrind: $(SAN)/hdtest-vg
 # machine): 200,000 runs of fuzz_nrrd 21-24 s against 9.4-9.7 s, fuzz_mhd 18-22 s against 10-11 s.
 check-all: test
 
+TEST_PROGRAMS += $(FUZZ_TARGETS:%=$(FZ)/fuzz_%) $(FZ)/fuzz_api $(FZ)/make_seeds $(SAN)/hdtest-asan \
+                 $(SAN)/conformance-asan $(SAN)/hdtest-tsan $(SAN)/hdtest-vg
 test: fuzz-smoke asan tsan valgrind
 
 # ---- soak ----
@@ -119,6 +121,7 @@ soak: $(B)/hdsoak
 .PHONY: soak-short
 soak-short: $(B)/hdsoak
 	$(B)/hdsoak 500 24
+TEST_PROGRAMS += $(B)/hdsoak
 test: soak-short
 
 # ---- the API fuzzer (tests/fuzz/fuzz_api.c): hd_desc / hd_params / lights / camera bytes with

@@ -63,4 +63,5 @@ $(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu.o $(B)/conf_
 bench-vulkan-multigrid: $(B)/hdbench_mg_vulkan data
 	$(B)/hdbench_mg_vulkan data/head.nrrd $(BENCH_ARGS)
 
+TEST_PROGRAMS += $(B)/conformance-vulkan $(B)/test_vulkan
 test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx
