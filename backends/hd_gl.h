@@ -45,6 +45,11 @@
    the caller's GL_RGBA8 2D texture (hybriddiff.h). */
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+/* <GL/gl.h> first, as GLFW and SDL include it: a window header included after this file then
+   still finds the GL 1.1 prototypes it expects (it skips its own include once GL is defined). */
+#if !defined(__gl_h_) && !defined(__GL_H__) && !defined(__gl_glcorearb_h_)
+#include <GL/gl.h>
+#endif
 #include <GL/glcorearb.h>
 #include "hd_glsl_embedded.h"
 
