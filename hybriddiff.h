@@ -52,6 +52,24 @@
    Threading: calls on one context must not overlap; different contexts may be used from
    different threads at the same time.
 
+   Integration (docs/INTEGRATION.md has each rule in full, examples/integrate_* use them)
+      - Include order: the implementation compiles under plain -std=c99 or -std=c++17 before or
+        after <stdio.h>, <stdlib.h>, <time.h>, <pthread.h>, vulkan.h, cl.h or glfw3.h, and
+        leaves no feature macro or VK_NO_PROTOTYPES behind. Strict C only: <unistd.h>,
+        <fcntl.h> or <sys/stat.h> before it needs -D_POSIX_C_SOURCE=200809L.
+      - Zero initialisers for C and C++: HD_DESC_INIT, HD_PARAMS_INIT, HD_LIGHT_INIT, ...
+      - Volume: x fastest, then y, then z; a box centred on 0 whose largest side is 1;
+        value_range maps raw values to TF 0..1 ({0,0}: the type's range); the loaders set it to
+        the file's min/max.
+      - Your GL context: desc.gl.use_current_context = 1, get_proc_address = glfwGetProcAddress;
+        it must be current at every call; the GL state each call touches is restored (program,
+        buffer bindings 0..3, image units 0..6, texture unit 0's 2D/3D bindings, pixel store).
+        The library's own EGL context cannot be current beside a GLX context on one thread
+        (libglvnd): pass yours, or make yours not current around the calls.
+      - Your Vulkan device: desc.vulkan.instance/physical_device/device/queue/queue_family and
+        get_instance_proc_addr = (hd_proc)vkGetInstanceProcAddr; hd_vulkan_record records into
+        your command buffer. Your OpenCL context: desc.opencl.context/device/queue (retained).
+
    Changelog
       0.1  first release: CPU backend, hybrid diffusion method.
 */
