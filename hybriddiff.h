@@ -17,8 +17,8 @@
       Only stage 3 depends on the camera: moving the camera keeps the converged illumination, and
       hd_render stops all light work once the light has converged (hd_stats.light_converged).
 
-   Quick start
-      hd_desc desc = {0};
+   Quick start (C and C++; docs/INTEGRATION.md has the rest)
+      hd_desc desc = HD_DESC_INIT;              // all zero: every default
       desc.volume.type = HD_VOXEL_U8;
       desc.volume.dims[0] = 128; desc.volume.dims[1] = 128; desc.volume.dims[2] = 84;
       desc.volume.data = voxels;                 // copied; may be freed after hd_create
@@ -52,22 +52,29 @@
    Threading: calls on one context must not overlap; different contexts may be used from
    different threads at the same time.
 
+   Integration (docs/INTEGRATION.md has each rule in full, examples/integrate_* use them)
+      - Include order: the implementation compiles under plain -std=c99 or -std=c++17 before or
+        after <stdio.h>, <stdlib.h>, <time.h>, <pthread.h>, vulkan.h, cl.h or glfw3.h, and
+        leaves no feature macro or VK_NO_PROTOTYPES behind. Strict C only: <unistd.h>,
+        <fcntl.h> or <sys/stat.h> before it needs -D_POSIX_C_SOURCE=200809L.
+      - Zero initialisers for C and C++: HD_DESC_INIT, HD_PARAMS_INIT, HD_LIGHT_INIT, ...
+      - Volume: x fastest, then y, then z; a box centred on 0 whose largest side is 1;
+        value_range maps raw values to TF 0..1 ({0,0}: the type's range); the loaders set it to
+        the file's min/max.
+      - Your GL context: desc.gl.use_current_context = 1, get_proc_address = glfwGetProcAddress;
+        it must be current at every call; the GL state each call touches is restored (program,
+        buffer bindings 0..3, image units 0..6, texture unit 0's 2D/3D bindings, pixel store).
+        The library's own EGL context cannot be current beside a GLX context on one thread
+        (libglvnd): pass yours, or make yours not current around the calls.
+      - Your Vulkan device: desc.vulkan.instance/physical_device/device/queue/queue_family and
+        get_instance_proc_addr = (hd_proc)vkGetInstanceProcAddr; hd_vulkan_record records into
+        your command buffer. Your OpenCL context: desc.opencl.context/device/queue (retained).
+
    Changelog
       0.1  first release: CPU backend, hybrid diffusion method.
 */
 #ifndef HYBRIDDIFF_H
 #define HYBRIDDIFF_H
-
-/* The implementation uses clock_gettime and pthreads, which are POSIX: a strict -std=c99 build
-   needs this before any system header, so include hybriddiff.h first in the implementation file
-   (or build with -D_POSIX_C_SOURCE=200809L, or -std=gnu99). */
-#if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_POSIX_C_SOURCE) && !defined(_WIN32)
-#define _POSIX_C_SOURCE 200809L
-#endif
-/* realpath (the MetaImage loader's folder check) is X/Open. */
-#if defined(HYBRIDDIFF_IMPLEMENTATION) && !defined(_XOPEN_SOURCE) && !defined(_WIN32)
-#define _XOPEN_SOURCE 700
-#endif
 
 #include <stddef.h>
 #include <stdint.h>
@@ -119,7 +126,8 @@ extern "C" {
     X(HD_ERROR_FILE_NOT_REGULAR, "the path is a directory, device, FIFO or socket, not a file") \
     X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
     X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes") \
-    X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current")
+    X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current") \
+    X(HD_ERROR_INVALID_TEXTURE, "GL backend: the texture is not a GL_RGBA8 2D texture of the camera's size")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -193,6 +201,21 @@ typedef enum hd_illumination {
     HD_ILLUMINATION_COUNT
 } hd_illumination;
 
+/* ---- zero initialisers ------------------------------------------------------------------------ */
+/* Every struct of this header is valid zeroed ("default" everywhere). `= {0}` is not C++ for a
+   struct whose first member is an enum, and `= {}` is not C99: these work in both.
+      hd_desc desc = HD_DESC_INIT;   hd_params p = HD_PARAMS_INIT;   hd_light l = HD_LIGHT_INIT; */
+#ifdef __cplusplus
+#define HD_ZERO_INIT {}
+#else
+#define HD_ZERO_INIT {0}
+#endif
+#define HD_DESC_INIT HD_ZERO_INIT
+#define HD_PARAMS_INIT HD_ZERO_INIT
+#define HD_LIGHT_INIT HD_ZERO_INIT
+#define HD_CAMERA_INIT HD_ZERO_INIT
+#define HD_LOAD_OPTIONS_INIT HD_ZERO_INIT
+
 /* ---- callbacks ------------------------------------------------------------------------------ */
 /* Silent unless a logger is given. hd_log_stderr is a ready one. */
 typedef void (*hd_log_fn)(void *user_data, hd_log_level level, hd_result code, const char *message,
@@ -201,6 +224,10 @@ typedef struct hd_logger {
     hd_log_fn func;
     void *user_data;
 } hd_logger;
+
+/* A function pointer of any type: loaders (glfwGetProcAddress, eglGetProcAddress) return it, and
+   any function pointer converts to it and back by a cast, which ISO C and C++ allow. */
+typedef void (*hd_proc)(void);
 
 /* All or none: giving one of alloc/free without the other is HD_ERROR_NULL_POINTER. */
 typedef struct hd_allocator {
@@ -342,7 +369,8 @@ typedef struct hd_desc {
     struct {
         void *instance, *physical_device, *device, *queue; /* VkInstance... or NULL */
         uint32_t queue_family;
-        void *get_instance_proc_addr; /* PFN_vkGetInstanceProcAddr, or NULL for the loader's */
+        hd_proc get_instance_proc_addr; /* (hd_proc)vkGetInstanceProcAddr (or volk's), NULL for
+                                           the loader's */
         const char *device_name;      /* substring (or env HD_VK_DEVICE) */
         int enable_validation;
     } vulkan;
@@ -351,7 +379,8 @@ typedef struct hd_desc {
                                     at every later call that reaches GL (iterate, read, render,
                                     destroy), else HD_ERROR_GL_CONTEXT_NOT_CURRENT (the one current
                                     at hd_create, where EGL or GLX can tell) */
-        void *(*get_proc_address)(const char *name); /* NULL -> eglGetProcAddress */
+        hd_proc (*get_proc_address)(const char *name); /* glfwGetProcAddress (no cast),
+                                                      eglGetProcAddress; NULL -> eglGetProcAddress */
     } gl;
 } hd_desc;
 
@@ -559,6 +588,39 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #else /* exactly one backend: the implementation (skipped after an #error, so that is all the
          compiler reports) */
 
+/* The implementation calls POSIX 2008 (clock_gettime, pthreads, pread, lstat, realpath,
+   O_NOFOLLOW), which a strict -std=c99 translation unit hides. The feature set is widened for the
+   implementation's own system headers and restored after it, so the include order does not
+   matter and no feature macro leaks into or is needed from the including file. glibc fixes its
+   feature set at the first system header (<features.h>), so it is evaluated again both ways. */
+#if !defined(_WIN32)
+#include <limits.h> /* any C library header: brings glibc's <features.h> and __GLIBC__ */
+#if defined(__GLIBC__)
+#if !defined(__USE_XOPEN2K8) || !(defined(__USE_MISC) || defined(__USE_XOPEN_EXTENDED))
+#define HD__WIDEN_POSIX 1
+#endif
+#elif defined(__STRICT_ANSI__) && !defined(__cplusplus)
+#define HD__WIDEN_POSIX 1
+#endif
+#if defined(HD__WIDEN_POSIX)
+#pragma push_macro("_POSIX_C_SOURCE")
+#pragma push_macro("_XOPEN_SOURCE")
+#undef _POSIX_C_SOURCE
+#undef _XOPEN_SOURCE
+#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700
+#if defined(__GLIBC__)
+#undef _FEATURES_H
+#include <features.h>
+#endif
+#if !defined(__cplusplus)
+/* <stdlib.h> included before under the narrower set does not declare it; a compatible
+   redeclaration is valid C. */
+extern char *realpath(const char *path, char *resolved);
+#endif
+#endif
+#endif
+
 #include "backends/hd_prelude_c.h"
 #include "src/hd_internal.h"
 #include "backends/kernels/hd_kernels.h"
@@ -577,6 +639,18 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #include "src/hd_io.h"
 #include "src/hd_io_mhd.h"
 #include "src/hd_io_nifti.h"
+
+#if defined(HD__WIDEN_POSIX) /* the including file's feature set again */
+#undef _POSIX_C_SOURCE
+#undef _XOPEN_SOURCE
+#pragma pop_macro("_POSIX_C_SOURCE")
+#pragma pop_macro("_XOPEN_SOURCE")
+#if defined(__GLIBC__)
+#undef _FEATURES_H
+#include <features.h>
+#endif
+#undef HD__WIDEN_POSIX
+#endif
 
 #endif /* exactly one backend */
 #endif /* HYBRIDDIFF_IMPLEMENTATION_DONE */

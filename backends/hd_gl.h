@@ -45,6 +45,11 @@
    the caller's GL_RGBA8 2D texture (hybriddiff.h). */
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+/* <GL/gl.h> first, as GLFW and SDL include it: a window header included after this file then
+   still finds the GL 1.1 prototypes it expects (it skips its own include once GL is defined). */
+#if !defined(__gl_h_) && !defined(__GL_H__) && !defined(__gl_glcorearb_h_)
+#include <GL/gl.h>
+#endif
 #include <GL/glcorearb.h>
 #include "hd_glsl_embedded.h"
 
@@ -66,13 +71,19 @@
     X(GENBUFFERS, GenBuffers) X(DELETEBUFFERS, DeleteBuffers) X(BINDBUFFER, BindBuffer) \
     X(BUFFERDATA, BufferData) X(BUFFERSUBDATA, BufferSubData) X(GETBUFFERSUBDATA, GetBufferSubData) \
     X(BINDBUFFERBASE, BindBufferBase) X(BINDBUFFERRANGE, BindBufferRange) X(CLEARBUFFERDATA, ClearBufferData) \
-    X(GENTEXTURES, GenTextures) X(DELETETEXTURES, DeleteTextures) X(BINDTEXTURE, BindTexture) \
+    X(_HD_GENTEXTURES, GenTextures) X(_HD_DELETETEXTURES, DeleteTextures) X(_HD_BINDTEXTURE, BindTexture) \
     X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
     X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
     X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei)
 /* optional: GL 4.4 / ARB_clear_texture, KHR_debug */
 #define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
     X(DEBUGMESSAGECONTROL, DebugMessageControl)
+
+/* GL 1.1's texture entry points, typed here: a <GL/gl.h> included first (GLFW's) defines
+   GL_VERSION_1_1, and <GL/glcorearb.h> then leaves out their pointer types. */
+typedef void (APIENTRYP PFNGL_HD_GENTEXTURESPROC)(GLsizei n, GLuint *textures);
+typedef void (APIENTRYP PFNGL_HD_DELETETEXTURESPROC)(GLsizei n, const GLuint *textures);
+typedef void (APIENTRYP PFNGL_HD_BINDTEXTUREPROC)(GLenum target, GLuint texture);
 
 typedef struct hd__gl_fns {
 #define HD__GL_FN(up, name) PFNGL##up##PROC name;
@@ -145,7 +156,7 @@ typedef struct hd__gl_state {
 struct hd__backend {
     hd__ctx *ctx;
     hd__gl_fns gl;
-    void *(*gpa)(const char *);
+    hd_proc (*gpa)(const char *);
     int own;                    /* 1: the EGL context is the backend's */
     EGLDisplay dpy;
     EGLContext egl;
@@ -182,8 +193,7 @@ static hd__gl_proc hd__gl_load(hd__backend *be, const char *name)
 {
     hd__gl_proc f = NULL;
     if (be->gpa) {
-        void *p = be->gpa(name);
-        memcpy(&f, &p, sizeof f); /* void* -> function pointer: a cast is not ISO C */
+        f = be->gpa(name);
     } else {
         f = (hd__gl_proc)eglGetProcAddress(name);
     }
@@ -309,8 +319,15 @@ static hd_result hd__gl_enter(hd__ctx *ctx)
         s->egl_read = eglGetCurrentSurface(EGL_READ);
         s->egl_ctx = eglGetCurrentContext();
         if (!eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, be->egl)) {
+            EGLint err = eglGetError();
             be->depth--;
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)eglGetError());
+            /* libglvnd lets a thread have one current context across EGL and GLX: a GLX context
+               (GLFW's default) makes every eglMakeCurrent on that thread fail so. */
+            if (err == EGL_BAD_ACCESS && s->egl_ctx == EGL_NO_CONTEXT)
+                return HD__ERR(&ctx->log, HD_ERROR_BACKEND,
+                               "gl: eglMakeCurrent failed (EGL_BAD_ACCESS): another API's context (GLX) is current on this "
+                               "thread; pass it (desc.gl.use_current_context = 1) or make it not current around the call");
+            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)err);
         }
         s->switched = 1;
     } else if (!be->own) {
@@ -784,8 +801,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
         be->caller_egl = eglGetCurrentContext();
         if (be->caller_egl == EGL_NO_CONTEXT && be->gpa) {
             /* a GLX caller: its loader knows glXGetCurrentContext; a NULL answer tells nothing */
-            void *p = be->gpa("glXGetCurrentContext");
-            memcpy(&be->glx_current, &p, sizeof p); /* void* -> function pointer: a cast is not ISO C */
+            be->glx_current = (void *(*)(void))be->gpa("glXGetCurrentContext");
             be->caller_glx = be->glx_current ? be->glx_current() : NULL;
             if (!be->caller_glx) be->glx_current = NULL;
         }
@@ -1397,12 +1413,12 @@ static hd_result hd__gl_to_texture(hd__ctx *ctx, GLuint texture)
     hd_result r;
     be->gl.BindTexture(GL_TEXTURE_2D, texture);
     if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_gl_render_to_texture: %u is not a 2D texture name", texture);
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: %u is not a 2D texture name in the current context", texture);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
     if (w != ctx->camera.width || h != ctx->camera.height || format != GL_RGBA8)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER,
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE,
                        "hd_gl_render_to_texture: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
                        texture, (int)w, (int)h, (unsigned)format, ctx->camera.width, ctx->camera.height);
     if ((r = hd__gl_program(ctx, HD__GL_TO_TEXTURE)) != HD_SUCCESS) return r;
@@ -1422,7 +1438,7 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
     hd__ctx *ctx = hd__lookup(h, &stale);
     hd_result r;
     if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
-    if (texture == 0) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_gl_render_to_texture: texture 0");
+    if (texture == 0) return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     HD__GL_STAGE(ctx, hd__gl_to_texture(ctx, (GLuint)texture));
 }

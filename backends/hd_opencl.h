@@ -217,7 +217,15 @@ static hd_result hd__cl_open(hd__ctx *ctx)
         be->context = clCreateContext(NULL, 1, &be->device, NULL, NULL, &e);
         if (e != CL_SUCCESS) { be->context = NULL; return hd__cl_fail(ctx, e, "clCreateContext", 0, __LINE__); }
     }
+    /* OpenCL 1.2's call; a <CL/cl.h> the including file read first for 2.0+ marks it deprecated */
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
+#endif
     be->queue = clCreateCommandQueue(be->context, be->device, 0, &e);
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
     if (e != CL_SUCCESS) { be->queue = NULL; return hd__cl_fail(ctx, e, "clCreateCommandQueue", 0, __LINE__); }
     return HD_SUCCESS;
 }

@@ -46,9 +46,8 @@
    Errors: every VkResult below zero is logged with the failing call and becomes an hd_result
    (OUT_OF_DEVICE_MEMORY -> HD_ERROR_OUT_OF_DEVICE_MEMORY, DEVICE_LOST -> HD_ERROR_DEVICE_LOST,
    which sticks: later calls fail fast, hd_destroy still frees everything). */
-#ifndef VK_NO_PROTOTYPES
-#define VK_NO_PROTOTYPES
-#endif
+/* Every call goes through the table below; the prototypes are left to the including file's
+   choice (VK_NO_PROTOTYPES is neither defined nor required here). */
 #include <vulkan/vulkan.h>
 #include "hd_spirv.h"
 
@@ -1257,7 +1256,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
     if (lose && *lose) be->lose_at = strtoul(lose, NULL, 10);
     /* void* -> function pointer by memcpy: a cast is not ISO C */
-    if (d->vulkan.get_instance_proc_addr) memcpy(&be->gipa, &d->vulkan.get_instance_proc_addr, sizeof be->gipa);
+    if (d->vulkan.get_instance_proc_addr) be->gipa = (PFN_vkGetInstanceProcAddr)d->vulkan.get_instance_proc_addr;
 #if !defined(HD_VK_NO_LOADER)
     if (!be->gipa) be->gipa = vkGetInstanceProcAddr;
 #endif

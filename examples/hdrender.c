@@ -103,7 +103,7 @@ static const char *usage_text_method =
     "  --grid-downsample N     store E and phi at the volume's resolution / N per axis (1..8,\n"
     "                          default 1): 8x less illumination memory and ~5x faster HD at 2\n"
     "  --half                  store E and phi as float16 (float32 arithmetic): 2 bytes per\n"
-    "                          voxel and channel instead of 4 (CPU and OpenCL backends)\n"
+    "                          voxel and channel instead of 4 (every backend)\n"
     "\n"
     "output\n"
     "  -o, --out FILE.png      output image (default " DEFAULT_OUTPUT "; its directory is\n"

@@ -87,14 +87,6 @@ static double now_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void *get_proc(const char *name)
-{
-    GLFWglproc f = glfwGetProcAddress(name);
-    void *p;
-    memcpy(&p, &f, sizeof p); /* function pointer -> void*: a cast is not ISO C */
-    return p;
-}
-
 /* ---- camera: orbit around the target, the head CT's up is +z ---------------------------------- */
 static void normalize3(float v[3])
 {
@@ -536,7 +528,7 @@ int main(int argc, char **argv)
     desc.params.seed = seed;
     desc.logger = logger;
     desc.gl.use_current_context = 1;
-    desc.gl.get_proc_address = get_proc;
+    desc.gl.get_proc_address = glfwGetProcAddress;
     if ((r = hd_create(&desc, &v.ctx)) != HD_SUCCESS) die("hd_create", r);
     hd_volume_free(&vol);
     hd_query_desc(v.ctx, &desc);

@@ -127,12 +127,23 @@ static void hd__free(hd__ctx *ctx, void *ptr)
 
 /* Wall clock for the per-stage timers. */
 #include <time.h>
+#if defined(CLOCK_MONOTONIC)
 static double hd__now(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
+#else
+/* <time.h> read before hybriddiff.h under a strict C feature set leaves out clock_gettime. */
+#include <sys/time.h>
+static double hd__now(void)
+{
+    struct timeval tv;
+    gettimeofday(&tv, NULL);
+    return (double)tv.tv_sec + 1e-6 * (double)tv.tv_usec;
+}
+#endif
 
 static int hd__finite(float v) { return v == v && v - v == 0.0f; }
 

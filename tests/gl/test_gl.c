@@ -8,7 +8,7 @@
       host's context is still current and no GL error is pending;
    2. hd_gl_render_to_texture writes the same pixels as hd_read_image_rgba8 (rows flipped: GL's
       bottom-first order), within 1/255 (the GPU's sRGB pow and unorm rounding), every method;
-   3. a texture of the wrong size or format is refused with HD_ERROR_INVALID_PARAMETER, and the
+   3. a texture of the wrong size or format is refused with HD_ERROR_INVALID_TEXTURE, and the
       other backends' hd_gl_render_to_texture is HD_ERROR_UNSUPPORTED (tests/test_core.c side:
       the CPU build of this call is compiled in every other test program).
    4. float16 illumination stores: hd_f16_round (hd_prelude_glsl.h, the embedded GLSL) and an
@@ -230,7 +230,7 @@ static void run_calls(int use_current, const char *what)
         printf("%s %s: render_to_texture vs read_image_rgba8: max difference %d/255\n", what, hd_method_name(methods[m]), maxd);
     }
     r = hd_gl_render_to_texture(c, wrong);
-    CHECK(r == HD_ERROR_INVALID_PARAMETER, "%s: a 40x48 texture for a 48x40 image: %s", what, hd_result_string(r));
+    CHECK(r == HD_ERROR_INVALID_TEXTURE, "%s: a 40x48 texture for a 48x40 image: %s", what, hd_result_string(r));
     CHECK(hd_destroy(c) == HD_SUCCESS, "%s: destroy", what);
     snap(&after);
     compare(&before, &after, what);

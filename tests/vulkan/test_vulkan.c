@@ -220,10 +220,7 @@ static void test_caller_device(void)
     d.vulkan.device = dev;
     d.vulkan.queue = queue;
     d.vulkan.queue_family = 0;
-    {
-        PFN_vkGetInstanceProcAddr f = counting_gipa;
-        memcpy(&d.vulkan.get_instance_proc_addr, &f, sizeof f);
-    }
+    d.vulkan.get_instance_proc_addr = (hd_proc)counting_gipa;
     r1 = hd_create(&d, &theirs);
     CHECK(r1 == HD_SUCCESS);
     CHECK(gipa_calls > 0);
