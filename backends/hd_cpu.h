@@ -46,6 +46,12 @@ struct hd__backend {
     float **lv;
     int nlv;                 /* lights with a volume (the buffers are nlv + 1) */
     int light;               /* the light of the convection / sum pass being run */
+    /* the projection's own inputs (hd__cpu_project_prepare): E + phi summed in the API's
+       x-fastest layout, valid while lsum_ok, and the TF table for the current step, rebuilt
+       every frame. lsum_ok is cleared by the clears, the test hook's writes and the first pass
+       of every light iteration (direct or the lights' sum), which precedes its diffusion */
+    float *lsum, *ptab;
+    int lsum_ok, ptab_cap, ptab_n;
 };
 
 static const char *hd__be_name(void) { return "cpu"; }
@@ -169,6 +175,8 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__free(ctx, be->workers);
     hd__cpu_mg_free(ctx);
     hd__free(ctx, be->sig);
+    hd__free(ctx, be->lsum);
+    hd__free(ctx, be->ptab);
     hd__free(ctx, be->E);
     hd__free(ctx, be->phi);
     hd__free(ctx, be->phi2);
@@ -277,6 +285,9 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     int ok;
     hd__free(ctx, be->sig);
     be->sig = be->k.sig = NULL;
+    hd__free(ctx, be->lsum);
+    be->lsum = NULL;
+    be->lsum_ok = 0;
     hd__cpu_free_illum(ctx, &be->E, &be->Eh);
     hd__cpu_free_illum(ctx, &be->phi, &be->phih);
     hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
@@ -323,6 +334,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     size_t n = be->illum_slots;
+    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
     if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, n * sizeof(float));
     if ((what & HD__DIRTY_PHI) && be->phi) memset(be->phi, 0, n * sizeof(float));
     if ((what & HD__DIRTY_PHI) && be->phi2) memset(be->phi2, 0, n * sizeof(float));
@@ -856,6 +868,9 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 {
     int px, w = be->ctx->kp.image.x;
     hd__kctx k = be->k;
+    k.lsum = be->lsum_ok ? be->lsum : NULL;
+    k.ptab = be->ptab;
+    k.ptab_n = be->ptab_n;
     if (k.f16) {
         k.f16 = 1;
         for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
@@ -873,6 +888,7 @@ static hd_result hd__be_classify(hd__ctx *ctx)
 }
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
+    ctx->be->lsum_ok = 0;
     hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
@@ -887,6 +903,7 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
     hd__backend *be = ctx->be;
     hd__cpu_grid fine;
     int s;
+    be->lsum_ok = 0;
     fine.k = &be->k;
     fine.res = NULL;
     be->grid = &fine;
@@ -906,8 +923,57 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
 }
 /* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { return hd__be_diffuse_sweeps(ctx, jacobi, 1); }
+/* One row (channel c, z, y: r = (c * gz + z) * gy + y) of lsum = E + phi, x-fastest. */
+static void hd__cpu_lsum_row(hd__backend *be, int r)
+{
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], y = r % gy, zz = r / gy, x;
+    float *dst = be->lsum + (size_t)r * (size_t)gx;
+    const float *E = be->E, *phi = be->phi;
+    const uint16_t *Eh = be->Eh, *phih = be->phih;
+    for (x = 0; x < gx; ++x) {
+        size_t s = hd__split_slot(gx, gy, x, y, zz);
+        dst[x] = Eh ? hd_h2f(Eh[s]) + hd_h2f(phih[s]) : E[s] + phi[s];
+    }
+}
+
+/* The projection's inputs: lsum (after any pass that changed E or phi) and the TF table for the
+   current TF, step and medium (entries as hd_project_lookup reads them; n - 1 a multiple of the
+   TF's segments, at least HD__CPU_PTAB_MIN of them). Without room for either the projection
+   reads E, phi and the TF directly, as the GPU backends do. */
+#define HD__CPU_PTAB_MIN 4096
+static void hd__cpu_project_prepare(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    const hd__kctx *K = &be->k;
+    int segs = ctx->tf_count - 1, m = segs < HD__CPU_PTAB_MIN ? (HD__CPU_PTAB_MIN + segs - 1) / segs : 1;
+    int n = segs * m + 1, j;
+    float dt = ctx->kp.march.x, k = ctx->kp.medium.y * ctx->kp.box.w;
+    size_t rows = (size_t)ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
+    if (!be->lsum && (be->E || be->Eh))
+        be->lsum = (float *)hd__alloc(ctx, rows * (size_t)ctx->gdims[0] * sizeof(float));
+    if (be->lsum && !be->lsum_ok) {
+        hd__cpu_parallel(be, hd__cpu_lsum_row, (int)rows);
+        be->lsum_ok = 1;
+    }
+    if (n > be->ptab_cap) {
+        hd__free(ctx, be->ptab);
+        be->ptab = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
+        be->ptab_cap = be->ptab ? n : 0;
+    }
+    for (j = 0; be->ptab && j < n; ++j) {
+        hd_v4 c = hd_tf(K, (float)j / (float)(n - 1));
+        float a = 1.0f - hd_exp(-(c.w * ctx->kp.medium.x) * dt);
+        be->ptab[j * 4] = c.x * a * k;
+        be->ptab[j * 4 + 1] = c.y * a * k;
+        be->ptab[j * 4 + 2] = c.z * a * k;
+        be->ptab[j * 4 + 3] = a;
+    }
+    be->ptab_n = n;
+}
+
 static hd_result hd__be_project(hd__ctx *ctx)
 {
+    hd__cpu_project_prepare(ctx);
     hd__cpu_parallel(ctx->be, hd__cpu_project_row, ctx->kp.image.y);
     return HD_SUCCESS;
 }
@@ -950,6 +1016,7 @@ static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, f
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
+    ctx->be->lsum_ok = 0;
     hd__cpu_copy_illumination(ctx, which, src, NULL);
     return HD_SUCCESS;
 }
@@ -1037,6 +1104,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     int l;
+    be->lsum_ok = 0;
     for (l = 0; l < be->nlv; ++l) {
         be->light = l;
         be->k.lv = be->lv[l];

@@ -154,10 +154,19 @@ typedef struct hd__kctx {
                           float pointers are NULL); see HD_GET */
     uint16_t *Eh, *phih, *phi2h;
     float *img;        /* RGBA float accumulation, width*height*4 */
+    const float *lsum; /* projection: E + phi summed, x-fastest channel-planar (NULL: read both) */
+    const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries (NULL: TF and exp) */
+    int ptab_n;
     const float *lv;   /* CD: the light volume being read (one light's rho) */
     float *lv2;        /* CD: the light volume being written (ping-pong) */
 } hd__kctx;
 
+/* The projection's shortcuts (hd_k_project.h), taken where the CPU backend fills them in. */
+#define HD_PRELUDE_LIGHT_SUM 1
+#define HD_LIGHT_SUM_READY (K->lsum != NULL)
+#define HD_PRELUDE_PROJECT_TABLE 1
+#define HD_PROJECT_TABLE_READY (K->ptab != NULL)
+#define HD_PTAB_N (K->ptab_n)
 #define HD_KARGS const hd__kctx *K,
 #define HD_KPASS K,
 #define HD_PRM(name) (K->p->name)

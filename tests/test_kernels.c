@@ -383,10 +383,42 @@ static void test_rng_uniform(void)
     CHECK(same < 5);
 }
 
-/* The projection's empty-space skip is exact: a ball and a small cube in empty space, projected
-   through the true majorant grid (cells of 8 voxels with their one-voxel halo, as the core builds
-   it) and through a grid of no empty cell (every sample marched), give the same image up to the
-   rounding of the sample positions. Oblique rays cross cell faces on all three axes. */
+/* The projection tests' scene on an n^3 fixture, w x w pixels: a ball and a small cube in empty
+   space, E and phi varying over the grid, an oblique camera. */
+static void proj_fixture(kfix *f, int n, int w)
+{
+    int x, y, z;
+    kfix_init(f, n, 40.0f, 1.0f);
+    for (z = 0; z < n; ++z)
+        for (y = 0; y < n; ++y)
+            for (x = 0; x < n; ++x) {
+                float dx = (float)x - 13.0f, dy = (float)y - 17.0f, dz = (float)z - 20.0f;
+                float v = dx * dx + dy * dy + dz * dz < 36.0f ? 0.8f : 0.0f;
+                if (x >= 25 && x <= 26 && y >= 4 && y <= 6 && z >= 7 && z <= 8) v = 1.0f;
+                f->vol[(z * n + y) * n + x] = v;
+                f->E[KAT(*f, x, y, z)] = 1.0f + 0.03f * (float)x;
+                f->phi[KAT(*f, x, y, z)] = 0.5f + 0.01f * (float)(y + z);
+            }
+    f->p.image.x = f->p.image.y = w;
+    f->p.frame.y = 1; f->p.frame.z = 7;
+    f->p.march.x = 0.5f / (float)n; f->p.march.y = 1.0f; f->p.march.z = 1e-4f;
+    f->p.medium.y = 0.9f; f->p.box.w = HD_INV_4PI;
+    f->p.chan_color.x = f->p.chan_color.y = f->p.chan_color.z = 1.0f;
+    {
+        hd_v3 eye = HD_V3(1.3f, -1.1f, 0.9f), wd = hd_normalize(hd_scale(eye, -1.0f));
+        hd_v3 u = hd_normalize(HD_V3(wd.y, -wd.x, 0.0f));
+        hd_v3 v = HD_V3(u.y * wd.z - u.z * wd.y, u.z * wd.x - u.x * wd.z, u.x * wd.y - u.y * wd.x);
+        f->p.cam_pos = HD_V4(eye.x, eye.y, eye.z, 0.0f);
+        f->p.cam_w = HD_V4(wd.x, wd.y, wd.z, 0.0f);
+        f->p.cam_u = HD_V4(u.x * 0.45f, u.y * 0.45f, u.z * 0.45f, 0.0f);
+        f->p.cam_v = HD_V4(v.x * 0.45f, v.y * 0.45f, v.z * 0.45f, 0.0f);
+    }
+}
+
+/* The projection's empty-space skip is exact: the fixture's scene projected through the true
+   majorant grid (cells of 8 voxels with their one-voxel halo, as the core builds it) and through
+   a grid of no empty cell (every sample marched) gives the same image up to the rounding of the
+   sample positions. Oblique rays cross cell faces on all three axes. */
 static void test_projection_skip(void)
 {
     enum { N = 32, W = 40 };
@@ -394,31 +426,7 @@ static void test_projection_skip(void)
     float *img[2];
     int x, y, z, cx, cy, cz, pass, i, covered = 0;
     double maxdiff = 0.0;
-    kfix_init(&f, N, 40.0f, 1.0f);
-    for (z = 0; z < N; ++z)
-        for (y = 0; y < N; ++y)
-            for (x = 0; x < N; ++x) {
-                float dx = (float)x - 13.0f, dy = (float)y - 17.0f, dz = (float)z - 20.0f;
-                float v = dx * dx + dy * dy + dz * dz < 36.0f ? 0.8f : 0.0f;
-                if (x >= 25 && x <= 26 && y >= 4 && y <= 6 && z >= 7 && z <= 8) v = 1.0f;
-                f.vol[(z * N + y) * N + x] = v;
-                f.E[KAT(f, x, y, z)] = 1.0f + 0.03f * (float)x;
-                f.phi[KAT(f, x, y, z)] = 0.5f + 0.01f * (float)(y + z);
-            }
-    f.p.image.x = f.p.image.y = W;
-    f.p.frame.y = 1; f.p.frame.z = 7;
-    f.p.march.x = 0.5f / (float)N; f.p.march.y = 1.0f; f.p.march.z = 1e-4f;
-    f.p.medium.y = 0.9f; f.p.box.w = HD_INV_4PI;
-    f.p.chan_color.x = f.p.chan_color.y = f.p.chan_color.z = 1.0f;
-    {
-        hd_v3 eye = HD_V3(1.3f, -1.1f, 0.9f), w = hd_normalize(hd_scale(eye, -1.0f));
-        hd_v3 u = hd_normalize(HD_V3(w.y, -w.x, 0.0f));
-        hd_v3 v = HD_V3(u.y * w.z - u.z * w.y, u.z * w.x - u.x * w.z, u.x * w.y - u.y * w.x);
-        f.p.cam_pos = HD_V4(eye.x, eye.y, eye.z, 0.0f);
-        f.p.cam_w = HD_V4(w.x, w.y, w.z, 0.0f);
-        f.p.cam_u = HD_V4(u.x * 0.45f, u.y * 0.45f, u.z * 0.45f, 0.0f);
-        f.p.cam_v = HD_V4(v.x * 0.45f, v.y * 0.45f, v.z * 0.45f, 0.0f);
-    }
+    proj_fixture(&f, N, W);
     for (pass = 0; pass < 2; ++pass) {
         img[pass] = (float *)calloc((size_t)W * W * 4, sizeof(float));
         f.k.img = img[pass];
@@ -449,11 +457,53 @@ static void test_projection_skip(void)
     kfix_free(&f);
 }
 
+/* The projection's shortcuts (hd_prelude_c.h; the CPU backend fills them in) give the image of
+   the plain path: the summed light grid lsum = E + phi, and the step's TF table with each entry's
+   opacity 1 - exp(-sigma_t dt) and premultiplied colour (hd_project_lookup), its segments inside
+   the TF's. The fixture's TF has one segment, so the table is sampled 64 times finer than it. */
+static void test_projection_tables(void)
+{
+    enum { N = 32, W = 40, T = 65 };
+    kfix f;
+    float *img[2], *lsum = (float *)malloc((size_t)N * N * N * sizeof(float)), ptab[T * 4];
+    int x, y, z, pass, i;
+    double maxdiff = 0.0, peak = 0.0;
+    proj_fixture(&f, N, W);
+    for (z = 0; z < N; ++z)
+        for (y = 0; y < N; ++y)
+            for (x = 0; x < N; ++x) lsum[(z * N + y) * N + x] = f.E[KAT(f, x, y, z)] + f.phi[KAT(f, x, y, z)];
+    for (i = 0; i < T; ++i) {
+        hd_v4 c = hd_tf(&f.k, (float)i / (float)(T - 1));
+        float a = 1.0f - expf(-c.w * f.p.medium.x * f.p.march.x), k = f.p.medium.y * f.p.box.w;
+        ptab[i * 4] = c.x * a * k; ptab[i * 4 + 1] = c.y * a * k; ptab[i * 4 + 2] = c.z * a * k; ptab[i * 4 + 3] = a;
+    }
+    for (pass = 0; pass < 2; ++pass) {
+        img[pass] = (float *)calloc((size_t)W * W * 4, sizeof(float));
+        f.k.img = img[pass];
+        f.k.lsum = pass ? lsum : NULL;
+        f.k.ptab = pass ? ptab : NULL;
+        f.k.ptab_n = T;
+        for (y = 0; y < W; ++y)
+            for (x = 0; x < W; ++x) hd_project_pixel(&f.k, x, y);
+    }
+    for (i = 0; i < W * W * 4; ++i) {
+        double d = fabs((double)img[0][i] - img[1][i]);
+        if (d > maxdiff) maxdiff = d;
+        if (i % 4 != 3 && img[0][i] > peak) peak = img[0][i];
+    }
+    fprintf(stderr, "  peak %.4f, max |tables - plain| %.2e\n", peak, maxdiff);
+    CHECK(peak > 0.05); /* the test has power: the objects are lit */
+    CHECK_MSG(maxdiff < 1e-3 * peak, "the tables changed the image by %.3e (peak %.3e)", maxdiff, peak);
+    free(img[0]); free(img[1]); free(lsum);
+    kfix_free(&f);
+}
+
 const hd_test_case hd_tests_kernels[] = {
     {"kernels_rng_uniform", test_rng_uniform},
     {"kernels_transmittance_homogeneous", test_transmittance_homogeneous},
     {"kernels_transmittance_step_dda", test_transmittance_step},
     {"kernels_projection_skip", test_projection_skip},
+    {"kernels_projection_tables", test_projection_tables},
     {"kernels_diffusion_point_source", test_diffusion_point_source},
     {"kernels_diffusion_jacobi_matches", test_diffusion_jacobi_matches},
     {"kernels_diffusion_surface_boundary", test_diffusion_surface_boundary},

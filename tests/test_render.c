@@ -153,6 +153,42 @@ static void test_render_loop(void)
     free(e0); free(p0); free(e1); free(p1); free(img0); free(img1);
 }
 
+/* A frame projects the light as it is now: the CPU backend's summed light grid (E + phi, kept
+   for the projection) follows hd_refine. Context a projects, refines on and projects again; b
+   refines as far at once: the same light and frame index, so the same image bit for bit. */
+static void test_render_follows_light(void)
+{
+    float *ia = (float *)malloc(W * W * 16), *ib = (float *)malloc(W * W * 16), *i0 = (float *)malloc(W * W * 16);
+    hd_desc d;
+    hd_context a, b;
+    hd_stats s;
+    make_desc(&d, NULL);
+    d.params.light_tolerance = 1e6f; /* converged within 3 iterations: hd_render only projects */
+    CHECK(hd_create(&d, &a) == HD_SUCCESS);
+    CHECK(hd_create(&d, &b) == HD_SUCCESS);
+    CHECK(hd_refine(a, 3) == HD_SUCCESS);
+    CHECK(hd_render(a) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(a, i0, W * W * 4) == HD_SUCCESS);
+    CHECK(hd_refine(a, 3) == HD_SUCCESS);
+    CHECK(hd_set_camera(a, &d.camera) == HD_SUCCESS); /* restart the image */
+    CHECK(hd_render(a) == HD_SUCCESS);
+    CHECK(hd_get_stats(a, &s) == HD_SUCCESS);
+    CHECK_MSG(s.iterations == 6 && s.frames == 1, "a: %llu iterations, %llu frames", (unsigned long long)s.iterations,
+              (unsigned long long)s.frames);
+    CHECK(hd_refine(b, 6) == HD_SUCCESS);
+    CHECK(hd_render(b) == HD_SUCCESS);
+    CHECK(hd_get_stats(b, &s) == HD_SUCCESS);
+    CHECK_MSG(s.iterations == 6 && s.frames == 1, "b: %llu iterations, %llu frames", (unsigned long long)s.iterations,
+              (unsigned long long)s.frames);
+    CHECK(hd_read_image_f32(a, ia, W * W * 4) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(b, ib, W * W * 4) == HD_SUCCESS);
+    CHECK(memcmp(ia, i0, W * W * 16) != 0); /* the test has power: the light changed the image */
+    CHECK_MSG(memcmp(ia, ib, W * W * 16) == 0, "the frame after hd_refine projected the old light");
+    hd_destroy(a);
+    hd_destroy(b);
+    free(ia); free(ib); free(i0);
+}
+
 /* render_budget: one call may run several light iterations; the path tracers add paths. */
 static void test_render_budget(void)
 {
@@ -226,6 +262,7 @@ const hd_test_case hd_tests_render[] = {
     {"render_light_error_falls", test_light_error_falls},
     {"render_loop", test_render_loop},
     {"render_budget", test_render_budget},
+    {"render_follows_light", test_render_follows_light},
     {"render_bad_input", test_render_bad_input},
 };
 const int hd_tests_render_count = sizeof hd_tests_render / sizeof hd_tests_render[0];

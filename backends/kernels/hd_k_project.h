@@ -17,6 +17,19 @@ HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
     int za = z0 + c * nz, zb = z1 + c * nz;
     int r00 = (za * ny + y0) * nx, r10 = (za * ny + y1) * nx;
     int r01 = (zb * ny + y0) * nx, r11 = (zb * ny + y1) * nx;
+#ifdef HD_PRELUDE_LIGHT_SUM
+    /* a backend that keeps E + phi summed in one x-fastest grid: the same sums, half the loads */
+    if (HD_LIGHT_SUM_READY) {
+        float s000 = HD_GET1(lsum, r00 + x0), s100 = HD_GET1(lsum, r00 + x1);
+        float s010 = HD_GET1(lsum, r10 + x0), s110 = HD_GET1(lsum, r10 + x1);
+        float s001 = HD_GET1(lsum, r01 + x0), s101 = HD_GET1(lsum, r01 + x1);
+        float s011 = HD_GET1(lsum, r11 + x0), s111 = HD_GET1(lsum, r11 + x1);
+        float d00 = s000 + wx * (s100 - s000), d10 = s010 + wx * (s110 - s010);
+        float d01 = s001 + wx * (s101 - s001), d11 = s011 + wx * (s111 - s011);
+        float d0 = d00 + wy * (d10 - d00), d1 = d01 + wy * (d11 - d01);
+        return d0 + wz * (d1 - d0);
+    }
+#endif
     float v000 = HD_GET(E, r00 + x0, x0, y0, za) + HD_GET(phi, r00 + x0, x0, y0, za);
     float v100 = HD_GET(E, r00 + x1, x1, y0, za) + HD_GET(phi, r00 + x1, x1, y0, za);
     float v010 = HD_GET(E, r10 + x0, x0, y1, za) + HD_GET(phi, r10 + x0, x0, y1, za);
@@ -53,11 +66,51 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
     HD_SET1(img, b + 3, HD_GET1(img, b + 3) + (v.w - HD_GET1(img, b + 3)) * w);
 }
 
+#ifdef HD_PRELUDE_PROJECT_TABLE
+/* The step's TF table, for backends that keep one (HD_PROJECT_TABLE_READY): entry j, at value
+   j / (n - 1), is (rgb * a * albedo / (4 pi), a) with a = 1 - exp(-sigma_t dt), one step's
+   opacity. n - 1 is a multiple of the TF's segments, so each table segment lies inside one TF
+   segment: a transparent TF segment stays exactly 0 (the empty-space skip relies on it) and the
+   interpolated opacity differs from the exact one only by the exponential's curvature. */
+HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
+{
+    int n = HD_PTAB_N;
+    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
+    int i = hd_mini(HD_I(t), n - 2);
+    float f = t - HD_F(i);
+    int a = i * 4, b = a + 4;
+    return HD_V4(HD_GET1(ptab, a) + f * (HD_GET1(ptab, b) - HD_GET1(ptab, a)),
+                 HD_GET1(ptab, a + 1) + f * (HD_GET1(ptab, b + 1) - HD_GET1(ptab, a + 1)),
+                 HD_GET1(ptab, a + 2) + f * (HD_GET1(ptab, b + 2) - HD_GET1(ptab, a + 2)),
+                 HD_GET1(ptab, a + 3) + f * (HD_GET1(ptab, b + 3) - HD_GET1(ptab, a + 3)));
+}
+#endif
+
 /* Adds one sample's emission to (r, g, b) and its absorption to T: colour and extinction from
    the TF at the volume sample, the light from hd_sample_light. */
 HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_INOUT(float) r,
                              HD_INOUT(float) g, HD_INOUT(float) b)
 {
+#ifdef HD_PRELUDE_PROJECT_TABLE
+    if (HD_PROJECT_TABLE_READY) {
+        hd_v4 q = hd_project_lookup(HD_KPASS hd_sample_value(HD_KPASS u));
+        if (q.w > 0.0f) {
+            float t = HD_DEREF(T);
+            if (HD_PRM(gdims).w == 1) {
+                float l0 = hd_sample_light(HD_KPASS u, 0) * t;
+                HD_DEREF(r) += q.x * l0 * HD_PRM(chan_color).x;
+                HD_DEREF(g) += q.y * l0 * HD_PRM(chan_color).y;
+                HD_DEREF(b) += q.z * l0 * HD_PRM(chan_color).z;
+            } else {
+                HD_DEREF(r) += q.x * hd_sample_light(HD_KPASS u, 0) * t;
+                HD_DEREF(g) += q.y * hd_sample_light(HD_KPASS u, 1) * t;
+                HD_DEREF(b) += q.z * hd_sample_light(HD_KPASS u, 2) * t;
+            }
+            HD_DEREF(T) = t * (1.0f - q.w);
+        }
+        return;
+    }
+#endif
     hd_v4 c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
     float st = c.w * HD_PRM(medium).x;
     if (st > 0.0f) {
