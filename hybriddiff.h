@@ -563,8 +563,10 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #include "src/hd_internal.h"
 #include "backends/kernels/hd_kernels.h"
 #include "src/hd_multigrid_cg.h"
+#include "src/hd_backend.h"
 #if defined(HYBRIDDIFF_BACKEND_CPU)
 #include "backends/hd_cpu.h"
+#include "backends/hd_cpu_multigrid.h"
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
@@ -572,6 +574,7 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #elif defined(HYBRIDDIFF_BACKEND_GL)
 #include "backends/hd_gl.h"
 #endif
+#include "src/hd_multigrid.h"
 #include "src/hd_validate.h"
 #include "src/hd_context.h"
 #include "src/hd_io.h"

@@ -14,7 +14,7 @@ typedef void (*hd__cpu_job)(hd__backend *be, int item);
 /* Red-black sweeps per walk through memory (hd__cpu_red_black): by default and at most */
 #define HD__CPU_RB_WALK_SWEEPS 2
 #define HD__CPU_RB_WALK_SWEEPS_MAX 8
-static void hd__cpu_mg_free(hd__ctx *ctx); /* hd_cpu_multigrid.h */
+static void hd__cpu_mg_free(hd__ctx *ctx); /* with the multigrid levels, below */
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -40,7 +40,6 @@ struct hd__backend {
     int rb_phases;           /* red-black walks of several sweeps: half-sweeps per walk (4: 2 sweeps) */
     int rb_walk_sweeps;      /* the most sweeps one walk takes (HD__CPU_RB_WALK_SWEEPS; bench/ varies it) */
     const struct hd__cpu_grid *grid; /* the grid the diffusion pass works on */
-    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     struct hd__cpu_mg *mg;   /* multigrid levels (hd_cpu_multigrid.h), NULL until first used */
     /* CD: one light volume per light plus one spare, rotated through them as the ping-pong */
     float **lv;
@@ -240,7 +239,6 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
     return HD_SUCCESS;
 }
 
-#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: Eh, phih, phi2h */
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */
@@ -375,6 +373,52 @@ typedef struct hd__cpu_grid {
     const hd__kctx *k;       /* its parameters (gdims, 1/h^2, flags) and buffers */
     float *res;              /* the residual pass's output (multigrid), in the colour layout */
 } hd__cpu_grid;
+
+/* HD_SOLVER_MULTIGRID's levels and CG's vectors (their passes: hd_cpu_multigrid.h). */
+typedef struct hd__cpu_level {
+    hd__kparams kp;          /* the fine parameters with this level's dims, h and the rhs flag */
+    hd__kctx k;
+    hd__cpu_grid g;
+    float *sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
+    float *rhs, *phi;        /* the right-hand side and the correction; level 0: r and z */
+    float *res;              /* the residual of this level's equation; level 0: also q = A p */
+    int dims[3];
+} hd__cpu_level;
+
+struct hd__cpu_mg {
+    hd__cpu_level lv[HD__MG_MAX_LEVELS];
+    int levels, channels, sig_channels, fine[3];
+    int cur;                 /* the level a transfer pass writes (coarse) */
+    int colour;              /* the colour ((x + y + z) & 1) hd__cpu_mg_extrap_row writes */
+    float *p;                /* CG's search direction (fine grid) */
+    float *lo;               /* the iterate's low part: CG's iterate is phi + lo, phi its float
+                                rounding (hd__cpu_mg_update_row) */
+    hd__kparams opkp;        /* A p: level 0's parameters, E = z (zeroed by then), phi = p */
+    hd__kctx opk;
+    hd__cpu_grid opg, fineg; /* A p into level 0's res; f - A phi into level 0's rhs (r) */
+    double *dot_a, *dot_b;   /* per-row partial sums of the dot products (level 0's rows) */
+    double alpha;
+    float beta;
+};
+
+static void hd__cpu_mg_free(hd__ctx *ctx)
+{
+    struct hd__cpu_mg *mg = ctx->be->mg;
+    int l;
+    if (!mg) return;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__free(ctx, mg->lv[l].sig);
+        hd__free(ctx, mg->lv[l].rhs);
+        hd__free(ctx, mg->lv[l].phi);
+        hd__free(ctx, mg->lv[l].res);
+    }
+    hd__free(ctx, mg->p);
+    hd__free(ctx, mg->lo);
+    hd__free(ctx, mg->dot_a);
+    hd__free(ctx, mg->dot_b);
+    hd__free(ctx, mg);
+    ctx->be->mg = NULL;
+}
 
 static int hd__cpu_row_variant(const hd__kctx *K)
 {
@@ -867,7 +911,6 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
-    ++ctx->be->sig_gen;
     hd__cpu_parallel(ctx->be, hd__cpu_classify_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
@@ -876,12 +919,10 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
-#include "hd_cpu_multigrid.h"
 
 /* `sweeps` full sweeps on the illumination grid: red-black through hd__cpu_red_black (walks of
    several sweeps, hd_context.h's hd__diffuse_sweeps hands it all of an iteration's), Jacobi one
    pass and a swap each. */
-#define HD__BE_HAS_DIFFUSE_SWEEPS 1
 static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
 {
     hd__backend *be = ctx->be;
@@ -974,8 +1015,6 @@ HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
 }
 
 /* ---- the other methods: CD's convection, PT_SS / PT_MS paths ---------------------------------- */
-#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
-#define HD__BE_HAS_PT 1 /* hd__be_path */
 
 /* CD's light volumes: frees the old ones and allocates count + 1 zeroed volumes of the
    illumination grid (count lights and one spare that rotates through them as the ping-pong

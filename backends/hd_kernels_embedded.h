@@ -1808,7 +1808,7 @@ static const char *const hd__cl_source[] = {
 "    hd_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));\n",
 "}\n",
 "\n",
-"/* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_multigrid ---------------\n",
+"/* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_mg_* -------------------\n",
 "   The math is hd_k_multigrid.h's; the V-cycle's smoothing is the diffusion kernels above, run on a\n",
 "   level's own parameter block (its dims, 1 / h^2, h and HD_FLAG_DIFFUSE_RHS) and buffers. Every\n",
 "   grid of the solver (each level's sigma_t, right-hand side, correction and residual, conjugate\n",

@@ -40,6 +40,18 @@ enum {
 
 typedef struct hd__backend hd__backend; /* defined by the selected backend */
 
+/* HD_SOLVER_MULTIGRID's run state, the same on every backend (src/hd_multigrid.h). */
+typedef struct hd__mg_cg {
+    unsigned sig_gen;        /* ctx->sig_gen the coarse sigma_t were restricted from */
+    int sig_surface;         /* ... and the boundary they were restricted for */
+    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
+    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
+    int have_dir;            /* the backend's p holds a direction of the current CG run */
+    double rz;               /* <r, z> of the previous step (beta's denominator) */
+    unsigned light_gen;      /* the context's light_gen of the current CG run */
+    double vcycle_seconds;   /* wall time in V-cycles (bench/hdbench_multigrid.c: a step against a V-cycle) */
+} hd__mg_cg;
+
 typedef struct hd__ctx {
     hd_desc desc;            /* with defaults filled in; pointers refer to the copies below */
     hd_allocator alloc;
@@ -85,6 +97,8 @@ typedef struct hd__ctx {
     uint64_t converged_frames; /* projection frames since the light converged */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
+    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
     hd__backend *be;
 } hd__ctx;
 
