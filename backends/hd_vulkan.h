@@ -1824,15 +1824,17 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
     return HD_SUCCESS;
 }
 
-/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz. */
-static hd_result hd__vk_mg_pass(hd__ctx *ctx, VkCommandBuffer cb, int stage, VkDescriptorSet set, int slot, int nx, int ny,
-                                int nz, int32_t pc0, int32_t pc1, int32_t pc2, int32_t pc3)
+/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz into
+   the backend's command buffer. */
+static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int nx, int ny, int nz, int32_t pc0,
+                                int32_t pc1, int32_t pc2, int32_t pc3)
 {
     hd__backend *be = ctx->be;
+    VkCommandBuffer cb;
     VkPipeline pipe;
     int32_t pc[4];
     hd_result r;
-    if ((r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
     hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg->slot_bytes), nx, ny, nz, pc);
     return HD_SUCCESS;
@@ -1864,10 +1866,7 @@ static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
     hd__vk_level *L = &mg->lv[l];
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * mg->channels, 0, 0, 0,
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * mg->channels, 0, 0, 0,
                           mg->channels);
 }
 
@@ -1876,10 +1875,7 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
     struct hd__vk_mg *mg = ctx->be->mg;
     hd__vk_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     int ch = mg->channels;
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
                           C->dims[1], C->dims[2], ch);
 }
 
@@ -1888,27 +1884,24 @@ static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
     struct hd__vk_mg *mg = ctx->be->mg;
     hd__vk_level *L = &mg->lv[l];
     int ch = mg->channels;
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch, L->dims[0],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch, L->dims[0],
                           L->dims[1], L->dims[2], ch);
 }
 
 /* The fine residual in double (hd_mg_res_f64) with set `set`: f - A (phi + lo) (the fine slot,
    use_lo) or, negate, A p (level 0's slot, E = z = 0, phi = p). */
-static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set, int slot, int use_lo, int negate)
+static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkDescriptorSet set, int slot, int use_lo, int negate)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
                           negate, 0, mg->channels);
 }
 
 /* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
-static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set)
+static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
+    return hd__vk_mg_pass(ctx, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1950,10 +1943,7 @@ static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
     const int *d = mg->lv[l].dims;
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
                           mg->sig_channels);
 }
 
@@ -1969,41 +1959,31 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
+    return hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 {
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_dot(ctx, cb, ctx->be->mg->cg_sets[HD__VK_MG_SET_DOT_RZ]);
+    return hd__vk_mg_dot(ctx, ctx->be->mg->cg_sets[HD__VK_MG_SET_DOT_RZ]);
 }
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
     int32_t bits;
-    hd_result r;
     memcpy(&bits, &beta, sizeof beta);
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
                           mg->fine[2] * mg->channels, bits, 0, 0, mg->channels);
 }
 
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
     hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
-        (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
+    if ((r = hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
+        (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
         return r;
-    return hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
+    return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
 }
 
 /* Submits what was recorded, the row sums made visible to the host, and waits; the sums are read
@@ -2025,16 +2005,13 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
     int32_t bits[2];
     uint64_t u;
-    hd_result r;
     int i;
     /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
                           mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels);
 }
 
@@ -2042,10 +2019,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0], mg->fine[1],
+    return hd__vk_mg_pass(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0], mg->fine[1],
                           mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
 }
 
