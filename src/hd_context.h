@@ -775,7 +775,7 @@ static hd_result hd__iterate_pt(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* One iteration of the current method (METHOD.md: what an iteration is, per method). */
+/* One iteration of the current method (docs/METHOD.md: what an iteration is, per method). */
 static hd_result hd__iterate_method(hd__ctx *ctx)
 {
     switch (ctx->params.method) {
