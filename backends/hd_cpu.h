@@ -51,8 +51,8 @@ static const char *hd__be_name(void) { return "cpu"; }
 
 /* Denormals flushed to zero (x86 MXCSR FTZ and DAZ) while this backend's threads compute, as GPUs
    compute: a diffusion solve started from phi = 0 spreads through empty space as a front of
-   values that underflow, and every operation on a denormal takes a microcode assist. On the head
-   CT (box boundary) the first sweeps took 4.7 against 1.5 ns per update. The workers set it once;
+   values that underflow, and every operation on a denormal takes a microcode assist (about 3x
+   slower first sweeps: docs/DESIGN-CPU.md). The workers set it once;
    the calling thread sets it for each pass and restores its own mode after (hd__cpu_parallel,
    through which every pass runs).
    Other architectures compute with denormals. */
@@ -359,11 +359,10 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
    bits as the per-voxel path (hd_diffuse_row). Rows on the grid's faces in y or z (y = 0 or
    gy - 1, z = 0 or gz - 1) take the same loop with their four y/z in-grid flags as run-time
    values (a second copy of each variant; an outside neighbour's loads read the row's own other
-   colour instead, and the kernels ignore the values of an outside neighbour): through the
-   per-voxel path they cost 14 against 1.1 ns per update, and on the 256x256x108 head those 2.6 %
-   of the rows took a fifth of a sweep (bench/hdbench_rb_schedule.c). The stride-2 loop over the
-   x-fastest layout this replaces needed permutes for every load: 1.77 against 1.06 ns per update
-   for the whole row (Jacobi) with the rows in L2 (bench/hdbench_rb_schedule.c). The two end
+   colour instead, and the kernels ignore the values of an outside neighbour), because the
+   per-voxel path made those few rows a large share of a sweep; the colour layout spares the
+   permutes a stride-2 loop over an x-fastest layout needs for every load (docs/DESIGN-CPU.md
+   has both measurements, bench/hdbench_rb_schedule.c reproduces them). The two end
    voxels go through hd_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
    neighbour lies outside the row). */
 #define HD__CPU_ROW_MAX 8192
@@ -667,10 +666,9 @@ static void hd__cpu_diffuse_block(hd__backend *be, int r)
    the first's new ones. Both fit in one walk through z: at step z the first colour in plane z,
    then the second in plane z - 1, whose first-colour neighbours (planes z - 2 .. z) are all new
    by then, while the first colour in plane z read the second's plane z - 1 before it changed. So
-   each plane streams through the caches once per sweep instead of once per colour (head CT, 2
-   threads, `make bench-rb-schedule`: 1.30-1.35x per sweep with the box boundary, 1.18-1.21x with
-   the surface boundary on the x-fastest layout; 1.07-1.12x and 1.07x with the colour layout's
-   cheaper rows, load 2). The same updates from the same values as
+   each plane streams through the caches once per sweep instead of once per colour (faster per
+   sweep on the head CT: docs/DESIGN-CPU.md, `make bench-rb-schedule`). The same updates from the
+   same values as
    relaxing colour by colour: the same bits, for any block size and thread count.
    Threads take blocks of rows (y). Rows beside a block's edge depend on the next block's, so a
    sweep is two parallel passes:
@@ -738,8 +736,8 @@ static void hd__cpu_rb_seam(hd__backend *be, int r)
 
 /* ---- red-black: several sweeps in one walk through z (temporal blocking) --------------------
    One walk of the schedule above streams sigma_t, E and phi once per sweep (16 B a voxel); a
-   walk of T sweeps streams them once for T sweeps (1.02-1.11x on the head, whose grid fits this
-   CI machine's L3): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
+   walk of T sweeps streams them once for T sweeps (a small gain where the grid fits the L3:
+   docs/DESIGN-CPU.md): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
    follow each other through z, phase k in plane z - k at step z. Phase k of a row reads the other
    colour (phase k - 1's) in rows y - 1 .. y + 1 of planes z - k - 1 .. z - k + 1 and must see
    exactly what the sweeps one after another give it: phase k - 1 done there, phase k + 1 not.

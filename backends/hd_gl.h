@@ -84,7 +84,7 @@ static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
 /* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
    surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
-   (Vulkan measured 1.4-1.6x from the same specialization). Program slots past
+   (docs/DESIGN-VULKAN.md measures the same specialization). Program slots past
    HD__GL_PROGRAM_COUNT hold these variants. */
 #define HD__GL_DIFFUSE_VARIANTS 8 /* bit 4: HD_FLAG_DIFFUSE_RHS (multigrid's levels) */
 #define HD__GL_SLOTS_F32 (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)

@@ -799,7 +799,7 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
    relaxes (one voxel per row, hd_entry_glsl.h): lavapipe pays a fixed cost per invocation (the
    store and its own set-up cost as much as 7 loads) and per static load, and the block loads each
    texel its voxels share once. Constant 2 is the solver (jacobi), so the
-   store of the other one is not compiled (1.08x sweeps/s, docs/DESIGN-VULKAN.md). flags: constant
+   store of the other one is not compiled (docs/DESIGN-VULKAN.md has the gain). flags: constant
    0's value, NULL for the other stages (bench/hdbench_vulkan.c's --ab also calls this). */
 static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
                                       VkPipeline *out)

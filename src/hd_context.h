@@ -693,7 +693,7 @@ static hd_result hd__prepare(hd__ctx *ctx)
 }
 
 /* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a
-   V-cycle: about 15 red-black sweeps of work on the head CT). */
+   V-cycle; docs/DESIGN-MULTIGRID.md has its cost in red-black sweeps). */
 static hd_result hd__diffuse_once(hd__ctx *ctx)
 {
     if (ctx->params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step(ctx);

@@ -17,8 +17,8 @@
 #endif
 /* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
 #define HD__MAX_VOXELS (1u << 30)
-#define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: on the head CT 4 tracks 12% faster
-                                than 8 (tighter majorants) and 9% faster than 2 (fewer DDA steps) */
+#define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
+                                majorants and few DDA steps (docs/DESIGN-CPU.md) */
 
 /* What a setter invalidates (see the table above hd_set_transfer_function). */
 enum {
