@@ -34,7 +34,7 @@ static hd_result hd__mg_step_passes(hd__ctx *ctx, int fresh)
     size_t rows = (size_t)ctx->gdims[1] * ctx->gdims[2] * (size_t)ctx->channels;
     int levels = hd__mg_levels(ctx->gdims), restart, stale, l, colour;
     double t0, rz, pq, rp;
-    const double *a, *b;
+    const double *a = NULL, *b = NULL;
     hd_result r;
     if (fresh) hd__mg_cg_init(cg, ctx->sig_gen);
     if (hd__mg_cg_begin(cg, ctx, ctx->sig_gen, &restart, &stale)) {
