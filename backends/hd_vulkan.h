@@ -1830,7 +1830,7 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
                                 int32_t pc1, int32_t pc2, int32_t pc3)
 {
     hd__backend *be = ctx->be;
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     int32_t pc[4];
     hd_result r;
@@ -1844,7 +1844,7 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd__vk_level *L = &be->mg->lv[l];
     int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
@@ -1912,7 +1912,7 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = be->mg;
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     HD__VK_LOST_CHECK(ctx);
     if (be->no_f64)
@@ -1933,7 +1933,7 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 
 static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 {
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     if (r != HD_SUCCESS) return r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
@@ -1949,7 +1949,7 @@ static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
 {
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
     hd__vk_zero_image(ctx->be, cb, ctx->be->mg->lo.image, HD__VK_G);
@@ -1991,7 +1991,7 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    VkCommandBuffer cb;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     (void)n;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
