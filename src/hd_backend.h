@@ -34,7 +34,8 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes);
 /* The volume, TF and majorant of ctx are new: upload them (classification follows). */
 static hd_result hd__be_upload_inputs(hd__ctx *ctx);
 /* E, phi and phi2 for illum_floats values (0: free them; PT methods), contents undefined until
-   hd__be_clear; any solver state on the old grid (multigrid levels) is dropped. */
+   hd__be_clear. Multigrid levels on the old grid may be dropped here; hd__be_mg_begin remakes
+   them whenever they are missing or the grid changed. */
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats);
 /* The Jacobi solver's second phi buffer: allocated when enable, freed otherwise. */
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable);
