@@ -40,7 +40,7 @@
                                  rejected with HD_ERROR_UNSUPPORTED_ENCODING); otherwise link -lz
       HD_MAX_CONTEXTS            live contexts per process (default 64)
 
-   Conventions (see docs/ and METHOD.md of the project)
+   Conventions (docs/METHOD.md has the method)
       - The volume fills a box centred on the origin whose largest side has length 1; the other
         sides follow dims * spacing. Voxel centres sit at (i + 0.5) / n in texture space.
       - sigma_t(x) = TF_alpha(v(x)) * extinction, sigma_s = albedo * sigma_t; v(x) is the trilinear
@@ -182,7 +182,7 @@ typedef enum hd_solver {
 } hd_solver;
 
 typedef enum hd_boundary {
-    HD_BOUNDARY_BOX = 0,     /* phi = 0 outside the volume box (METHOD.md's convention) */
+    HD_BOUNDARY_BOX = 0,     /* phi = 0 outside the volume box (docs/METHOD.md) */
     HD_BOUNDARY_SURFACE,     /* Marshak vacuum condition at the medium's surface */
     HD_BOUNDARY_COUNT
 } hd_boundary;
@@ -326,7 +326,7 @@ typedef struct hd_params {
                                a colour grid: +28 bytes per voxel). 0 (default): grey diffusion,
                                tinted once at projection, as in the paper. */
     hd_boundary diffusion_boundary; /* where the diffusion's vacuum is: HD_BOUNDARY_BOX (default,
-                               METHOD.md: phi = 0 outside the volume box, empty voxels solved
+                               docs/METHOD.md: phi = 0 outside the volume box, empty voxels solved
                                with a floored D, so air drains light) or HD_BOUNDARY_SURFACE
                                (the medium's surface carries the Marshak vacuum condition; empty
                                voxels are not solved for and hold the Marshak extrapolation of
@@ -625,8 +625,10 @@ extern char *realpath(const char *path, char *resolved);
 #include "src/hd_internal.h"
 #include "backends/kernels/hd_kernels.h"
 #include "src/hd_multigrid_cg.h"
+#include "src/hd_backend.h"
 #if defined(HYBRIDDIFF_BACKEND_CPU)
 #include "backends/hd_cpu.h"
+#include "backends/hd_cpu_multigrid.h"
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
@@ -634,6 +636,7 @@ extern char *realpath(const char *path, char *resolved);
 #elif defined(HYBRIDDIFF_BACKEND_GL)
 #include "backends/hd_gl.h"
 #endif
+#include "src/hd_multigrid.h"
 #include "src/hd_validate.h"
 #include "src/hd_context.h"
 #include "src/hd_io.h"

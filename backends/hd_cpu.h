@@ -14,7 +14,7 @@ typedef void (*hd__cpu_job)(hd__backend *be, int item);
 /* Red-black sweeps per walk through memory (hd__cpu_red_black): by default and at most */
 #define HD__CPU_RB_WALK_SWEEPS 2
 #define HD__CPU_RB_WALK_SWEEPS_MAX 8
-static void hd__cpu_mg_free(hd__ctx *ctx); /* hd_cpu_multigrid.h */
+static void hd__cpu_mg_free(hd__ctx *ctx); /* with the multigrid levels, below */
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -40,7 +40,6 @@ struct hd__backend {
     int rb_phases;           /* red-black walks of several sweeps: half-sweeps per walk (4: 2 sweeps) */
     int rb_walk_sweeps;      /* the most sweeps one walk takes (HD__CPU_RB_WALK_SWEEPS; bench/ varies it) */
     const struct hd__cpu_grid *grid; /* the grid the diffusion pass works on */
-    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     struct hd__cpu_mg *mg;   /* multigrid levels (hd_cpu_multigrid.h), NULL until first used */
     /* CD: one light volume per light plus one spare, rotated through them as the ping-pong */
     float **lv;
@@ -58,8 +57,8 @@ static const char *hd__be_name(void) { return "cpu"; }
 
 /* Denormals flushed to zero (x86 MXCSR FTZ and DAZ) while this backend's threads compute, as GPUs
    compute: a diffusion solve started from phi = 0 spreads through empty space as a front of
-   values that underflow, and every operation on a denormal takes a microcode assist. On the head
-   CT (box boundary) the first sweeps took 4.7 against 1.5 ns per update. The workers set it once;
+   values that underflow, and every operation on a denormal takes a microcode assist (about 3x
+   slower first sweeps: docs/DESIGN-CPU.md). The workers set it once;
    the calling thread sets it for each pass and restores its own mode after (hd__cpu_parallel,
    through which every pass runs).
    Other architectures compute with denormals. */
@@ -248,7 +247,6 @@ static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
     return HD_SUCCESS;
 }
 
-#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: Eh, phih, phi2h */
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */
@@ -373,11 +371,10 @@ static void hd__cpu_direct_row(hd__backend *be, int r)
    bits as the per-voxel path (hd_diffuse_row). Rows on the grid's faces in y or z (y = 0 or
    gy - 1, z = 0 or gz - 1) take the same loop with their four y/z in-grid flags as run-time
    values (a second copy of each variant; an outside neighbour's loads read the row's own other
-   colour instead, and the kernels ignore the values of an outside neighbour): through the
-   per-voxel path they cost 14 against 1.1 ns per update, and on the 256x256x108 head those 2.6 %
-   of the rows took a fifth of a sweep (bench/hdbench_rb_schedule.c). The stride-2 loop over the
-   x-fastest layout this replaces needed permutes for every load: 1.77 against 1.06 ns per update
-   for the whole row (Jacobi) with the rows in L2 (bench/hdbench_rb_schedule.c). The two end
+   colour instead, and the kernels ignore the values of an outside neighbour), because the
+   per-voxel path made those few rows a large share of a sweep; the colour layout spares the
+   permutes a stride-2 loop over an x-fastest layout needs for every load (docs/DESIGN-CPU.md
+   has both measurements, bench/hdbench_rb_schedule.c reproduces them). The two end
    voxels go through hd_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
    neighbour lies outside the row). */
 #define HD__CPU_ROW_MAX 8192
@@ -387,6 +384,52 @@ typedef struct hd__cpu_grid {
     const hd__kctx *k;       /* its parameters (gdims, 1/h^2, flags) and buffers */
     float *res;              /* the residual pass's output (multigrid), in the colour layout */
 } hd__cpu_grid;
+
+/* HD_SOLVER_MULTIGRID's levels and CG's vectors (their passes: hd_cpu_multigrid.h). */
+typedef struct hd__cpu_level {
+    hd__kparams kp;          /* the fine parameters with this level's dims, h and the rhs flag */
+    hd__kctx k;
+    hd__cpu_grid g;
+    float *sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
+    float *rhs, *phi;        /* the right-hand side and the correction; level 0: r and z */
+    float *res;              /* the residual of this level's equation; level 0: also q = A p */
+    int dims[3];
+} hd__cpu_level;
+
+struct hd__cpu_mg {
+    hd__cpu_level lv[HD__MG_MAX_LEVELS];
+    int levels, channels, sig_channels, fine[3];
+    int cur;                 /* the level a transfer pass writes (coarse) */
+    int colour;              /* the colour ((x + y + z) & 1) hd__cpu_mg_extrap_row writes */
+    float *p;                /* CG's search direction (fine grid) */
+    float *lo;               /* the iterate's low part: CG's iterate is phi + lo, phi its float
+                                rounding (hd__cpu_mg_update_row) */
+    hd__kparams opkp;        /* A p: level 0's parameters, E = z (zeroed by then), phi = p */
+    hd__kctx opk;
+    hd__cpu_grid opg, fineg; /* A p into level 0's res; f - A phi into level 0's rhs (r) */
+    double *dot_a, *dot_b;   /* per-row partial sums of the dot products (level 0's rows) */
+    double alpha;
+    float beta;
+};
+
+static void hd__cpu_mg_free(hd__ctx *ctx)
+{
+    struct hd__cpu_mg *mg = ctx->be->mg;
+    int l;
+    if (!mg) return;
+    for (l = 0; l < mg->levels; ++l) {
+        hd__free(ctx, mg->lv[l].sig);
+        hd__free(ctx, mg->lv[l].rhs);
+        hd__free(ctx, mg->lv[l].phi);
+        hd__free(ctx, mg->lv[l].res);
+    }
+    hd__free(ctx, mg->p);
+    hd__free(ctx, mg->lo);
+    hd__free(ctx, mg->dot_a);
+    hd__free(ctx, mg->dot_b);
+    hd__free(ctx, mg);
+    ctx->be->mg = NULL;
+}
 
 static int hd__cpu_row_variant(const hd__kctx *K)
 {
@@ -635,10 +678,9 @@ static void hd__cpu_diffuse_block(hd__backend *be, int r)
    the first's new ones. Both fit in one walk through z: at step z the first colour in plane z,
    then the second in plane z - 1, whose first-colour neighbours (planes z - 2 .. z) are all new
    by then, while the first colour in plane z read the second's plane z - 1 before it changed. So
-   each plane streams through the caches once per sweep instead of once per colour (head CT, 2
-   threads, `make bench-rb-schedule`: 1.30-1.35x per sweep with the box boundary, 1.18-1.21x with
-   the surface boundary on the x-fastest layout; 1.07-1.12x and 1.07x with the colour layout's
-   cheaper rows, load 2). The same updates from the same values as
+   each plane streams through the caches once per sweep instead of once per colour (faster per
+   sweep on the head CT: docs/DESIGN-CPU.md, `make bench-rb-schedule`). The same updates from the
+   same values as
    relaxing colour by colour: the same bits, for any block size and thread count.
    Threads take blocks of rows (y). Rows beside a block's edge depend on the next block's, so a
    sweep is two parallel passes:
@@ -706,8 +748,8 @@ static void hd__cpu_rb_seam(hd__backend *be, int r)
 
 /* ---- red-black: several sweeps in one walk through z (temporal blocking) --------------------
    One walk of the schedule above streams sigma_t, E and phi once per sweep (16 B a voxel); a
-   walk of T sweeps streams them once for T sweeps (1.02-1.11x on the head, whose grid fits this
-   CI machine's L3): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
+   walk of T sweeps streams them once for T sweeps (a small gain where the grid fits the L3:
+   docs/DESIGN-CPU.md): its 2T half-sweeps ("phases" k = 0 .. 2T - 1, colour first ^ (k & 1))
    follow each other through z, phase k in plane z - k at step z. Phase k of a row reads the other
    colour (phase k - 1's) in rows y - 1 .. y + 1 of planes z - k - 1 .. z - k + 1 and must see
    exactly what the sweeps one after another give it: phase k - 1 done there, phase k + 1 not.
@@ -882,7 +924,6 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
-    ++ctx->be->sig_gen;
     hd__cpu_parallel(ctx->be, hd__cpu_classify_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
@@ -892,12 +933,10 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
     return HD_SUCCESS;
 }
-#include "hd_cpu_multigrid.h"
 
 /* `sweeps` full sweeps on the illumination grid: red-black through hd__cpu_red_black (walks of
    several sweeps, hd_context.h's hd__diffuse_sweeps hands it all of an iteration's), Jacobi one
    pass and a swap each. */
-#define HD__BE_HAS_DIFFUSE_SWEEPS 1
 static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
 {
     hd__backend *be = ctx->be;
@@ -1041,8 +1080,6 @@ HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
 }
 
 /* ---- the other methods: CD's convection, PT_SS / PT_MS paths ---------------------------------- */
-#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
-#define HD__BE_HAS_PT 1 /* hd__be_path */
 
 /* CD's light volumes: frees the old ones and allocates count + 1 zeroed volumes of the
    illumination grid (count lights and one spare that rotates through them as the ping-pong

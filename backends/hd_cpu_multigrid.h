@@ -1,133 +1,14 @@
-/* hd_cpu_multigrid.h - the CPU backend's multigrid-preconditioned conjugate gradients for the
-   diffusion solve (params.solver = HD_SOLVER_MULTIGRID), included by hd_cpu.h. This file is the
-   design; the per-voxel math is the shared backends/kernels/hd_k_multigrid.h, and the OpenCL
-   backend (hd_opencl.h's hd__be_multigrid) runs the same passes in the same order.
-
-   Why: one relaxation sweep moves information one voxel, so single-level sweeps need O(n^2) of
-   them to carry light across an n-voxel volume. A V-cycle reduces every scale of the error at
-   once, but on the head CT alone it contracted only 0.89-0.99 per cycle: thin, optically thin
-   structures (skin next to bone) are not represented on the coarse grids, and the few error
-   modes they carry are left to the smoother. Used as the preconditioner of conjugate gradients
-   (the discrete operator A is symmetric positive definite: harmonic-mean face weights, the
-   Marshak terms and sigma_a on the diagonal; empty voxels of the surface boundary are identity
-   rows), CG removes those few slow modes in a few extra steps.
-
-   One solver step (diffusion_sweeps counts them; default 1 per HD iteration):
-   1. r = f - A (phi + lo), recomputed from the iterate and E at every step (so a new E is used
-      at once and rounding in the updates never accumulates into r), with the kernel's own float
-      coefficients but summed in double as differences (hd_mg_res_f64): the float kernel's
-      residual cancels two terms of about den phi and floored the residual near 1e-4;
-   2. z = M r: one symmetric V-cycle (below) from z = 0;
-   3. beta = <r, z> / <r, z>_previous (0 at a restart), p = z + beta p;
-   4. q = A p (the same double-summed residual with a zero right-hand side),
-      alpha = <r, p> / <p, q>;
-   5. phi + lo += alpha p in double, phi the float rounding of the sum (what the projection
-      reads), lo the rest: the iterate keeps about 48 bits, and phi is the solution rounded once;
-   6. surface boundary: the empty voxels' phi = the sweeps' Marshak extrapolation, lo = -phi
-      (hd__cpu_mg_extrap_row: the iterate stays 0 on their identity rows).
-   The dot products are summed in double, per row and then in row order: the same bits for any
-   thread count. Step 5 is an exact line search along p, so the error's energy norm never grows,
-   whatever p is. CG restarts (beta = 0) at each new HD iteration (a new E: ctx->iterations
-   changed) and whenever A changes (sigma_t reclassified, albedo, g, grid, boundary).
-   Cost: about 15 red-black sweeps of wall time per step (head CT, surface boundary, 2 threads:
-   300 ms against 20.5 ms per sweep at 256x256x108, 47.8 against 3.23 at half resolution); the
-   V-cycle is two thirds of it, the two double-summed residual passes most of the rest.
-   Every level's buffers are in the colour layout (hd__mg_slots), so the smoothing runs the
-   sweep's unit-stride rows. A load by coordinates alternates between the two colour halves of a
-   row (a gather): with the transfers loading so (hd_mg_prolong, hd_mg_restrict_line) a step went
-   from 213 to 280 ms (box) and 268 to 316 ms (surface) at full resolution (one A/B pair, load 2;
-   perf: the prolongation 1.7x, the restriction 1.3-1.4x), so they load each row they read once,
-   as its two unit-stride half-rows (hd__cpu_mg_load_row), and run the kernel's per-term
-   functions on the values (hd_mg_prolong_term, hd_mg_restrict_term, hd_mg_medium_of: the same
-   operations in the same order, the same bits), as do CG's dot products (hd_mg_dot_term): full
-   resolution box 211-213 ms against 212-236 before the colour layout and 274-278 with the
-   gathers, surface 267-277 against 261-266 and 304; half resolution 31-32 / 38 against 29 / 36
-   and 39 / 43 (two interleaved rounds, load 2.5-3). Still through coordinates: the double
-   residual (1.2x) and the surface extrapolation (1.3x; a literal f16 there gained nothing).
-
-   The V-cycle is a symmetric positive definite preconditioner (M^-1 symmetric, what CG needs):
-   - every level's smoothing and residual are the shared kernel's (hd_k_diffuse.h: the same
-     discretisation, both boundaries, RGB scattering) with HD_FLAG_DIFFUSE_RHS (E holds the
-     right-hand side: r on the fine level, the restricted residual below) and a parameter block
-     of its own: its dims, 1 / h^2 and h scaled by 2 per level;
-   - pre-smoothing: 2 red-black sweeps (red, then black); post-smoothing: 2 black-red sweeps,
-     the adjoint order; the coarsest grid (at most 4 voxels per axis, or fewer than 4 on one
-     axis): 8 red-black then 8 black-red sweeps from 0 (symmetric too);
-   - prolongation P: trilinear interpolation of the coarse correction at the fine voxel centres
-     (weights 3/4, 1/4 per axis), 0 beyond the coarse grid, added with weight 1 (a fixed linear
-     map: the energy-minimising weight the plain V-cycle used made M nonlinear);
-   - restriction R = P^T / 8 (full weighting, 1/8 3/8 3/8 1/8 per axis: a weighted mean, as both
-     sides of the equation are per unit volume);
-   - box boundary: both transfers masked to medium voxels (hd_mg_medium: the prolongation writes
-     no correction into air, the restriction reads no residual from it; still R = (D P)^T / 8):
-     trilinear interpolation put a quarter of the tissue's correction into the air beside it,
-     whose conductance is about 1e4 times tissue's, and CG's line search shrank every step
-     (24^3 sphere, 12 steps: max error 9.1e-3 before, 1.9e-6 with the coarse sigma_t rule);
-   - a coarse grid has half its fine grid's voxels per axis, rounded DOWN: with an odd size the
-     last fine voxel has no parent (rounding up put the last coarse voxel's centre on the fine
-     box's vacuum boundary, and the plain cycle diverged on odd sizes with air);
-   - coarse sigma_t: the harmonic mean of the 8 children (hd_mg_coarse_sig; over the medium ones
-     when at least 4 are), rebuilt when sigma_t changes; RGB colour channels: the mean.
-   The fixed point is the fine grid's discrete solution (tested: phi matches red-black's).
-   Memory: r, z, p, lo and the fine residual (which doubles as q) are 20 bytes per voxel and
-   channel, the coarse levels about 2.3 more (hd__be_solver_bytes, counted in method_bytes). */
-
-#define HD__MG_MAX_LEVELS 12
-#define HD__MG_PRE 2
-#define HD__MG_POST 2
-#define HD__MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
-
-typedef struct hd__cpu_level {
-    hd__kparams kp;          /* the fine parameters with this level's dims, h and the rhs flag */
-    hd__kctx k;
-    hd__cpu_grid g;
-    float *sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
-    float *rhs, *phi;        /* the right-hand side and the correction; level 0: r and z */
-    float *res;              /* the residual of this level's equation; level 0: also q = A p */
-    int dims[3];
-} hd__cpu_level;
-
-struct hd__cpu_mg {
-    hd__cpu_level lv[HD__MG_MAX_LEVELS];
-    int levels, channels, sig_channels, fine[3];
-    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
-    int cur;                 /* the level a transfer pass writes (coarse) */
-    int colour;              /* the colour ((x + y + z) & 1) hd__cpu_mg_extrap_row writes */
-    float *p;                /* CG's search direction (fine grid) */
-    float *lo;               /* the iterate's low part: CG's iterate is phi + lo, phi its float
-                                rounding (hd__cpu_mg_update_row) */
-    hd__kparams opkp;        /* A p: level 0's parameters, E = z (zeroed by then), phi = p */
-    hd__kctx opk;
-    hd__cpu_grid opg, fineg; /* A p into level 0's res; f - A phi into level 0's rhs (r) */
-    double *dot_a, *dot_b;   /* per-row partial sums of the dot products (level 0's rows) */
-    double alpha;
-    float beta;
-    double vcycle_seconds;   /* wall time in V-cycles (benchmark: a step against a V-cycle) */
-};
+/* hd_cpu_multigrid.h - the CPU backend's multigrid primitives (src/hd_backend.h's hd__be_mg_*;
+   the step that runs them is src/hd_multigrid.h). The per-voxel math is the shared
+   backends/kernels/hd_k_multigrid.h. Every level's buffers are in the colour layout, so the
+   smoothing runs the sweep's unit-stride rows; the transfers and dot products load each row they
+   read once, as its two unit-stride half-rows (hd__cpu_mg_load_row), because a load by
+   coordinates alternates between them (docs/DESIGN-MULTIGRID.md has the measurements). */
 
 /* Elements of a level's grid of `channels` channels: every buffer is in the colour layout
    (hd_prelude_c.h's hd__split_slot, as the backend's sigma_t, E and phi), so the shared kernels
    and the sweep's row loop read them alike; padding slots stay 0. */
 static size_t hd__mg_slots(const int *d, int channels) { return hd__split_slots(d[0], d[1], (size_t)d[2] * (size_t)channels); }
-
-static void hd__cpu_mg_free(hd__ctx *ctx)
-{
-    struct hd__cpu_mg *mg = ctx->be->mg;
-    int l;
-    if (!mg) return;
-    for (l = 0; l < mg->levels; ++l) {
-        hd__free(ctx, mg->lv[l].sig);
-        hd__free(ctx, mg->lv[l].rhs);
-        hd__free(ctx, mg->lv[l].phi);
-        hd__free(ctx, mg->lv[l].res);
-    }
-    hd__free(ctx, mg->p);
-    hd__free(ctx, mg->lo);
-    hd__free(ctx, mg->dot_a);
-    hd__free(ctx, mg->dot_b);
-    hd__free(ctx, mg);
-    ctx->be->mg = NULL;
-}
 
 /* Bytes the solver holds (r, z, p, the fine residual and every coarse grid); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx)
@@ -144,7 +25,6 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     }
     return b;
 }
-#define HD__BE_HAS_SOLVER_BYTES 1
 
 /* Level l's parameter block and kernel context: the fine block with the level's dims, 1 / h^2
    and h, and the right-hand-side flag; its buffers (level 0: the backend's sigma_t). */
@@ -184,13 +64,12 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     struct hd__cpu_mg *mg;
-    int l, d[3], i;
+    int l, n, d[3], i;
     size_t rows, fine;
     be->mg = mg = (struct hd__cpu_mg *)hd__calloc(ctx, 1, sizeof *mg);
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = (size_t)d[1] * d[2] * (size_t)mg->channels;
     fine = hd__mg_slots(d, mg->channels);
@@ -202,9 +81,11 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
         hd__cpu_mg_free(ctx);
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the conjugate gradients' vectors");
     }
-    for (l = 0; l < HD__MG_MAX_LEVELS; ++l) {
+    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
         hd__cpu_level *L = &mg->lv[l];
-        size_t v = hd__mg_slots(d, mg->channels);
+        size_t v;
+        hd__mg_level_dims(mg->fine, l, d);
+        v = hd__mg_slots(d, mg->channels);
         memcpy(L->dims, d, sizeof d);
         mg->levels = l + 1;
         L->res = (float *)hd__calloc(ctx, v, sizeof(float));
@@ -216,8 +97,6 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
             return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate multigrid level %d (%dx%dx%d)", l,
                            d[0], d[1], d[2]);
         }
-        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     return HD_SUCCESS;
 }
@@ -334,29 +213,7 @@ static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
     }
 }
 
-/* ---- the V-cycle: z = M r ------------------------------------------------------------------------ */
 static int hd__mg_rows(const hd__cpu_level *L, int channels) { return L->dims[1] * L->dims[2] * channels; }
-
-static void hd__cpu_mg_cycle(hd__backend *be, int l)
-{
-    struct hd__cpu_mg *mg = be->mg;
-    hd__cpu_level *L = &mg->lv[l];
-    be->grid = &L->g;
-    if (l == mg->levels - 1) {
-        hd__cpu_red_black(be, HD__MG_COARSEST_SWEEPS, 0);
-        hd__cpu_red_black(be, HD__MG_COARSEST_SWEEPS, 1);
-        return;
-    }
-    hd__cpu_red_black(be, HD__MG_PRE, 0);
-    hd__cpu_parallel(be, hd__cpu_residual_row, hd__mg_rows(L, mg->channels));
-    mg->cur = l + 1;
-    hd__cpu_parallel(be, hd__cpu_mg_restrict_row, hd__mg_rows(&mg->lv[l + 1], mg->channels));
-    hd__cpu_mg_cycle(be, l + 1);
-    mg->cur = l + 1;
-    hd__cpu_parallel(be, hd__cpu_mg_prolong_row, hd__mg_rows(L, mg->channels));
-    be->grid = &L->g;
-    hd__cpu_red_black(be, HD__MG_POST, 1);
-}
 
 /* ---- the fine residual in double ------------------------------------------------------------------ */
 /* f - A (phi + lo) of row r (= (c * gz + z) * gy + y) of be->grid into out[], evaluated in double
@@ -507,64 +364,127 @@ static HD__CPU_FLATTEN void hd__cpu_mg_extrap_row(hd__backend *be, int r)
         }
 }
 
-/* Rebuilds the levels if the grid changed, refreshes every level's parameters and restricts
-   sigma_t when it changed; returns whether CG must restart. */
-static hd_result hd__cpu_mg_prepare(hd__ctx *ctx, int *restart)
+/* ---- the primitives (src/hd_backend.h) -------------------------------------------------------- */
+static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
     struct hd__cpu_mg *mg = be->mg;
     hd_result r;
-    int l, stale;
+    int l;
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
                memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
         hd__cpu_mg_free(ctx);
+    *fresh = !be->mg;
     if (!be->mg && (r = hd__cpu_mg_alloc(ctx)) != HD_SUCCESS) return r;
     mg = be->mg;
     for (l = 0; l < mg->levels; ++l) hd__cpu_mg_params(ctx, l);
     hd__cpu_mg_fine_params(ctx);
-    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
-        for (mg->cur = 1; mg->cur < mg->levels; ++mg->cur)
-            hd__cpu_parallel(be, hd__cpu_mg_sig_row, mg->lv[mg->cur].dims[1] * mg->lv[mg->cur].dims[2] * mg->sig_channels);
-        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
-    }
-    if (stale) memset(mg->lo, 0, hd__mg_slots(mg->fine, mg->channels) * sizeof(float));
     return HD_SUCCESS;
 }
 
-/* One step of multigrid-preconditioned conjugate gradients on the illumination grid (the
-   solver's "sweep"; the top of this file lists its passes). */
-static hd_result hd__be_multigrid(hd__ctx *ctx)
+static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 {
-    hd__backend *be = ctx->be;
-    struct hd__cpu_mg *mg;
-    int restart, rows;
-    double t0, rz, pq, rp;
-    hd_result r;
-    if ((r = hd__cpu_mg_prepare(ctx, &restart)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    rows = hd__mg_rows(&mg->lv[0], mg->channels);
-    be->grid = &mg->fineg; /* r = f - A phi */
-    hd__cpu_parallel(be, hd__cpu_mg_residual_f64_row, rows);
-    t0 = hd__now(); /* z = M r (z is 0 here: zeroed by the last step's direction pass, or new) */
-    hd__cpu_mg_cycle(be, 0);
-    mg->vcycle_seconds += hd__now() - t0;
-    hd__cpu_parallel(be, hd__cpu_mg_rz_row, rows);
-    rz = hd__mg_row_sum(mg->dot_a, (size_t)rows);
-    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
-    hd__cpu_parallel(be, hd__cpu_mg_dir_row, rows);
-    be->grid = &mg->opg; /* q = A p */
-    hd__cpu_parallel(be, hd__cpu_mg_op_row, rows);
-    pq = hd__mg_row_sum(mg->dot_a, (size_t)rows);
-    rp = hd__mg_row_sum(mg->dot_b, (size_t)rows);
-    be->grid = NULL;
-    mg->cg.have_dir = 1;
-    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (pq > 0.0) {
-        mg->alpha = rp / pq;
-        hd__cpu_parallel(be, hd__cpu_mg_update_row, rows);
-    }
-    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) /* one colour at a time: it reads the other */
-        for (mg->colour = 0; mg->colour < 2; ++mg->colour) hd__cpu_parallel(be, hd__cpu_mg_extrap_row, rows);
+    ctx->be->grid = NULL;
+    return r;
+}
+
+static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
+{
+    struct hd__cpu_mg *mg = ctx->be->mg;
+    mg->cur = l;
+    hd__cpu_parallel(ctx->be, hd__cpu_mg_sig_row, mg->lv[l].dims[1] * mg->lv[l].dims[2] * mg->sig_channels);
     return HD_SUCCESS;
 }
-#define HD__BE_HAS_MULTIGRID 1
+
+static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
+{
+    struct hd__cpu_mg *mg = ctx->be->mg;
+    memset(mg->lo, 0, hd__mg_slots(mg->fine, mg->channels) * sizeof(float));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    be->grid = &be->mg->fineg;
+    hd__cpu_parallel(be, hd__cpu_mg_residual_f64_row, hd__mg_rows(&be->mg->lv[0], be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+{
+    hd__backend *be = ctx->be;
+    be->grid = &be->mg->lv[l].g;
+    hd__cpu_red_black(be, sweeps, first);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    be->grid = &be->mg->lv[l].g;
+    hd__cpu_parallel(be, hd__cpu_residual_row, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    be->mg->cur = l + 1;
+    hd__cpu_parallel(be, hd__cpu_mg_restrict_row, hd__mg_rows(&be->mg->lv[l + 1], be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    be->mg->cur = l + 1;
+    hd__cpu_parallel(be, hd__cpu_mg_prolong_row, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
+{
+    hd__cpu_parallel(ctx->be, hd__cpu_mg_rz_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+{
+    ctx->be->mg->beta = beta;
+    hd__cpu_parallel(ctx->be, hd__cpu_mg_dir_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    return HD_SUCCESS;
+}
+
+/* q and both dot products in one pass over the rows (hd__cpu_mg_op_row). */
+static hd_result hd__be_mg_apply(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    be->grid = &be->mg->opg;
+    hd__cpu_parallel(be, hd__cpu_mg_op_row, hd__mg_rows(&be->mg->lv[0], be->mg->channels));
+    be->grid = NULL;
+    return HD_SUCCESS;
+}
+
+/* The passes ran to completion in hd__cpu_parallel: the row sums are the host's. */
+static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+{
+    (void)n;
+    *a = ctx->be->mg->dot_a;
+    *b = ctx->be->mg->dot_b;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
+{
+    ctx->be->mg->alpha = alpha;
+    hd__cpu_parallel(ctx->be, hd__cpu_mg_update_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
+{
+    ctx->be->mg->colour = colour;
+    hd__cpu_parallel(ctx->be, hd__cpu_mg_extrap_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    return HD_SUCCESS;
+}

@@ -123,7 +123,7 @@ __kernel void hd_k_path(HD__CL_BUFFERS)
     hd_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
 
-/* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_multigrid ---------------
+/* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_mg_* -------------------
    The math is hd_k_multigrid.h's; the V-cycle's smoothing is the diffusion kernels above, run on a
    level's own parameter block (its dims, 1 / h^2, h and HD_FLAG_DIFFUSE_RHS) and buffers. Every
    grid of the solver (each level's sigma_t, right-hand side, correction and residual, conjugate

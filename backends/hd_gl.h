@@ -53,9 +53,6 @@
 #include <GL/glcorearb.h>
 #include "hd_glsl_embedded.h"
 
-#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
-#define HD__BE_HAS_PT 1 /* hd__be_path */
-#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: GL_R16F E / phi / phi2 */
 
 /* ---- function table: every GL function through the loader ------------------------------- */
 #define HD__GL_FNS(X) \
@@ -98,7 +95,7 @@ static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
 /* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
    surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
-   (Vulkan measured 1.4-1.6x from the same specialization). Program slots past
+   (docs/DESIGN-VULKAN.md measures the same specialization). Program slots past
    HD__GL_PROGRAM_COUNT hold these variants. */
 #define HD__GL_DIFFUSE_VARIANTS 8 /* bit 4: HD_FLAG_DIFFUSE_RHS (multigrid's levels) */
 #define HD__GL_SLOTS_F32 (HD__GL_PROGRAM_COUNT + HD__GL_DIFFUSE_VARIANTS)
@@ -180,7 +177,6 @@ struct hd__backend {
     size_t illum_floats, img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
-    unsigned sig_gen;           /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     struct hd__gl_mg *mg;       /* multigrid levels, NULL until first used */
     GLuint mg_programs[HD__GL_MG_PROGRAMS]; /* by HD_MG_STAGE - 1, then the 4 flag variants */
 };
@@ -904,7 +900,6 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what) { HD__GL_STAGE(ctx, h
 /* ---- stages ------------------------------------------------------------------------------------ */
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
-    ++ctx->be->sig_gen;
     HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
 }
 
@@ -1040,19 +1035,13 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_sum_
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
-   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
-   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design), structured
+   The per-level primitives of src/hd_multigrid.h's step (docs/DESIGN-MULTIGRID.md), structured
    as the OpenCL port (docs/DESIGN-OPENCL.md): the per-voxel math is the shared hd_k_multigrid.h
    (entry points hd_entry_glsl_multigrid.h), the V-cycle's smoothing the diffusion program with
    HD_FLAG_DIFFUSE_RHS on each level's own parameter block. Every level's sigma_t / rhs / phi /
    residual and CG's p and lo are r32f 3D textures like the backend's own; the double passes are
    GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
-   storage buffer 3) and the rows in row order on the host, as the CPU does. */
-#define HD__BE_HAS_MULTIGRID 1
-#define HD__GL_MG_MAX_LEVELS 12
-#define HD__GL_MG_PRE 2
-#define HD__GL_MG_POST 2
-#define HD__GL_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
+   storage buffer 3) and the rows in row order by the core, as on the CPU. */
 enum { HD__GL_MG_SIG = 1, HD__GL_MG_RESIDUAL, HD__GL_MG_RESTRICT, HD__GL_MG_PROLONG, HD__GL_MG_DIR, HD__GL_MG_RES_F64,
        HD__GL_MG_DOT, HD__GL_MG_UPDATE, HD__GL_MG_EXTRAP };
 static const char *const hd__gl_mg_names[HD__GL_MG_STAGES] = {
@@ -1070,13 +1059,11 @@ typedef struct hd__gl_level {
 } hd__gl_level;
 
 struct hd__gl_mg {
-    hd__gl_level lv[HD__GL_MG_MAX_LEVELS];
+    hd__gl_level lv[HD__MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     hd__gl_tex p, lo;        /* the search direction; the iterate's low part (phi + lo) */
     GLuint dot_a, dot_b;     /* per-row partial sums (double) */
     double *host_dot;        /* their host copy */
-    float beta;
 };
 
 static size_t hd__gl_mg_rows(const struct hd__gl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
@@ -1116,7 +1103,6 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
     return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
 }
-#define HD__BE_HAS_SOLVER_BYTES 1
 
 /* A level's grid of `channels` channels stacked in z, zeroed. */
 static hd_result hd__gl_mg_tex(hd__ctx *ctx, hd__gl_tex *t, const int *d, int channels, const char *what)
@@ -1124,23 +1110,21 @@ static hd_result hd__gl_mg_tex(hd__ctx *ctx, hd__gl_tex *t, const int *d, int ch
     return hd__gl_tex_new(ctx, t, d[0], d[1], d[2] * channels, NULL, what);
 }
 
-/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
-   one: hd_cpu_multigrid.h's rule) and CG's vectors, zeroed. */
+/* The levels (hd__mg_levels) and CG's vectors, zeroed. */
 static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg;
-    int l, i, d[3];
+    int l, i, n, d[3];
     hd_result r;
     size_t rows;
     be->mg = mg = (struct hd__gl_mg *)hd__calloc(ctx, 1, sizeof *mg);
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = hd__gl_mg_rows(mg);
-    mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
+    mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double));
     if (!mg->host_dot) { hd__gl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows"); }
     if ((r = hd__gl_mg_tex(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
         (r = hd__gl_mg_tex(ctx, &mg->lo, d, mg->channels, "multigrid's lo")) != HD_SUCCESS ||
@@ -1149,8 +1133,9 @@ static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
         hd__gl_mg_free(ctx);
         return r;
     }
-    for (l = 0; l < HD__GL_MG_MAX_LEVELS; ++l) {
+    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
         hd__gl_level *L = &mg->lv[l];
+        hd__mg_level_dims(mg->fine, l, d);
         memcpy(L->dims, d, sizeof d);
         mg->levels = l + 1;
         be->gl.GenBuffers(1, &L->params);
@@ -1161,8 +1146,6 @@ static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
             hd__gl_mg_free(ctx);
             return r;
         }
-        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     return HD_SUCCESS;
 }
@@ -1242,9 +1225,8 @@ static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double 
     return hd__gl_check(ctx, "multigrid's uniforms", __LINE__);
 }
 
-/* `sweeps` red-black sweeps of level l with the diffusion program (HD_FLAG_DIFFUSE_RHS variant);
-   first = 0: red then black, 1: black then red (the adjoint order, for post-smoothing). */
-static hd_result hd__gl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+/* Level l's smoothing: the diffusion program (HD_FLAG_DIFFUSE_RHS variant) on its parameter block. */
+static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
     hd__gl_level *L = &be->mg->lv[l];
@@ -1264,29 +1246,31 @@ static hd_result hd__gl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     return HD_SUCCESS;
 }
 
-/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
-static hd_result hd__gl_mg_cycle(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
-    hd__gl_level *L = &mg->lv[l], *C;
-    int ch = mg->channels;
-    hd_result r;
-    if (l == mg->levels - 1) {
-        if ((r = hd__gl_mg_smooth(ctx, l, HD__GL_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
-        return hd__gl_mg_smooth(ctx, l, HD__GL_MG_COARSEST_SWEEPS, 1);
-    }
-    C = &mg->lv[l + 1];
-    if ((r = hd__gl_mg_smooth(ctx, l, HD__GL_MG_PRE, 0)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL,
-                            L->dims[0], L->dims[1], L->dims[2] * ch, 0, 0, 0, ch)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
-                            C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch)) != HD_SUCCESS ||
-        (r = hd__gl_mg_cycle(ctx, l + 1)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0], L->dims[1],
-                            L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch)) != HD_SUCCESS)
-        return r;
-    return hd__gl_mg_smooth(ctx, l, HD__GL_MG_POST, 1);
+    hd__gl_level *L = &be->mg->lv[l];
+    int ch = be->mg->channels;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, L->dims[0],
+                          L->dims[1], L->dims[2] * ch, 0, 0, 0, ch);
+}
+
+static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
+    int ch = be->mg->channels;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
+                          C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch);
+}
+
+static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    hd__gl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
+    int ch = be->mg->channels;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0],
+                          L->dims[1], L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch);
 }
 
 /* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
@@ -1299,103 +1283,138 @@ static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex
                           mg->fine[2] * mg->channels, use_lo, negate, 0, mg->channels);
 }
 
-/* <a, b> per fine row into dot, then the rows summed in row order on the host (as the CPU's
-   hd__mg_row_sum). */
-static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot, double *out)
+/* <a, b> per fine row into dot (storage buffer 3). */
+static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
+    return hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, mg->fine[1], mg->fine[2] * mg->channels, 1,
+                          0, 0, 0, mg->channels);
+}
+
+/* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
+/* Makes the backend's context current for the whole step (hd__be_mg_end leaves it), makes the
+   levels and sends their parameter blocks. */
+static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
+{
+    hd__backend *be;
+    struct hd__gl_mg *mg;
+    hd_result r = hd__gl_enter(ctx);
+    int l;
+    if (r != HD_SUCCESS) return r;
+    be = ctx->be;
+    mg = be->mg;
+    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
+               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
+        hd__gl_mg_free(ctx);
+    *fresh = !be->mg;
+    if (!be->mg && (r = hd__gl_mg_alloc(ctx)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
+    mg = be->mg;
+    for (l = 0; l < mg->levels; ++l)
+        if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
+    hd__gl_send_params(ctx);
+    return HD_SUCCESS;
+}
+
+/* A step ends complete, as OpenCL's clFinish (timings per step mean the step). */
+static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+{
+    if (r == HD_SUCCESS) {
+        ctx->be->gl.Finish();
+        r = hd__gl_check(ctx, "glFinish", __LINE__);
+    }
+    return hd__gl_leave(ctx, r);
+}
+
+static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    struct hd__gl_mg *mg = be->mg;
+    const int *d = mg->lv[l].dims;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
+                          d[1], d[2] * mg->sig_channels, d[0], d[1], d[2], mg->sig_channels);
+}
+
+static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gl_tex_zero(ctx, &ctx->be->mg->lo); }
+
+static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    return hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &be->mg->lv[0].rhs, 1, 0);
+}
+
+static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
+{
+    struct hd__gl_mg *mg = ctx->be->mg;
+    return hd__gl_mg_dot(ctx, &mg->lv[0].rhs, &mg->lv[0].phi, mg->dot_a);
+}
+
+static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+{
+    struct hd__gl_mg *mg = ctx->be->mg;
+    hd_result r;
+    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
+}
+
+static hd_result hd__be_mg_apply(hd__ctx *ctx)
+{
+    struct hd__gl_mg *mg = ctx->be->mg;
+    hd__gl_level *L = &mg->lv[0];
+    hd_result r;
+    if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS ||
+        (r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a)) != HD_SUCCESS)
+        return r;
+    return hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b);
+}
+
+/* The row sums read into their host copy (glGetBufferSubData waits for the passes). */
+static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
     size_t rows = hd__gl_mg_rows(mg);
-    hd_result r;
-    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
-    if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, mg->fine[1],
-                            mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels)) != HD_SUCCESS)
-        return r;
-    be->gl.BindBuffer(GL_COPY_READ_BUFFER, dot);
-    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(rows * sizeof(double)), mg->host_dot);
-    HD__GL_CHECK(ctx, "reading multigrid's row sums");
-    *out = hd__mg_row_sum(mg->host_dot, rows);
+    int i;
+    for (i = 0; i < n && i < 2; ++i) {
+        be->gl.BindBuffer(GL_COPY_READ_BUFFER, i ? mg->dot_b : mg->dot_a);
+        be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(rows * sizeof(double)), mg->host_dot + i * rows);
+        HD__GL_CHECK(ctx, "reading multigrid's row sums");
+    }
+    *a = mg->host_dot;
+    *b = mg->host_dot + rows;
     return HD_SUCCESS;
 }
 
-/* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
-   when it changed; *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
-static hd_result hd__gl_mg_prepare(hd__ctx *ctx, int *restart)
+static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
     hd_result r;
-    int l, stale;
-    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
-               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
-        hd__gl_mg_free(ctx);
-    if (!be->mg && (r = hd__gl_mg_alloc(ctx)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    for (l = 0; l < mg->levels; ++l)
-        if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return r;
-    hd__gl_send_params(ctx);
-    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
-        for (l = 1; l < mg->levels; ++l) {
-            const int *d = mg->lv[l].dims;
-            if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL,
-                                    &mg->lv[l].sig, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
-                                    mg->sig_channels)) != HD_SUCCESS)
-                return r;
-        }
-        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
-    }
-    if (stale) return hd__gl_tex_zero(ctx, &mg->lo);
-    return HD_SUCCESS;
+    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
 }
 
-/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
-static hd_result hd__gl_multigrid(hd__ctx *ctx)
+/* The fine parameters (no right-hand-side flag). */
+static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg;
-    hd__gl_level *L;
-    int restart;
-    double rz, pq, rp, alpha;
-    hd_result r;
-    if ((r = hd__gl_mg_prepare(ctx, &restart)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    L = &mg->lv[0];
-    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new) */
-    if ((r = hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &L->rhs, 1, 0)) != HD_SUCCESS) return r;
-    if ((r = hd__gl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
-    if ((r = hd__gl_mg_dot(ctx, &L->rhs, &L->phi, mg->dot_a, &rz)) != HD_SUCCESS) return r;
-    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
-    /* p = z + beta p, z = 0 */
-    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, mg->beta, 0.0)) != HD_SUCCESS ||
-        (r = hd__gl_mg_pass(ctx, HD__GL_MG_DIR, L->params, NULL, &L->phi, &mg->p, NULL, NULL, mg->fine[0], mg->fine[1],
-                            mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
-        return r;
-    /* q = A p; <p, q>, <r, p> */
-    if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS) return r;
-    if ((r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a, &pq)) != HD_SUCCESS) return r;
-    if ((r = hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b, &rp)) != HD_SUCCESS) return r;
-    mg->cg.have_dir = 1;
-    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (pq > 0.0) {
-        alpha = rp / pq;
-        if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS ||
-            (r = hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, L->params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0],
-                                mg->fine[1], mg->fine[2] * mg->channels, 0, 0, 0, mg->channels)) != HD_SUCCESS)
-            return r;
-    }
-    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
-       one colour per pass; the fine parameters (no right-hand-side flag) */
-    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) {
-        int colour;
-        for (colour = 0; colour < 2; ++colour)
-            if ((r = hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, mg->fine[0],
-                                    mg->fine[1], mg->fine[2] * mg->channels, colour, 0, 0, mg->channels)) != HD_SUCCESS)
-                return r;
-    }
-    be->gl.Finish(); /* a step ends complete, as OpenCL's clFinish (timings per step mean the step) */
-    return hd__gl_check(ctx, "glFinish", __LINE__);
+    struct hd__gl_mg *mg = be->mg;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
 }
-static hd_result hd__be_multigrid(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_multigrid(ctx)); }
+
+/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
+{
+    hd_result r;
+    int s;
+    for (s = 0; s < sweeps; ++s)
+        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
 
 static hd_result hd__be_path(hd__ctx *ctx)
 {

@@ -549,7 +549,7 @@ static const char *const hd__gl_source[] = {
 "   weighted sum of the 6 neighbours:\n",
 "   phi_i = (sigma_s E_i + sum_j w_j phi_j) / (sigma_a + sum_j w_j),  w_j = D_ij / h^2.\n",
 "   Two boundary conditions (params.diffusion_boundary):\n",
-"   - box (default, METHOD.md): phi = 0 outside the box, reached through the voxel's own D. Empty\n",
+"   - box (default, docs/METHOD.md): phi = 0 outside the box, reached through the voxel's own D. Empty\n",
 "     voxels are solved too, with the floored D: air conducts light to the box faces almost\n",
 "     freely, so every tissue surface acts nearly as phi = 0.\n",
 "   - surface (HD_FLAG_SURFACE_BOUNDARY): empty voxels (sigma' below half the floor) are not\n",

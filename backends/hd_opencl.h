@@ -28,9 +28,6 @@
 #endif
 #include "hd_kernels_embedded.h"
 
-#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
-#define HD__BE_HAS_PT 1 /* hd__be_path */
-#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: the _half kernels */
 
 /* the eight diffusion kernels from HD__CL_DIFFUSE on, indexed by 4 * Jacobi + 2 * surface
    boundary + RGB scattering; then the binary16-storage twins of the stages that touch E or phi
@@ -57,7 +54,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
     "hd_k_mg_extrap"};
 
-struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (hd__be_multigrid, at the end) */
+struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (the hd__be_mg_* primitives, at the end) */
 static void hd__cl_mg_free(hd__ctx *ctx);
 
 struct hd__backend {
@@ -79,7 +76,6 @@ struct hd__backend {
     int params_valid;
     int lost;                /* a call reported a lost device: every later call fails fast */
     int fp64;                /* the device has cl_khr_fp64 (multigrid's double passes) */
-    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     struct hd__cl_mg *mg;    /* multigrid levels, NULL until first used */
 };
 
@@ -525,7 +521,6 @@ static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
     hd_result r;
-    ++ctx->be->sig_gen;
     if ((r = hd__cl_bind(ctx, HD__CL_CLASSIFY)) != HD_SUCCESS) return r;
     return hd__cl_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
 }
@@ -723,22 +718,26 @@ static hd_result hd__be_path(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
+{
+    hd_result r;
+    int s;
+    for (s = 0; s < sweeps; ++s)
+        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
-   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
-   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design and its
-   measurements), on the device: the per-voxel math is the shared hd_k_multigrid.h, the V-cycle's
+   The per-level primitives of src/hd_multigrid.h's step (docs/DESIGN-MULTIGRID.md) on the
+   device: the per-voxel math is the shared hd_k_multigrid.h, the V-cycle's
    smoothing the diffusion kernels on each level's own parameter block. Every grid (levels and CG
    vectors) is in the colour layout of its own dims, so those kernels smooth a level unchanged;
    level 0's sigma_t is the backend's. Where the CPU sums in double, so does the device
    (cl_khr_fp64; without it the solver is unsupported, logged); the dot products are summed per
-   row on the device (x in order) and the rows in order on the host, as the CPU does: the same
+   row on the device (x in order) and the rows in order by the core, as on the CPU: the same
    operations in the same order, so the result has the CPU's bits wherever the kernels do (the
    conformance suite measures it). */
-#define HD__BE_HAS_MULTIGRID 1
-#define HD__CL_MG_MAX_LEVELS 12
-#define HD__CL_MG_PRE 2
-#define HD__CL_MG_POST 2
-#define HD__CL_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
 
 typedef struct hd__cl_level {
     int dims[3];
@@ -750,14 +749,12 @@ typedef struct hd__cl_level {
 } hd__cl_level;
 
 struct hd__cl_mg {
-    hd__cl_level lv[HD__CL_MG_MAX_LEVELS];
+    hd__cl_level lv[HD__MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    hd__mg_cg cg;            /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
     cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
     cl_mem line;             /* the restriction's row buffer: a fine row's shares per coarse row */
     double *host_dot;        /* their host copy, one row sum per fine row */
-    float beta;
 };
 
 static size_t hd__cl_mg_slots(const int *d, int channels)
@@ -804,25 +801,22 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     }
     return b;
 }
-#define HD__BE_HAS_SOLVER_BYTES 1
 
-/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
-   one: hd_cpu_multigrid.h's rule) and CG's vectors, zeroed. */
+/* The levels (hd__mg_levels) and CG's vectors, zeroed. */
 static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg;
-    int l, i, d[3];
+    int l, i, n, d[3];
     hd_result r;
     size_t rows;
     be->mg = mg = (struct hd__cl_mg *)hd__calloc(ctx, 1, sizeof *mg);
     if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the multigrid levels");
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
-    hd__mg_cg_init(&mg->cg, be->sig_gen);
     for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
     rows = hd__cl_mg_rows(mg);
-    mg->host_dot = (double *)hd__calloc(ctx, rows, sizeof(double));
+    mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double));
     if (!mg->host_dot) { hd__cl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows"); }
     if ((r = hd__cl_buffer(ctx, &mg->p, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's p")) != HD_SUCCESS ||
         (r = hd__cl_buffer(ctx, &mg->lo, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's lo")) != HD_SUCCESS ||
@@ -832,9 +826,11 @@ static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
         hd__cl_mg_free(ctx);
         return r;
     }
-    for (l = 0; l < HD__CL_MG_MAX_LEVELS; ++l) {
+    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
         hd__cl_level *L = &mg->lv[l];
-        size_t bytes = hd__cl_mg_slots(d, mg->channels) * sizeof(float);
+        size_t bytes;
+        hd__mg_level_dims(mg->fine, l, d);
+        bytes = hd__cl_mg_slots(d, mg->channels) * sizeof(float);
         memcpy(L->dims, d, sizeof d);
         mg->levels = l + 1;
         if ((r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters")) != HD_SUCCESS ||
@@ -846,8 +842,6 @@ static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
             hd__cl_mg_free(ctx);
             return r;
         }
-        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        for (i = 0; i < 3; ++i) d[i] = d[i] / 2;
     }
     return HD_SUCCESS;
 }
@@ -916,9 +910,8 @@ static hd_result hd__cl_mg_bind_level(hd__ctx *ctx, int k, int l)
     return hd__cl_mg_args(ctx, k, 9, args);
 }
 
-/* `sweeps` red-black sweeps of level l with the diffusion kernel; first = 0: red then black,
-   1: black then red (the adjoint order, for post-smoothing). */
-static hd_result hd__cl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+/* Level l's smoothing: the diffusion kernel on its parameter block. */
+static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     int k = hd__cl_mg_variant(ctx, HD__CL_DIFFUSE), s, h;
     hd_result r;
@@ -929,27 +922,26 @@ static hd_result hd__cl_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     return HD_SUCCESS;
 }
 
-/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
-static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
+{
+    int k = hd__cl_mg_variant(ctx, HD__CL_MG_RESIDUAL);
+    hd_result r;
+    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS || (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 0)) != HD_SUCCESS)
+        return r;
+    return hd__cl_mg_colour_pass(ctx, k, l, 9, 1);
+}
+
+/* Each fine column's share of the coarse rows (both parities), then their sum per coarse voxel. */
+static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
-    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1 < mg->levels ? l + 1 : l];
-    cl_mem a[5], fsig;
+    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
+    cl_mem a[5], fsig = hd__cl_mg_sig(be, l); /* the transfers' mask, hd_mg_medium (argument 5 of both) */
     hd_result r;
     int k;
-    if (l == mg->levels - 1) {
-        if ((r = hd__cl_mg_smooth(ctx, l, HD__CL_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
-        return hd__cl_mg_smooth(ctx, l, HD__CL_MG_COARSEST_SWEEPS, 1);
-    }
-    if ((r = hd__cl_mg_smooth(ctx, l, HD__CL_MG_PRE, 0)) != HD_SUCCESS) return r;
-    k = hd__cl_mg_variant(ctx, HD__CL_MG_RESIDUAL);
-    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS || (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 0)) != HD_SUCCESS ||
-        (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 1)) != HD_SUCCESS)
-        return r;
     a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = mg->line;
-    fsig = hd__cl_mg_sig(be, l); /* the transfers' mask, hd_mg_medium (argument 5 of both) */
-    for (k = 0; k < 2; ++k) { /* the shares of the fine columns of each parity */
+    for (k = 0; k < 2; ++k) {
         cl_int parity = k;
         if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT_LINE, 4, a)) != HD_SUCCESS) return r;
         HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 4, sizeof parity, &parity), "clSetKernelArg(parity)");
@@ -959,17 +951,23 @@ static hd_result hd__cl_mg_cycle(hd__ctx *ctx, int l)
             return r;
     }
     a[0] = L->params; a[1] = C->params; a[2] = mg->line; a[3] = C->rhs; a[4] = C->phi;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT, 5, a)) != HD_SUCCESS ||
-        (r = hd__cl_mg_run(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels)) != HD_SUCCESS)
-        return r;
-    if ((r = hd__cl_mg_cycle(ctx, l + 1)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT, 5, a)) != HD_SUCCESS) return r;
+    return hd__cl_mg_run(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels);
+}
+
+static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
+    cl_mem a[4], fsig = hd__cl_mg_sig(be, l);
+    hd_result r;
     a[0] = L->params; a[1] = C->params; a[2] = C->phi; a[3] = L->phi;
     HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_PROLONG], 5, sizeof fsig, &fsig), "clSetKernelArg(fsig)");
     if ((r = hd__cl_mg_args(ctx, HD__CL_MG_PROLONG, 4, a)) != HD_SUCCESS ||
-        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 0)) != HD_SUCCESS ||
-        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 1)) != HD_SUCCESS)
+        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 0)) != HD_SUCCESS)
         return r;
-    return hd__cl_mg_smooth(ctx, l, HD__CL_MG_POST, 1);
+    return hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 1);
 }
 
 /* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
@@ -1000,101 +998,123 @@ static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot
     return hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)mg->fine[1], (size_t)mg->fine[2] * (size_t)mg->channels, 1);
 }
 
-/* Reads the row sums of dot (blocking: after every pass enqueued before) and sums them in row
-   order, as the CPU's hd__mg_row_sum. */
-static hd_result hd__cl_mg_sum(hd__ctx *ctx, cl_mem dot, double *out)
-{
-    struct hd__cl_mg *mg = ctx->be->mg;
-    size_t rows = hd__cl_mg_rows(mg);
-    HD__CL_TRY(ctx, clEnqueueReadBuffer(ctx->be->queue, dot, CL_TRUE, 0, rows * sizeof(double), mg->host_dot, 0, NULL, NULL),
-               "clEnqueueReadBuffer(multigrid row sums)");
-    *out = hd__mg_row_sum(mg->host_dot, rows);
-    return HD_SUCCESS;
-}
-
-/* Rebuilds the levels if the grid changed, sends every level's parameters and restricts sigma_t
-   when it changed; *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
-static hd_result hd__cl_mg_prepare(hd__ctx *ctx, int *restart)
+/* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
+static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
     hd_result r;
-    int l, stale;
+    int l;
+    HD__CL_LOST_CHECK(ctx);
+    if (!be->fp64)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
                memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
         hd__cl_mg_free(ctx);
+    *fresh = !be->mg;
     if (!be->mg && (r = hd__cl_mg_alloc(ctx)) != HD_SUCCESS) return r;
     mg = be->mg;
     for (l = 0; l < mg->levels; ++l)
         if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
-    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
-        for (l = 1; l < mg->levels; ++l) {
-            cl_mem a[4];
-            a[0] = mg->lv[l - 1].params; a[1] = mg->lv[l].params; a[2] = hd__cl_mg_sig(be, l - 1); a[3] = mg->lv[l].sig;
-            if ((r = hd__cl_mg_args(ctx, HD__CL_MG_SIG, 4, a)) != HD_SUCCESS ||
-                (r = hd__cl_mg_run(ctx, HD__CL_MG_SIG, l, mg->sig_channels)) != HD_SUCCESS)
-                return r;
-        }
-        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
-    }
-    if (stale) return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(mg->fine, mg->channels));
+    return hd__cl_send_params(ctx);
+}
+
+static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+{
+    if (r != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
     return HD_SUCCESS;
 }
 
-/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
-static hd_result hd__be_multigrid(hd__ctx *ctx)
+static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg;
-    hd__cl_level *L;
-    int restart;
-    double rz, pq, rp, alpha;
+    struct hd__cl_mg *mg = be->mg;
     cl_mem a[4];
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
-    if (!be->fp64)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if ((r = hd__cl_mg_prepare(ctx, &restart)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    L = &mg->lv[0];
-    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new) */
-    if ((r = hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, L->rhs, 1, 0)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_cycle(ctx, 0)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, L->phi, mg->dot_a)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &rz)) != HD_SUCCESS) return r;
-    mg->beta = hd__mg_cg_beta(&mg->cg, rz, restart);
-    a[0] = L->params; a[1] = L->phi; a[2] = mg->p;
+    a[0] = mg->lv[l - 1].params; a[1] = mg->lv[l].params; a[2] = hd__cl_mg_sig(be, l - 1); a[3] = mg->lv[l].sig;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_SIG, 4, a)) != HD_SUCCESS) return r;
+    return hd__cl_mg_run(ctx, HD__CL_MG_SIG, l, mg->sig_channels);
+}
+
+static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(mg->fine, mg->channels));
+}
+
+static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    return hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, be->mg->lv[0].rhs, 1, 0);
+}
+
+static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    return hd__cl_mg_dot_rows(ctx, mg->lv[0].rhs, mg->lv[0].phi, mg->dot_a);
+}
+
+static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    cl_mem a[3];
+    hd_result r;
+    a[0] = mg->lv[0].params; a[1] = mg->lv[0].phi; a[2] = mg->p;
     if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DIR, 3, a)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_DIR], 3, sizeof mg->beta, &mg->beta), "clSetKernelArg(beta)");
-    if ((r = hd__cl_mg_run(ctx, HD__CL_MG_DIR, 0, mg->channels)) != HD_SUCCESS) return r;
-    /* q = A p; <p, q>, <r, p> */
-    if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_dot_rows(ctx, mg->p, L->res, mg->dot_a)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_sum(ctx, mg->dot_a, &pq)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_mg_sum(ctx, mg->dot_b, &rp)) != HD_SUCCESS) return r;
-    mg->cg.have_dir = 1;
-    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
-    if (pq > 0.0) {
-        alpha = rp / pq;
-        a[0] = L->params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
-        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
-        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
-        if ((r = hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels)) != HD_SUCCESS) return r;
-    }
-    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
-       one colour at a time; the fine parameters (no right-hand-side flag) */
-    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) {
-        cl_mem e[5];
-        cl_int colour;
-        e[0] = be->params; e[1] = be->sig; e[2] = be->E; e[3] = be->phi; e[4] = mg->lo;
-        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_EXTRAP, 5, e)) != HD_SUCCESS) return r;
-        for (colour = 0; colour < 2; ++colour) {
-            HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_EXTRAP], 5, sizeof colour, &colour), "clSetKernelArg(colour)");
-            if ((r = hd__cl_mg_run(ctx, HD__CL_MG_EXTRAP, 0, mg->channels)) != HD_SUCCESS) return r;
-        }
-    }
-    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_DIR], 3, sizeof beta, &beta), "clSetKernelArg(beta)");
+    return hd__cl_mg_run(ctx, HD__CL_MG_DIR, 0, mg->channels);
+}
+
+static hd_result hd__be_mg_apply(hd__ctx *ctx)
+{
+    struct hd__cl_mg *mg = ctx->be->mg;
+    hd__cl_level *L = &mg->lv[0];
+    hd_result r;
+    if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS ||
+        (r = hd__cl_mg_dot_rows(ctx, mg->p, L->res, mg->dot_a)) != HD_SUCCESS)
+        return r;
+    return hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b);
+}
+
+/* The buffers read (blocking: after every pass enqueued before) into their host copies. */
+static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    size_t rows = hd__cl_mg_rows(mg);
+    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, mg->dot_a, CL_TRUE, 0, rows * sizeof(double), mg->host_dot, 0, NULL, NULL),
+               "clEnqueueReadBuffer(multigrid row sums)");
+    if (n > 1)
+        HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, mg->dot_b, CL_TRUE, 0, rows * sizeof(double), mg->host_dot + rows, 0, NULL, NULL),
+                   "clEnqueueReadBuffer(multigrid row sums)");
+    *a = mg->host_dot;
+    *b = mg->host_dot + rows;
     return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    cl_mem a[4];
+    hd_result r;
+    a[0] = mg->lv[0].params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
+    return hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels);
+}
+
+static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
+{
+    hd__backend *be = ctx->be;
+    struct hd__cl_mg *mg = be->mg;
+    cl_mem e[5];
+    cl_int c = colour;
+    hd_result r;
+    e[0] = be->params; e[1] = be->sig; e[2] = be->E; e[3] = be->phi; e[4] = mg->lo;
+    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_EXTRAP, 5, e)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_EXTRAP], 5, sizeof c, &c), "clSetKernelArg(colour)");
+    return hd__cl_mg_run(ctx, HD__CL_MG_EXTRAP, 0, mg->channels);
 }

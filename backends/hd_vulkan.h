@@ -61,9 +61,6 @@ VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instan
 #endif
 #endif
 
-#define HD__BE_HAS_CD 1 /* hd__be_alloc_lights, hd__be_convect, hd__be_sum_lights */
-#define HD__BE_HAS_PT 1 /* hd__be_path */
-#define HD__BE_HAS_HALF 1 /* illumination_precision FLOAT16: r16f E / phi / phi2 where the device has them */
 
 /* ---- function table: everything is loaded through vkGetInstanceProcAddr ------------------ */
 #define HD__VK_GLOBAL_FNS(X) X(vkCreateInstance) X(vkEnumerateInstanceLayerProperties) \
@@ -171,7 +168,6 @@ struct hd__backend {
     struct hd__vk_mg *mg;         /* HD_SOLVER_MULTIGRID's levels, CG vectors and sets, or NULL */
     VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
-    unsigned sig_gen;             /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
     size_t illum_floats, img_floats, tf_bytes;
@@ -802,7 +798,7 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
    relaxes (one voxel per row, hd_entry_glsl.h): lavapipe pays a fixed cost per invocation (the
    store and its own set-up cost as much as 7 loads) and per static load, and the block loads each
    texel its voxels share once. Constant 2 is the solver (jacobi), so the
-   store of the other one is not compiled (1.08x sweeps/s, docs/DESIGN-VULKAN.md). flags: constant
+   store of the other one is not compiled (docs/DESIGN-VULKAN.md has the gain). flags: constant
    0's value, NULL for the other stages (bench/hdbench_vulkan.c's --ab also calls this). */
 static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
                                       VkPipeline *out)
@@ -1427,7 +1423,6 @@ static hd_result hd__be_classify(hd__ctx *ctx)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    ++ctx->be->sig_gen;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CLASSIFY], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
@@ -1580,34 +1575,27 @@ static hd_result hd__be_path(hd__ctx *ctx)
 }
 
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
-   Conjugate gradients preconditioned by a symmetric geometric multigrid V-cycle: the CPU
-   reference's algorithm step for step (backends/hd_cpu_multigrid.h has the design), structured as
+   The per-level primitives of src/hd_multigrid.h's step (docs/DESIGN-MULTIGRID.md), structured as
    the GL port (hd_gl.h): the per-voxel math is the shared hd_k_multigrid.h (entry points
    hd_entry_glsl_multigrid.h, SPIR-V hd__spv_mg_*), the V-cycle's smoothing the diffusion pipeline
-   specialized with HD_FLAG_DIFFUSE_RHS on each level's own parameter block; the restarts, beta and
-   the row-order sum are hd_multigrid_cg.h's. Every level's sigma_t / rhs / phi / residual and CG's
+   specialized with HD_FLAG_DIFFUSE_RHS on each level's own parameter block. Every level's sigma_t / rhs / phi / residual and CG's
    p and lo are r32f storage images like the backend's own; the double passes need shaderFloat64;
    the dot products are summed per row on the device (x in order, doubles into a host-visible
-   storage buffer at binding 11) and the rows in row order on the host, as the CPU does.
+   storage buffer at binding 11) and the rows in row order by the core, as on the CPU.
    Vulkan binds through descriptor sets, not per pass as GL does: each pass's combination of
    images (a level's smoothing, a restriction, ...) is a set of the multigrid's own pool, written
    when the levels are made and again whenever the backend's sets are rebuilt (its sigma_t, E and
    phi may be new: be->sets_gen); the parameter blocks are slots of the multigrid's own uniform
    buffer, one per level and one for the fine ctx->kp, bound with a dynamic offset.
-   A step is three submissions, each waited for: r, the V-cycle and <r, z> (read back: beta);
-   the direction, q = A p, <p, q> and <r, p> (read back: alpha); the update. So hd_vulkan_record
-   cannot record it (HD_ERROR_UNSUPPORTED there). */
-#define HD__BE_HAS_MULTIGRID 1
-#define HD__VK_MG_MAX_LEVELS 12
-#define HD__VK_MG_PRE 2
-#define HD__VK_MG_POST 2
-#define HD__VK_MG_COARSEST_SWEEPS 8 /* red-black, then as many black-red */
+   The passes are recorded into the backend's command buffer (hd__vk_cmd) and submitted at each
+   read-back of the row sums and at the end: three submissions a step, each waited for, so
+   hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROLONG, HD__VK_MG_DIR, HD__VK_MG_RES_F64,
        HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_EXTRAP, HD__VK_MG_STAGES = HD__VK_MG_EXTRAP };
 /* CG's passes' sets (level 0 and the backend's grids) */
 enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
        HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
-#define HD__VK_MG_SETS (4 * HD__VK_MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
+#define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
 typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 typedef struct hd__vk_level {
@@ -1620,9 +1608,8 @@ typedef struct hd__vk_level {
 } hd__vk_level;
 
 struct hd__vk_mg {
-    hd__vk_level lv[HD__VK_MG_MAX_LEVELS];
+    hd__vk_level lv[HD__MG_MAX_LEVELS];
     int levels, channels, sig_channels, fine[3];
-    hd__mg_cg cg;             /* restarts, the coarse sigma_t's generation, <r, z> (hd_multigrid_cg.h) */
     hd__vk_image p, lo;       /* the search direction; the iterate's low part (phi + lo) */
     hd__vk_buffer dot_a, dot_b; /* per-row partial sums (double), host-visible */
     hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
@@ -1666,7 +1653,6 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
     return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
 }
-#define HD__BE_HAS_SOLVER_BYTES 1
 
 /* A level's grid of `channels` channels stacked in z, zeroed (by the next submission). */
 static hd_result hd__vk_mg_image(hd__ctx *ctx, hd__vk_image *im, const int *d, int channels, const char *what)
@@ -1674,8 +1660,7 @@ static hd_result hd__vk_mg_image(hd__ctx *ctx, hd__vk_image *im, const int *d, i
     return hd__vk_image_new(ctx, im, d[0], d[1], d[2] * channels, what);
 }
 
-/* The levels (halving the grid, rounded down, until at most 4 voxels per axis or fewer than 4 on
-   one: hd_cpu_multigrid.h's rule), CG's vectors (zeroed), the row-sum buffers, the parameter
+/* The levels (hd__mg_levels), CG's vectors (zeroed), the row-sum buffers, the parameter
    slots and the set pool. On failure everything made so far is freed again. */
 static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
 {
@@ -1683,7 +1668,7 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
     struct hd__vk_mg *mg = be->mg;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
     size_t rows = hd__vk_mg_rows(mg);
-    int l, i, d[3];
+    int l, i, n, d[3];
     hd_result r;
     for (i = 0; i < 3; ++i) d[i] = mg->fine[i];
     if ((r = hd__vk_mg_image(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
@@ -1693,8 +1678,9 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
         (r = hd__vk_buffer_create(ctx, &mg->dot_b, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "multigrid's row sums")) != HD_SUCCESS)
         return r;
-    for (l = 0; l < HD__VK_MG_MAX_LEVELS; ++l) {
+    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
         hd__vk_level *L = &mg->lv[l];
+        hd__mg_level_dims(mg->fine, l, d);
         memcpy(L->dims, d, sizeof d);
         mg->levels = l + 1;
         if ((r = hd__vk_mg_image(ctx, &L->rhs, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
@@ -1702,8 +1688,6 @@ static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
             (r = hd__vk_mg_image(ctx, &L->res, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
             (l > 0 && (r = hd__vk_mg_image(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS))
             return r;
-        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
-        hd__mg_level_dims(mg->fine, l + 1, d); /* as hd__mg_bytes counts them */
     }
     mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
     if ((r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(mg->levels + 1),
@@ -1723,7 +1707,6 @@ static hd_result hd__vk_mg_alloc(hd__ctx *ctx)
     mg->channels = ctx->channels;
     mg->sig_channels = ctx->sig_channels;
     for (i = 0; i < 3; ++i) mg->fine[i] = ctx->gdims[i];
-    hd__mg_cg_init(&mg->cg, be->sig_gen);
     if ((r = hd__vk_mg_alloc_parts(ctx)) != HD_SUCCESS) {
         hd__vk_flush(ctx); /* the new images' clears were recorded: submit them before the images go */
         hd__vk_mg_free(ctx);
@@ -1840,25 +1823,27 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
     return HD_SUCCESS;
 }
 
-/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz. */
-static hd_result hd__vk_mg_pass(hd__ctx *ctx, VkCommandBuffer cb, int stage, VkDescriptorSet set, int slot, int nx, int ny,
-                                int nz, int32_t pc0, int32_t pc1, int32_t pc2, int32_t pc3)
+/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz into
+   the backend's command buffer. */
+static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int nx, int ny, int nz, int32_t pc0,
+                                int32_t pc1, int32_t pc2, int32_t pc3)
 {
     hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     int32_t pc[4];
     hd_result r;
-    if ((r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
     hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg->slot_bytes), nx, ny, nz, pc);
     return HD_SUCCESS;
 }
 
-/* `sweeps` red-black sweeps of level l with the diffusion pipeline (HD_FLAG_DIFFUSE_RHS flags);
-   first = 0: red then black, 1: black then red (the adjoint order, for post-smoothing). */
-static hd_result hd__vk_mg_smooth(hd__ctx *ctx, VkCommandBuffer cb, int l, int sweeps, int first)
+/* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
+static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd__vk_level *L = &be->mg->lv[l];
     int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
@@ -1866,7 +1851,7 @@ static hd_result hd__vk_mg_smooth(hd__ctx *ctx, VkCommandBuffer cb, int l, int s
     VkPipeline pipe;
     hd_result r;
     int s, h;
-    if ((r = hd__vk_diffuse_pipeline_for(ctx, flags, 0, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_diffuse_pipeline_for(ctx, flags, 0, &pipe)) != HD_SUCCESS) return r;
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
@@ -1876,61 +1861,59 @@ static hd_result hd__vk_mg_smooth(hd__ctx *ctx, VkCommandBuffer cb, int l, int s
     return HD_SUCCESS;
 }
 
-/* The V-cycle from level l down (z = M r at l = 0, z zero on entry). */
-static hd_result hd__vk_mg_cycle(hd__ctx *ctx, VkCommandBuffer cb, int l)
+static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    hd__vk_level *L = &mg->lv[l], *C;
+    hd__vk_level *L = &mg->lv[l];
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * mg->channels, 0, 0, 0,
+                          mg->channels);
+}
+
+static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    hd__vk_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     int ch = mg->channels;
-    hd_result r;
-    if (l == mg->levels - 1) {
-        if ((r = hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_COARSEST_SWEEPS, 0)) != HD_SUCCESS) return r;
-        return hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_COARSEST_SWEEPS, 1);
-    }
-    C = &mg->lv[l + 1];
-    if ((r = hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_PRE, 0)) != HD_SUCCESS ||
-        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * ch, 0, 0, 0, ch)) != HD_SUCCESS ||
-        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
-                            C->dims[1], C->dims[2], ch)) != HD_SUCCESS ||
-        (r = hd__vk_mg_cycle(ctx, cb, l + 1)) != HD_SUCCESS ||
-        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch,
-                            L->dims[0], L->dims[1], L->dims[2], ch)) != HD_SUCCESS)
-        return r;
-    return hd__vk_mg_smooth(ctx, cb, l, HD__VK_MG_POST, 1);
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
+                          C->dims[1], C->dims[2], ch);
+}
+
+static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    hd__vk_level *L = &mg->lv[l];
+    int ch = mg->channels;
+    return hd__vk_mg_pass(ctx, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch, L->dims[0],
+                          L->dims[1], L->dims[2], ch);
 }
 
 /* The fine residual in double (hd_mg_res_f64) with set `set`: f - A (phi + lo) (the fine slot,
    use_lo) or, negate, A p (level 0's slot, E = z = 0, phi = p). */
-static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set, int slot, int use_lo, int negate)
+static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkDescriptorSet set, int slot, int use_lo, int negate)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
+    return hd__vk_mg_pass(ctx, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
                           negate, 0, mg->channels);
 }
 
 /* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
-static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkCommandBuffer cb, VkDescriptorSet set)
+static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, cb, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
+    return hd__vk_mg_pass(ctx, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
 }
 
-/* Submits what was recorded, the row sums made visible to the host, and waits. */
-static hd_result hd__vk_mg_sync(hd__ctx *ctx, VkCommandBuffer cb)
-{
-    hd__vk_barrier(ctx->be, cb);
-    return hd__vk_flush(ctx);
-}
-
-/* Rebuilds the levels if the grid changed, writes the parameter slots, writes the sets, and
-   records the restriction of sigma_t when it changed and lo's zeroing when it is stale;
-   *restart: CG must restart (the CPU's hd__cpu_mg_prepare). */
-static hd_result hd__vk_mg_prepare(hd__ctx *ctx, VkCommandBuffer *cb, int *restart)
+/* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
+/* Submits what is pending, makes the levels, writes the parameter slots and the sets; the step's
+   passes are recorded into one command buffer up to each read-back (hd__be_mg_row_sums), so a
+   step is three submissions. */
+static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = be->mg;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    int l, stale;
+    HD__VK_LOST_CHECK(ctx);
     if (be->no_f64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
                        be->no_f64);
@@ -1940,79 +1923,113 @@ static hd_result hd__vk_mg_prepare(hd__ctx *ctx, VkCommandBuffer *cb, int *resta
     if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
                memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
         hd__vk_mg_free(ctx);
+    *fresh = !be->mg;
     if (!be->mg && (r = hd__vk_mg_alloc(ctx)) != HD_SUCCESS) return r;
-    mg = be->mg;
     hd__vk_mg_params(ctx);
-    if ((r = hd__vk_begin(ctx, cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
-    if ((r = hd__vk_mg_sets(ctx)) != HD_SUCCESS) return r;
-    if (hd__mg_cg_begin(&mg->cg, ctx, be->sig_gen, restart, &stale)) {
-        for (l = 1; l < mg->levels; ++l) {
-            const int *d = mg->lv[l].dims;
-            if ((r = hd__vk_mg_pass(ctx, *cb, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0],
-                                    d[1], d[2], mg->sig_channels)) != HD_SUCCESS)
-                return r;
-        }
-        hd__mg_cg_restricted(&mg->cg, ctx, be->sig_gen);
-    }
-    if (stale) hd__vk_zero_image(be, *cb, mg->lo.image, HD__VK_G);
+    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
+    return hd__vk_mg_sets(ctx);
+}
+
+static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    if (r != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    const int *d = mg->lv[l].dims;
+    return hd__vk_mg_pass(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
+                          mg->sig_channels);
+}
+
+static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_zero_image(ctx->be, cb, ctx->be->mg->lo.image, HD__VK_G);
     return HD_SUCCESS;
 }
 
-/* One step of multigrid-preconditioned conjugate gradients (the CPU's hd__be_multigrid). */
-static hd_result hd__be_multigrid(hd__ctx *ctx)
+static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
-    hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg;
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    int restart, i;
-    int32_t bits[2];
-    double rz, pq, rp, alpha;
-    float beta;
+    struct hd__vk_mg *mg = ctx->be->mg;
+    return hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
+}
+
+static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
+{
+    return hd__vk_mg_dot(ctx, ctx->be->mg->cg_sets[HD__VK_MG_SET_DOT_RZ]);
+}
+
+static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    int32_t bits;
+    memcpy(&bits, &beta, sizeof beta);
+    return hd__vk_mg_pass(ctx, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, bits, 0, 0, mg->channels);
+}
+
+static hd_result hd__be_mg_apply(hd__ctx *ctx)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_mg_prepare(ctx, &cb, &restart)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    /* r = f - A (phi + lo); z = M r (z is 0 here: zeroed by the last direction pass, or new); <r, z> */
-    if ((r = hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0)) != HD_SUCCESS ||
-        (r = hd__vk_mg_cycle(ctx, cb, 0)) != HD_SUCCESS || (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_RZ])) != HD_SUCCESS ||
-        (r = hd__vk_mg_sync(ctx, cb)) != HD_SUCCESS)
+    if ((r = hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
+        (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
         return r;
-    rz = hd__mg_row_sum((const double *)mg->dot_a.map, hd__vk_mg_rows(mg));
-    beta = hd__mg_cg_beta(&mg->cg, rz, restart);
-    /* p = z + beta p, z = 0; q = A p; <p, q>, <r, p> */
-    memcpy(&bits[0], &beta, sizeof beta);
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS ||
-        (r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
-                            mg->fine[2] * mg->channels, bits[0], 0, 0, mg->channels)) != HD_SUCCESS ||
-        (r = hd__vk_mg_res_f64(ctx, cb, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
-        (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS ||
-        (r = hd__vk_mg_dot(ctx, cb, mg->cg_sets[HD__VK_MG_SET_DOT_RP])) != HD_SUCCESS || (r = hd__vk_mg_sync(ctx, cb)) != HD_SUCCESS)
-        return r;
-    pq = hd__mg_row_sum((const double *)mg->dot_a.map, hd__vk_mg_rows(mg));
-    rp = hd__mg_row_sum((const double *)mg->dot_b.map, hd__vk_mg_rows(mg));
-    mg->cg.have_dir = 1;
-    /* pq > 0 unless p = 0 (phi already solves the equation to the last bit): then no step */
+    return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
+}
+
+/* Submits what was recorded, the row sums made visible to the host, and waits; the sums are read
+   in the host-visible buffers themselves. */
+static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    (void)n;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    if (pq > 0.0) {
-        alpha = rp / pq;
-        /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
-        for (i = 0; i < 2; ++i) {
-            uint64_t u;
-            memcpy(&u, &alpha, sizeof u);
-            bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-        }
-        if ((r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
-                                mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels)) != HD_SUCCESS)
-            return r;
-    }
-    /* surface boundary: the empty voxels' extrapolation, lo = -phi (the CPU's hd__cpu_mg_extrap_row),
-       one colour per pass; the fine parameters (slot `levels`: no right-hand-side flag) */
-    if (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY)
-        for (i = 0; i < 2; ++i)
-            if ((r = hd__vk_mg_pass(ctx, cb, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0],
-                                    mg->fine[1], mg->fine[2] * mg->channels, i, 0, 0, mg->channels)) != HD_SUCCESS)
-                return r;
-    return hd__vk_flush(ctx);
+    hd__vk_barrier(ctx->be, cb);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    *a = (const double *)mg->dot_a.map;
+    *b = (const double *)mg->dot_b.map;
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    int32_t bits[2];
+    uint64_t u;
+    int i;
+    /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
+    memcpy(&u, &alpha, sizeof u);
+    for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
+    return hd__vk_mg_pass(ctx, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels);
+}
+
+/* The fine parameters: slot `levels` (no right-hand-side flag). */
+static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    return hd__vk_mg_pass(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0], mg->fine[1],
+                          mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
+}
+
+/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
+{
+    hd_result r;
+    int s;
+    for (s = 0; s < sweeps; ++s)
+        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
 }
 
 /* ---- recording into the caller's command buffer ------------------------------------------------ */

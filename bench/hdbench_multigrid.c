@@ -284,7 +284,7 @@ int main(int argc, char **argv)
         printf("| %s | multigrid | %d PCG steps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
         {
             hd__ctx *m = hd__lookup(mg, NULL);
-            double vc = m && m->be->mg ? m->be->mg->vcycle_seconds : 0.0;
+            double vc = m && m->be->mg ? m->mg.vcycle_seconds : 0.0;
             printf("per step (wall): red-black sweep %.2f ms, PCG step %.2f ms, of which its V-cycle %.2f ms\n",
                    1e3 * a.wall / a.steps, 1e3 * b.wall / b.steps, 1e3 * vc / b.steps);
         }

@@ -808,7 +808,7 @@ static void run_downsample_study(const ref_img *ref, const char *out)
 
 /* Beyond the paper: HD's diffusion variants against the 1-light PT_MS reference, at the scene's HD
    iteration count and at 4x it: grey (the paper) and RGB scattering, each with the box boundary
-   (METHOD.md) and the surface (Marshak) boundary. rgb.md, rgb-checks lines, the mean radiance of
+   (docs/METHOD.md) and the surface (Marshak) boundary. rgb.md, rgb-checks lines, the mean radiance of
    each image against the reference's (the diffusion's energy balance), and the side-by-side
    figure rgb_scattering.png (the four variants, then PT_MS).
    Colour, apart from brightness: PT_MS multiplies a path by the TF colour at every scattering

@@ -658,14 +658,12 @@ static hd_result hd__prepare(hd__ctx *ctx)
     if (dirty & HD__DIRTY_JACOBI) {
         if ((r = hd__be_alloc_jacobi(ctx, !pt && ctx->params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
     }
-#ifdef HD__BE_HAS_CD
     /* CD's light volumes follow the lights: reallocated (dark) when they change; freed for the
        other methods (a method change sets every dirty bit) */
     if (dirty & HD__DIRTY_DIRECT) {
         if ((r = hd__be_alloc_lights(ctx, ctx->params.method == HD_METHOD_CD ? ctx->light_count : 0)) != HD_SUCCESS)
             return r;
     }
-#endif
     /* the path tracers' state is their image: whatever resets it restarts them */
     if (pt && (dirty & HD__DIRTY_IMAGE)) dirty |= HD__DIRTY_DIRECT;
     if (dirty & HD__DIRTY_IMAGE_ALLOC) {
@@ -684,7 +682,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
     hd__fill_kparams(ctx);
     if (dirty & HD__DIRTY_SIGMA) {
         if ((r = hd__be_upload_inputs(ctx)) != HD_SUCCESS) return r;
-        if (!pt && (r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
+        if (!pt) {
+            ++ctx->sig_gen;
+            if ((r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
+        }
     }
     if ((r = hd__be_clear(ctx, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
     ctx->dirty = 0;
@@ -692,12 +693,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
 }
 
 /* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a
-   V-cycle: about 15 red-black sweeps of work on the head CT). */
+   V-cycle; docs/DESIGN-MULTIGRID.md has its cost in red-black sweeps). */
 static hd_result hd__diffuse_once(hd__ctx *ctx)
 {
-#ifdef HD__BE_HAS_MULTIGRID
-    if (ctx->params.solver == HD_SOLVER_MULTIGRID) return hd__be_multigrid(ctx);
-#endif
+    if (ctx->params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step(ctx);
     return hd__be_diffuse(ctx, ctx->params.solver == HD_SOLVER_JACOBI);
 }
 
@@ -707,11 +706,9 @@ static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
     hd_result r;
     int s;
     if (ctx->params.disable_diffusion) return HD_SUCCESS;
-#ifdef HD__BE_HAS_DIFFUSE_SWEEPS
     /* all of them in one call: the CPU backend walks memory once for several red-black sweeps */
     if (ctx->params.solver != HD_SOLVER_MULTIGRID)
         return hd__be_diffuse_sweeps(ctx, ctx->params.solver == HD_SOLVER_JACOBI, ctx->params.diffusion_sweeps);
-#endif
     for (s = 0; s < ctx->params.diffusion_sweeps; ++s)
         if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
     return HD_SUCCESS;
@@ -726,15 +723,12 @@ static hd_result hd__light_iteration(hd__ctx *ctx)
     double t0 = hd__now(), t1, t2;
     ctx->iterations++;
     hd__fill_kparams(ctx);
-#ifdef HD__BE_HAS_CD
     if (ctx->params.method == HD_METHOD_CD) {
         int l;
         for (l = 0; l < ctx->light_count; ++l)
             if ((r = hd__be_convect(ctx, l)) != HD_SUCCESS) return r;
         if ((r = hd__be_sum_lights(ctx)) != HD_SUCCESS) return r;
-    } else
-#endif
-    if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
+    } else if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
     t1 = hd__now();
     if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
     /* iterations recorded into a caller's command buffer have not run yet: nothing to measure */
@@ -767,7 +761,6 @@ static hd_result hd__iterate_light(hd__ctx *ctx)
     return hd__project_frame(ctx);
 }
 
-#ifdef HD__BE_HAS_PT
 /* One PT_SS / PT_MS iteration: one full path per pixel into the image's plain running mean.
    Its time counts as the direct stage (paths), none as diffusion or projection. */
 static hd_result hd__iterate_pt(hd__ctx *ctx)
@@ -781,19 +774,14 @@ static hd_result hd__iterate_pt(hd__ctx *ctx)
     ctx->seconds[0] += hd__now() - t0;
     return HD_SUCCESS;
 }
-#endif
 
-/* One iteration of the current method (METHOD.md: what an iteration is, per method). */
+/* One iteration of the current method (docs/METHOD.md: what an iteration is, per method). */
 static hd_result hd__iterate_method(hd__ctx *ctx)
 {
     switch (ctx->params.method) {
-#ifdef HD__BE_HAS_CD
     case HD_METHOD_CD: return hd__iterate_light(ctx);
-#endif
-#ifdef HD__BE_HAS_PT
     case HD_METHOD_PT_SS:
     case HD_METHOD_PT_MS: return hd__iterate_pt(ctx);
-#endif
     case HD_METHOD_HD: return hd__iterate_light(ctx);
     default:
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
@@ -985,9 +973,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
                         hd__illum_floats(ctx) * hd__illum_elem_bytes(ctx) * (ctx->params.solver == HD_SOLVER_JACOBI ? 3 : 2);
 #endif
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
-#ifdef HD__BE_HAS_SOLVER_BYTES
-    out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (CPU multigrid levels) */
-#endif
+    out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (multigrid levels) */
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
     out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
     hd__be_volume_bytes(ctx, &out->volume_bytes);

@@ -17,8 +17,8 @@
 #endif
 /* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
 #define HD__MAX_VOXELS (1u << 30)
-#define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: on the head CT 4 tracks 12% faster
-                                than 8 (tighter majorants) and 9% faster than 2 (fewer DDA steps) */
+#define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
+                                majorants and few DDA steps (docs/DESIGN-CPU.md) */
 
 /* What a setter invalidates (see the table above hd_set_transfer_function). */
 enum {
@@ -39,6 +39,18 @@ enum {
 #endif
 
 typedef struct hd__backend hd__backend; /* defined by the selected backend */
+
+/* HD_SOLVER_MULTIGRID's run state, the same on every backend (src/hd_multigrid.h). */
+typedef struct hd__mg_cg {
+    unsigned sig_gen;        /* ctx->sig_gen the coarse sigma_t were restricted from */
+    int sig_surface;         /* ... and the boundary they were restricted for */
+    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
+    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
+    int have_dir;            /* the backend's p holds a direction of the current CG run */
+    double rz;               /* <r, z> of the previous step (beta's denominator) */
+    unsigned light_gen;      /* the context's light_gen of the current CG run */
+    double vcycle_seconds;   /* wall time in V-cycles (bench/hdbench_multigrid.c: a step against a V-cycle) */
+} hd__mg_cg;
 
 typedef struct hd__ctx {
     hd_desc desc;            /* with defaults filled in; pointers refer to the copies below */
@@ -85,6 +97,8 @@ typedef struct hd__ctx {
     uint64_t converged_frames; /* projection frames since the light converged */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
+    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
     hd__backend *be;
 } hd__ctx;
 

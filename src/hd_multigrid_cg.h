@@ -1,22 +1,11 @@
-/* hd_multigrid_cg.h - the host-side bookkeeping of HD_SOLVER_MULTIGRID that is the same on every
-   backend with the solver (hd_cpu_multigrid.h, hd_opencl.h, hd_gl.h, hd_vulkan.h):
-   when conjugate gradients restart, when the coarse levels' sigma_t must be restricted again, beta,
-   the row-order sum of the dot products' row sums, the levels' grids and parameter blocks, and
-   the solver's bytes (OpenCL pads its rows: its own count). The passes are each backend's; their
-   per-voxel math is backends/kernels/hd_k_multigrid.h. The design is at the top of
-   hd_cpu_multigrid.h. */
+/* hd_multigrid_cg.h - HD_SOLVER_MULTIGRID's rules that the core's step (src/hd_multigrid.h) and
+   the backends' primitives share: when conjugate gradients restart, when the coarse levels'
+   sigma_t must be restricted again, beta, the row-order sum of the dot products' row sums, the
+   levels' count, grids and parameter blocks, and the solver's bytes (OpenCL pads its rows: its
+   own count). Below the backends: it calls none of them. docs/DESIGN-MULTIGRID.md has the design. */
 #ifndef HD_MULTIGRID_CG_H
 #define HD_MULTIGRID_CG_H
 
-typedef struct hd__mg_cg {
-    unsigned sig_gen;        /* the backend's sig_gen the coarse sigma_t were restricted from */
-    int sig_surface;         /* ... and the boundary they were restricted for */
-    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
-    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
-    int have_dir;            /* the backend's p holds a direction of the current CG run */
-    double rz;               /* <r, z> of the previous step (beta's denominator) */
-    unsigned light_gen;      /* the context's light_gen of the current CG run */
-} hd__mg_cg;
 
 /* A new state for a backend whose sigma_t generation is sig_gen: the first step restricts. */
 HD__MAYBE_UNUSED static void hd__mg_cg_init(hd__mg_cg *cg, unsigned sig_gen)
@@ -77,12 +66,25 @@ HD__MAYBE_UNUSED static double hd__mg_row_sum(const double *d, size_t rows)
     return s;
 }
 
-/* Level l's grid: the fine grid halved l times, rounded down (hd_cpu_multigrid.h's rule; halving
+/* Level l's grid: the fine grid halved l times, rounded down (hd__mg_levels' rule; halving
    a grid already halved and rounded down is the same as dividing by 2^l once). */
 HD__MAYBE_UNUSED static void hd__mg_level_dims(const int *fine, int l, int *d)
 {
     int i;
     for (i = 0; i < 3; ++i) d[i] = fine[i] / (1 << l);
+}
+
+/* How many levels a fine grid has: halved (rounded down) until at most 4 voxels per axis, or
+   fewer than 4 on one axis; at most HD__MG_MAX_LEVELS. */
+#define HD__MG_MAX_LEVELS 12
+HD__MAYBE_UNUSED static int hd__mg_levels(const int *fine)
+{
+    int l, d[3];
+    for (l = 0; l < HD__MG_MAX_LEVELS - 1; ++l) {
+        hd__mg_level_dims(fine, l, d);
+        if ((d[0] <= 4 && d[1] <= 4 && d[2] <= 4) || d[0] < 4 || d[1] < 4 || d[2] < 4) break;
+    }
+    return l + 1;
 }
 
 /* Level l's parameter block: the fine one with the level's grid d, 1 / h^2 and h of its spacing

@@ -235,26 +235,8 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_budget = %g s must be >= 0 and finite", (double)p->render_budget);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
-#ifndef HD__BE_HAS_CD
-    if (p->method == HD_METHOD_CD)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method CD is not available on the %s backend", hd__be_name());
-#endif
-#ifndef HD__BE_HAS_MULTIGRID
-    if (p->solver == HD_SOLVER_MULTIGRID)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "solver MULTIGRID is not available on the %s backend", hd__be_name());
-#endif
-#ifndef HD__BE_HAS_HALF
-    if (p->illumination_precision == HD_PRECISION_FLOAT16)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 is not available on the %s backend",
-                       hd__be_name());
-#endif
-    /* the multigrid levels (hd_cpu_multigrid.h) restrict and prolong float32 fine grids */
+    /* the multigrid levels (src/hd_multigrid.h) restrict and prolong float32 fine grids */
     if (p->illumination_precision == HD_PRECISION_FLOAT16 && p->solver == HD_SOLVER_MULTIGRID)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 with solver MULTIGRID is not available (float32 levels only)");
-#ifndef HD__BE_HAS_PT
-    if (p->method == HD_METHOD_PT_SS || p->method == HD_METHOD_PT_MS)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
-                       hd_method_name(p->method), hd__be_name());
-#endif
     return HD_SUCCESS;
 }

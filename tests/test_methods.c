@@ -165,7 +165,7 @@ static int tm_compare(const char *what, const tm_est *a, const tm_est *b, double
 /* Both estimate L = integral T_cam sigma_s c E / (4 pi) dt (+ background, black here) over the
    pixel: PT_SS by a collision and a shadow ray, HD by ray marching E, which the direct stage
    estimates without bias at the voxel centres. What separates them is the projection's
-   discretisation (METHOD.md):
+   discretisation (docs/METHOD.md):
      - the ray-march step dt (0.5 voxel): T is accumulated per segment and the emission taken at
        a jittered point; the two errors cancel to first order, the residual is O((sigma dt)^2);
      - trilinear interpolation of E between voxel centres: O((sigma h)^2 / 8) where E ~

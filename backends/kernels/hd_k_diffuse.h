@@ -6,7 +6,7 @@
    weighted sum of the 6 neighbours:
    phi_i = (sigma_s E_i + sum_j w_j phi_j) / (sigma_a + sum_j w_j),  w_j = D_ij / h^2.
    Two boundary conditions (params.diffusion_boundary):
-   - box (default, METHOD.md): phi = 0 outside the box, reached through the voxel's own D. Empty
+   - box (default, docs/METHOD.md): phi = 0 outside the box, reached through the voxel's own D. Empty
      voxels are solved too, with the floored D: air conducts light to the box faces almost
      freely, so every tissue surface acts nearly as phi = 0.
    - surface (HD_FLAG_SURFACE_BOUNDARY): empty voxels (sigma' below half the floor) are not
