@@ -85,6 +85,14 @@ typedef struct hd__ctx {
     uint64_t converged_frames; /* projection frames since the light converged */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
+    /* HD's direct light is tracked only at the illumination-grid voxels whose E is read (the
+       projection's and the diffusion's footprint of the medium, hd__direct_mask); rebuilt with
+       sigma_t, E elsewhere stays 0 */
+    uint32_t *dl_idx;        /* their grid indices, ascending (every voxel with dl_all) */
+    size_t dl_count;
+    uint8_t *dl_bits;        /* the same voxels, one bit each (read by the convergence estimate) */
+    int dl_all;              /* track every voxel (a test hook: the reference for the mask) */
+    unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
     hd__backend *be;
 } hd__ctx;
 
