@@ -558,8 +558,9 @@ static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
 }
 
 /* Dual cells [lo, hi] along one axis (volume size n) that an interpolation reading grid voxel x
-   (grid size g) can sample: the grid's lerp reads x for s = u g in [x - 0.5, x + 1.5] (clamped to
-   the edge), the volume's lerp samples cell min(floor(u n - 0.5), n - 2), clamped to [0, n - 2]. */
+   (grid size g) can sample: the grid's lerp reads x for s = u g in [x - 0.5, x + 1.5), and its
+   clamps make voxels 0 and 1 read from s = 0 on and voxels g - 2 and g - 1 up to s = g; the
+   volume's lerp samples cell min(floor(u n - 0.5), n - 2), clamped to [0, n - 2]. */
 static void hd__dl_axis(int x, int g, int n, int *lo, int *hi)
 {
     int last = n - 2 > 0 ? n - 2 : 0;
@@ -567,7 +568,7 @@ static void hd__dl_axis(int x, int g, int n, int *lo, int *hi)
     float plo = ((float)x - 0.5f) / (float)g * (float)n - 0.5f - eps;
     float phi = ((float)x + 1.5f) / (float)g * (float)n - 0.5f + eps;
     int a = plo <= 0.0f ? 0 : (int)floorf(plo), b = phi <= 0.0f ? 0 : (int)ceilf(phi) - 1; /* s < x + 1.5 */
-    if (x == 0) a = 0;
+    if (x <= 1) a = 0;
     if (x >= g - 2) b = last;
     *lo = a > last ? last : a;
     *hi = b > last ? last : b;

@@ -767,6 +767,7 @@ int main(int argc, char **argv)
     /* mostly empty space: the direct light tracked only where it is read */
     case_shell(HD_VOXEL_U8, odd, 1, 0, 3, 6);
     case_shell(HD_VOXEL_F32, other, 2, 1, 1, 6);
+    case_shell(HD_VOXEL_U16, odd, 3, 0, 1, 6);
     case_method(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 0, 0, 8);
     case_method(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 1, 1, 8);
     case_method(HD_METHOD_CD, HD_VOXEL_F32, other, 16, 0, 1, 4);
