@@ -983,6 +983,11 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     hd_result r;
     int i;
+    /* the set's storage buffers (TF, majorants, image, row sums, direct light's list): one above
+       Vulkan's guaranteed minimum of 4 per stage */
+    if (be->limits.maxPerStageDescriptorStorageBuffers < 5)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: the device binds %u storage buffers per shader stage; 5 needed",
+                       be->limits.maxPerStageDescriptorStorageBuffers);
     if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
