@@ -7,7 +7,8 @@
    GL keeps separate binding points per kind, numbered within GL 4.3's minimums (8 image units,
    8 storage buffers): uniform block 0 the parameter block (hd_prelude_glsl.h); image units
    0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written; storage
-   buffers 0 TF, 1 majorants, 2 image accumulation. GL has no push
+   buffers 0 TF, 1 majorants, 2 image accumulation, 4 the direct light's list of voxels
+   (hd_context.h, hd__direct_mask; hd_pc.x its length in the direct stage). GL has no push
    constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
    uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision
    FLOAT16): E, phi and phi2 are r16f (GL_R16F textures, core in GL 4.3), converted by imageLoad /
@@ -28,6 +29,7 @@ layout(binding = 2, HD_ILLUM_FMT) uniform image3D hd_i_E;
 layout(binding = 3, HD_ILLUM_FMT) uniform image3D hd_i_phi;
 layout(binding = 4, HD_ILLUM_FMT) uniform image3D hd_i_phi2;
 layout(std430, binding = 2) buffer hd_b_img { float img[]; };
+layout(std430, binding = 4) readonly buffer hd_b_dl { uint dl[]; };
 layout(binding = 5, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 6, r32f) uniform image3D hd_i_lv2;
 layout(location = 0) uniform ivec4 hd_pc;

@@ -21,7 +21,9 @@
    imageLoad / imageStore, the arithmetic float32; r16f needs shaderStorageImageExtendedFormats.
    Binding 11: HD_SOLVER_MULTIGRID's row sums (doubles, hd_entry_glsl_multigrid.h, its modules
    compiled with HD_MG_STAGE = n and HD_STAGE 0); its passes' flags, like the diffusion stage's,
-   are hd_sc_flags, and their beta / alpha come in the push constants (HD_MG_PUSH_SCALARS). */
+   are hd_sc_flags, and their beta / alpha come in the push constants (HD_MG_PUSH_SCALARS).
+   Binding 12: the direct light's list of voxels (hd_context.h, hd__direct_mask); the direct
+   stage's push constant x is its length. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 #extension GL_EXT_control_flow_attributes : require
 #define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
@@ -42,6 +44,7 @@ layout(binding = 7, HD_ILLUM_FMT) uniform image3D hd_i_phi2;
 layout(std430, binding = 8) buffer hd_b_img { float img[]; };
 layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 10, r32f) uniform image3D hd_i_lv2;
+layout(std430, binding = 12) readonly buffer hd_b_dl { uint dl[]; };
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;

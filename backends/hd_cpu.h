@@ -349,10 +349,14 @@ static void hd__cpu_classify_row(hd__backend *be, int r)
     int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_classify_voxel(&be->k, x, r % gy, r / gy);
 }
-static void hd__cpu_direct_row(hd__backend *be, int r)
+/* Direct light: items of HD__CPU_DIRECT_CHUNK consecutive entries of the tracked voxels' list. */
+#define HD__CPU_DIRECT_CHUNK 64
+static void hd__cpu_direct_chunk(hd__backend *be, int item)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
-    for (x = 0; x < gx; ++x) hd_direct_voxel(&be->k, x, r % gy, r / gy);
+    const hd__ctx *ctx = be->ctx;
+    size_t j = (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
+    if (end > ctx->dl_count) end = ctx->dl_count;
+    for (; j < end; ++j) hd_direct_index(&be->k, (int)ctx->dl_idx[j]);
 }
 /* ---- diffusion -------------------------------------------------------------------------------
    A pass works on be->grid: the illumination grid itself, or a multigrid level
@@ -929,8 +933,15 @@ static hd_result hd__be_classify(hd__ctx *ctx)
 }
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
+    size_t n = ctx->dl_count;
     ctx->be->lsum_ok = 0;
-    hd__cpu_parallel(ctx->be, hd__cpu_direct_row, ctx->gdims[1] * ctx->gdims[2]);
+    hd__cpu_parallel(ctx->be, hd__cpu_direct_chunk, (int)((n + HD__CPU_DIRECT_CHUNK - 1) / HD__CPU_DIRECT_CHUNK));
+    return HD_SUCCESS;
+}
+/* The list of voxels to track lives in the context (ctx->dl_idx): nothing to upload. */
+static hd_result hd__be_direct_list(hd__ctx *ctx)
+{
+    (void)ctx;
     return HD_SUCCESS;
 }
 

@@ -132,7 +132,9 @@ void main()
 #if HD_STAGE == HD_STAGE_CLASSIFY
     if (x < g.x && y < g.y && z < g.z) hd_classify_voxel(x, y, z);
 #elif HD_STAGE == HD_STAGE_DIRECT
-    if (x < g.x && y < g.y && z < g.z) hd_direct_voxel(x, y, z);
+    /* over the list of voxels whose E is read, hd_pc.x entries, in rows of the dispatch's width */
+    int j = x + y * int(gl_NumWorkGroups.x * gl_WorkGroupSize.x);
+    if (j < hd_pc.x) hd_direct_index(int(dl[j]));
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT

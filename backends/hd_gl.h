@@ -123,7 +123,7 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_DIFFUSE_ZK 4
 #define HD__GL_DIFFUSE_YK 2
 #define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
-#define HD__GL_SSBOS 4       /* storage buffers 0..3 (3: multigrid's row sums) */
+#define HD__GL_SSBOS 5       /* storage buffers 0..4 (3: multigrid's row sums, 4: the direct light's list) */
 
 /* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..9), each in the
    4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
@@ -170,6 +170,7 @@ struct hd__backend {
     hd__kparams params_kp;      /* what it holds */
     int params_valid;
     GLuint tf, maj, img, dummy_buffer;
+    GLuint dl;                  /* the direct light's list of voxels (ctx->dl_idx), storage buffer 4 */
     hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
     int f16;                    /* E, phi, phi2 are GL_R16F (params.illumination_precision) */
     hd__gl_tex *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
@@ -585,6 +586,7 @@ static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const h
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->tf ? be->tf : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->maj ? be->maj : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, be->dl ? be->dl : be->dummy_buffer);
     for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
         hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
@@ -727,6 +729,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_mg_free(ctx);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
+        hd__gl_free_buffer(be, &be->dl);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
         hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2); hd__gl_free_tex(be, &be->dummy);
         hd__gl_free_tex(be, &be->dummy16);
@@ -903,9 +906,20 @@ static hd_result hd__be_classify(hd__ctx *ctx)
     HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
 }
 
+/* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
+static hd_result hd__be_direct_list(hd__ctx *ctx)
+{
+    HD__GL_STAGE(ctx, hd__gl_buffer_data(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, GL_STATIC_DRAW,
+                                         "the direct light's list"));
+}
+
+/* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
+   groups along x are limited to 65535). */
+#define HD__DIRECT_ROW (HD__GL_LOCAL_X * 32768)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
-    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
+    int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0));
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one

@@ -45,7 +45,8 @@ static const char *const hd__gl_source[] = {
 "   GL keeps separate binding points per kind, numbered within GL 4.3's minimums (8 image units,\n",
 "   8 storage buffers): uniform block 0 the parameter block (hd_prelude_glsl.h); image units\n",
 "   0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written; storage\n",
-"   buffers 0 TF, 1 majorants, 2 image accumulation. GL has no push\n",
+"   buffers 0 TF, 1 majorants, 2 image accumulation, 4 the direct light's list of voxels\n",
+"   (hd_context.h, hd__direct_mask; hd_pc.x its length in the direct stage). GL has no push\n",
 "   constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain\n",
 "   uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision\n",
 "   FLOAT16): E, phi and phi2 are r16f (GL_R16F textures, core in GL 4.3), converted by imageLoad /\n",
@@ -66,6 +67,7 @@ static const char *const hd__gl_source[] = {
 "layout(binding = 3, HD_ILLUM_FMT) uniform image3D hd_i_phi;\n",
 "layout(binding = 4, HD_ILLUM_FMT) uniform image3D hd_i_phi2;\n",
 "layout(std430, binding = 2) buffer hd_b_img { float img[]; };\n",
+"layout(std430, binding = 4) readonly buffer hd_b_dl { uint dl[]; };\n",
 "layout(binding = 5, r32f) uniform readonly image3D hd_i_lv;\n",
 "layout(binding = 6, r32f) uniform image3D hd_i_lv2;\n",
 "layout(location = 0) uniform ivec4 hd_pc;\n",
@@ -172,6 +174,7 @@ static const char *const hd__gl_source[] = {
 "layout(std430, binding = 8) buffer hd_b_img { float img[]; };\n",
 "layout(std430, binding = 9) readonly buffer hd_b_lv { float lv[]; };\n",
 "layout(std430, binding = 10) buffer hd_b_lv2 { float lv2[]; };\n",
+"layout(std430, binding = 12) readonly buffer hd_b_dl { uint dl[]; };\n",
 "#define HD_GET(buf, i, x, y, z) buf[(i)]\n",
 "#define HD_SET(buf, i, x, y, z, v) buf[(i)] = (v)\n",
 "#define HD_GET1(buf, i) buf[(i)]\n",
@@ -539,6 +542,16 @@ static const char *const hd__gl_source[] = {
 "        float sample_x = HD_F(nl) * hd_light_channel(HD_KPASS l, c) * falloff * T;\n",
 "        HD_SET(E, ic, x, y, z + c * gz, e + (sample_x - e) * w);\n",
 "    }\n",
+"}\n",
+"\n",
+"/* The same at illumination-grid index i (x fastest): the dispatch over the list of voxels whose\n",
+"   E is read (hd_context.h, hd__direct_mask). The random key stays the voxel's grid index, so a\n",
+"   tracked voxel's E is bit-identical to tracking every voxel. */\n",
+"HD_FN void hd_direct_index(HD_KARGS int i)\n",
+"{\n",
+"    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y;\n",
+"    int row = i / gx;\n",
+"    hd_direct_voxel(HD_KPASS i - row * gx, row % gy, row / gy);\n",
 "}\n",
 "#line 1 7\n",
 "/* hd_k_diffuse.h - stage 2 of HD and CD: one relaxation sweep of the diffusion equation\n",
@@ -1865,7 +1878,9 @@ static const char *const hd__gl_source[] = {
 "#if HD_STAGE == HD_STAGE_CLASSIFY\n",
 "    if (x < g.x && y < g.y && z < g.z) hd_classify_voxel(x, y, z);\n",
 "#elif HD_STAGE == HD_STAGE_DIRECT\n",
-"    if (x < g.x && y < g.y && z < g.z) hd_direct_voxel(x, y, z);\n",
+"    /* over the list of voxels whose E is read, hd_pc.x entries, in rows of the dispatch's width */\n",
+"    int j = x + y * int(gl_NumWorkGroups.x * gl_WorkGroupSize.x);\n",
+"    if (j < hd_pc.x) hd_direct_index(int(dl[j]));\n",
 "#elif HD_STAGE == HD_STAGE_DIFFUSE\n",
 "    hd_diffuse_block(x, y, z);\n",
 "#elif HD_STAGE == HD_STAGE_PROJECT\n",
@@ -2001,7 +2016,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1695 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1708 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

@@ -66,6 +66,7 @@ struct hd__backend {
     cl_kernel kernels[HD__CL_KERNEL_COUNT];
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
+    cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
     cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
     int nlv;
     size_t tf_bytes, illum_floats, img_floats;
@@ -317,6 +318,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf);
     hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
     hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
+    hd__cl_release(&be->dl);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
@@ -525,12 +527,22 @@ static hd_result hd__be_classify(hd__ctx *ctx)
     return hd__cl_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
 }
 
+/* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
+static hd_result hd__be_direct_list(hd__ctx *ctx)
+{
+    hd__cl_release(&ctx->be->dl);
+    return hd__cl_buffer(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, "the direct light's list");
+}
+
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     hd_result r;
     int k = hd__cl_k(ctx, HD__CL_DIRECT);
+    cl_int count = (cl_int)ctx->dl_count;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], 9, sizeof(cl_mem), &ctx->be->dl), "clSetKernelArg");
+    HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], 10, sizeof count, &count), "clSetKernelArg");
+    if ((r = hd__cl_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS) return r;
     /* each stage returns when its work is done, as on the CPU, so the core's per-stage clocks
        measure the device rather than the enqueueing (cost: one clFinish per stage) */
     HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");

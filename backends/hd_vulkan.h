@@ -100,7 +100,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
                                      (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
-#define HD__VK_BINDINGS 12
+#define HD__VK_BINDINGS 13
 #define HD__VK_MG_PIPELINES (9 * 4) /* HD_SOLVER_MULTIGRID: 9 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
@@ -161,6 +161,7 @@ struct hd__backend {
     hd__kparams slot_kp;          /* what the current slot holds */
     /* resources */
     hd__vk_buffer tf, maj, img, staging, dummy_buffer;
+    hd__vk_buffer dl;             /* the direct light's list of voxels (ctx->dl_idx), binding 12 */
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
     int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
     const char *no_half;          /* why r16f storage images are missing, or NULL */
@@ -923,7 +924,7 @@ static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uin
 }
 
 /* A descriptor pool for `sets` sets of the backend's set layout (hd__vk_pipelines' types: per set
-   1 dynamic uniform buffer, 7 storage images, 4 storage buffers): the backend's sets and the
+   1 dynamic uniform buffer, 7 storage images, 5 storage buffers): the backend's sets and the
    multigrid's (HD_SOLVER_MULTIGRID) each have one. */
 static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool)
 {
@@ -932,7 +933,7 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     VkDescriptorPoolCreateInfo dpci;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = sets;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * sets;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 4 * sets;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 5 * sets;
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = sets;
@@ -973,9 +974,15 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+        VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     hd_result r;
     int i;
+    /* the set's storage buffers (TF, majorants, image, row sums, direct light's list): one above
+       Vulkan's guaranteed minimum of 4 per stage */
+    if (be->limits.maxPerStageDescriptorStorageBuffers < 5)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: the device binds %u storage buffers per shader stage; 5 needed",
+                       be->limits.maxPerStageDescriptorStorageBuffers);
     if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
@@ -1020,10 +1027,11 @@ static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buf
 }
 
 /* The buffers every set binds (TF, majorants, image; binding 11, multigrid's row sums, a
-   placeholder unless given) into bu. */
+   placeholder unless given; 12, the direct light's list) into bu. */
 static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, const hd__vk_buffer *dot)
 {
     bu[2] = &be->tf; bu[3] = &be->maj; bu[8] = &be->img; bu[11] = dot ? dot : &be->dummy_buffer;
+    bu[12] = &be->dl;
 }
 
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
@@ -1164,6 +1172,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__vk_free_image(ctx, &be->dummy16);
         hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
+        hd__vk_free_buffer(ctx, &be->dl);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -1428,14 +1437,34 @@ static hd_result hd__be_classify(hd__ctx *ctx)
     return hd__vk_flush(ctx);
 }
 
+/* Uploads the direct light's list of voxels (rebuilt with sigma_t) into a host-visible buffer;
+   the sets are rewritten (nothing is in flight here). */
+static hd_result hd__be_direct_list(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    hd__vk_free_buffer(ctx, &be->dl);
+    if ((r = hd__vk_buffer_create(ctx, &be->dl, ctx->dl_count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+                                  "the direct light's list")) != HD_SUCCESS)
+        return r;
+    if (ctx->dl_count) memcpy(be->dl.map, ctx->dl_idx, ctx->dl_count * sizeof(uint32_t));
+    return HD_SUCCESS;
+}
+
+/* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
+   groups along x are limited to maxComputeWorkGroupCount, at least 65535). */
+#define HD__DIRECT_ROW ((int)HD__VK_LOCAL_X * 32768)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     VkPipeline pipe;
+    int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_DIRECT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 

@@ -331,9 +331,12 @@ static void hd__fill_kparams(hd__ctx *ctx)
 /* ---- life cycle ---------------------------------------------------------------------------- */
 static void hd__conv_free(hd__ctx *ctx);
 
+static void hd__direct_mask_free(hd__ctx *ctx);
+
 static void hd__ctx_free(hd__ctx *ctx)
 {
     hd__conv_free(ctx);
+    hd__direct_mask_free(ctx);
     if (ctx->be) hd__be_destroy(ctx);
     hd__free(ctx, ctx->vol);
     hd__free(ctx, ctx->cell_range);
@@ -525,6 +528,160 @@ static size_t hd__illum_floats(const hd__ctx *ctx)
     return (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2] * (size_t)ctx->channels;
 }
 
+/* ---- where the direct light is read ------------------------------------------------------------
+   E is read by the projection, trilinearly at samples whose sigma_t > 0, and by the diffusion as
+   sigma_s E at voxels whose sigma_t > 0 (the surface boundary reads sigma_t only); a grid voxel
+   no such read reaches keeps E = 0 with no effect on phi or the image. The mask is exact at the
+   level of the volume's dual cells (the 8 voxels a trilinear sample interpolates): a cell is
+   empty when its 8 values lie in one run of TF entries whose alpha is 0, widened by
+   HD__DL_VALUE_EPS for the kernels' rounding of the interpolation, or when they are 8 equal
+   values (interpolated exactly) where alpha is 0; a grid voxel is tracked when
+   an interpolation that reads it (weight 0 included) can sample a non-empty cell. */
+#define HD__DL_VALUE_EPS 1e-5f
+#define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
+
+/* The run of zero-alpha TF entries (numbered from 1) every value within HD__DL_VALUE_EPS of t
+   lies in, 0 when some of them may have sigma_t > 0. */
+static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
+{
+    float lo = t - HD__DL_VALUE_EPS, hi = t + HD__DL_VALUE_EPS, n1 = (float)(n - 1);
+    int i, i0, i1;
+    lo = lo < 0.0f ? 0.0f : lo;
+    hi = hi > 1.0f ? 1.0f : hi;
+    i0 = (int)(lo * n1);
+    i1 = (int)(hi * n1) + 1;
+    if (i0 > n - 2) i0 = n - 2;
+    if (i1 > n - 1) i1 = n - 1;
+    for (i = i0; i <= i1; ++i)
+        if (entry_run[i] == 0) return 0;
+    return entry_run[i0]; /* consecutive zero entries share their run */
+}
+
+/* Dual cells [lo, hi] along one axis (volume size n) that an interpolation reading grid voxel x
+   (grid size g) can sample: the grid's lerp reads x for s = u g in [x - 0.5, x + 1.5), and its
+   clamps make voxels 0 and 1 read from s = 0 on and voxels g - 2 and g - 1 up to s = g; the
+   volume's lerp samples cell min(floor(u n - 0.5), n - 2), clamped to [0, n - 2]. */
+static void hd__dl_axis(int x, int g, int n, int *lo, int *hi)
+{
+    int last = n - 2 > 0 ? n - 2 : 0;
+    float eps = g == n ? 0.0f : HD__DL_COORD_EPS; /* same grid: the same float expression */
+    float plo = ((float)x - 0.5f) / (float)g * (float)n - 0.5f - eps;
+    float phi = ((float)x + 1.5f) / (float)g * (float)n - 0.5f + eps;
+    int a = plo <= 0.0f ? 0 : (int)floorf(plo), b = phi <= 0.0f ? 0 : (int)ceilf(phi) - 1; /* s < x + 1.5 */
+    if (x <= 1) a = 0;
+    if (x >= g - 2) b = last;
+    *lo = a > last ? last : a;
+    *hi = b > last ? last : b;
+}
+
+static void hd__direct_mask_free(hd__ctx *ctx)
+{
+    hd__free(ctx, ctx->dl_idx);
+    hd__free(ctx, ctx->dl_bits);
+    ctx->dl_idx = NULL;
+    ctx->dl_bits = NULL;
+    ctx->dl_count = 0;
+}
+
+/* Builds dl_bits and dl_idx for the current TF, extinction and grid. */
+static hd_result hd__direct_mask(hd__ctx *ctx)
+{
+    const int *n = ctx->dims, *g = ctx->gdims;
+    int dn[3], d, x, y, z, j;
+    size_t gvox = (size_t)g[0] * g[1] * g[2], ndual, i, k;
+    int32_t *entry_run = NULL, *run = NULL;
+    uint8_t *cell = NULL, *ax = NULL, *ay = NULL;
+    int (*span)[2] = NULL;
+    hd_result r = HD_SUCCESS;
+    hd__direct_mask_free(ctx);
+    for (d = 0; d < 3; ++d) dn[d] = n[d] > 1 ? n[d] - 1 : 1;
+    ndual = (size_t)dn[0] * dn[1] * dn[2];
+    ctx->dl_bits = (uint8_t *)hd__calloc(ctx, (gvox + 7) / 8, 1);
+    entry_run = (int32_t *)hd__alloc(ctx, (size_t)ctx->tf_count * sizeof(int32_t));
+    run = (int32_t *)hd__alloc(ctx, ctx->nvox * sizeof(int32_t));
+    cell = (uint8_t *)hd__alloc(ctx, ndual);
+    ax = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * dn[1] * dn[2]);
+    ay = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * g[1] * dn[2]);
+    span = (int (*)[2])hd__alloc(ctx, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
+    if (!ctx->dl_bits || !entry_run || !run || !cell || !ax || !ay || !span) {
+        r = HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
+        goto done;
+    }
+    /* runs of zero-alpha entries; with no extinction nothing is medium */
+    for (j = 0, k = 0; j < ctx->tf_count; ++j) {
+        int zero = !(ctx->tf[4 * j + 3] > 0.0f) || !(ctx->params.extinction > 0.0f);
+        if (zero && (j == 0 || entry_run[j - 1] == 0)) ++k;
+        entry_run[j] = zero ? (int32_t)k : 0;
+    }
+    for (i = 0; i < ctx->nvox; ++i) run[i] = hd__dl_run(entry_run, ctx->tf_count, ctx->vol[i]);
+    /* a dual cell is empty when its 8 voxels share one zero run */
+    for (z = 0, k = 0; z < dn[2]; ++z)
+        for (y = 0; y < dn[1]; ++y)
+            for (x = 0; x < dn[0]; ++x, ++k) {
+                int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
+                size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
+                size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
+                int32_t a = run[r00 + x];
+                const float *vol = ctx->vol;
+                float v = vol[r00 + x];
+                cell[k] = !(a != 0 && run[r00 + x1] == a && run[r10 + x] == a && run[r10 + x1] == a &&
+                            run[r01 + x] == a && run[r01 + x1] == a && run[r11 + x] == a && run[r11 + x1] == a);
+                /* 8 equal values interpolate to that value exactly, whatever the weights */
+                if (cell[k] && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
+                    vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
+                    !(hd__tf_alpha(ctx, v) * ctx->params.extinction > 0.0f))
+                    cell[k] = 0;
+            }
+    /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
+    for (d = 0, k = 0; d < 3; ++d)
+        for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
+    for (z = 0; z < dn[2]; ++z)
+        for (y = 0; y < dn[1]; ++y)
+            for (x = 0; x < g[0]; ++x) {
+                const uint8_t *c = cell + ((size_t)z * dn[1] + y) * dn[0];
+                uint8_t v = 0;
+                for (j = span[x][0]; j <= span[x][1]; ++j) v |= c[j];
+                ax[((size_t)z * dn[1] + y) * g[0] + x] = v;
+            }
+    for (z = 0; z < dn[2]; ++z)
+        for (y = 0; y < g[1]; ++y)
+            for (x = 0; x < g[0]; ++x) {
+                uint8_t v = 0;
+                for (j = span[g[0] + y][0]; j <= span[g[0] + y][1]; ++j) v |= ax[((size_t)z * dn[1] + j) * g[0] + x];
+                ay[((size_t)z * g[1] + y) * g[0] + x] = v;
+            }
+    ctx->dl_count = 0;
+    for (z = 0, k = 0; z < g[2]; ++z)
+        for (y = 0; y < g[1]; ++y)
+            for (x = 0; x < g[0]; ++x, ++k) {
+                uint8_t v = 0;
+                for (j = span[g[0] + g[1] + z][0]; j <= span[g[0] + g[1] + z][1]; ++j)
+                    v |= ay[((size_t)j * g[1] + y) * g[0] + x];
+                if (v) {
+                    ctx->dl_bits[k >> 3] |= (uint8_t)(1u << (k & 7));
+                    ++ctx->dl_count;
+                }
+            }
+    if (ctx->dl_all) ctx->dl_count = gvox;
+    ctx->dl_idx = (uint32_t *)hd__alloc(ctx, (ctx->dl_count ? ctx->dl_count : 1) * sizeof(uint32_t));
+    if (!ctx->dl_idx) {
+        r = HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's list (%zu voxels)", ctx->dl_count);
+        goto done;
+    }
+    for (k = 0, i = 0; k < gvox; ++k)
+        if (ctx->dl_all || (ctx->dl_bits[k >> 3] >> (k & 7) & 1u)) ctx->dl_idx[i++] = (uint32_t)k;
+done:
+    hd__free(ctx, entry_run);
+    hd__free(ctx, run);
+    hd__free(ctx, cell);
+    hd__free(ctx, ax);
+    hd__free(ctx, ay);
+    hd__free(ctx, span);
+    if (r != HD_SUCCESS) hd__direct_mask_free(ctx);
+    ctx->dl_gen++;
+    return r;
+}
+
 /* ---- light convergence ------------------------------------------------------------------------ */
 static void hd__conv_reset(hd__ctx *ctx)
 {
@@ -549,13 +706,15 @@ static void hd__conv_free(hd__ctx *ctx)
 
 /* The illumination-grid voxels the estimate is taken over: those whose majorant cell holds
    medium (the projection reads E and phi only there; light in air is exact and would dilute
-   the relative error). */
+   the relative error), and with HD's direct-light mask only those it tracks. */
 static int hd__conv_in_medium(const hd__ctx *ctx, int x, int y, int z)
 {
     int f = ctx->params.illumination_downsample, c = HD__MAJORANT_CELL;
     int vx = hd_mini(x * f + f / 2, ctx->dims[0] - 1);
     int vy = hd_mini(y * f + f / 2, ctx->dims[1] - 1);
     int vz = hd_mini(z * f + f / 2, ctx->dims[2] - 1);
+    size_t k = ((size_t)z * ctx->gdims[1] + (size_t)y) * ctx->gdims[0] + (size_t)x;
+    if (ctx->dl_bits && !(ctx->dl_bits[k >> 3] >> (k & 7) & 1u)) return 0; /* E and phi never read */
     return ctx->majorant[((size_t)(vz / c) * ctx->mdims[1] + (size_t)(vy / c)) * ctx->mdims[0] + (size_t)(vx / c)] > 0.0f;
 }
 
@@ -685,6 +844,11 @@ static hd_result hd__prepare(hd__ctx *ctx)
         if (!pt) {
             ++ctx->sig_gen;
             if ((r = hd__be_classify(ctx)) != HD_SUCCESS) return r;
+        }
+        hd__direct_mask_free(ctx);
+        if (ctx->params.method == HD_METHOD_HD) {
+            if ((r = hd__direct_mask(ctx)) != HD_SUCCESS) return r;
+            if ((r = hd__be_direct_list(ctx)) != HD_SUCCESS) return r;
         }
     }
     if ((r = hd__be_clear(ctx, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;

@@ -99,6 +99,14 @@ typedef struct hd__ctx {
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
+    /* HD's direct light is tracked only at the illumination-grid voxels whose E is read (the
+       projection's and the diffusion's footprint of the medium, hd__direct_mask); rebuilt with
+       sigma_t, E elsewhere stays 0 */
+    uint32_t *dl_idx;        /* their grid indices, ascending (every voxel with dl_all) */
+    size_t dl_count;
+    uint8_t *dl_bits;        /* the same voxels, one bit each (read by the convergence estimate) */
+    int dl_all;              /* track every voxel (a test hook: the reference for the mask) */
+    unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
     hd__backend *be;
 } hd__ctx;
 

@@ -26,6 +26,24 @@ HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
     return HD_SUCCESS;
 }
 
+/* on = 1: HD's direct light tracks every voxel of the illumination grid; 0: only the voxels
+   whose E is read (the library's way, hd__direct_mask). The reference the mask is tested and
+   benchmarked against; E, phi and the image restart. */
+HD__MAYBE_UNUSED static hd_result hd__test_direct_all(hd_context h, int on)
+{
+    HD__GET_CTX(ctx, h);
+    ctx->dl_all = on != 0;
+    ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+/* The number of illumination-grid voxels the direct light tracks (after hd__test_prepare). */
+HD__MAYBE_UNUSED static size_t hd__test_direct_count(hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    return ctx ? ctx->dl_count : 0;
+}
+
 /* n diffusion sweeps of the selected solver (multigrid: CG steps) on the current E and phi. */
 HD__MAYBE_UNUSED static hd_result hd__test_diffuse(hd_context h, int n)
 {

@@ -30,3 +30,13 @@ HD_FN void hd_direct_voxel(HD_KARGS int x, int y, int z)
         HD_SET(E, ic, x, y, z + c * gz, e + (sample_x - e) * w);
     }
 }
+
+/* The same at illumination-grid index i (x fastest): the dispatch over the list of voxels whose
+   E is read (hd_context.h, hd__direct_mask). The random key stays the voxel's grid index, so a
+   tracked voxel's E is bit-identical to tracking every voxel. */
+HD_FN void hd_direct_index(HD_KARGS int i)
+{
+    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y;
+    int row = i / gx;
+    hd_direct_voxel(HD_KPASS i - row * gx, row % gy, row / gy);
+}

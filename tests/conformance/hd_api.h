@@ -34,6 +34,7 @@ typedef struct hd_api {
     hd_result (*test_project)(hd_context, int);
     hd_result (*test_write_illumination)(hd_context, hd_illumination, const float *);
     hd_result (*test_finish)(hd_context);
+    hd_result (*test_direct_all)(hd_context, int);
     hd_result (*refine)(hd_context, int);
     hd_result (*render)(hd_context);
 } hd_api;
@@ -49,5 +50,5 @@ extern const hd_api hd_api_backend;
                         hd_read_illumination, hd_get_stats, hd_volume_load_nrrd, hd_volume_load_raw, \
                         hd_volume_parse_nrrd, hd_volume_free, hd__test_prepare, hd__test_direct, \
                         hd__test_diffuse, hd__test_project, hd__test_write_illumination, hd__test_finish, \
-                        hd_refine, hd_render}
+                        hd__test_direct_all, hd_refine, hd_render}
 #endif

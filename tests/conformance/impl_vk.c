@@ -78,6 +78,7 @@ VK_WRAP_HOOK(test_diffuse, (hd_context c, int n), (c, n))
 VK_WRAP_HOOK(test_project, (hd_context c, int n), (c, n))
 VK_WRAP_HOOK(test_write_illumination, (hd_context c, hd_illumination w, const float *src), (c, w, src))
 VK_WRAP_HOOK(test_finish, (hd_context c), (c))
+VK_WRAP_HOOK(test_direct_all, (hd_context c, int on), (c, on))
 
 const hd_api hd_api_backend = {hd_backend_name, hd_result_string, hd_method_name, hd_log_stderr, vk_create,
                                vk_destroy, hd_query_desc, vk_set_transfer_function, vk_set_lights, vk_set_camera,
@@ -85,4 +86,4 @@ const hd_api hd_api_backend = {hd_backend_name, hd_result_string, hd_method_name
                                vk_read_illumination, hd_get_stats, hd_volume_load_nrrd, hd_volume_load_raw,
                                hd_volume_parse_nrrd, hd_volume_free, vk_test_prepare, vk_test_direct,
                                vk_test_diffuse, vk_test_project, vk_test_write_illumination, vk_test_finish,
-                               vk_refine, vk_render};
+                               vk_test_direct_all, vk_refine, vk_render};

@@ -1,0 +1,23 @@
+# mk/bench_direct.mk - HD's direct-light stage per backend: tracked only where E is read against
+# every voxel, in one process (bench/hdbench_direct.c, figures in docs/DESIGN-DIRECT.md).
+#   make bench-direct    build/hdbench_direct_{cpu,opencl,gl,vulkan} on the head CT, full grid,
+#                        ct-skin and ct-bone TFs; DIRECT_ITERS passes per block, DIRECT_REPS blocks
+DIRECT_BACKENDS := cpu opencl gl vulkan
+DIRECT_DEF_cpu := -DHYBRIDDIFF_BACKEND_CPU
+DIRECT_DEF_opencl := -DHYBRIDDIFF_BACKEND_OPENCL
+DIRECT_DEF_gl := -DHYBRIDDIFF_BACKEND_GL
+DIRECT_DEF_vulkan := -DHYBRIDDIFF_BACKEND_VULKAN
+DIRECT_LIB_cpu :=
+DIRECT_LIB_opencl := -lOpenCL
+DIRECT_LIB_gl := -lEGL
+DIRECT_LIB_vulkan := -lvulkan
+DIRECT_ITERS ?= 4
+DIRECT_REPS ?= 3
+
+.PHONY: bench-direct
+
+$(B)/hdbench_direct_%: bench/hdbench_direct.c examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
+	$(CC) $(CPPFLAGS) $(DIRECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(DIRECT_LIB_$*)
+
+bench-direct: $(foreach b,$(DIRECT_BACKENDS),$(B)/hdbench_direct_$(b)) data
+	@for be in $(DIRECT_BACKENDS); do $(B)/hdbench_direct_$$be --iters $(DIRECT_ITERS) --reps $(DIRECT_REPS) data/head.nrrd || exit 1; done
