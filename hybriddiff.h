@@ -54,9 +54,9 @@
 
    Integration (docs/INTEGRATION.md has each rule in full, examples/integrate_* use them)
       - Include order: the implementation compiles under plain -std=c99 or -std=c++17 before or
-        after <stdio.h>, <stdlib.h>, <time.h>, <pthread.h>, vulkan.h, cl.h or glfw3.h, and
-        leaves no feature macro or VK_NO_PROTOTYPES behind. Strict C only: <unistd.h>,
-        <fcntl.h> or <sys/stat.h> before it needs -D_POSIX_C_SOURCE=200809L.
+        after <stdio.h>, <stdlib.h>, <time.h>, <pthread.h>, <unistd.h>, <fcntl.h>,
+        <sys/stat.h>, vulkan.h, cl.h or glfw3.h, and leaves no feature macro or
+        VK_NO_PROTOTYPES behind.
       - Zero initialisers for C and C++: HD_DESC_INIT, HD_PARAMS_INIT, HD_LIGHT_INIT, ...
       - Volume: x fastest, then y, then z; a box centred on 0 whose largest side is 1;
         value_range maps raw values to TF 0..1 ({0,0}: the type's range); the loaders set it to
@@ -588,8 +588,8 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #else /* exactly one backend: the implementation (skipped after an #error, so that is all the
          compiler reports) */
 
-/* The implementation calls POSIX 2008 (clock_gettime, pthreads, pread, lstat, realpath,
-   O_NOFOLLOW), which a strict -std=c99 translation unit hides. The feature set is widened for the
+/* The implementation calls POSIX 2008 (clock_gettime, pthreads, realpath, O_NOFOLLOW), which a
+   strict -std=c99 translation unit hides. The feature set is widened for the
    implementation's own system headers and restored after it, so the include order does not
    matter and no feature macro leaks into or is needed from the including file. glibc fixes its
    feature set at the first system header (<features.h>), so it is evaluated again both ways. */

@@ -31,14 +31,20 @@ $(IB)/units: examples/integrate_units.c examples/integrate_units_cxx.cpp $(LIB_S
 $(IB)/glfw: examples/integrate_glfw.cpp $(LIB_SRC) | $(IB)
 	$(INT_CXX) $< -o $@ $(INT_LIBS) -lglfw -lOpenGL -lEGL
 
-# The other language and include order of each: compiled only (-fsyntax-only, ~0.2 s each).
+# The other language and include order of each: compiled only (-fsyntax-only, ~0.2 s each); then
+# the implementation after each system header whose feature set strict C99 would otherwise narrow.
+INT_FIRST := unistd.h fcntl.h sys/stat.h stdlib.h stdio.h time.h pthread.h
 integrate-compile:
 	@set -e; for p in $(INT_ONE) units; do f=examples/integrate_$$p.c; \
 	  $(CC) -std=c99 $(INT_WARN) -fsyntax-only -DINTEGRATE_HD_LAST $$f; \
 	  $(CXX) -std=c++17 $(INT_WARN) -fsyntax-only -x c++ $$f; \
 	  $(CXX) -std=c++17 $(INT_WARN) -fsyntax-only -x c++ -DINTEGRATE_HD_LAST $$f; done; \
 	$(CXX) -std=c++17 $(INT_WARN) -fsyntax-only -DINTEGRATE_HD_LAST examples/integrate_glfw.cpp; \
-	echo "integrate-compile: 13 language/include-order variants compile warning-free"
+	echo "integrate-compile: 13 language/include-order variants compile warning-free"; \
+	for h in $(INT_FIRST); do for b in CPU OPENCL VULKAN GL; do \
+	  printf '#include <%s>\n#define HYBRIDDIFF_IMPLEMENTATION\n#define HYBRIDDIFF_BACKEND_%s\n#include "hybriddiff.h"\n' \
+	    $$h $$b | $(CC) -std=c99 $(INT_WARN) -fsyntax-only -x c -; done; done; \
+	echo "integrate-compile: the implementation after each of $(INT_FIRST), strict C99, every backend"
 
 # `make dist-builds` builds every examples/*.c as a program of its own from dist/hybriddiff.h.
 $(B)/integrate_%: examples/integrate_%.c $(LIB_SRC) | $(B)
