@@ -4,7 +4,9 @@
 
    `hdrender --help` lists the options. Exit status: 0 done, 2 a bad option, value or input file
    (one line on stderr names it), 1 the library or the output failed while rendering.
-   The backend is the CPU one unless another HYBRIDDIFF_BACKEND_* is given with -D. */
+   One binary per backend is built from this file: build/hdrender (CPU, the default) and
+   build/hdrender-opencl, -vulkan, -gl (-DHYBRIDDIFF_BACKEND_*); `--backend NAME` runs the
+   binary of that backend from the same directory with the same arguments. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -12,6 +14,15 @@
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && \
     !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
 #define HYBRIDDIFF_BACKEND_CPU
+#endif
+#if defined(HYBRIDDIFF_BACKEND_OPENCL)
+#define HDR_BACKEND "opencl"
+#elif defined(HYBRIDDIFF_BACKEND_VULKAN)
+#define HDR_BACKEND "vulkan"
+#elif defined(HYBRIDDIFF_BACKEND_GL)
+#define HDR_BACKEND "gl"
+#else
+#define HDR_BACKEND "cpu"
 #endif
 #define HYBRIDDIFF_IMPLEMENTATION
 #include "hybriddiff.h"
@@ -24,6 +35,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
@@ -39,6 +51,13 @@ static const char *usage_text =
     "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
     "\n"
     "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
+    "\n"
+    "backend\n"
+    "  --backend B             cpu (default), opencl, vulkan or gl: runs build/hdrender-B\n"
+    "                          (one binary per backend, built by `make`). The device:\n"
+    "                          HD_CL_DEVICE, HD_VK_DEVICE (name substrings), VK_DRIVER_FILES,\n"
+    "                          __EGL_VENDOR_LIBRARY_FILENAMES; see README\n"
+    "  --list-backends         each backend and the device it would use, then exit\n"
     "\n"
     "input\n"
     "  FILE                    NRRD (.nrrd: attached header, raw or gzip), MetaImage\n"
@@ -137,7 +156,34 @@ static void fail(int status, const char *fmt, ...)
 typedef struct log_state {
     char last[1024];
     hd_result code;
+    char device[256]; /* the device the backend picked, from its information message */
 } log_state;
+
+/* The backends name their device in an information message at hd_create: "cpu: N threads",
+   "opencl: device NAME (VERSION)...", "vulkan: device NAME (...)...", "gl: RENDERER, VERSION
+   (...)"; the device is what follows the prefix. */
+static void note_device(log_state *s, const char *m)
+{
+    static const char *prefix[] = {"opencl: device ", "vulkan: device ", "gl: "};
+    size_t i, n;
+    if (strncmp(m, "cpu: ", 5) == 0 && strstr(m, " threads") && !strstr(m, "started")) {
+        snprintf(s->device, sizeof s->device, "CPU, %s", m + 5);
+        return;
+    }
+    for (i = 0; i < sizeof prefix / sizeof prefix[0]; ++i) {
+        n = strlen(prefix[i]);
+        if (strncmp(m, prefix[i], n) != 0) continue;
+        if (i == 2 && (!strstr(m, " context)") || strncmp(m + n, "EGL", 3) == 0)) return;
+        if (!s->device[0]) {
+            char *end;
+            snprintf(s->device, sizeof s->device, "%s", m + n);
+            /* the context's ownership is no part of the device's name */
+            if ((end = strstr(s->device, " (own")) != NULL || (end = strstr(s->device, " (the caller")) != NULL)
+                *end = 0;
+        }
+        return;
+    }
+}
 
 static void log_fn(void *user, hd_log_level level, hd_result code, const char *message,
                    const char *file, int line)
@@ -145,6 +191,7 @@ static void log_fn(void *user, hd_log_level level, hd_result code, const char *m
     log_state *s = (log_state *)user;
     (void)file;
     (void)line;
+    if (level == HD_LOG_INFO) note_device(s, message);
     if (level == HD_LOG_ERROR) {
         snprintf(s->last, sizeof s->last, "%s", message);
         s->code = code;
@@ -391,6 +438,105 @@ static const char *voxel_type_name(hd_voxel_type t)
     return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32";
 }
 
+/* ---- backends -------------------------------------------------------------------------------- */
+static const char *const backend_names[] = {"cpu", "opencl", "vulkan", "gl"};
+
+/* The path of backend's binary: the directory of this executable, then "hdrender" (cpu) or
+   "hdrender-NAME". 0 if this executable's path is unknown. */
+static int backend_path(const char *argv0, const char *backend, char *out, size_t size)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    char *slash;
+    if (n > 0) {
+        self[n] = 0;
+    } else if (strchr(argv0, '/') && strlen(argv0) < sizeof self) {
+        strcpy(self, argv0);
+    } else {
+        return 0;
+    }
+    slash = strrchr(self, '/');
+    slash[1] = 0;
+    return snprintf(out, size, "%shdrender%s%s", self, strcmp(backend, "cpu") ? "-" : "",
+                    strcmp(backend, "cpu") ? backend : "") < (int)size;
+}
+
+/* Replaces this process by backend's binary, with the same arguments. */
+static void exec_backend(const char *backend, char **argv)
+{
+    char path[4200];
+    if (!backend_path(argv[0], backend, path, sizeof path))
+        fail(2, "--backend %s: cannot find this program's directory", backend);
+    if (access(path, X_OK) != 0)
+        fail(2, "--backend %s: %s is not built (make %s; see mk/hdrender.mk)", backend, path,
+             strcmp(backend, "cpu") ? "hdrender-backends" : "build/hdrender");
+    fflush(NULL);
+    execv(path, argv);
+    fail(2, "--backend %s: cannot run %s: %s", backend, path, strerror(errno));
+}
+
+/* --probe: creates a context on a 4^3 volume and prints "BACKEND  DEVICE" or why it cannot. */
+static int probe_backend(void)
+{
+    static const uint8_t voxels[64] = {0};
+    hd_desc desc;
+    hd_context ctx;
+    log_state ls;
+    hd_result r;
+    memset(&desc, 0, sizeof desc);
+    memset(&ls, 0, sizeof ls);
+    desc.volume.type = HD_VOXEL_U8;
+    desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = 4;
+    desc.volume.data = voxels;
+    desc.camera.width = desc.camera.height = 8;
+    desc.camera.eye[1] = 2.0f;
+    desc.camera.up[2] = 1.0f;
+    desc.logger.func = log_fn;
+    desc.logger.user_data = &ls;
+    g_quiet = 1;
+    r = hd_create(&desc, &ctx);
+    if (r != HD_SUCCESS) {
+        printf("%-8s unavailable: %s (%s)\n", HDR_BACKEND, ls.last[0] ? ls.last : "hd_create failed",
+               hd_result_string(r));
+        return 1;
+    }
+    printf("%-8s %s\n", HDR_BACKEND, ls.device[0] ? ls.device : "(device not named)");
+    hd_destroy(ctx);
+    return 0;
+}
+
+/* --list-backends: each backend's binary probed in turn, in its own process. */
+static int list_backends(const char *argv0)
+{
+    size_t b;
+    int any = 0;
+    for (b = 0; b < sizeof backend_names / sizeof backend_names[0]; ++b) {
+        char path[4200];
+        pid_t pid;
+        int st = 0;
+        if (!backend_path(argv0, backend_names[b], path, sizeof path) || access(path, X_OK) != 0) {
+            printf("%-8s not built (make hdrender-backends)\n", backend_names[b]);
+            continue;
+        }
+        fflush(stdout);
+        pid = fork();
+        if (pid == 0) {
+            char *args[3];
+            args[0] = path;
+            args[1] = (char *)"--probe";
+            args[2] = NULL;
+            execv(path, args);
+            _exit(127);
+        }
+        if (pid < 0 || waitpid(pid, &st, 0) != pid || !WIFEXITED(st) || WEXITSTATUS(st) == 127) {
+            printf("%-8s unavailable: %s did not run\n", backend_names[b], path);
+            continue;
+        }
+        any += WEXITSTATUS(st) == 0;
+    }
+    return any ? 0 : 1;
+}
+
 /* ---- main ------------------------------------------------------------------------------------ */
 /* The value of option argv[*i] ("--x V" or "--x=V"). */
 static const char *opt_value(int argc, char **argv, int *i, const char *eq)
@@ -425,6 +571,25 @@ int main(int argc, char **argv)
     size_t npix;
     char err[512];
 
+    /* the backend first: another backend's binary takes over the whole command line */
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *b = NULL;
+        if (strcmp(a, "--backend") == 0) {
+            if (i + 1 >= argc) fail(2, "--backend needs a value (see --help)");
+            b = argv[++i];
+        } else if (strncmp(a, "--backend=", 10) == 0) {
+            b = a + 10;
+        } else if (strcmp(a, "--list-backends") == 0) {
+            return list_backends(argv[0]);
+        } else if (strcmp(a, "--probe") == 0) {
+            return probe_backend();
+        }
+        if (!b) continue;
+        for (k = 0; k < 4 && strcmp(b, backend_names[k]) != 0; ++k) {}
+        if (k == 4) fail(2, "--backend: '%s' is not cpu, opencl, vulkan or gl", b);
+        if (strcmp(b, HDR_BACKEND) != 0) exec_backend(b, argv);
+    }
+
     memset(&desc, 0, sizeof desc);
     memset(&ls, 0, sizeof ls);
     logger.func = log_fn;
@@ -449,7 +614,9 @@ int main(int argc, char **argv)
 #define IS(s) (strcmp(a, s) == 0)
 #define VAL() (v = opt_value(argc, argv, &i, eq))
 #define FLAG() do { if (eq) fail(2, "%s takes no value", a); } while (0)
-        if (IS("-h") || IS("--help")) {
+        if (IS("--backend")) {
+            VAL(); /* handled above */
+        } else if (IS("-h") || IS("--help")) {
             fputs(usage_text, stdout);
             fputs(usage_text_method, stdout);
             return 0;
@@ -655,13 +822,14 @@ int main(int argc, char **argv)
     }
     if (!g_quiet)
         fprintf(stderr, "hdrender: %s %dx%dx%d %s, values %g..%g, tf %s, %d light%s, %s on %s, "
-                "%dx%d, %s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
+                "%dx%d, %s\nhdrender: device: %s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
                 vol.desc.dims[2], voxel_type_name(vol.desc.type), (double)vol.value_min,
                 (double)vol.value_max, tf.name, light_count, light_count == 1 ? "" : "s",
                 hd_method_name(desc.params.method == HD_METHOD_DEFAULT ? HD_METHOD_HD
                                                                         : desc.params.method),
                 hd_backend_name(), desc.camera.width, desc.camera.height,
-                iterations ? "fixed iterations" : "light refined to convergence");
+                iterations ? "fixed iterations" : "light refined to convergence",
+                ls.device[0] ? ls.device : "(not named by the backend)");
     hd_volume_free(&vol);
 
     t0 = now_seconds();
