@@ -72,7 +72,9 @@ static const char *usage_text =
     "transfer function\n"
     "  --tf PRESET|FILE        ct-skin, ct-bone, ct-tissue, ct-flesh, ramp, or a TF file\n"
     "                          (docs/TF_FORMAT.md). Default: ct-skin for CT data (values\n"
-    "                          below -500), else ramp. CT presets map -1024..3071 HU.\n"
+    "                          below -500), else from the histogram: transparent up to the\n"
+    "                          Otsu threshold, a white ramp to the 99.5th percentile.\n"
+    "                          CT presets map -1024..3071 HU.\n"
     "  --print-tf              print the chosen TF in the file format and exit\n"
     "\n"
     "lights (world space: the volume box is centred at 0, its largest side is 1)\n"
@@ -84,7 +86,8 @@ static const char *usage_text =
     "  --lights N              N preset directional lights placed around the camera\n"
     "                          (1: key light, 3: key, fill and rim; default 1)\n"
     "\n"
-    "camera (default: in front of the face, for the head CT's axes: face +y, top +z)\n"
+    "camera (default: in front of the face, for the head CT's axes: face +y, top +z;\n"
+    "        data/brainsmall.nrrd: its left side, from the front and above)\n"
     "  --eye X,Y,Z             camera position (default 0.6,1.65,0.3: face, three-quarter)\n"
     "  --target X,Y,Z          looked-at point (default 0,0,-0.04)\n"
     "  --up X,Y,Z              up direction (default 0,0,1)\n"
@@ -97,7 +100,8 @@ static const char *usage_text_method =
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
     "  --iterations N          hd, cd: N full iterations, each projecting a frame (default:\n"
     "                          refine the light without frames until it converges, at most\n"
-    "                          " HDR_MAX_LIGHT " iterations, then project --frame-window frames);\n"
+    "                          " HDR_MAX_LIGHT " iterations, CD at least 200, then project\n"
+    "                          --frame-window frames);\n"
     "                          pt_ss, pt_ms: paths per pixel (default 256)\n"
     "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
     "                          as converged (default 0.1)\n"
@@ -438,6 +442,99 @@ static const char *voxel_type_name(hd_voxel_type t)
     return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32";
 }
 
+/* ---- defaults for data other than the head CT ------------------------------------------------- */
+/* The value of voxel i in file units. */
+static float voxel_value(const hd_volume_file *v, size_t i)
+{
+    if (v->desc.type == HD_VOXEL_U8) return (float)((const uint8_t *)v->data)[i];
+    if (v->desc.type == HD_VOXEL_U16) return (float)((const uint16_t *)v->data)[i];
+    return ((const float *)v->data)[i];
+}
+
+/* A TF for data of unknown modality, from its histogram: transparent up to the Otsu threshold
+   (which separates the background, air, from the object), then a white ramp to opaque at the
+   99.5th percentile, so the object's surface shows instead of a cloud filling the box. */
+static void histogram_tf(const hd_volume_file *v, hdx_tf *tf)
+{
+    enum { NB = 256 };
+    static double hist[NB];
+    size_t i, n = (size_t)v->desc.dims[0] * v->desc.dims[1] * v->desc.dims[2];
+    float lo = v->value_min, hi = v->value_max;
+    double total = 0.0, sum = 0.0, w0 = 0.0, s0 = 0.0, best = -1.0, acc = 0.0;
+    int b, t = 0, p995 = NB - 1;
+    if (!(hi > lo)) hi = lo + 1.0f;
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < n; ++i) {
+        float x = voxel_value(v, i);
+        if (!isfinite(x)) continue;
+        b = (int)((x - lo) / (hi - lo) * (NB - 1) + 0.5f);
+        hist[b < 0 ? 0 : b > NB - 1 ? NB - 1 : b] += 1.0;
+    }
+    for (b = 0; b < NB; ++b) { total += hist[b]; sum += b * hist[b]; }
+    for (b = 0; b < NB - 1 && total > 0.0; ++b) { /* Otsu: the split of most between-class variance */
+        double w1, m0, m1, var;
+        w0 += hist[b];
+        s0 += b * hist[b];
+        w1 = total - w0;
+        if (w0 <= 0.0 || w1 <= 0.0) continue;
+        m0 = s0 / w0;
+        m1 = (sum - s0) / w1;
+        var = w0 * w1 * (m0 - m1) * (m0 - m1);
+        if (var > best) { best = var; t = b; }
+    }
+    for (b = 0; b < NB; ++b) {
+        acc += hist[b];
+        if (acc >= 0.995 * total) { p995 = b; break; }
+    }
+    if (p995 <= t + 1) p995 = t + 2 < NB ? t + 2 : NB - 1;
+    memset(tf, 0, sizeof *tf);
+    snprintf(tf->name, sizeof tf->name, "histogram");
+    tf->domain[0] = lo;
+    tf->domain[1] = hi;
+    tf->count = HDX_TF_DEFAULT_ENTRIES;
+    tf->point_count = 4;
+    tf->points[0].value = lo;
+    tf->points[1].value = lo + (hi - lo) * (float)t / (NB - 1);
+    tf->points[2].value = lo + (hi - lo) * (float)p995 / (NB - 1);
+    tf->points[3].value = hi;
+    for (b = 0; b < 4; ++b) {
+        tf->points[b].rgba[0] = tf->points[b].rgba[1] = tf->points[b].rgba[2] = 1.0f;
+        tf->points[b].rgba[3] = b >= 2 ? 1.0f : 0.0f;
+    }
+    hdx_tf_resample(tf);
+}
+
+/* Cameras for the volumes scripts/fetch-data fetches, by file name and size: the default camera
+   suits the head CT's axes (face +y, top +z); brainsmall (VolPack's MRI head) has the face
+   toward -x and the top toward -y, and is seen from its left side, front and above. */
+static int known_volume_camera(const char *path, const hd_volume_file *v, hd_camera *cam)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (strcmp(base, "brainsmall.nrrd") == 0 && v->desc.dims[0] == 128 && v->desc.dims[1] == 128 &&
+        v->desc.dims[2] == 84) {
+        cam->eye[0] = -0.95f; cam->eye[1] = -0.75f; cam->eye[2] = 1.25f;
+        cam->target[0] = cam->target[1] = cam->target[2] = 0.0f;
+        cam->up[0] = 0.0f; cam->up[1] = -1.0f; cam->up[2] = 0.0f;
+        return 1;
+    }
+    return 0;
+}
+
+/* Mean of the image in 8-bit code values and the share of pixels above near black. */
+static void image_brightness(const uint8_t *rgba, size_t npix, double *mean, double *lit)
+{
+    size_t i, n = 0;
+    double sum = 0.0;
+    for (i = 0; i < npix; ++i) {
+        const uint8_t *p = rgba + 4 * i;
+        if (p[0] > 8 || p[1] > 8 || p[2] > 8) ++n;
+        sum += (p[0] + p[1] + p[2]) / 3.0;
+    }
+    *mean = npix ? sum / (double)npix : 0.0;
+    *lit = npix ? (double)n / (double)npix : 0.0;
+}
+
 /* ---- backends -------------------------------------------------------------------------------- */
 static const char *const backend_names[] = {"cpu", "opencl", "vulkan", "gl"};
 
@@ -552,7 +649,8 @@ int main(int argc, char **argv)
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
-    int print_tf = 0, i, k, have_spacing = 0, status;
+    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0;
+    double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
     float spacing[3] = {0, 0, 0};
@@ -663,10 +761,13 @@ int main(int argc, char **argv)
             lights_n = (int)parse_int(a, VAL(), 1, HD_MAX_LIGHTS);
         } else if (IS("--eye")) {
             parse_floats(a, VAL(), desc.camera.eye, 3);
+            camera_given = 1;
         } else if (IS("--target")) {
             parse_floats(a, VAL(), desc.camera.target, 3);
+            camera_given = 1;
         } else if (IS("--up")) {
             parse_floats(a, VAL(), desc.camera.up, 3);
+            camera_given = 1;
         } else if (IS("--fov")) {
             desc.camera.fov_y = parse_float(a, VAL(), 0.0f, 180.0f, 1, 1);
         } else if (IS("--size")) {
@@ -761,6 +862,10 @@ int main(int argc, char **argv)
 
     pt = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS;
     if (!iterations && pt) iterations = 256;
+    /* CD's multiple scattering spreads one cell per sweep: its convergence estimate settles
+       (about 100 iterations on the head CT) long before the light has reached the far side,
+       and the image is nearly black below about 200 */
+    if (desc.params.method == HD_METHOD_CD) min_light = 200;
 
     /* ---- transfer function ---- */
     if (tf_arg) {
@@ -794,8 +899,11 @@ int main(int argc, char **argv)
     desc.volume = vol.desc;
     if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
 
-    if (!tf_arg) hdx_tf_preset(vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f
-                                   ? "ct-skin" : "ramp", &tf);
+    if (!tf_arg) {
+        if (vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f) hdx_tf_preset("ct-skin", &tf);
+        else histogram_tf(&vol, &tf);
+    }
+    if (!camera_given && !raw) known_volume_camera(input, &vol, &desc.camera);
     if (tf.data_domain) {
         float lo = vol.value_min, hi = vol.value_max;
         if (!(hi > lo)) hi = lo + 1.0f;
@@ -847,7 +955,7 @@ int main(int argc, char **argv)
             if (!g_quiet && isatty(2))
                 fprintf(stderr, "\r  light: %d iterations, estimated error %.4f (converged below %g), %.1f s ", done,
                         stats.light_error, (double)desc.params.light_tolerance, now_seconds() - t0);
-            if (stats.light_converged) break;
+            if (stats.light_converged && done >= min_light) break;
         }
         if (!g_quiet && isatty(2)) fputc('\n', stderr);
         if (!stats.light_converged && !g_quiet)
@@ -890,6 +998,12 @@ int main(int argc, char **argv)
     r = hd_read_image_rgba8(ctx, rgba, npix * 4);
     if (r != HD_SUCCESS) fail_lib(1, &ls, r, "hd_read_image_rgba8", NULL);
     for (i = 0; (size_t)i < npix; ++i) memcpy(rgb + 3 * (size_t)i, rgba + 4 * (size_t)i, 3);
+    image_brightness(rgba, npix, &mean, &lit);
+    if (mean < 4.0 || lit < 0.05)
+        fprintf(stderr, "hdrender: warning: the image is essentially black (mean %.2f/255, %.1f%% of "
+                "the pixels above 8/255): raise --exposure or --iterations%s, or check --tf and the "
+                "camera (--eye, --target)\n", mean, 100.0 * lit,
+                desc.params.method == HD_METHOD_CD ? " (CD needs about 200)" : "");
     status = stbi_write_png(out_path, desc.camera.width, desc.camera.height, 3, rgb,
                             desc.camera.width * 3);
     if (!status) fail(1, "cannot write %s", out_path);

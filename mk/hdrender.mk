@@ -3,7 +3,9 @@
 #   make hdrender-backends      build/hdrender (CPU), build/hdrender-opencl, -vulkan, -gl
 #   make test-hdrender-backends each backend renders the head CT from the command line with one
 #                               flag; the four PNGs must agree (part of `make test`)
-.PHONY: hdrender-backends test-hdrender-backends
+#   make test-hdrender-defaults the histogram TF and camera on the MRI head give a lit image;
+#                               a black image is warned about (part of `make test`)
+.PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults
 
 HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC)
 HDR_BACKENDS := $(B)/hdrender $(B)/hdrender-opencl $(B)/hdrender-vulkan $(B)/hdrender-gl
@@ -23,4 +25,7 @@ all: hdrender-backends
 test-hdrender-backends: $(HDR_BACKENDS) $(B)/pngcmp data
 	scripts/test-hdrender-backends $(B)
 
-test: test-hdrender-backends
+test-hdrender-defaults: $(B)/hdrender $(B)/pngcmp data
+	scripts/test-hdrender-defaults $(B)
+
+test: test-hdrender-backends test-hdrender-defaults
