@@ -39,6 +39,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "hd_dicom.h"
 #include "hd_png.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
@@ -47,7 +48,7 @@
 #define HDR_MAX_LIGHT "2000"
 
 static const char *usage_text =
-    "usage: hdrender [options] [FILE]               (default input: " DEFAULT_INPUT ")\n"
+    "usage: hdrender [options] [FILE|DIR]           (default input: " DEFAULT_INPUT ")\n"
     "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
     "\n"
     "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
@@ -61,7 +62,8 @@ static const char *usage_text =
     "\n"
     "input\n"
     "  FILE                    NRRD (.nrrd: attached header, raw or gzip), MetaImage\n"
-    "                          (.mhd, .mha) or NIfTI-1 (.nii, .nii.gz) volume\n"
+    "                          (.mhd, .mha) or NIfTI-1 (.nii, .nii.gz) volume, or a\n"
+    "                          directory: a DICOM series (GDCM), sorted along the normal\n"
     "  --raw FILE              headerless raw volume, x fastest; needs --dims and --type\n"
     "  --dims X,Y,Z            raw: voxels per axis\n"
     "  --type T                raw: u8 i8 u16 i16 u32 i32 f32 f64\n"
@@ -890,7 +892,12 @@ int main(int argc, char **argv)
         if (r != HD_SUCCESS) fail_lib(2, &ls, r, NULL, NULL);
     } else {
         if (!input) input = DEFAULT_INPUT;
-        r = hd_volume_load(input, &vol, &logger);
+        if (hdx_is_directory(input)) {
+            if (!hdx_dicom_load_series(input, &vol, err, sizeof err)) fail(2, "DICOM: %s", err);
+            r = HD_SUCCESS;
+        } else {
+            r = hd_volume_load(input, &vol, &logger);
+        }
         if (r != HD_SUCCESS)
             fail_lib(2, &ls, r, NULL,
                      r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0
