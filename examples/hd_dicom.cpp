@@ -7,6 +7,7 @@
 #include <gdcmReader.h>
 #include <gdcmStringFilter.h>
 #include <gdcmTag.h>
+#include <gdcmTrace.h>
 #include <gdcmTransferSyntax.h>
 
 #include <sys/stat.h>
@@ -19,6 +20,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -93,6 +95,8 @@ extern "C" int hdx_is_directory(const char *path)
 extern "C" int hdx_dicom_load_series(const char *dir, hd_volume_file *out, char *err, size_t err_size)
 {
     std::memset(out, 0, sizeof *out);
+    // GDCM's own warnings go to stderr; a failure here is reported as one line in err instead
+    gdcm::Trace::WarningOff();
     gdcm::Directory d;
     if (access(dir, R_OK | X_OK) != 0)
         return fail(err, err_size, std::string(dir) + ": cannot read the directory: " + std::strerror(errno));
@@ -107,10 +111,35 @@ extern "C" int hdx_dicom_load_series(const char *dir, hd_volume_file *out, char 
     for (const std::string &path : files) {
         gdcm::Reader header;
         header.SetFileName(path.c_str());
-        if (!header.Read()) continue; // not DICOM: a README, a thumbnail
+        if (!header.Read()) {
+            // not DICOM (a README, a thumbnail) unless it has the DICOM preamble: then it is damaged
+            char magic[4] = {0, 0, 0, 0};
+            std::FILE *f = std::fopen(path.c_str(), "rb");
+            bool dicm = f && std::fseek(f, 128, SEEK_SET) == 0 && std::fread(magic, 1, 4, f) == 4 &&
+                        std::memcmp(magic, "DICM", 4) == 0;
+            if (f) std::fclose(f);
+            if (dicm) return fail(err, err_size, path + ": a DICOM file GDCM cannot parse (truncated or damaged)");
+            continue;
+        }
         const gdcm::File &file = header.GetFile();
-        if (!file.GetDataSet().FindDataElement(gdcm::Tag(0x7fe0, 0x0010))) continue; // no image (DICOMDIR)
+        if (!file.GetDataSet().FindDataElement(gdcm::Tag(0x7fe0, 0x0010))) {
+            if (file.GetDataSet().FindDataElement(gdcm::Tag(0x0028, 0x0010))) // Rows: an image's header
+                return fail(err, err_size, path + ": an image without its pixel data (truncated?)");
+            continue; // no image (a DICOMDIR, a report)
+        }
         const gdcm::TransferSyntax ts = file.GetHeader().GetDataSetTransferSyntax();
+        if (!ts.IsEncapsulated()) {
+            // GDCM reads a file cut short in its pixel data with a warning only: the value, which
+            // starts where a read that skips it stops, must end inside the file
+            gdcm::Reader upto;
+            upto.SetFileName(path.c_str());
+            struct stat st;
+            const size_t vl = file.GetDataSet().GetDataElement(gdcm::Tag(0x7fe0, 0x0010)).GetVL();
+            const std::set<gdcm::Tag> skip = {gdcm::Tag(0x7fe0, 0x0010)};
+            if (upto.ReadUpToTag(gdcm::Tag(0x7fe0, 0x0010), skip) && stat(path.c_str(), &st) == 0 &&
+                (size_t)st.st_size < upto.GetStreamCurrentPosition() + vl)
+                return fail(err, err_size, path + ": its pixel data is cut short (a truncated file)");
+        }
         gdcm::ImageReader reader;
         reader.SetFileName(path.c_str());
         if (!reader.Read())
