@@ -81,9 +81,7 @@ TEST_OBJ := $(patsubst tests/%.c,$(B)/%.o,$(wildcard tests/*.c))
 $(B)/hdtest: $(TEST_OBJ)
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
 
-$(B)/hdrender: examples/hdrender.c examples/*.h $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
-
+# build/hdrender and its per-backend siblings: mk/hdrender.mk
 $(B)/hdbench: bench/hdbench.c bench/hdbench_triad.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 

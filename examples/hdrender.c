@@ -4,7 +4,9 @@
 
    `hdrender --help` lists the options. Exit status: 0 done, 2 a bad option, value or input file
    (one line on stderr names it), 1 the library or the output failed while rendering.
-   The backend is the CPU one unless another HYBRIDDIFF_BACKEND_* is given with -D. */
+   One binary per backend is built from this file: build/hdrender (CPU, the default) and
+   build/hdrender-opencl, -vulkan, -gl (-DHYBRIDDIFF_BACKEND_*); `--backend NAME` runs the
+   binary of that backend from the same directory with the same arguments. */
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200809L
 #endif
@@ -12,6 +14,15 @@
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && \
     !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
 #define HYBRIDDIFF_BACKEND_CPU
+#endif
+#if defined(HYBRIDDIFF_BACKEND_OPENCL)
+#define HDR_BACKEND "opencl"
+#elif defined(HYBRIDDIFF_BACKEND_VULKAN)
+#define HDR_BACKEND "vulkan"
+#elif defined(HYBRIDDIFF_BACKEND_GL)
+#define HDR_BACKEND "gl"
+#else
+#define HDR_BACKEND "cpu"
 #endif
 #define HYBRIDDIFF_IMPLEMENTATION
 #include "hybriddiff.h"
@@ -24,9 +35,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
+#include "hd_dicom.h"
 #include "hd_png.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
@@ -35,14 +48,22 @@
 #define HDR_MAX_LIGHT "2000"
 
 static const char *usage_text =
-    "usage: hdrender [options] [FILE]               (default input: " DEFAULT_INPUT ")\n"
+    "usage: hdrender [options] [FILE|DIR]           (default input: " DEFAULT_INPUT ")\n"
     "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
     "\n"
     "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
     "\n"
+    "backend\n"
+    "  --backend B             cpu (default), opencl, vulkan or gl: runs build/hdrender-B\n"
+    "                          (one binary per backend, built by `make`). The device:\n"
+    "                          HD_CL_DEVICE, HD_VK_DEVICE (name substrings), VK_DRIVER_FILES,\n"
+    "                          __EGL_VENDOR_LIBRARY_FILENAMES; see README\n"
+    "  --list-backends         each backend and the device it would use, then exit\n"
+    "\n"
     "input\n"
     "  FILE                    NRRD (.nrrd: attached header, raw or gzip), MetaImage\n"
-    "                          (.mhd, .mha) or NIfTI-1 (.nii, .nii.gz) volume\n"
+    "                          (.mhd, .mha) or NIfTI-1 (.nii, .nii.gz) volume, or a\n"
+    "                          directory: a DICOM series (GDCM), sorted along the normal\n"
     "  --raw FILE              headerless raw volume, x fastest; needs --dims and --type\n"
     "  --dims X,Y,Z            raw: voxels per axis\n"
     "  --type T                raw: u8 i8 u16 i16 u32 i32 f32 f64\n"
@@ -53,7 +74,9 @@ static const char *usage_text =
     "transfer function\n"
     "  --tf PRESET|FILE        ct-skin, ct-bone, ct-tissue, ct-flesh, ramp, or a TF file\n"
     "                          (docs/TF_FORMAT.md). Default: ct-skin for CT data (values\n"
-    "                          below -500), else ramp. CT presets map -1024..3071 HU.\n"
+    "                          below -500), else from the histogram: transparent up to the\n"
+    "                          Otsu threshold, a white ramp to the 99.5th percentile.\n"
+    "                          CT presets map -1024..3071 HU.\n"
     "  --print-tf              print the chosen TF in the file format and exit\n"
     "\n"
     "lights (world space: the volume box is centred at 0, its largest side is 1)\n"
@@ -65,7 +88,8 @@ static const char *usage_text =
     "  --lights N              N preset directional lights placed around the camera\n"
     "                          (1: key light, 3: key, fill and rim; default 1)\n"
     "\n"
-    "camera (default: in front of the face, for the head CT's axes: face +y, top +z)\n"
+    "camera (default: in front of the face, for the head CT's axes: face +y, top +z;\n"
+    "        data/brainsmall.nrrd: its left side, from the front and above)\n"
     "  --eye X,Y,Z             camera position (default 0.6,1.65,0.3: face, three-quarter)\n"
     "  --target X,Y,Z          looked-at point (default 0,0,-0.04)\n"
     "  --up X,Y,Z              up direction (default 0,0,1)\n"
@@ -78,7 +102,8 @@ static const char *usage_text_method =
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
     "  --iterations N          hd, cd: N full iterations, each projecting a frame (default:\n"
     "                          refine the light without frames until it converges, at most\n"
-    "                          " HDR_MAX_LIGHT " iterations, then project --frame-window frames);\n"
+    "                          " HDR_MAX_LIGHT " iterations, CD at least 200, then project\n"
+    "                          --frame-window frames);\n"
     "                          pt_ss, pt_ms: paths per pixel (default 256)\n"
     "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
     "                          as converged (default 0.1)\n"
@@ -137,7 +162,34 @@ static void fail(int status, const char *fmt, ...)
 typedef struct log_state {
     char last[1024];
     hd_result code;
+    char device[256]; /* the device the backend picked, from its information message */
 } log_state;
+
+/* The backends name their device in an information message at hd_create: "cpu: N threads",
+   "opencl: device NAME (VERSION)...", "vulkan: device NAME (...)...", "gl: RENDERER, VERSION
+   (...)"; the device is what follows the prefix. */
+static void note_device(log_state *s, const char *m)
+{
+    static const char *prefix[] = {"opencl: device ", "vulkan: device ", "gl: "};
+    size_t i, n;
+    if (strncmp(m, "cpu: ", 5) == 0 && strstr(m, " threads") && !strstr(m, "started")) {
+        snprintf(s->device, sizeof s->device, "CPU, %s", m + 5);
+        return;
+    }
+    for (i = 0; i < sizeof prefix / sizeof prefix[0]; ++i) {
+        n = strlen(prefix[i]);
+        if (strncmp(m, prefix[i], n) != 0) continue;
+        if (i == 2 && (!strstr(m, " context)") || strncmp(m + n, "EGL", 3) == 0)) return;
+        if (!s->device[0]) {
+            char *end;
+            snprintf(s->device, sizeof s->device, "%s", m + n);
+            /* the context's ownership is no part of the device's name */
+            if ((end = strstr(s->device, " (own")) != NULL || (end = strstr(s->device, " (the caller")) != NULL)
+                *end = 0;
+        }
+        return;
+    }
+}
 
 static void log_fn(void *user, hd_log_level level, hd_result code, const char *message,
                    const char *file, int line)
@@ -145,6 +197,7 @@ static void log_fn(void *user, hd_log_level level, hd_result code, const char *m
     log_state *s = (log_state *)user;
     (void)file;
     (void)line;
+    if (level == HD_LOG_INFO) note_device(s, message);
     if (level == HD_LOG_ERROR) {
         snprintf(s->last, sizeof s->last, "%s", message);
         s->code = code;
@@ -391,6 +444,198 @@ static const char *voxel_type_name(hd_voxel_type t)
     return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32";
 }
 
+/* ---- defaults for data other than the head CT ------------------------------------------------- */
+/* The value of voxel i in file units. */
+static float voxel_value(const hd_volume_file *v, size_t i)
+{
+    if (v->desc.type == HD_VOXEL_U8) return (float)((const uint8_t *)v->data)[i];
+    if (v->desc.type == HD_VOXEL_U16) return (float)((const uint16_t *)v->data)[i];
+    return ((const float *)v->data)[i];
+}
+
+/* A TF for data of unknown modality, from its histogram: transparent up to the Otsu threshold
+   (which separates the background, air, from the object), then a white ramp to opaque at the
+   99.5th percentile, so the object's surface shows instead of a cloud filling the box. */
+static void histogram_tf(const hd_volume_file *v, hdx_tf *tf)
+{
+    enum { NB = 256 };
+    static double hist[NB];
+    size_t i, n = (size_t)v->desc.dims[0] * v->desc.dims[1] * v->desc.dims[2];
+    float lo = v->value_min, hi = v->value_max;
+    double total = 0.0, sum = 0.0, w0 = 0.0, s0 = 0.0, best = -1.0, acc = 0.0;
+    int b, t = 0, p995 = NB - 1;
+    if (!(hi > lo)) hi = lo + 1.0f;
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < n; ++i) {
+        float x = voxel_value(v, i);
+        if (!isfinite(x)) continue;
+        b = (int)((x - lo) / (hi - lo) * (NB - 1) + 0.5f);
+        hist[b < 0 ? 0 : b > NB - 1 ? NB - 1 : b] += 1.0;
+    }
+    for (b = 0; b < NB; ++b) { total += hist[b]; sum += b * hist[b]; }
+    for (b = 0; b < NB - 1 && total > 0.0; ++b) { /* Otsu: the split of most between-class variance */
+        double w1, m0, m1, var;
+        w0 += hist[b];
+        s0 += b * hist[b];
+        w1 = total - w0;
+        if (w0 <= 0.0 || w1 <= 0.0) continue;
+        m0 = s0 / w0;
+        m1 = (sum - s0) / w1;
+        var = w0 * w1 * (m0 - m1) * (m0 - m1);
+        if (var > best) { best = var; t = b; }
+    }
+    for (b = 0; b < NB; ++b) {
+        acc += hist[b];
+        if (acc >= 0.995 * total) { p995 = b; break; }
+    }
+    if (p995 <= t + 1) p995 = t + 2 < NB ? t + 2 : NB - 1;
+    memset(tf, 0, sizeof *tf);
+    snprintf(tf->name, sizeof tf->name, "histogram");
+    tf->domain[0] = lo;
+    tf->domain[1] = hi;
+    tf->count = HDX_TF_DEFAULT_ENTRIES;
+    tf->point_count = 4;
+    tf->points[0].value = lo;
+    tf->points[1].value = lo + (hi - lo) * (float)t / (NB - 1);
+    tf->points[2].value = lo + (hi - lo) * (float)p995 / (NB - 1);
+    tf->points[3].value = hi;
+    for (b = 0; b < 4; ++b) {
+        tf->points[b].rgba[0] = tf->points[b].rgba[1] = tf->points[b].rgba[2] = 1.0f;
+        tf->points[b].rgba[3] = b >= 2 ? 1.0f : 0.0f;
+    }
+    hdx_tf_resample(tf);
+}
+
+/* Cameras for the volumes scripts/fetch-data fetches, by file name and size: the default camera
+   suits the head CT's axes (face +y, top +z); brainsmall (VolPack's MRI head) has the face
+   toward -x and the top toward -y, and is seen from its left side, front and above. */
+static int known_volume_camera(const char *path, const hd_volume_file *v, hd_camera *cam)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    if (strcmp(base, "brainsmall.nrrd") == 0 && v->desc.dims[0] == 128 && v->desc.dims[1] == 128 &&
+        v->desc.dims[2] == 84) {
+        cam->eye[0] = -0.95f; cam->eye[1] = -0.75f; cam->eye[2] = 1.25f;
+        cam->target[0] = cam->target[1] = cam->target[2] = 0.0f;
+        cam->up[0] = 0.0f; cam->up[1] = -1.0f; cam->up[2] = 0.0f;
+        return 1;
+    }
+    return 0;
+}
+
+/* Mean of the image in 8-bit code values and the share of pixels above near black. */
+static void image_brightness(const uint8_t *rgba, size_t npix, double *mean, double *lit)
+{
+    size_t i, n = 0;
+    double sum = 0.0;
+    for (i = 0; i < npix; ++i) {
+        const uint8_t *p = rgba + 4 * i;
+        if (p[0] > 8 || p[1] > 8 || p[2] > 8) ++n;
+        sum += (p[0] + p[1] + p[2]) / 3.0;
+    }
+    *mean = npix ? sum / (double)npix : 0.0;
+    *lit = npix ? (double)n / (double)npix : 0.0;
+}
+
+/* ---- backends -------------------------------------------------------------------------------- */
+static const char *const backend_names[] = {"cpu", "opencl", "vulkan", "gl"};
+
+/* The path of backend's binary: the directory of this executable, then "hdrender" (cpu) or
+   "hdrender-NAME". 0 if this executable's path is unknown. */
+static int backend_path(const char *argv0, const char *backend, char *out, size_t size)
+{
+    char self[4096];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+    char *slash;
+    if (n > 0) {
+        self[n] = 0;
+    } else if (strchr(argv0, '/') && strlen(argv0) < sizeof self) {
+        strcpy(self, argv0);
+    } else {
+        return 0;
+    }
+    slash = strrchr(self, '/');
+    slash[1] = 0;
+    return snprintf(out, size, "%shdrender%s%s", self, strcmp(backend, "cpu") ? "-" : "",
+                    strcmp(backend, "cpu") ? backend : "") < (int)size;
+}
+
+/* Replaces this process by backend's binary, with the same arguments. */
+static void exec_backend(const char *backend, char **argv)
+{
+    char path[4200];
+    if (!backend_path(argv[0], backend, path, sizeof path))
+        fail(2, "--backend %s: cannot find this program's directory", backend);
+    if (access(path, X_OK) != 0)
+        fail(2, "--backend %s: %s is not built (make %s; see mk/hdrender.mk)", backend, path,
+             strcmp(backend, "cpu") ? "hdrender-backends" : "build/hdrender");
+    fflush(NULL);
+    execv(path, argv);
+    fail(2, "--backend %s: cannot run %s: %s", backend, path, strerror(errno));
+}
+
+/* --probe: creates a context on a 4^3 volume and prints "BACKEND  DEVICE" or why it cannot. */
+static int probe_backend(void)
+{
+    static const uint8_t voxels[64] = {0};
+    hd_desc desc;
+    hd_context ctx;
+    log_state ls;
+    hd_result r;
+    memset(&desc, 0, sizeof desc);
+    memset(&ls, 0, sizeof ls);
+    desc.volume.type = HD_VOXEL_U8;
+    desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = 4;
+    desc.volume.data = voxels;
+    desc.camera.width = desc.camera.height = 8;
+    desc.camera.eye[1] = 2.0f;
+    desc.camera.up[2] = 1.0f;
+    desc.logger.func = log_fn;
+    desc.logger.user_data = &ls;
+    g_quiet = 1;
+    r = hd_create(&desc, &ctx);
+    if (r != HD_SUCCESS) {
+        printf("%-8s unavailable: %s (%s)\n", HDR_BACKEND, ls.last[0] ? ls.last : "hd_create failed",
+               hd_result_string(r));
+        return 1;
+    }
+    printf("%-8s %s\n", HDR_BACKEND, ls.device[0] ? ls.device : "(device not named)");
+    hd_destroy(ctx);
+    return 0;
+}
+
+/* --list-backends: each backend's binary probed in turn, in its own process. */
+static int list_backends(const char *argv0)
+{
+    size_t b;
+    int any = 0;
+    for (b = 0; b < sizeof backend_names / sizeof backend_names[0]; ++b) {
+        char path[4200];
+        pid_t pid;
+        int st = 0;
+        if (!backend_path(argv0, backend_names[b], path, sizeof path) || access(path, X_OK) != 0) {
+            printf("%-8s not built (make hdrender-backends)\n", backend_names[b]);
+            continue;
+        }
+        fflush(stdout);
+        pid = fork();
+        if (pid == 0) {
+            char *args[3];
+            args[0] = path;
+            args[1] = (char *)"--probe";
+            args[2] = NULL;
+            execv(path, args);
+            _exit(127);
+        }
+        if (pid < 0 || waitpid(pid, &st, 0) != pid || !WIFEXITED(st) || WEXITSTATUS(st) == 127) {
+            printf("%-8s unavailable: %s did not run\n", backend_names[b], path);
+            continue;
+        }
+        any += WEXITSTATUS(st) == 0;
+    }
+    return any ? 0 : 1;
+}
+
 /* ---- main ------------------------------------------------------------------------------------ */
 /* The value of option argv[*i] ("--x V" or "--x=V"). */
 static const char *opt_value(int argc, char **argv, int *i, const char *eq)
@@ -406,7 +651,8 @@ int main(int argc, char **argv)
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
-    int print_tf = 0, i, k, have_spacing = 0, status;
+    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0;
+    double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
     float spacing[3] = {0, 0, 0};
@@ -424,6 +670,25 @@ int main(int argc, char **argv)
     int done = 0, chunk = 1, pt;
     size_t npix;
     char err[512];
+
+    /* the backend first: another backend's binary takes over the whole command line */
+    for (i = 1; i < argc; ++i) {
+        const char *a = argv[i], *b = NULL;
+        if (strcmp(a, "--backend") == 0) {
+            if (i + 1 >= argc) fail(2, "--backend needs a value (see --help)");
+            b = argv[++i];
+        } else if (strncmp(a, "--backend=", 10) == 0) {
+            b = a + 10;
+        } else if (strcmp(a, "--list-backends") == 0) {
+            return list_backends(argv[0]);
+        } else if (strcmp(a, "--probe") == 0) {
+            return probe_backend();
+        }
+        if (!b) continue;
+        for (k = 0; k < 4 && strcmp(b, backend_names[k]) != 0; ++k) {}
+        if (k == 4) fail(2, "--backend: '%s' is not cpu, opencl, vulkan or gl", b);
+        if (strcmp(b, HDR_BACKEND) != 0) exec_backend(b, argv);
+    }
 
     memset(&desc, 0, sizeof desc);
     memset(&ls, 0, sizeof ls);
@@ -449,7 +714,9 @@ int main(int argc, char **argv)
 #define IS(s) (strcmp(a, s) == 0)
 #define VAL() (v = opt_value(argc, argv, &i, eq))
 #define FLAG() do { if (eq) fail(2, "%s takes no value", a); } while (0)
-        if (IS("-h") || IS("--help")) {
+        if (IS("--backend")) {
+            VAL(); /* handled above */
+        } else if (IS("-h") || IS("--help")) {
             fputs(usage_text, stdout);
             fputs(usage_text_method, stdout);
             return 0;
@@ -496,10 +763,13 @@ int main(int argc, char **argv)
             lights_n = (int)parse_int(a, VAL(), 1, HD_MAX_LIGHTS);
         } else if (IS("--eye")) {
             parse_floats(a, VAL(), desc.camera.eye, 3);
+            camera_given = 1;
         } else if (IS("--target")) {
             parse_floats(a, VAL(), desc.camera.target, 3);
+            camera_given = 1;
         } else if (IS("--up")) {
             parse_floats(a, VAL(), desc.camera.up, 3);
+            camera_given = 1;
         } else if (IS("--fov")) {
             desc.camera.fov_y = parse_float(a, VAL(), 0.0f, 180.0f, 1, 1);
         } else if (IS("--size")) {
@@ -594,6 +864,10 @@ int main(int argc, char **argv)
 
     pt = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS;
     if (!iterations && pt) iterations = 256;
+    /* CD's multiple scattering spreads one cell per sweep: its convergence estimate settles
+       (about 100 iterations on the head CT) long before the light has reached the far side,
+       and the image is nearly black below about 200 */
+    if (desc.params.method == HD_METHOD_CD) min_light = 200;
 
     /* ---- transfer function ---- */
     if (tf_arg) {
@@ -618,7 +892,12 @@ int main(int argc, char **argv)
         if (r != HD_SUCCESS) fail_lib(2, &ls, r, NULL, NULL);
     } else {
         if (!input) input = DEFAULT_INPUT;
-        r = hd_volume_load(input, &vol, &logger);
+        if (hdx_is_directory(input)) {
+            if (!hdx_dicom_load_series(input, &vol, err, sizeof err)) fail(2, "DICOM: %s", err);
+            r = HD_SUCCESS;
+        } else {
+            r = hd_volume_load(input, &vol, &logger);
+        }
         if (r != HD_SUCCESS)
             fail_lib(2, &ls, r, NULL,
                      r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0
@@ -627,8 +906,11 @@ int main(int argc, char **argv)
     desc.volume = vol.desc;
     if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
 
-    if (!tf_arg) hdx_tf_preset(vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f
-                                   ? "ct-skin" : "ramp", &tf);
+    if (!tf_arg) {
+        if (vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f) hdx_tf_preset("ct-skin", &tf);
+        else histogram_tf(&vol, &tf);
+    }
+    if (!camera_given && !raw) known_volume_camera(input, &vol, &desc.camera);
     if (tf.data_domain) {
         float lo = vol.value_min, hi = vol.value_max;
         if (!(hi > lo)) hi = lo + 1.0f;
@@ -655,13 +937,14 @@ int main(int argc, char **argv)
     }
     if (!g_quiet)
         fprintf(stderr, "hdrender: %s %dx%dx%d %s, values %g..%g, tf %s, %d light%s, %s on %s, "
-                "%dx%d, %s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
+                "%dx%d, %s\nhdrender: device: %s\n", raw ? raw : input, vol.desc.dims[0], vol.desc.dims[1],
                 vol.desc.dims[2], voxel_type_name(vol.desc.type), (double)vol.value_min,
                 (double)vol.value_max, tf.name, light_count, light_count == 1 ? "" : "s",
                 hd_method_name(desc.params.method == HD_METHOD_DEFAULT ? HD_METHOD_HD
                                                                         : desc.params.method),
                 hd_backend_name(), desc.camera.width, desc.camera.height,
-                iterations ? "fixed iterations" : "light refined to convergence");
+                iterations ? "fixed iterations" : "light refined to convergence",
+                ls.device[0] ? ls.device : "(not named by the backend)");
     hd_volume_free(&vol);
 
     t0 = now_seconds();
@@ -679,7 +962,7 @@ int main(int argc, char **argv)
             if (!g_quiet && isatty(2))
                 fprintf(stderr, "\r  light: %d iterations, estimated error %.4f (converged below %g), %.1f s ", done,
                         stats.light_error, (double)desc.params.light_tolerance, now_seconds() - t0);
-            if (stats.light_converged) break;
+            if (stats.light_converged && done >= min_light) break;
         }
         if (!g_quiet && isatty(2)) fputc('\n', stderr);
         if (!stats.light_converged && !g_quiet)
@@ -722,6 +1005,12 @@ int main(int argc, char **argv)
     r = hd_read_image_rgba8(ctx, rgba, npix * 4);
     if (r != HD_SUCCESS) fail_lib(1, &ls, r, "hd_read_image_rgba8", NULL);
     for (i = 0; (size_t)i < npix; ++i) memcpy(rgb + 3 * (size_t)i, rgba + 4 * (size_t)i, 3);
+    image_brightness(rgba, npix, &mean, &lit);
+    if (mean < 4.0 || lit < 0.05)
+        fprintf(stderr, "hdrender: warning: the image is essentially black (mean %.2f/255, %.1f%% of "
+                "the pixels above 8/255): raise --exposure or --iterations%s, or check --tf and the "
+                "camera (--eye, --target)\n", mean, 100.0 * lit,
+                desc.params.method == HD_METHOD_CD ? " (CD needs about 200)" : "");
     status = stbi_write_png(out_path, desc.camera.width, desc.camera.height, 3, rgb,
                             desc.camera.width * 3);
     if (!status) fail(1, "cannot write %s", out_path);

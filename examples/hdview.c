@@ -4,7 +4,8 @@
    CPU round trip. hd_render refines the light only until it has converged; after that a frame is
    one projection, and once the image holds frame_window frames the viewer waits for input.
 
-     make hdview && build/hdview [FILE]          (default data/head.nrrd; make data fetches it)
+     make hdview && build/hdview [FILE|DIR]      (default data/head.nrrd; make data fetches it;
+                                                  DIR: a DICOM series, read with GDCM)
 
    Mouse: left drag orbits, right (or shift + left) drag pans, the wheel zooms. The illumination
    (E, phi) does not depend on the camera, so moving the camera restarts only the image: over
@@ -49,6 +50,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "hd_dicom.h"
 #include "hd_png.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
@@ -483,13 +485,19 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = (unsigned)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc && sscanf(argv[i + 1], "%dx%d", &w, &h) == 2) ++i;
         else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
-            printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE] [FILE]\n"
-                   "(default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n");
+            printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE] [FILE|DIR]\n"
+                   "(DIR: a DICOM series; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n");
             return 0;
         } else if (argv[i][0] == '-') { fprintf(stderr, "hdview: unknown option %s (--help)\n", argv[i]); return 2; }
         else input = argv[i];
     }
-    if ((r = hd_volume_load(input, &vol, &logger)) != HD_SUCCESS) {
+    if (hdx_is_directory(input)) { /* a DICOM series (examples/hd_dicom.cpp, GDCM) */
+        char err[512];
+        if (!hdx_dicom_load_series(input, &vol, err, sizeof err)) {
+            fprintf(stderr, "hdview: DICOM: %s\n", err);
+            return 2;
+        }
+    } else if ((r = hd_volume_load(input, &vol, &logger)) != HD_SUCCESS) {
         fprintf(stderr, "hdview: cannot load %s: %s%s\n", input, hd_result_string(r),
                 strcmp(input, DEFAULT_INPUT) == 0 ? " (make data fetches the head CT)" : "");
         return 2;

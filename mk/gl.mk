@@ -38,8 +38,8 @@ test: conformance-gl test-gl compile-gl-cxx
 
 # ---- the viewer -------------------------------------------------------------------------------
 VIEW_LDLIBS := -lglfw -lOpenGL -lEGL
-$(B)/hdview: examples/hdview.c $(wildcard examples/*.h) $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VIEW_LDLIBS)
+$(B)/hdview: examples/hdview.c $(wildcard examples/*.h) $(LIB_SRC) $(B)/hd_dicom.o | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) $(VIEW_LDLIBS) $(DICOM_LDLIBS)
 hdview: $(B)/hdview
 
 $(B)/pngcmp: tests/gl/pngcmp.c | $(B)
