@@ -29,6 +29,7 @@ $(B)/hdrender-gl: $(HDR_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) -lEGL $(DICOM_LDLIBS)
 
 hdrender-backends: $(HDR_BACKENDS)
+TEST_PROGRAMS += $(HDR_BACKENDS)
 all: hdrender-backends
 
 test-hdrender-backends: $(HDR_BACKENDS) $(B)/pngcmp data
