@@ -97,13 +97,13 @@ $(B):
 
 # make test builds every program it runs first, TEST_JOBS compiles at a time (compiling the
 # implementation is most of the build), then runs the tests one after another. Each mk/*.mk adds
-# its programs to TEST_PROGRAMS.
+# its programs to TEST_PROGRAMS. The loader tests' real files come next (mk/test-data.mk).
 TEST_JOBS ?= $(shell getconf _NPROCESSORS_ONLN 2>/dev/null || echo 2)
 TEST_PROGRAMS := $(B)/hdtest
 .PHONY: test-programs
 test-programs:
 	$(MAKE) --no-print-directory $(if $(filter -j%,$(MAKEFLAGS)),,-j$(TEST_JOBS)) $(TEST_PROGRAMS)
-test: test-programs $(B)/hdtest
+test: test-programs test-data $(B)/hdtest
 	$(B)/hdtest
 
 data:

@@ -6,3 +6,5 @@
 test-data:
 	scripts/fetch-test-data
 test: test-data
+# the suites that run the loader tests, also under make -j
+asan tsan valgrind: test-data
