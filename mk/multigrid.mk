@@ -1,4 +1,4 @@
-# mk/multigrid.mk - the multigrid diffusion solver's benchmark (issue 9).
+# mk/multigrid.mk - the multigrid diffusion solver's benchmark.
 #   make bench-multigrid   build/hdbench_multigrid on the head CT (make data): time to a relative
 #                          residual of 1e-4, red-black sweeps against HD_SOLVER_MULTIGRID's steps
 #                          (conjugate gradients preconditioned by a V-cycle)

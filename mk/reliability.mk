@@ -1,5 +1,5 @@
-# mk/reliability.mk - hostile input, sanitizers and checkers (issue 8). Each job exits non-zero
-# on any report. Timings measured on the 2-core CI machine are in README.md, "Guarantees".
+# mk/reliability.mk - hostile input, sanitizers and checkers. Each job exits non-zero
+# on any report. Timings measured on the 2-core CI machine: docs/DESIGN-OVERVIEW.md, "Guarantees".
 #   make fuzz-smoke   libFuzzer, FUZZ_RUNS executions per loader from generated seeds plus
 #                     tests/fuzz/regressions/ (part of `make test`); every accepted volume of at
 #                     most 64^3 voxels is rendered (tests/fuzz/hd_fuzz_check.h)
@@ -126,8 +126,8 @@ test: soak-short
 
 # ---- the API fuzzer (tests/fuzz/fuzz_api.c): hd_desc / hd_params / lights / camera bytes with
 # finite extremes, one context and iterations per input; -timeout makes a hang a finding. It
-# starts from its regressions only (no generated seeds). FUZZ_API_RUNS in make test; the README
-# ("Guarantees") gives the 200,000-run figure.
+# starts from its regressions only (no generated seeds). FUZZ_API_RUNS in make test;
+# docs/DESIGN-OVERVIEW.md ("Guarantees") gives the 200,000-run figure.
 FUZZ_API_RUNS ?= 20000
 FUZZ_API_ARGS := -seed=1 -max_len=1024 -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
 .PHONY: fuzz-smoke-api fuzz-long-api

@@ -1,4 +1,4 @@
-/* test_methods.c - the methods tied together (issue 3 §2), through the public API on the CPU
+/* test_methods.c - the methods tied together, through the public API on the CPU
    backend: HD without diffusion converges to PT_SS, PT_MS with one bounce converges to PT_SS,
    CD's converged direct light against exp(-sigma depth) with the error its first-order scheme
    allows, CD's memory growing with the light count while HD's does not; plus what a change
