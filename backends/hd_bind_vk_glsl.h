@@ -11,7 +11,7 @@
    Specialization constant 0, hd_sc_flags: in the diffusion module, the flags word (counts.z) as
    a constant fixed when hd_vulkan.h makes the pipeline, one per flags value, read by the kernel
    through HD_DIFFUSE_FLAGS: lavapipe runs both sides of every branch, so a flag tested at run
-   time costs the untaken path's image loads (the RGB path: 1.3x fewer sweeps/s on the head CT).
+   time costs the untaken path's image loads (docs/DESIGN-VULKAN.md has the measurement).
    Specialization constants 1, hd_sc_zk, and 3, hd_sc_yk: the slices and rows of the block each
    diffusion invocation relaxes (HD_DIFFUSE_ZK, HD_DIFFUSE_YK, hd_entry_glsl.h), fixed by
    hd_vulkan.h, which dispatches to match; 2, hd_sc_jacobi: the solver (HD_DIFFUSE_JACOBI), so

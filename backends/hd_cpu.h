@@ -240,13 +240,6 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
-{
-    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
-             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
-    return HD_SUCCESS;
-}
-
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */

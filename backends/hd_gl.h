@@ -828,13 +828,6 @@ static hd_result hd__gl_upload_inputs(hd__ctx *ctx)
 }
 static hd_result hd__be_upload_inputs(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_upload_inputs(ctx)); }
 
-static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
-{
-    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
-             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
-    return HD_SUCCESS;
-}
-
 static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
@@ -1319,9 +1312,7 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     if (r != HD_SUCCESS) return r;
     be = ctx->be;
     mg = be->mg;
-    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
-               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
-        hd__gl_mg_free(ctx);
+    if (mg && hd__mg_stale(ctx, mg->fine, mg->channels, mg->sig_channels)) hd__gl_mg_free(ctx);
     *fresh = !be->mg;
     if (!be->mg && (r = hd__gl_mg_alloc(ctx)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
     mg = be->mg;
@@ -1420,15 +1411,8 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
                           mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
 }
 
-/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
-{
-    hd_result r;
-    int s;
-    for (s = 0; s < sweeps; ++s)
-        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
-}
+/* The single-level solver's sweeps: each its own dispatches. */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
 
 static hd_result hd__be_path(hd__ctx *ctx)
 {

@@ -137,6 +137,9 @@ static hd_result hd__cl_fail(hd__ctx *ctx, cl_int e, const char *call, int alloc
 
 #define HD__CL_LOST_CHECK(ctx) \
     do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "opencl: the device was lost earlier"); } while (0)
+/* Sets kernel k's argument i to the scalar lvalue v; returns from the calling function on failure. */
+#define HD__CL_ARG(ctx, k, i, v) \
+    HD__CL_TRY(ctx, clSetKernelArg((ctx)->be->kernels[k], (cl_uint)(i), sizeof(v), &(v)), "clSetKernelArg(" #v ")")
 
 /* ---- device selection -------------------------------------------------------------------- */
 static int hd__cl_name_matches(cl_device_id dev, const char *want, char *name, size_t cap)
@@ -378,13 +381,6 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
-{
-    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
-             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
-    return HD_SUCCESS;
-}
-
 /* Bytes of an illumination buffer (E, phi, phi2) of n elements: 4 per float, 2 per binary16,
    rounded up to whole floats so hd__cl_buffer's and hd__cl_zero's 4-byte fill reaches the end. */
 static size_t hd__cl_illum_bytes(const hd__backend *be, size_t n)
@@ -489,20 +485,37 @@ static hd_result hd__cl_send_params(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* Sets kernel k's arguments first, first + 1, ... to the n buffers (cl_mem) in ap. */
+static hd_result hd__cl_vmems(hd__ctx *ctx, int k, cl_uint first, int n, va_list ap)
+{
+    cl_int e = CL_SUCCESS;
+    int i;
+    for (i = 0; i < n && e == CL_SUCCESS; ++i) {
+        cl_mem m = va_arg(ap, cl_mem);
+        e = clSetKernelArg(ctx->be->kernels[k], first + (cl_uint)i, sizeof m, &m);
+    }
+    return e == CL_SUCCESS ? HD_SUCCESS : hd__cl_fail(ctx, e, "clSetKernelArg", 0, __LINE__);
+}
+
+/* The same with the n buffers following n. */
+static hd_result hd__cl_mems(hd__ctx *ctx, int k, cl_uint first, int n, ...)
+{
+    va_list ap;
+    hd_result r;
+    va_start(ap, n);
+    r = hd__cl_vmems(ctx, k, first, n, ap);
+    va_end(ap);
+    return r;
+}
+
 /* Sends ctx->kp if it changed (hd__cl_send_params) and binds the buffers to kernel k's first
    nine arguments. */
 static hd_result hd__cl_bind(hd__ctx *ctx, int k)
 {
     hd__backend *be = ctx->be;
-    cl_mem args[9];
-    cl_uint i;
     hd_result r;
     if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
-    args[0] = be->params; args[1] = be->vol; args[2] = be->tf; args[3] = be->maj; args[4] = be->sig;
-    args[5] = be->E; args[6] = be->phi; args[7] = be->phi2; args[8] = be->img;
-    for (i = 0; i < 9; ++i)
-        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], i, sizeof(cl_mem), &args[i]), "clSetKernelArg");
-    return HD_SUCCESS;
+    return hd__cl_mems(ctx, k, 0, 9, be->params, be->vol, be->tf, be->maj, be->sig, be->E, be->phi, be->phi2, be->img);
 }
 
 static hd_result hd__cl_run_local(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz, const size_t *local)
@@ -520,11 +533,54 @@ static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t
     return hd__cl_run_local(ctx, k, dims, gx, gy, gz, NULL);
 }
 
+/* Binds kernel k (hd__cl_bind) and runs it over gx x gy x gz. */
+static hd_result hd__cl_bind_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+{
+    hd_result r = hd__cl_bind(ctx, k);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, dims, gx, gy, gz);
+}
+
+/* Waits for the queue. Each stage returns when its work is done, as on the CPU, so the core's
+   per-stage clocks measure the device rather than the enqueueing (cost: one clFinish per stage). */
+static hd_result hd__cl_finish(hd__ctx *ctx)
+{
+    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    return HD_SUCCESS;
+}
+
+/* The variant of a kernel family (diffusion, residuals) for the boundary and RGB flags. */
+static int hd__cl_variant(const hd__ctx *ctx, int first)
+{
+    return first + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+}
+
+/* n passes of kernel k over alternate colours of a grid of dims d (channels stacked in z), the
+   first of colour `first`, the parity kernel argument `arg`. A pass has one work-item per voxel
+   of its colour, (gx + 1) / 2 per row (hd_entry_cl.h), and a work-group is one x-row: PoCL
+   vectorises a work-group along x, and its own choice of local size can cut a row into pieces as
+   small as one item (it did for a prime row length). A row longer than the kernel's largest
+   work-group leaves the choice to the runtime. */
+static hd_result hd__cl_colour_passes(hd__ctx *ctx, int k, const int *d, int channels, cl_uint arg, int first, int n)
+{
+    hd__backend *be = ctx->be;
+    size_t hx = ((size_t)d[0] + 1) / 2, local[3], wg = 0;
+    hd_result r;
+    int i;
+    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+               "clGetKernelWorkGroupInfo");
+    local[0] = hx; local[1] = 1; local[2] = 1;
+    for (i = 0; i < n; ++i) {
+        cl_int parity = (first ^ i) & 1;
+        HD__CL_ARG(ctx, k, arg, parity);
+        if ((r = hd__cl_run_local(ctx, k, 3, hx, (size_t)d[1], (size_t)d[2] * (size_t)channels, hx <= wg ? local : NULL)) != HD_SUCCESS)
+            return r;
+    }
+    return HD_SUCCESS;
+}
+
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
-    hd_result r;
-    if ((r = hd__cl_bind(ctx, HD__CL_CLASSIFY)) != HD_SUCCESS) return r;
-    return hd__cl_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
+    return hd__cl_bind_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
@@ -539,52 +595,29 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd_result r;
     int k = hd__cl_k(ctx, HD__CL_DIRECT);
     cl_int count = (cl_int)ctx->dl_count;
-    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], 9, sizeof(cl_mem), &ctx->be->dl), "clSetKernelArg");
-    HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], 10, sizeof count, &count), "clSetKernelArg");
-    if ((r = hd__cl_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS) return r;
-    /* each stage returns when its work is done, as on the CPU, so the core's per-stage clocks
-       measure the device rather than the enqueueing (cost: one clFinish per stage) */
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
-    return HD_SUCCESS;
+    HD__CL_ARG(ctx, k, 10, count);
+    if ((r = hd__cl_mems(ctx, k, 9, 1, ctx->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS)
+        return r;
+    return hd__cl_finish(ctx);
 }
 
-/* One full sweep: two half-sweeps (red, black), or Jacobi's two colour passes and a swap. A
-   pass has one work-item per voxel of its colour, (gx + 1) / 2 per row (hd_entry_cl.h), and a
-   work-group is one x-row: PoCL vectorises a work-group along x, and its own choice of local
-   size can cut a row into pieces as small as one item (it did for a prime row length). A row
-   longer than the kernel's largest work-group leaves the choice to the runtime. */
+/* One full sweep: two half-sweeps (red, black), or Jacobi's two colour passes and a swap. */
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
-    int k = hd__cl_k(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0) + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) +
-                          ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0));
-    size_t hx = ((size_t)ctx->gdims[0] + 1) / 2, local[3], wg = 0;
+    int k = hd__cl_k(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
     hd_result r;
-    cl_int parity;
-    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
-               "clGetKernelWorkGroupInfo");
-    local[0] = hx; local[1] = 1; local[2] = 1;
-    for (parity = 0; parity < 2; ++parity) {
-        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], 9, sizeof parity, &parity), "clSetKernelArg(parity)");
-        if ((r = hd__cl_run_local(ctx, k, 3, hx, (size_t)ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels,
-                                  hx <= wg ? local : NULL)) != HD_SUCCESS)
-            return r;
-    }
+    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(ctx, k, ctx->gdims, ctx->channels, 9, 0, 2)) != HD_SUCCESS)
+        return r;
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
-    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
-    return HD_SUCCESS;
+    return hd__cl_finish(ctx);
 }
 
 static hd_result hd__be_project(hd__ctx *ctx)
 {
-    hd_result r;
     int k = hd__cl_k(ctx, HD__CL_PROJECT);
-    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
-    return HD_SUCCESS;
+    hd_result r = hd__cl_bind_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1);
+    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------ */
@@ -613,8 +646,7 @@ static hd_result hd__cl_unmap_illumination(hd__ctx *ctx, hd_illumination which, 
     hd__backend *be = ctx->be;
     HD__CL_TRY(ctx, clEnqueueUnmapMemObject(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, mapped, 0, NULL, NULL),
                "clEnqueueUnmapMemObject(illumination)");
-    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
-    return HD_SUCCESS;
+    return hd__cl_finish(ctx);
 }
 
 /* Copies E or phi between the colour layout, mapped, and the API's x-fastest channel-planar
@@ -684,61 +716,46 @@ static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 static hd_result hd__be_convect(hd__ctx *ctx, int light)
 {
     hd__backend *be = ctx->be;
-    cl_kernel k = be->kernels[HD__CL_CONVECT];
     cl_int l = light;
     cl_mem t;
     hd_result r;
-    if ((r = hd__cl_bind(ctx, HD__CL_CONVECT)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(k, 9, sizeof(cl_mem), &be->lv[light]), "clSetKernelArg(lv)");
-    HD__CL_TRY(ctx, clSetKernelArg(k, 10, sizeof(cl_mem), &be->lv[be->nlv]), "clSetKernelArg(lv2)");
-    HD__CL_TRY(ctx, clSetKernelArg(k, 11, sizeof l, &l), "clSetKernelArg(light)");
-    if ((r = hd__cl_run(ctx, HD__CL_CONVECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS) return r;
+    HD__CL_ARG(ctx, HD__CL_CONVECT, 11, l);
+    if ((r = hd__cl_mems(ctx, HD__CL_CONVECT, 9, 2, be->lv[light], be->lv[be->nlv])) != HD_SUCCESS ||
+        (r = hd__cl_bind_run(ctx, HD__CL_CONVECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+        return r;
     t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
-    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
-    return HD_SUCCESS;
+    return hd__cl_finish(ctx);
 }
 
 /* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
 static hd_result hd__be_sum_lights(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    int ki = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
-    cl_kernel k = be->kernels[ki];
+    int k = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
     hd_result r;
     int l;
-    if ((r = hd__cl_bind(ctx, ki)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
     for (l = 0; l < be->nlv; ++l) {
         cl_int li = l, first = l == 0;
-        HD__CL_TRY(ctx, clSetKernelArg(k, 9, sizeof(cl_mem), &be->lv[l]), "clSetKernelArg(lv)");
-        HD__CL_TRY(ctx, clSetKernelArg(k, 10, sizeof li, &li), "clSetKernelArg(light)");
-        HD__CL_TRY(ctx, clSetKernelArg(k, 11, sizeof first, &first), "clSetKernelArg(first)");
-        if ((r = hd__cl_run(ctx, ki, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+        HD__CL_ARG(ctx, k, 10, li);
+        HD__CL_ARG(ctx, k, 11, first);
+        if ((r = hd__cl_mems(ctx, k, 9, 1, be->lv[l])) != HD_SUCCESS ||
+            (r = hd__cl_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
             return r;
     }
-    HD__CL_TRY(ctx, clFinish(be->queue), "clFinish");
-    return HD_SUCCESS;
+    return hd__cl_finish(ctx);
 }
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------ */
 /* One path per pixel, folded into the image with weight march.y. */
 static hd_result hd__be_path(hd__ctx *ctx)
 {
-    hd_result r;
-    if ((r = hd__cl_bind(ctx, HD__CL_PATH)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_run(ctx, HD__CL_PATH, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
-    return HD_SUCCESS;
+    hd_result r = hd__cl_bind_run(ctx, HD__CL_PATH, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1);
+    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
 }
 
-/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
-{
-    hd_result r;
-    int s;
-    for (s = 0; s < sweeps; ++s)
-        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
-}
+/* The single-level solver's sweeps: each its own pair of passes. */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
 
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
    The per-level primitives of src/hd_multigrid.h's step (docs/DESIGN-MULTIGRID.md) on the
@@ -873,113 +890,75 @@ static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
 /* Level l's sigma_t buffer. */
 static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg->lv[l].sig; }
 
-/* Binds n buffers to kernel k's first arguments. */
-static hd_result hd__cl_mg_args(hd__ctx *ctx, int k, int n, const cl_mem *m)
-{
-    int i;
-    for (i = 0; i < n; ++i)
-        HD__CL_TRY(ctx, clSetKernelArg(ctx->be->kernels[k], (cl_uint)i, sizeof(cl_mem), &m[i]), "clSetKernelArg(multigrid)");
-    return HD_SUCCESS;
-}
-
-/* Runs kernel k over level l's voxels (channels: how many stacked in z). */
-static hd_result hd__cl_mg_run(hd__ctx *ctx, int k, int l, int channels)
+/* Kernel k over level l's voxels (channels of them stacked in z), its first n arguments the
+   buffers following n. */
+static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n, ...)
 {
     const int *d = ctx->be->mg->lv[l].dims;
-    return hd__cl_run(ctx, k, 3, (size_t)d[0], (size_t)d[1], (size_t)d[2] * (size_t)channels);
+    va_list ap;
+    hd_result r;
+    va_start(ap, n);
+    r = hd__cl_vmems(ctx, k, 0, n, ap);
+    va_end(ap);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)d[0], (size_t)d[1], (size_t)d[2] * (size_t)channels);
 }
 
-/* The variant of a kernel family (diffusion, residuals) for the boundary and RGB flags. */
-static int hd__cl_mg_variant(const hd__ctx *ctx, int first)
+/* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
+static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
 {
-    return first + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+    return hd__cl_colour_passes(ctx, k, ctx->be->mg->lv[l].dims, ctx->be->mg->channels, arg, first, n);
 }
 
-/* One pass of kernel k over the voxels of colour `parity` of level l in the diffusion's
-   work-item mapping (hd__be_diffuse: one x-row per work-group, (gx + 1) / 2 items), its parity
-   argument at index `arg`. */
-static hd_result hd__cl_mg_colour_pass(hd__ctx *ctx, int k, int l, cl_uint arg, cl_int parity)
-{
-    hd__backend *be = ctx->be;
-    const int *d = be->mg->lv[l].dims;
-    size_t hx = ((size_t)d[0] + 1) / 2, local[3], wg = 0;
-    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
-               "clGetKernelWorkGroupInfo");
-    local[0] = hx; local[1] = 1; local[2] = 1;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[k], arg, sizeof parity, &parity), "clSetKernelArg(parity)");
-    return hd__cl_run_local(ctx, k, 3, hx, (size_t)d[1], (size_t)d[2] * (size_t)be->mg->channels, hx <= wg ? local : NULL);
-}
-
-/* Binds level l to kernel k's nine HD__CL_BUFFERS arguments: sigma_t, E = the right-hand side,
-   phi = the correction, phi2 = the residual (written by the residual kernels only). */
-static hd_result hd__cl_mg_bind_level(hd__ctx *ctx, int k, int l)
+/* n colour passes of kernel k with level l bound to its nine HD__CL_BUFFERS arguments: sigma_t,
+   E = the right-hand side, phi = the correction, phi2 = the residual (written by the residual
+   kernels only). */
+static hd_result hd__cl_mg_level_passes(hd__ctx *ctx, int k, int l, int first, int n)
 {
     hd__backend *be = ctx->be;
     hd__cl_level *L = &be->mg->lv[l];
-    cl_mem args[9];
-    args[0] = L->params; args[1] = be->vol; args[2] = be->tf; args[3] = be->maj; args[4] = hd__cl_mg_sig(be, l);
-    args[5] = L->rhs; args[6] = L->phi; args[7] = L->res; args[8] = be->img;
-    return hd__cl_mg_args(ctx, k, 9, args);
+    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, hd__cl_mg_sig(be, l), L->rhs, L->phi, L->res, be->img);
+    return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, l, 9, first, n);
 }
 
 /* Level l's smoothing: the diffusion kernel on its parameter block. */
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
-    int k = hd__cl_mg_variant(ctx, HD__CL_DIFFUSE), s, h;
-    hd_result r;
-    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS) return r;
-    for (s = 0; s < sweeps; ++s)
-        for (h = 0; h < 2; ++h)
-            if ((r = hd__cl_mg_colour_pass(ctx, k, l, 9, first ^ h)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
+    return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE), l, first, 2 * sweeps);
 }
 
 static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
-    int k = hd__cl_mg_variant(ctx, HD__CL_MG_RESIDUAL);
-    hd_result r;
-    if ((r = hd__cl_mg_bind_level(ctx, k, l)) != HD_SUCCESS || (r = hd__cl_mg_colour_pass(ctx, k, l, 9, 0)) != HD_SUCCESS)
-        return r;
-    return hd__cl_mg_colour_pass(ctx, k, l, 9, 1);
+    return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), l, 0, 2);
 }
 
-/* Each fine column's share of the coarse rows (both parities), then their sum per coarse voxel. */
+/* Each fine column's share of the coarse rows (both parities), then their sum per coarse voxel;
+   argument 5 of the first is the transfers' mask, the fine sigma_t (hd_mg_medium). */
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
     hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    cl_mem a[5], fsig = hd__cl_mg_sig(be, l); /* the transfers' mask, hd_mg_medium (argument 5 of both) */
     hd_result r;
-    int k;
-    a[0] = L->params; a[1] = C->params; a[2] = L->res; a[3] = mg->line;
-    for (k = 0; k < 2; ++k) {
-        cl_int parity = k;
-        if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT_LINE, 4, a)) != HD_SUCCESS) return r;
-        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 4, sizeof parity, &parity), "clSetKernelArg(parity)");
-        HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_RESTRICT_LINE], 5, sizeof fsig, &fsig), "clSetKernelArg(fsig)");
+    cl_int parity;
+    if ((r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 0, 4, L->params, C->params, L->res, mg->line)) != HD_SUCCESS ||
+        (r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 5, 1, hd__cl_mg_sig(be, l))) != HD_SUCCESS)
+        return r;
+    for (parity = 0; parity < 2; ++parity) {
+        HD__CL_ARG(ctx, HD__CL_MG_RESTRICT_LINE, 4, parity);
         if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
                             (size_t)C->dims[2] * (size_t)mg->channels)) != HD_SUCCESS)
             return r;
     }
-    a[0] = L->params; a[1] = C->params; a[2] = mg->line; a[3] = C->rhs; a[4] = C->phi;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_RESTRICT, 5, a)) != HD_SUCCESS) return r;
-    return hd__cl_mg_run(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
 }
 
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    cl_mem a[4], fsig = hd__cl_mg_sig(be, l);
-    hd_result r;
-    a[0] = L->params; a[1] = C->params; a[2] = C->phi; a[3] = L->phi;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_PROLONG], 5, sizeof fsig, &fsig), "clSetKernelArg(fsig)");
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_PROLONG, 4, a)) != HD_SUCCESS ||
-        (r = hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 0)) != HD_SUCCESS)
-        return r;
-    return hd__cl_mg_colour_pass(ctx, HD__CL_MG_PROLONG, l, 4, 1);
+    hd__cl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
+    hd_result r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, L->params, C->params, C->phi, L->phi);
+    if (r == HD_SUCCESS) r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, hd__cl_mg_sig(be, l));
+    return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, l, 4, 0, 2);
 }
 
 /* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
@@ -987,66 +966,50 @@ static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 static hd_result hd__cl_mg_res_f64(hd__ctx *ctx, cl_mem params, cl_mem E, cl_mem phi, cl_mem out, cl_int use_lo, cl_int negate)
 {
     hd__backend *be = ctx->be;
-    cl_mem a[6];
-    int ki = hd__cl_mg_variant(ctx, HD__CL_MG_RES_F64);
-    cl_kernel k = be->kernels[ki];
+    int k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
     hd_result r;
-    a[0] = params; a[1] = be->sig; a[2] = E; a[3] = phi; a[4] = be->mg->lo; a[5] = out;
-    if ((r = hd__cl_mg_args(ctx, ki, 6, a)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(k, 7, sizeof use_lo, &use_lo), "clSetKernelArg(use_lo)");
-    HD__CL_TRY(ctx, clSetKernelArg(k, 8, sizeof negate, &negate), "clSetKernelArg(negate)");
-    if ((r = hd__cl_mg_colour_pass(ctx, ki, 0, 6, 0)) != HD_SUCCESS) return r;
-    return hd__cl_mg_colour_pass(ctx, ki, 0, 6, 1);
+    HD__CL_ARG(ctx, k, 7, use_lo);
+    HD__CL_ARG(ctx, k, 8, negate);
+    if ((r = hd__cl_mems(ctx, k, 0, 6, params, be->sig, E, phi, be->mg->lo, out)) != HD_SUCCESS) return r;
+    return hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
 }
 
 /* Enqueues <a, b> per fine row into dot (double per row). */
 static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot)
 {
     struct hd__cl_mg *mg = ctx->be->mg;
-    cl_mem m[4];
-    hd_result r;
-    m[0] = mg->lv[0].params; m[1] = a; m[2] = b; m[3] = dot;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DOT, 4, m)) != HD_SUCCESS) return r;
-    return hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)mg->fine[1], (size_t)mg->fine[2] * (size_t)mg->channels, 1);
+    hd_result r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, mg->lv[0].params, a, b, dot);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)mg->fine[1], (size_t)mg->fine[2] * (size_t)mg->channels, 1);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
     hd_result r;
     int l;
     HD__CL_LOST_CHECK(ctx);
     if (!be->fp64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
-               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
-        hd__cl_mg_free(ctx);
+    if (be->mg && hd__mg_stale(ctx, be->mg->fine, be->mg->channels, be->mg->sig_channels)) hd__cl_mg_free(ctx);
     *fresh = !be->mg;
     if (!be->mg && (r = hd__cl_mg_alloc(ctx)) != HD_SUCCESS) return r;
-    mg = be->mg;
-    for (l = 0; l < mg->levels; ++l)
+    for (l = 0; l < be->mg->levels; ++l)
         if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
     return hd__cl_send_params(ctx);
 }
 
 static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 {
-    if (r != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
-    return HD_SUCCESS;
+    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
 }
 
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
-    cl_mem a[4];
-    hd_result r;
-    a[0] = mg->lv[l - 1].params; a[1] = mg->lv[l].params; a[2] = hd__cl_mg_sig(be, l - 1); a[3] = mg->lv[l].sig;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_SIG, 4, a)) != HD_SUCCESS) return r;
-    return hd__cl_mg_run(ctx, HD__CL_MG_SIG, l, mg->sig_channels);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_SIG, l, mg->sig_channels, 4, mg->lv[l - 1].params, mg->lv[l].params,
+                          hd__cl_mg_sig(be, l - 1), mg->lv[l].sig);
 }
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
@@ -1069,14 +1032,9 @@ static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
-    hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    cl_mem a[3];
-    hd_result r;
-    a[0] = mg->lv[0].params; a[1] = mg->lv[0].phi; a[2] = mg->p;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_DIR, 3, a)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_DIR], 3, sizeof beta, &beta), "clSetKernelArg(beta)");
-    return hd__cl_mg_run(ctx, HD__CL_MG_DIR, 0, mg->channels);
+    struct hd__cl_mg *mg = ctx->be->mg;
+    HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, beta);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_DIR, 0, mg->channels, 3, mg->lv[0].params, mg->lv[0].phi, mg->p);
 }
 
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
@@ -1096,11 +1054,10 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = be->mg;
     size_t rows = hd__cl_mg_rows(mg);
-    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, mg->dot_a, CL_TRUE, 0, rows * sizeof(double), mg->host_dot, 0, NULL, NULL),
-               "clEnqueueReadBuffer(multigrid row sums)");
-    if (n > 1)
-        HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, mg->dot_b, CL_TRUE, 0, rows * sizeof(double), mg->host_dot + rows, 0, NULL, NULL),
-                   "clEnqueueReadBuffer(multigrid row sums)");
+    int i;
+    for (i = 0; i < n && i < 2; ++i)
+        HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, i ? mg->dot_b : mg->dot_a, CL_TRUE, 0, rows * sizeof(double),
+                                            mg->host_dot + i * rows, 0, NULL, NULL), "clEnqueueReadBuffer(multigrid row sums)");
     *a = mg->host_dot;
     *b = mg->host_dot + rows;
     return HD_SUCCESS;
@@ -1109,24 +1066,14 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    cl_mem a[4];
-    hd_result r;
-    a[0] = mg->lv[0].params; a[1] = be->phi; a[2] = mg->lo; a[3] = mg->p;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_UPDATE, 4, a)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_UPDATE], 4, sizeof alpha, &alpha), "clSetKernelArg(alpha)");
-    return hd__cl_mg_run(ctx, HD__CL_MG_UPDATE, 0, mg->channels);
+    HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->mg->channels, 4, be->mg->lv[0].params, be->phi, be->mg->lo, be->mg->p);
 }
 
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    cl_mem e[5];
     cl_int c = colour;
-    hd_result r;
-    e[0] = be->params; e[1] = be->sig; e[2] = be->E; e[3] = be->phi; e[4] = mg->lo;
-    if ((r = hd__cl_mg_args(ctx, HD__CL_MG_EXTRAP, 5, e)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clSetKernelArg(be->kernels[HD__CL_MG_EXTRAP], 5, sizeof c, &c), "clSetKernelArg(colour)");
-    return hd__cl_mg_run(ctx, HD__CL_MG_EXTRAP, 0, mg->channels);
+    HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->mg->channels, 5, be->params, be->sig, be->E, be->phi, be->mg->lo);
 }

@@ -221,6 +221,10 @@ static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int lin
          if (hd__e < 0) return hd__vk_fail((ctx), hd__e, (name), __LINE__); } while (0)
 #define HD__VK_LOST_CHECK(ctx) \
     do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
+/* HD__VK_LOST_CHECK, then what the backend recorded submitted and waited for (hd__vk_flush), so
+   nothing is in flight; returns from the calling function on failure. */
+#define HD__VK_IDLE(ctx) \
+    do { hd_result hd__r; HD__VK_LOST_CHECK(ctx); if ((hd__r = hd__vk_flush(ctx)) != HD_SUCCESS) return hd__r; } while (0)
 
 /* The validation layer's messages: logged as errors and counted (the tests fail on any). */
 static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -1335,8 +1339,7 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
     size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     if (tf_bytes != be->tf_bytes) {
         hd__vk_free_buffer(ctx, &be->tf);
         be->tf_bytes = 0;
@@ -1349,20 +1352,12 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes)
-{
-    *bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
-             (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
-    return HD_SUCCESS;
-}
-
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
     hd_result r;
     int *g = ctx->gdims;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
     hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
     be->illum_floats = 0;
@@ -1381,8 +1376,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     hd__vk_free_image(ctx, &be->phi2);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
     if ((r = hd__vk_illum_new(ctx, &be->phi2, "Jacobi's buffer")) != HD_SUCCESS) return r;
@@ -1394,8 +1388,7 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
     hd__backend *be = ctx->be;
     VkDeviceSize bytes = (VkDeviceSize)width * height * 4 * sizeof(float);
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     hd__vk_free_buffer(ctx, &be->img);
     be->img_floats = 0;
     if (bytes > be->limits.maxStorageBufferRange)
@@ -1428,13 +1421,22 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 }
 
 /* ---- stages ------------------------------------------------------------------------------------ */
-static hd_result hd__be_classify(hd__ctx *ctx)
+/* Stage p (not the diffusion) as one dispatch of its pipeline (hd__vk_stage_pipeline) over
+   nx x ny x nz with set 0 and push constants (pc0, 0, 0, 0), then submitted. */
+static hd_result hd__vk_stage(hd__ctx *ctx, int p, int nx, int ny, int nz, int pc0)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkPipeline pipe;
     hd_result r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CLASSIFY], 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_stage_pipeline(ctx, p, &pipe)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_dispatch(ctx, cb, pipe, 0, nx, ny, nz, pc0, 0, 0, 0)) != HD_SUCCESS)
+        return r;
     return hd__vk_flush(ctx);
+}
+
+static hd_result hd__be_classify(hd__ctx *ctx)
+{
+    return hd__vk_stage(ctx, HD__VK_CLASSIFY, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t) into a host-visible buffer;
@@ -1443,8 +1445,7 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     hd__vk_free_buffer(ctx, &be->dl);
     if ((r = hd__vk_buffer_create(ctx, &be->dl, ctx->dl_count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "the direct light's list")) != HD_SUCCESS)
@@ -1458,14 +1459,8 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 #define HD__DIRECT_ROW ((int)HD__VK_LOCAL_X * 32768)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd_result r;
-    VkPipeline pipe;
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_DIRECT, &pipe)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_stage(ctx, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
@@ -1497,13 +1492,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 
 static hd_result hd__be_project(hd__ctx *ctx)
 {
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd_result r;
-    VkPipeline pipe;
-    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &pipe)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_stage(ctx, HD__VK_PROJECT, ctx->kp.image.x, ctx->kp.image.y, 1, 0);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
@@ -1514,8 +1503,7 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     VkBufferCopy bc;
     size_t bytes = (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float);
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
     hd__vk_barrier(be, cb);
@@ -1548,8 +1536,7 @@ static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
     hd__backend *be = ctx->be;
     hd_result r;
     int l;
-    HD__VK_LOST_CHECK(ctx);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(ctx);
     hd__vk_free_lights(ctx);
     if (count <= 0) return HD_SUCCESS;
     be->lv = (hd__vk_image *)hd__calloc(ctx, (size_t)count + 1, sizeof(hd__vk_image));
@@ -1596,11 +1583,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
 static hd_result hd__be_path(hd__ctx *ctx)
 {
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd_result r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_PATH], 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_stage(ctx, HD__VK_PATH, ctx->kp.image.x, ctx->kp.image.y, 1, 0);
 }
 
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
@@ -1868,6 +1851,22 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
     return HD_SUCCESS;
 }
 
+/* Pass `stage` over level l's grid of `channels` channels stacked in z, push constants (the
+   level's dims, or with dims_pc 0 zeros, and channels). */
+static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int l, int channels, int dims_pc)
+{
+    const int *d = ctx->be->mg->lv[l].dims;
+    return hd__vk_mg_pass(ctx, stage, set, slot, d[0], d[1], d[2] * channels, dims_pc ? d[0] : 0, dims_pc ? d[1] : 0,
+                          dims_pc ? d[2] : 0, channels);
+}
+
+/* Pass `stage` over the fine grid, push constants (pc0, pc1, 0, channels). */
+static hd_result hd__vk_mg_fine(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int32_t pc0, int32_t pc1)
+{
+    struct hd__vk_mg *mg = ctx->be->mg;
+    return hd__vk_mg_pass(ctx, stage, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, pc0, pc1, 0, mg->channels);
+}
+
 /* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
@@ -1893,36 +1892,19 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    hd__vk_level *L = &mg->lv[l];
-    return hd__vk_mg_pass(ctx, HD__VK_MG_RESIDUAL, L->smooth, l, L->dims[0], L->dims[1], L->dims[2] * mg->channels, 0, 0, 0,
-                          mg->channels);
+    return hd__vk_mg_level(ctx, HD__VK_MG_RESIDUAL, mg->lv[l].smooth, l, l, mg->channels, 0);
 }
 
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    hd__vk_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    int ch = mg->channels;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_RESTRICT, L->restrict_to, l, C->dims[0], C->dims[1], C->dims[2] * ch, C->dims[0],
-                          C->dims[1], C->dims[2], ch);
+    return hd__vk_mg_level(ctx, HD__VK_MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, mg->channels, 1);
 }
 
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    hd__vk_level *L = &mg->lv[l];
-    int ch = mg->channels;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_PROLONG, L->prolong_from, l + 1, L->dims[0], L->dims[1], L->dims[2] * ch, L->dims[0],
-                          L->dims[1], L->dims[2], ch);
-}
-
-/* The fine residual in double (hd_mg_res_f64) with set `set`: f - A (phi + lo) (the fine slot,
-   use_lo) or, negate, A p (level 0's slot, E = z = 0, phi = p). */
-static hd_result hd__vk_mg_res_f64(hd__ctx *ctx, VkDescriptorSet set, int slot, int use_lo, int negate)
-{
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_RES_F64, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, use_lo,
-                          negate, 0, mg->channels);
+    return hd__vk_mg_level(ctx, HD__VK_MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, mg->channels, 1);
 }
 
 /* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
@@ -1949,9 +1931,7 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
-               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
-        hd__vk_mg_free(ctx);
+    if (mg && hd__mg_stale(ctx, mg->fine, mg->channels, mg->sig_channels)) hd__vk_mg_free(ctx);
     *fresh = !be->mg;
     if (!be->mg && (r = hd__vk_mg_alloc(ctx)) != HD_SUCCESS) return r;
     hd__vk_mg_params(ctx);
@@ -1970,9 +1950,7 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    const int *d = mg->lv[l].dims;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, d[0], d[1], d[2] * mg->sig_channels, d[0], d[1], d[2],
-                          mg->sig_channels);
+    return hd__vk_mg_level(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, l, mg->sig_channels, 1);
 }
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
@@ -1984,10 +1962,11 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* The fine residual in double (hd_mg_res_f64), f - A (phi + lo): the fine slot, use_lo. */
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
@@ -1997,18 +1976,17 @@ static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
     int32_t bits;
     memcpy(&bits, &beta, sizeof beta);
-    return hd__vk_mg_pass(ctx, HD__VK_MG_DIR, mg->cg_sets[HD__VK_MG_SET_DIR], 0, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, bits, 0, 0, mg->channels);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_DIR, ctx->be->mg->cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
 }
 
+/* q = A p: the double residual with negate on level 0's slot (E = z = 0, phi = p). */
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
     hd_result r;
-    if ((r = hd__vk_mg_res_f64(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
+    if ((r = hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
         (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
         return r;
     return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
@@ -2032,34 +2010,24 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
     int32_t bits[2];
     uint64_t u;
     int i;
     /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    return hd__vk_mg_pass(ctx, HD__VK_MG_UPDATE, mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, bits[0], bits[1], 0, mg->channels);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_UPDATE, ctx->be->mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
 }
 
 /* The fine parameters: slot `levels` (no right-hand-side flag). */
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, colour, 0);
 }
 
-/* ---- the single-level solver's sweeps (src/hd_backend.h) -------------------------------------- */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
-{
-    hd_result r;
-    int s;
-    for (s = 0; s < sweeps; ++s)
-        if ((r = hd__be_diffuse(ctx, jacobi)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
-}
+/* The single-level solver's sweeps: each its own submission. */
+static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
 
 /* ---- recording into the caller's command buffer ------------------------------------------------ */
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);

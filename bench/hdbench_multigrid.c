@@ -1,7 +1,7 @@
 /* hdbench_multigrid - the multigrid target of issue 9, in one run: on the head CT (256x256x108,
    full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
    source), the time single-level red-black sweeps and HD_SOLVER_MULTIGRID's steps (conjugate
-   gradients preconditioned by a V-cycle, backends/hd_cpu_multigrid.h) take to bring the
+   gradients preconditioned by a V-cycle, docs/DESIGN-MULTIGRID.md) take to bring the
    diffusion's relative residual |f - A phi| / |f| from phi = 0 below 1e-4, for the box and the
    surface boundary. Times: wall clock of the solver calls only (residual checks excluded) and
    process CPU seconds / threads (robust to other load on the machine). Red-black stops at
@@ -294,7 +294,7 @@ int main(int argc, char **argv)
         else
             printf("neither reached %.0e within %.0f s: at equal time multigrid's residual is %.0fx lower\n", tol, cap,
                    a.res / b.res);
-        if (f64) /* the solver's own iterate, phi + lo (hd_cpu_multigrid.h): no float32 storage floor */
+        if (f64) /* the solver's own iterate, phi + lo (src/hd_multigrid.h): no float32 storage floor */
             printf("the multigrid solver's own iterate phi + lo (about 48 bits; phi is its float32 rounding): "
                    "residual %.2e\n", residual_kernel_f64(mg, 1));
         printf("the solver's vectors and levels add %.2f bytes per data voxel\n",

@@ -1,8 +1,9 @@
 /* hd_backend.h - the interface between the core (src/) and a backend (backends/hd_cpu.h,
    hd_opencl.h, hd_vulkan.h, hd_gl.h): every primitive the core calls, declared once with its
    contract. Exactly one backend is compiled in; it defines struct hd__backend and every function
-   below, with these signatures. One it lacks is a compile error ("used but never defined") and a
-   different signature a conflicting declaration, so the list is the whole job of a new backend.
+   declared below, with these signatures (the helpers at the end are the core's, for backends to
+   use). One it lacks is a compile error ("used but never defined") and a different signature a
+   conflicting declaration, so the list is the whole job of a new backend.
 
    Common rules:
    - Every primitive returns HD_SUCCESS or a specific hd_result with one line logged through
@@ -27,8 +28,6 @@ static const char *hd__be_name(void);
 static hd_result hd__be_create(hd__ctx *ctx);
 /* Releases everything the backend holds, ctx->be included; safe on a partly created backend. */
 static void hd__be_destroy(hd__ctx *ctx);
-/* Bytes the backend holds for the volume and its majorant grid, into *bytes. */
-static hd_result hd__be_volume_bytes(hd__ctx *ctx, size_t *bytes);
 
 /* ---- allocation (the core calls these from hd__prepare when its dirty bits say so) ----------- */
 /* The volume, TF and majorant of ctx are new: upload them (classification follows). */
@@ -129,5 +128,15 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha);
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour);
 /* Bytes the solver's buffers hold (counted in method_bytes); 0 without them or with another solver. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx);
+
+/* ---- helpers a backend may use ----------------------------------------------------------------- */
+/* hd__be_diffuse_sweeps for a backend whose sweeps are separate passes: hd__be_diffuse each. */
+HD__MAYBE_UNUSED static hd_result hd__be_diffuse_each(hd__ctx *ctx, int jacobi, int sweeps)
+{
+    hd_result r = HD_SUCCESS;
+    int s;
+    for (s = 0; s < sweeps && r == HD_SUCCESS; ++s) r = hd__be_diffuse(ctx, jacobi);
+    return r;
+}
 
 #endif

@@ -1140,7 +1140,9 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (multigrid levels) */
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
     out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
-    hd__be_volume_bytes(ctx, &out->volume_bytes);
+    /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */
+    out->volume_bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
+                        (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);
     memcpy(out->illumination_dims, ctx->gdims, sizeof ctx->gdims);
     out->illumination_channels = ctx->channels;
     out->seconds_direct = ctx->seconds[0];

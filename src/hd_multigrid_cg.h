@@ -1,8 +1,9 @@
 /* hd_multigrid_cg.h - HD_SOLVER_MULTIGRID's rules that the core's step (src/hd_multigrid.h) and
    the backends' primitives share: when conjugate gradients restart, when the coarse levels'
    sigma_t must be restricted again, beta, the row-order sum of the dot products' row sums, the
-   levels' count, grids and parameter blocks, and the solver's bytes (OpenCL pads its rows: its
-   own count). Below the backends: it calls none of them. docs/DESIGN-MULTIGRID.md has the design. */
+   levels' count, grids and parameter blocks, the solver's bytes (OpenCL pads its rows: its own
+   count) and whether a backend's buffers still fit the grid. Below the backends: it calls none
+   of them. docs/DESIGN-MULTIGRID.md has the design. */
 #ifndef HD_MULTIGRID_CG_H
 #define HD_MULTIGRID_CG_H
 
@@ -117,6 +118,13 @@ HD__MAYBE_UNUSED static size_t hd__mg_bytes(const int *fine, int levels, int cha
         if (l > 0) b += sizeof(float) * hd__mg_voxels(d, sig_channels);
     }
     return b;
+}
+
+/* Whether a backend's solver buffers, made for fine grid `fine` with channels and sig_channels
+   channels, no longer fit ctx's grid (hd__be_mg_begin then remakes them). */
+HD__MAYBE_UNUSED static int hd__mg_stale(const hd__ctx *ctx, const int *fine, int channels, int sig_channels)
+{
+    return channels != ctx->channels || sig_channels != ctx->sig_channels || memcmp(fine, ctx->gdims, 3 * sizeof(int)) != 0;
 }
 
 #endif

@@ -69,8 +69,8 @@ HD_FN float hd_diffuse_sigp(HD_KARGS int j, int x, int y, int z, int c, int rgb,
    mean of their D = 1 / (3 sigma'), 2 / (3 (spi + spj)), floored at fl so empty space stays finite,
    times the axis' 1 / h^2 (scale). A face on the box boundary passes spj = spi: phi = 0 outside
    with the voxel's own D. One division per face, and both voxels of a face get the same bits
-   (a + b == b + a in IEEE arithmetic): the operator the CPU's conjugate gradients applies
-   (hd_cpu_multigrid.h) is exactly symmetric. The sweep computes the same weights as a / d, an
+   (a + b == b + a in IEEE arithmetic): the operator conjugate gradients applies
+   (src/hd_multigrid.h) is exactly symmetric. The sweep computes the same weights as a / d, an
    axis' two faces over one division (hd_diffuse_box_axis below), within a few ulps of these. */
 HD_FN float hd_diffuse_face(float scale, float spi, float spj, float fl)
 {
@@ -143,8 +143,8 @@ HD_FN float hd_diffuse_own(HD_KARGS int i, int x, int y, int z, int c, int rgb, 
    form did not (|phi| near 1e31 at h = 1/256). The sums are symmetric in the two faces (a
    mirrored grid gives the same bits), but a face's effective weight depends on the voxel's
    opposite face, so the two voxels of a face may see it differ in the last bits:
-   hd_diffuse_face / _surface_face above stay the exact per-face forms, for the operator CPU
-   conjugate gradients applies (hd_cpu_multigrid.h), which must be exactly symmetric. */
+   hd_diffuse_face / _surface_face above stay the exact per-face forms, for the operator
+   conjugate gradients applies (src/hd_multigrid.h), which must be exactly symmetric. */
 
 /* The denominator d of a box face toward a neighbour with sigma' s (inside == 0: the box's
    outside, the voxel's own D). */
@@ -213,7 +213,7 @@ HD_FN float hd_diffuse_surface_start(float src, float sp, float fl, HD_INOUT(flo
     float o = hd_diffuse_open_of(sp, 1, fl);
     HD_DEREF(self) = o;
     return o * src; /* a product, not a select: gcc sank src's loads under a select's branch, and the
-                       CPU's row loops stopped vectorising (12 against 3.4 ns per update) */
+                       CPU's row loops stopped vectorising (docs/DESIGN-CPU.md) */
 }
 
 /* The surface boundary's end of the update. A medium voxel: num / dn. An empty voxel (self 0)
@@ -254,7 +254,7 @@ HD_FN float hd_diffuse_box_of(HD_KARGS float num, float dn, float sp, float s_xm
    extrapolation (hd_diffuse_surface_end); a medium voxel's faces toward empty neighbours or the
    box's outside carry the Marshak weight and no neighbour term. Every select is arithmetic, so
    the CPU's row loop stays branch-free; it passes rhs as a literal (with the flag loaded at run
-   time its loops took 11 against 3.4 ns per update, GCC 12). */
+   time its loops stopped vectorising, docs/DESIGN-CPU.md). */
 HD_FN float hd_diffuse_surface_rhs_of(HD_KARGS int rhs, float num, float dn, float sp, float s_xm, float s_xp,
                                       float s_ym, float s_yp, float s_zm, float s_zp, float p_xm, float p_xp,
                                       float p_ym, float p_yp, float p_zm, float p_zp, int in_xm, int in_xp, int in_ym,

@@ -1,6 +1,6 @@
 /* hd_k_multigrid.h - the per-voxel math of HD_SOLVER_MULTIGRID (conjugate gradients
-   preconditioned by a geometric multigrid V-cycle; the design and its measurements are at the top
-   of backends/hd_cpu_multigrid.h): the coarse levels' sigma_t, the V-cycle's transfers, and
+   preconditioned by a geometric multigrid V-cycle; the design and its measurements are in
+   docs/DESIGN-MULTIGRID.md): the coarse levels' sigma_t, the V-cycle's transfers, and
    conjugate gradients' double-summed residual, dot products and updates (shared source).
    The smoothing and the levels' float residual are hd_k_diffuse.h's, with HD_FLAG_DIFFUSE_RHS.
    Conventions, so one text serves every backend's layout:
@@ -11,7 +11,7 @@
    - Every load passes both the x-fastest channel-planar index (C) and the image coordinates,
      channel c at z + c * gz (the OpenCL colour layout, image3Ds), as hd_k_diffuse.h does.
    - Each function does its arithmetic in the order the CPU reference did before it moved here, so
-     the CPU's bits did not change (hashes of phi, E and the image compared, hd_cpu_multigrid.h).
+     the CPU's bits did not change (hashes of phi, E and the image compared).
    Double precision: core in C and GLSL 4.00+, the extension cl_khr_fp64 in OpenCL C 1.2. Without
    it (HD_MG_F64 undefined) the double functions are left out and the OpenCL backend reports the
    solver unsupported (hd_opencl.h). HD_D is HD_F's double twin. */
@@ -105,11 +105,12 @@ HD_FN float hd_mg_fw(int t)
 
 /* Fine column x's share of coarse row (Y, Z), channel c: the fine residual (K's phi, K the fine
    grid) of the up to 16 fine rows 2 Z - 1 + a, 2 Y - 1 + b (a, b = 0..3) at x, weighted
-   fw(a) fw(b), each residual times its voxel's hd_mg_medium (K's sigma_t), summed in a, b order (rows outside the grid skipped by a branch: the select form
-   hd_mg_prolong uses made the OpenCL step slower, 360 against 322 ms on the head CT in two runs
-   minutes apart, and the rows' tests are uniform along x anyway). A backend computes it once per fine x and
-   coarse row (the CPU a vector loop per row, OpenCL a pass into a row buffer) and combines four
-   of them per coarse voxel, in order, with hd_mg_restrict_x. */
+   fw(a) fw(b), each residual times its voxel's hd_mg_medium (K's sigma_t), summed in a, b order
+   (rows outside the grid skipped by a branch: the select form hd_mg_prolong uses made the OpenCL
+   step slower, docs/DESIGN-MULTIGRID.md, and the rows' tests are uniform along x anyway). A
+   backend computes it once per fine x and coarse row (the CPU a vector loop per row, OpenCL a
+   pass into a row buffer) and combines four of them per coarse voxel, in order, with
+   hd_mg_restrict_x. */
 /* hd_mg_restrict_line's step for fine row (a, b) on values the caller loaded: the residual res
    and its voxel's hd_mg_medium m (the same operations in the same order: the same bits). */
 HD_FN float hd_mg_restrict_term(float line, int a, int b, float res, float m)
@@ -155,10 +156,10 @@ HD_FN float hd_mg_pw(int t)
 /* The coarse correction (K's phi, K the coarse grid) interpolated at fine voxel (x, y, z), channel
    c: the 8 nearest coarse voxels, weights 3/4, 1/4 per axis, 0 beyond the coarse grid (a fixed
    linear map, so the V-cycle stays a symmetric preconditioner). Terms beyond the grid are skipped
-   by a select on a clamped load, not a branch (the x tests vary along a row): the CPU's step took
-   0.83x (box) and 0.91x (surface boundary) of its time before (head CT, full resolution); skipping rather than adding a zero term
-   keeps the CPU's bits (a zero term could flip the sign of a zero sum). The caller multiplies the
-   value by the fine voxel's hd_mg_medium (the restriction's mask) before adding it. */
+   by a select on a clamped load, not a branch (the x tests vary along a row), which made the
+   CPU's step faster (docs/DESIGN-MULTIGRID.md); skipping rather than adding a zero term keeps the
+   CPU's bits (a zero term could flip the sign of a zero sum). The caller multiplies the value by
+   the fine voxel's hd_mg_medium (the restriction's mask) before adding it. */
 /* hd_mg_prolong's step for corner (a, b, t) inside the coarse grid on the coarse value u the
    caller loaded (the same operations in the same order: the same bits). */
 HD_FN float hd_mg_prolong_term(float v, int a, int b, int t, float u)

@@ -476,15 +476,15 @@ static void case_half(hd_method method, hd_voxel_type type, const int *d, int li
     scene_free(&s);
 }
 
-/* HD_SOLVER_MULTIGRID (conjugate gradients preconditioned by a multigrid V-cycle, CPU design in
-   backends/hd_cpu_multigrid.h). steps > 0: `steps` solver steps from identical E and phi (test
+/* HD_SOLVER_MULTIGRID (conjugate gradients preconditioned by a multigrid V-cycle,
+   src/hd_multigrid.h; docs/DESIGN-MULTIGRID.md). steps > 0: `steps` solver steps from identical E and phi (test
    hooks), phi compared with the deterministic bounds: the backend runs the CPU's passes in the
    CPU's order (the shared hd_k_multigrid.h, row sums in row order), so only a kernel's float
    rounding could differ; steps == 0: n whole HD iterations (diffusion_sweeps 4 = 4 steps each),
    E, phi and the image with the stochastic bound, as the other whole-iteration cases. grid:
-   illumination_downsample (an odd grid exercises the levels' rounding down). A backend without
-   the solver (HD_ERROR_UNSUPPORTED at create: Vulkan and GL so far) is reported as skipped,
-   neither passed nor failed. */
+   illumination_downsample (an odd grid exercises the levels' rounding down). A backend that
+   refuses the solver at create (HD_ERROR_UNSUPPORTED) is reported as skipped, neither passed nor
+   failed. */
 static void case_multigrid(hd_voxel_type type, const int *d, int lights, int rgb, int surface, int grid, int steps, int n)
 {
     scene s;
