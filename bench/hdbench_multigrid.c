@@ -1,4 +1,4 @@
-/* hdbench_multigrid - the multigrid target of issue 9, in one run: on the head CT (256x256x108,
+/* hdbench_multigrid - the multigrid solver against single-level sweeps, in one run: on the head CT (256x256x108,
    full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
    source), the time single-level red-black sweeps and HD_SOLVER_MULTIGRID's steps (conjugate
    gradients preconditioned by a V-cycle, docs/DESIGN-MULTIGRID.md) take to bring the
