@@ -1,5 +1,5 @@
-/* hdbench_multigrid - the multigrid solver against single-level sweeps, in one run: on the head CT (256x256x108,
-   full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
+/* hdbench_multigrid - the multigrid solver against single-level sweeps, in one run: on the head
+   CT (256x256x108, full-resolution illumination grid, one light, the direct light of 4 HD iterations as the
    source), the time single-level red-black sweeps and HD_SOLVER_MULTIGRID's steps (conjugate
    gradients preconditioned by a V-cycle, docs/DESIGN-MULTIGRID.md) take to bring the
    diffusion's relative residual |f - A phi| / |f| from phi = 0 below 1e-4, for the box and the
