@@ -87,47 +87,41 @@ HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
 #endif
 
 /* Adds one sample's emission to (r, g, b) and its absorption to T: colour and extinction from
-   the TF at the volume sample, the light from hd_sample_light. */
+   the TF at the volume sample (or the step's table), the light from hd_sample_light. */
 HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_INOUT(float) r,
                              HD_INOUT(float) g, HD_INOUT(float) b)
 {
+    hd_v4 c;    /* rgb: the emission's colour weights */
+    float e;    /* the emission's scale: transmittance so far (and opacity, albedo / (4 pi)) */
+    float keep; /* the share of T the step keeps */
 #ifdef HD_PRELUDE_PROJECT_TABLE
     if (HD_PROJECT_TABLE_READY) {
-        hd_v4 q = hd_project_lookup(HD_KPASS hd_sample_value(HD_KPASS u));
-        if (q.w > 0.0f) {
-            float t = HD_DEREF(T);
-            if (HD_PRM(gdims).w == 1) {
-                float l0 = hd_sample_light(HD_KPASS u, 0) * t;
-                HD_DEREF(r) += q.x * l0 * HD_PRM(chan_color).x;
-                HD_DEREF(g) += q.y * l0 * HD_PRM(chan_color).y;
-                HD_DEREF(b) += q.z * l0 * HD_PRM(chan_color).z;
-            } else {
-                HD_DEREF(r) += q.x * hd_sample_light(HD_KPASS u, 0) * t;
-                HD_DEREF(g) += q.y * hd_sample_light(HD_KPASS u, 1) * t;
-                HD_DEREF(b) += q.z * hd_sample_light(HD_KPASS u, 2) * t;
-            }
-            HD_DEREF(T) = t * (1.0f - q.w);
-        }
-        return;
-    }
+        c = hd_project_lookup(HD_KPASS hd_sample_value(HD_KPASS u));
+        if (!(c.w > 0.0f)) return;
+        e = HD_DEREF(T);
+        keep = 1.0f - c.w;
+    } else
 #endif
-    hd_v4 c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
-    float st = c.w * HD_PRM(medium).x;
-    if (st > 0.0f) {
-        float a = 1.0f - hd_exp(-st * dt);
-        float e = HD_DEREF(T) * a * HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
-        if (HD_PRM(gdims).w == 1) {
-            float l0 = hd_sample_light(HD_KPASS u, 0) * e;
-            HD_DEREF(r) += c.x * l0 * HD_PRM(chan_color).x;
-            HD_DEREF(g) += c.y * l0 * HD_PRM(chan_color).y;
-            HD_DEREF(b) += c.z * l0 * HD_PRM(chan_color).z;
-        } else {
-            HD_DEREF(r) += c.x * hd_sample_light(HD_KPASS u, 0) * e;
-            HD_DEREF(g) += c.y * hd_sample_light(HD_KPASS u, 1) * e;
-            HD_DEREF(b) += c.z * hd_sample_light(HD_KPASS u, 2) * e;
-        }
-        HD_DEREF(T) *= 1.0f - a;
+    {
+        float st, a;
+        c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
+        st = c.w * HD_PRM(medium).x;
+        if (!(st > 0.0f)) return;
+        a = 1.0f - hd_exp(-st * dt);
+        e = HD_DEREF(T) * a * HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
+        keep = 1.0f - a;
     }
+    if (HD_PRM(gdims).w == 1) {
+        float l0 = hd_sample_light(HD_KPASS u, 0) * e;
+        HD_DEREF(r) += c.x * l0 * HD_PRM(chan_color).x;
+        HD_DEREF(g) += c.y * l0 * HD_PRM(chan_color).y;
+        HD_DEREF(b) += c.z * l0 * HD_PRM(chan_color).z;
+    } else {
+        HD_DEREF(r) += c.x * hd_sample_light(HD_KPASS u, 0) * e;
+        HD_DEREF(g) += c.y * hd_sample_light(HD_KPASS u, 1) * e;
+        HD_DEREF(b) += c.z * hd_sample_light(HD_KPASS u, 2) * e;
+    }
+    HD_DEREF(T) *= keep;
 }
 
 /* The samples sit at s0 + n dt from the ray's entry into the box, n counted (s0: the jitter), so
