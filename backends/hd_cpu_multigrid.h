@@ -403,11 +403,17 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* One pass of job over the rows of every channel of level l (0: the finest). */
+static void hd__cpu_mg_pass(hd__backend *be, hd__cpu_job job, int l)
+{
+    hd__cpu_parallel(be, job, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
+}
+
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     be->grid = &be->mg->fineg;
-    hd__cpu_parallel(be, hd__cpu_mg_residual_f64_row, hd__mg_rows(&be->mg->lv[0], be->mg->channels));
+    hd__cpu_mg_pass(be, hd__cpu_mg_residual_f64_row, 0);
     return HD_SUCCESS;
 }
 
@@ -423,7 +429,7 @@ static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     be->grid = &be->mg->lv[l].g;
-    hd__cpu_parallel(be, hd__cpu_residual_row, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
+    hd__cpu_mg_pass(be, hd__cpu_residual_row, l);
     return HD_SUCCESS;
 }
 
@@ -431,7 +437,7 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     be->mg->cur = l + 1;
-    hd__cpu_parallel(be, hd__cpu_mg_restrict_row, hd__mg_rows(&be->mg->lv[l + 1], be->mg->channels));
+    hd__cpu_mg_pass(be, hd__cpu_mg_restrict_row, l + 1);
     return HD_SUCCESS;
 }
 
@@ -439,20 +445,20 @@ static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
     be->mg->cur = l + 1;
-    hd__cpu_parallel(be, hd__cpu_mg_prolong_row, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
+    hd__cpu_mg_pass(be, hd__cpu_mg_prolong_row, l);
     return HD_SUCCESS;
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 {
-    hd__cpu_parallel(ctx->be, hd__cpu_mg_rz_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_rz_row, 0);
     return HD_SUCCESS;
 }
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
     ctx->be->mg->beta = beta;
-    hd__cpu_parallel(ctx->be, hd__cpu_mg_dir_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_dir_row, 0);
     return HD_SUCCESS;
 }
 
@@ -461,7 +467,7 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     be->grid = &be->mg->opg;
-    hd__cpu_parallel(be, hd__cpu_mg_op_row, hd__mg_rows(&be->mg->lv[0], be->mg->channels));
+    hd__cpu_mg_pass(be, hd__cpu_mg_op_row, 0);
     be->grid = NULL;
     return HD_SUCCESS;
 }
@@ -478,13 +484,13 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     ctx->be->mg->alpha = alpha;
-    hd__cpu_parallel(ctx->be, hd__cpu_mg_update_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_update_row, 0);
     return HD_SUCCESS;
 }
 
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     ctx->be->mg->colour = colour;
-    hd__cpu_parallel(ctx->be, hd__cpu_mg_extrap_row, hd__mg_rows(&ctx->be->mg->lv[0], ctx->be->mg->channels));
+    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_extrap_row, 0);
     return HD_SUCCESS;
 }
