@@ -367,7 +367,9 @@ typedef struct hd_desc {
         const char *device_name;        /* substring of the device to pick (or env HD_CL_DEVICE) */
     } opencl;
     struct {
-        void *instance, *physical_device, *device, *queue; /* VkInstance... or NULL */
+        void *instance, *physical_device, *device, *queue; /* VkInstance... or NULL: the
+                                           backend's own device, on one VkInstance it keeps for
+                                           the process (drivers limit instance re-creation) */
         uint32_t queue_family;
         hd_proc get_instance_proc_addr; /* (hd_proc)vkGetInstanceProcAddr (or volk's), NULL for
                                            the loader's */

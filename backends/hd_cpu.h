@@ -1029,15 +1029,16 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 /* Copies E or phi between the colour layout and the API's x-fastest channel-planar order, one
    direction per call: into dst (src NULL; binary16 widened exactly) or from src (dst NULL; rounded
    to nearest even), as the OpenCL backend's hd__cl_copy_illumination. Padding slots are not
-   touched (they stay 0). */
-static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst)
+   touched (they stay 0). With a slice list (list, count), only those stacked slices, in its order. */
+static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst, const int *list,
+                                      int count)
 {
     hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = list ? count : ctx->gdims[2] * ctx->channels, x, y, k, zz;
     float *f = which == HD_ILLUMINATION_DIRECT ? be->E : be->phi;
     uint16_t *h = which == HD_ILLUMINATION_DIRECT ? be->Eh : be->phih;
-    for (zz = 0; zz < nz; ++zz)
-        for (y = 0; y < gy; ++y)
+    for (k = 0; k < nz; ++k)
+        for (zz = list ? list[k] : k, y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__split_slot(gx, gy, x, y, zz);
                 if (h) {
@@ -1052,7 +1053,13 @@ static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const
 
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
-    hd__cpu_copy_illumination(ctx, which, NULL, dst);
+    hd__cpu_copy_illumination(ctx, which, NULL, dst, NULL, 0);
+    return HD_SUCCESS;
+}
+
+static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+{
+    hd__cpu_copy_illumination(ctx, which, NULL, dst, zz, count);
     return HD_SUCCESS;
 }
 
@@ -1060,7 +1067,7 @@ static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, f
 HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
     ctx->be->lsum_ok = 0;
-    hd__cpu_copy_illumination(ctx, which, src, NULL);
+    hd__cpu_copy_illumination(ctx, which, src, NULL, NULL, 0);
     return HD_SUCCESS;
 }
 

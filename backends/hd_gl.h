@@ -72,9 +72,9 @@
     X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
     X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
     X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei)
-/* optional: GL 4.4 / ARB_clear_texture, KHR_debug */
+/* optional: GL 4.4 / ARB_clear_texture, KHR_debug, GL 4.5 / ARB_get_texture_sub_image */
 #define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
-    X(DEBUGMESSAGECONTROL, DebugMessageControl)
+    X(DEBUGMESSAGECONTROL, DebugMessageControl) X(GETTEXTURESUBIMAGE, GetTextureSubImage)
 
 /* GL 1.1's texture entry points, typed here: a <GL/gl.h> included first (GLFW's) defines
    GL_VERSION_1_1, and <GL/glcorearb.h> then leaves out their pointer types. */
@@ -249,8 +249,10 @@ static void APIENTRY hd__gl_debug(GLenum source, GLenum type, GLuint id, GLenum 
 {
     const hd__ctx *ctx = (const hd__ctx *)user;
     (void)source; (void)length; (void)severity;
-    hd__logf(&ctx->log, type == GL_DEBUG_TYPE_ERROR ? HD_LOG_ERROR : HD_LOG_WARNING, HD_SUCCESS, __FILE__, __LINE__,
-             "gl debug (id %u): %s", (unsigned)id, message);
+    /* a performance hint (e.g. NVIDIA's note that the image buffer moves to host memory for
+       hd_read_image) is information, not a fault */
+    hd_log_level level = type == GL_DEBUG_TYPE_ERROR ? HD_LOG_ERROR : type == GL_DEBUG_TYPE_PERFORMANCE ? HD_LOG_INFO : HD_LOG_WARNING;
+    hd__logf(&ctx->log, level, HD_SUCCESS, __FILE__, __LINE__, "gl debug (id %u): %s", (unsigned)id, message);
 }
 #endif
 
@@ -963,6 +965,32 @@ static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, float *dst)
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
     HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst));
+}
+
+/* Slices of a grid, one glGetTextureSubImage each; without GL 4.5 the whole grid is read and
+   the slices copied out of it. */
+static hd_result hd__gl_read_tex_slices(hd__ctx *ctx, const hd__gl_tex *t, const int *list, int count, float *dst)
+{
+    size_t slice = (size_t)t->extent[0] * t->extent[1];
+    float *all;
+    hd_result r;
+    int k;
+    if (ctx->be->gl.GetTextureSubImage) {
+        for (k = 0; k < count; ++k)
+            ctx->be->gl.GetTextureSubImage(t->name, 0, 0, 0, list[k], t->extent[0], t->extent[1], 1, GL_RED, GL_FLOAT,
+                                           (GLsizei)(slice * sizeof(float)), dst + (size_t)k * slice);
+        return hd__gl_check(ctx, "reading illumination slices", __LINE__);
+    }
+    if (!(all = (float *)hd__alloc(ctx, slice * (size_t)t->extent[2] * sizeof(float))))
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to read an illumination grid");
+    if ((r = hd__gl_read_tex(ctx, t, all)) == HD_SUCCESS)
+        for (k = 0; k < count; ++k) memcpy(dst + (size_t)k * slice, all + (size_t)list[k] * slice, slice * sizeof(float));
+    hd__free(ctx, all);
+    return r;
+}
+static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+{
+    HD__GL_STAGE(ctx, hd__gl_read_tex_slices(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst));
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */

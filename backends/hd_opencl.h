@@ -652,18 +652,19 @@ static hd_result hd__cl_unmap_illumination(hd__ctx *ctx, hd_illumination which, 
 /* Copies E or phi between the colour layout, mapped, and the API's x-fastest channel-planar
    order, one direction per call: into dst (src NULL; binary16 widened with the CPU's exact
    hd_h2f) or from src (dst NULL; rounded with the CPU's hd_f2h). */
-static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst)
+static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst, const int *list,
+                                          int count)
 {
     hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = ctx->gdims[2] * ctx->channels, x, y, zz;
+    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = list ? count : ctx->gdims[2] * ctx->channels, x, y, k, zz;
     unsigned char *m;
     void *mv;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
     if ((r = hd__cl_map_illumination(ctx, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
     m = (unsigned char *)mv;
-    for (zz = 0; zz < nz; ++zz)
-        for (y = 0; y < gy; ++y)
+    for (k = 0; k < nz; ++k)
+        for (zz = list ? list[k] : k, y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__cl_slot(ctx, x, y, zz);
                 if (be->f16) {
@@ -680,13 +681,18 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
 
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
-    return hd__cl_copy_illumination(ctx, which, NULL, dst);
+    return hd__cl_copy_illumination(ctx, which, NULL, dst, NULL, 0);
+}
+
+static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+{
+    return hd__cl_copy_illumination(ctx, which, NULL, dst, zz, count);
 }
 
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    return hd__cl_copy_illumination(ctx, which, src, NULL);
+    return hd__cl_copy_illumination(ctx, which, src, NULL, NULL, 0);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */

@@ -13,6 +13,10 @@
    desc.vulkan.device_name or $HD_VK_DEVICE, else a discrete, integrated, virtual, then CPU
    device. Force lavapipe on a machine with a GPU with
        VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
+   The first such context's instance is kept for the process and shared by every later context
+   that makes its own device through the same get_instance_proc_addr: NVIDIA's driver refuses
+   vkCreateInstance after about 30 create/destroy cycles in one process (docs/DESIGN-VULKAN.md),
+   so an application that recreates its context must not cycle instances.
    Validation: desc.vulkan.enable_validation or $HD_VK_VALIDATION=1 (own instance only) enables
    VK_LAYER_KHRONOS_validation with synchronization validation; every message of its debug
    messenger is logged as an error ("vulkan validation: ...") and counted.
@@ -48,6 +52,7 @@
    which sticks: later calls fail fast, hd_destroy still frees everything). */
 /* Every call goes through the table below; the prototypes are left to the including file's
    choice (VK_NO_PROTOTYPES is neither defined nor required here). */
+#include <pthread.h>
 #include <vulkan/vulkan.h>
 #include "hd_spirv.h"
 
@@ -128,7 +133,8 @@ struct hd__backend {
     VkDevice device;
     VkQueue queue;
     uint32_t queue_family;
-    int own_device;               /* 1: instance and device are the backend's */
+    int own_device;               /* 1: the device is the backend's, and the instance unless kept */
+    int kept_instance;            /* 1: instance is one of hd__vk_kept's, never destroyed here */
     VkDebugUtilsMessengerEXT messenger;
     VkPhysicalDeviceLimits limits;
     VkPhysicalDeviceMemoryProperties memprops;
@@ -271,6 +277,17 @@ static int hd__vk_env_flag(const char *name)
     return v && v[0] && strcmp(v, "0") != 0;
 }
 
+/* The process's kept instances (without validation), one per loader (get_instance_proc_addr)
+   for up to HD__VK_KEPT loaders: made by the first context that needs one, reused by every later
+   one, destroyed only with the process. Past that many loaders a context makes and destroys its
+   own instance. */
+#define HD__VK_KEPT 4
+static struct {
+    pthread_mutex_t mu;
+    PFN_vkGetInstanceProcAddr gipa[HD__VK_KEPT];
+    VkInstance instance[HD__VK_KEPT];
+} hd__vk_kept = {PTHREAD_MUTEX_INITIALIZER, {NULL}, {VK_NULL_HANDLE}};
+
 /* The backend's own headless instance, with the validation layer when asked. */
 static hd_result hd__vk_create_instance(hd__ctx *ctx)
 {
@@ -327,7 +344,24 @@ static hd_result hd__vk_create_instance(hd__ctx *ctx)
         ici.enabledExtensionCount = 1;
         ici.ppEnabledExtensionNames = &ext;
     }
-    HD__VK_TRY(ctx, be->fn.vkCreateInstance(&ici, NULL, &be->instance), "vkCreateInstance");
+    if (!validate) {
+        VkResult vr = VK_SUCCESS;
+        int k;
+        pthread_mutex_lock(&hd__vk_kept.mu);
+        for (k = 0; k < HD__VK_KEPT && hd__vk_kept.instance[k] && hd__vk_kept.gipa[k] != be->gipa; ++k) {}
+        if (k < HD__VK_KEPT && hd__vk_kept.instance[k]) {
+            be->instance = hd__vk_kept.instance[k];
+            be->kept_instance = 1;
+        } else if ((vr = be->fn.vkCreateInstance(&ici, NULL, &be->instance)) >= 0 && k < HD__VK_KEPT) {
+            hd__vk_kept.instance[k] = be->instance;
+            hd__vk_kept.gipa[k] = be->gipa;
+            be->kept_instance = 1;
+        }
+        pthread_mutex_unlock(&hd__vk_kept.mu);
+        HD__VK_TRY(ctx, vr, "vkCreateInstance");
+    } else {
+        HD__VK_TRY(ctx, be->fn.vkCreateInstance(&ici, NULL, &be->instance), "vkCreateInstance");
+    }
     if (hd__vk_load_instance_fns(ctx) != HD_SUCCESS) return HD_ERROR_UNSUPPORTED;
     if (validate) {
         if (!be->fn.vkCreateDebugUtilsMessengerEXT || !be->fn.vkDestroyDebugUtilsMessengerEXT)
@@ -738,23 +772,39 @@ static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float
     return hd__vk_flush(ctx);
 }
 
-/* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar); an
-   r16f image's halves are widened exactly (hd_h2f). */
-static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst)
+/* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar), or
+   with a slice list (list, count) those z slices only, in its order, in one copy; an r16f
+   image's halves are widened exactly (hd_h2f). */
+static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst, const int *list, int count)
 {
     hd__backend *be = ctx->be;
-    size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
-    VkBufferImageCopy reg = hd__vk_region(im);
+    size_t slice = (size_t)im->extent[0] * im->extent[1] * (size_t)im->texel;
+    size_t bytes = slice * (size_t)(list ? count : im->extent[2]);
+    VkBufferImageCopy one = hd__vk_region(im), *regs = &one;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_SRC, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    be->fn.vkCmdCopyImageToBuffer(cb, im->image, HD__VK_SRC, be->staging.buffer, 1, &reg);
-    hd__vk_layout(be, cb, im->image, HD__VK_SRC, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    hd__vk_barrier(be, cb);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    int k;
+    if (list) {
+        if (count <= 0) return HD_SUCCESS;
+        if (!(regs = (VkBufferImageCopy *)hd__calloc(ctx, (size_t)count, sizeof *regs)))
+            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for %d copy regions", count);
+        for (k = 0; k < count; ++k) {
+            regs[k] = one;
+            regs[k].bufferOffset = (VkDeviceSize)k * slice;
+            regs[k].imageOffset.z = list[k];
+            regs[k].imageExtent.depth = 1;
+        }
+    }
+    if ((r = hd__vk_flush(ctx)) == HD_SUCCESS && (r = hd__vk_staging(ctx, bytes)) == HD_SUCCESS &&
+        (r = hd__vk_cmd(ctx, &cb)) == HD_SUCCESS) {
+        hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_SRC, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+        be->fn.vkCmdCopyImageToBuffer(cb, im->image, HD__VK_SRC, be->staging.buffer, list ? (uint32_t)count : 1u, regs);
+        hd__vk_layout(be, cb, im->image, HD__VK_SRC, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+        hd__vk_barrier(be, cb);
+        r = hd__vk_flush(ctx);
+    }
+    if (regs != &one) hd__free(ctx, regs);
+    if (r != HD_SUCCESS) return r;
     if (im->texel == 2) {
         size_t i;
         for (i = 0; i < bytes / 2; ++i) dst[i] = hd_h2f(((const uint16_t *)be->staging.map)[i]);
@@ -1191,7 +1241,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->pool) be->fn.vkDestroyCommandPool(be->device, be->pool, NULL);
         if (be->own_device) be->fn.vkDestroyDevice(be->device, NULL);
     }
-    if (be->own_device && be->instance && be->fn.vkDestroyInstance) {
+    if (be->own_device && !be->kept_instance && be->instance && be->fn.vkDestroyInstance) {
         if (be->messenger) be->fn.vkDestroyDebugUtilsMessengerEXT(be->instance, be->messenger, NULL);
         be->fn.vkDestroyInstance(be->instance, NULL);
     }
@@ -1519,7 +1569,13 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
 {
     HD__VK_LOST_CHECK(ctx);
-    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst);
+    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, NULL, 0);
+}
+
+static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+{
+    HD__VK_LOST_CHECK(ctx);
+    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, zz, count);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */

@@ -75,6 +75,10 @@ static hd_result hd__be_path(hd__ctx *ctx);
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst);
 /* E (HD_ILLUMINATION_DIRECT) or phi (SCATTERED) as floats, x fastest, channels stacked in z. */
 static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst);
+/* Some z slices of the same stacking (slice zz: channel zz / gdims[2], z zz % gdims[2]), zz[0..
+   count) in that order, each gdims[0] * gdims[1] floats, one after another into dst: the light's
+   convergence estimate reads only what it measures. */
+static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst);
 
 /* ---- HD_SOLVER_MULTIGRID's per-level primitives -------------------------------------------------
    The core's hd__mg_step (src/hd_multigrid.h) runs conjugate gradients preconditioned by a

@@ -698,9 +698,14 @@ static void hd__conv_free(hd__ctx *ctx)
     hd__free(ctx, ctx->conv_idx);
     hd__free(ctx, ctx->conv_prev);
     hd__free(ctx, ctx->conv_tmp);
+    hd__free(ctx, ctx->conv_zz);
+    hd__free(ctx, ctx->conv_off);
     ctx->conv_idx = NULL;
     ctx->conv_prev = ctx->conv_tmp = NULL;
+    ctx->conv_zz = NULL;
+    ctx->conv_off = NULL;
     ctx->conv_count = 0;
+    ctx->conv_nz = 0;
     hd__conv_reset(ctx);
 }
 
@@ -718,51 +723,72 @@ static int hd__conv_in_medium(const hd__ctx *ctx, int x, int y, int z)
     return ctx->majorant[((size_t)(vz / c) * ctx->mdims[1] + (size_t)(vy / c)) * ctx->mdims[0] + (size_t)(vx / c)] > 0.0f;
 }
 
+/* Medium voxels the estimate reads, about, at most: past this, every k-th z slice is measured
+   (the relative change is an average, which a lattice of slices estimates as well), so the
+   read-back and the fold stay small on large grids, where a GPU's transfer would dominate. */
+#define HD__CONV_SAMPLE 131072
+
 static hd_result hd__conv_alloc(hd__ctx *ctx)
 {
-    size_t n = 0, i = 0, gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
-    int x, y, z;
+    size_t n = 0, i = 0, total = 0, slice = (size_t)ctx->gdims[0] * ctx->gdims[1];
+    int x, y, z, c, j, step, gz = ctx->gdims[2], nz;
     if (ctx->conv_tmp) return HD_SUCCESS;
-    for (z = 0; z < ctx->gdims[2]; ++z)
+    for (z = 0; z < gz; ++z)
         for (y = 0; y < ctx->gdims[1]; ++y)
-            for (x = 0; x < ctx->gdims[0]; ++x) n += (size_t)hd__conv_in_medium(ctx, x, y, z);
+            for (x = 0; x < ctx->gdims[0]; ++x) total += (size_t)hd__conv_in_medium(ctx, x, y, z);
+    step = total > HD__CONV_SAMPLE ? (int)((total + HD__CONV_SAMPLE - 1) / HD__CONV_SAMPLE) : 1;
+    if (step > gz) step = gz;
+    nz = (gz - step / 2 + step - 1) / step;
+    for (j = 0; j < nz; ++j)
+        for (y = 0; y < ctx->gdims[1]; ++y)
+            for (x = 0; x < ctx->gdims[0]; ++x) n += (size_t)hd__conv_in_medium(ctx, x, y, step / 2 + j * step);
     ctx->conv_idx = (uint32_t *)hd__alloc(ctx, (n ? n : 1) * sizeof(uint32_t));
     ctx->conv_prev = (float *)hd__calloc(ctx, (n ? n : 1) * 2 * (size_t)ctx->channels, sizeof(float));
-    ctx->conv_tmp = (float *)hd__alloc(ctx, gvox * (size_t)ctx->channels * sizeof(float));
-    if (!ctx->conv_idx || !ctx->conv_prev || !ctx->conv_tmp) {
+    ctx->conv_tmp = (float *)hd__alloc(ctx, (size_t)nz * slice * sizeof(float));
+    ctx->conv_zz = (int *)hd__alloc(ctx, (size_t)nz * (size_t)ctx->channels * sizeof(int));
+    ctx->conv_off = (size_t *)hd__alloc(ctx, ((size_t)nz + 1) * sizeof(size_t));
+    if (!ctx->conv_idx || !ctx->conv_prev || !ctx->conv_tmp || !ctx->conv_zz || !ctx->conv_off) {
         hd__conv_free(ctx);
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the light's convergence estimate (%zu voxels)", n);
     }
-    for (z = 0; z < ctx->gdims[2]; ++z)
+    for (j = 0; j < nz; ++j) {
+        z = step / 2 + j * step;
+        ctx->conv_off[j] = i;
+        for (c = 0; c < ctx->channels; ++c) ctx->conv_zz[c * nz + j] = c * gz + z;
         for (y = 0; y < ctx->gdims[1]; ++y)
             for (x = 0; x < ctx->gdims[0]; ++x)
-                if (hd__conv_in_medium(ctx, x, y, z))
-                    ctx->conv_idx[i++] = (uint32_t)(((size_t)z * ctx->gdims[1] + (size_t)y) * ctx->gdims[0] + (size_t)x);
+                if (hd__conv_in_medium(ctx, x, y, z)) ctx->conv_idx[i++] = (uint32_t)((size_t)y * ctx->gdims[0] + (size_t)x);
+    }
+    ctx->conv_off[nz] = i;
+    ctx->conv_nz = nz;
     ctx->conv_count = n;
     return HD_SUCCESS;
 }
 
-/* Reads one illumination volume back into the measured voxels' copies: *dsq gets the sum of
-   squared changes; for phi (read after E) *lsq gets the sum of squares of E + phi. */
+/* Reads the measured slices of one illumination volume into the measured voxels' copies: *dsq
+   gets the sum of squared changes; for phi (read after E) *lsq gets the sum of squares of E + phi. */
 static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq, double *lsq)
 {
     hd_result r;
-    size_t i, c, gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], n = ctx->conv_count;
+    size_t i, slice = (size_t)ctx->gdims[0] * ctx->gdims[1], n = ctx->conv_count;
     size_t m = n * (size_t)ctx->channels;
     float *prev = ctx->conv_prev + (which == HD_ILLUMINATION_DIRECT ? 0 : m);
     double d = 0.0, l = 0.0;
-    if ((r = hd__be_read_illumination(ctx, which, ctx->conv_tmp)) != HD_SUCCESS) return r;
-    for (c = 0; c < (size_t)ctx->channels; ++c)
-        for (i = 0; i < n; ++i) {
-            float v = ctx->conv_tmp[c * gvox + ctx->conv_idx[i]];
-            float e = v - prev[c * n + i];
-            d += (double)e * e;
-            prev[c * n + i] = v;
-            if (which == HD_ILLUMINATION_SCATTERED) {
-                double t = (double)ctx->conv_prev[c * n + i] + v;
-                l += t * t;
+    int c, j, nz = ctx->conv_nz;
+    for (c = 0; c < ctx->channels; ++c) {
+        if ((r = hd__be_read_illumination_slices(ctx, which, ctx->conv_zz + c * nz, nz, ctx->conv_tmp)) != HD_SUCCESS) return r;
+        for (j = 0; j < nz; ++j)
+            for (i = ctx->conv_off[j]; i < ctx->conv_off[j + 1]; ++i) {
+                float v = ctx->conv_tmp[(size_t)j * slice + ctx->conv_idx[i]];
+                float e = v - prev[(size_t)c * n + i];
+                d += (double)e * e;
+                prev[(size_t)c * n + i] = v;
+                if (which == HD_ILLUMINATION_SCATTERED) {
+                    double t = (double)ctx->conv_prev[(size_t)c * n + i] + v;
+                    l += t * t;
+                }
             }
-        }
+    }
     *dsq = d;
     *lsq = l;
     return HD_SUCCESS;

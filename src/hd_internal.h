@@ -85,10 +85,13 @@ typedef struct hd__ctx {
     double seconds[3];       /* direct (or convection / paths), diffusion, projection */
     /* light convergence (hd__light_measure): E and phi of the medium's voxels after the
        previous light iteration, to estimate the error from their change */
-    uint32_t *conv_idx;      /* illumination-grid indices of the voxels measured */
+    uint32_t *conv_idx;      /* in-slice indices (y * gx + x) of the voxels measured, slice by slice */
     size_t conv_count;
+    int *conv_zz;            /* the stacked slices read back: conv_nz per channel, channel-major */
+    size_t *conv_off;        /* conv_nz + 1 starts in conv_idx, one per measured slice */
+    int conv_nz;             /* measured slices per channel */
     float *conv_prev;        /* conv_count * channels values of E, then the same of phi */
-    float *conv_tmp;         /* one illumination volume read back */
+    float *conv_tmp;         /* the measured slices of one illumination volume read back */
     int conv_have_prev;      /* conv_prev holds the previous iteration */
     int conv_below;          /* light iterations in a row with light_error below the tolerance */
     double conv_dphi;        /* |phi_n - phi_n-1| of the previous iteration */

@@ -89,6 +89,54 @@ static void test_light_error_falls(void)
     }
 }
 
+/* On a grid with more medium voxels than the estimate reads (it measures a lattice of z slices
+   there), the estimate stays close to the same formula over every voxel, computed here from
+   hd_read_illumination. */
+static void test_light_error_sampled(void)
+{
+    enum { X = 72, Y = 72, Z = 40, K = 10 };
+    size_t n = (size_t)X * Y * Z, i;
+    uint8_t *v = (uint8_t *)malloc(n);
+    float *e = (float *)calloc(n, 4), *p = (float *)calloc(n, 4), *e1 = (float *)malloc(n * 4), *p1 = (float *)malloc(n * 4);
+    double dp_prev = 0.0, worst = 1.0;
+    hd_desc d;
+    hd_context ctx;
+    hd_stats s;
+    int k;
+    for (i = 0; i < n; ++i) v[i] = (uint8_t)(96 + (i * 2654435761u >> 27)); /* medium everywhere, uneven */
+    make_desc(&d, NULL);
+    d.volume.dims[0] = X; d.volume.dims[1] = Y; d.volume.dims[2] = Z;
+    d.volume.data = v;
+    d.params.extinction = 10.0f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    for (k = 1; k <= K; ++k) {
+        double de = 0.0, dp = 0.0, ls = 0.0, q, err, ratio;
+        CHECK(hd_refine(ctx, 1) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e1, n) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_SCATTERED, p1, n) == HD_SUCCESS);
+        for (i = 0; i < n; ++i) {
+            de += (double)(e1[i] - e[i]) * (e1[i] - e[i]);
+            dp += (double)(p1[i] - p[i]) * (p1[i] - p[i]);
+            ls += ((double)e1[i] + p1[i]) * ((double)e1[i] + p1[i]);
+        }
+        memcpy(e, e1, n * 4);
+        memcpy(p, p1, n * 4);
+        dp = sqrt(dp);
+        q = dp_prev > 0.0 ? dp / dp_prev : 0.0;
+        q = q > 0.9 ? 0.9 : q;
+        dp_prev = dp;
+        err = (sqrt((double)k * de) + dp * q / (1.0 - q)) / sqrt(ls);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+        if (k < 3) continue; /* the first estimate is 1 by definition */
+        ratio = s.light_error / err;
+        if (fabs(log(ratio)) > fabs(log(worst))) worst = ratio;
+        CHECK_MSG(ratio > 0.75 && ratio < 1.33, "iteration %d: estimate %g, over every voxel %g", k, s.light_error, err);
+    }
+    printf("  sampled light_error against every voxel's: worst ratio %.3f over iterations 3..%d\n", worst, K);
+    hd_destroy(ctx);
+    free(v); free(e); free(p); free(e1); free(p1);
+}
+
 /* A per-frame loop: light work until the light converges, then projections only, then nothing
    once the frame window is full; a camera move costs one projection and keeps the light. */
 static void test_render_loop(void)
@@ -260,6 +308,7 @@ static void test_render_bad_input(void)
 const hd_test_case hd_tests_render[] = {
     {"render_refine_is_iterate_without_frames", test_refine_is_iterate_without_frames},
     {"render_light_error_falls", test_light_error_falls},
+    {"render_light_error_sampled", test_light_error_sampled},
     {"render_loop", test_render_loop},
     {"render_budget", test_render_budget},
     {"render_follows_light", test_render_follows_light},

@@ -69,6 +69,24 @@ static PFN_vkVoidFunction VKAPI_CALL counting_gipa(VkInstance instance, const ch
     return vkGetInstanceProcAddr(instance, name);
 }
 
+/* A loader that counts the instances made through it (test 7). */
+static unsigned long instances_made;
+static PFN_vkCreateInstance real_create_instance;
+static VKAPI_ATTR VkResult VKAPI_CALL counting_create_instance(const VkInstanceCreateInfo *ci, const VkAllocationCallbacks *a,
+                                                                VkInstance *out)
+{
+    ++instances_made;
+    return real_create_instance(ci, a, out);
+}
+static PFN_vkVoidFunction VKAPI_CALL instance_counting_gipa(VkInstance instance, const char *name)
+{
+    if (!instance && strcmp(name, "vkCreateInstance") == 0) {
+        real_create_instance = (PFN_vkCreateInstance)vkGetInstanceProcAddr(NULL, name);
+        return (PFN_vkVoidFunction)counting_create_instance;
+    }
+    return vkGetInstanceProcAddr(instance, name);
+}
+
 static unsigned char vox[24 * 20 * 16];
 
 static hd_desc test_desc(void)
@@ -503,6 +521,40 @@ static void test_multigrid(void)
            ok && messages == 0 ? "PASS" : "FAIL", bmg, brb, oom, fits, lost, messages);
 }
 
+/* 7: contexts that make their own device share one instance for the process, so that creating
+   and destroying many contexts never cycles vkCreateInstance (NVIDIA's driver refuses it after
+   about 30 cycles); a validation context still gets, and destroys, its own. */
+static void test_kept_instance(void)
+{
+    enum { CYCLES = 40 };
+    hd_desc d = test_desc();
+    hd_context h, live;
+    int i, ok = 1, rendered = 0;
+    d.vulkan.get_instance_proc_addr = (hd_proc)instance_counting_gipa;
+    CHECK(hd_create(&d, &live) == HD_SUCCESS); /* alive while the others come and go */
+    for (i = 0; i < CYCLES && ok; ++i) {
+        ok = hd_create(&d, &h) == HD_SUCCESS;
+        if (ok && i % 8 == 0) { ok = hd_render(h) == HD_SUCCESS; rendered += ok; }
+        if (ok) hd_destroy(h);
+    }
+    CHECK(ok);
+    CHECK(hd_render(live) == HD_SUCCESS);
+    hd_destroy(live);
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    hd_destroy(h);
+    ok = ok && instances_made == 1;
+    CHECK(instances_made == 1);
+    d.vulkan.enable_validation = 1;
+    if (hd_create(&d, &h) == HD_SUCCESS) {
+        hd_destroy(h);
+        CHECK(instances_made == 2);
+        ok = ok && instances_made == 2 && messages == 0;
+    }
+    printf("%s %d contexts created and destroyed, %d rendered, through %lu vkCreateInstance call%s "
+           "(the kept instance, and one for a validation context)\n",
+           ok ? "PASS" : "FAIL", CYCLES + 2, rendered + 1, instances_made, instances_made == 1 ? "" : "s");
+}
+
 int main(void)
 {
     if (test_messenger()) {
@@ -511,6 +563,7 @@ int main(void)
         test_device_lost();
         test_half();
         test_multigrid();
+        test_kept_instance();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
