@@ -296,6 +296,24 @@ static int in_list(const char *list, const char *name)
     return 0;
 }
 
+/* 1 if every comma-separated name of list (NULL: all) is a case (cases != 0) or a configuration. */
+static int names_known(const char *list, int cases)
+{
+    const char *p = list;
+    if (list == NULL) return 1;
+    for (;;) {
+        size_t n = strcspn(p, ",");
+        int k, found = 0, count = cases ? NCASES : NCONFIGS;
+        for (k = 0; k < count && !found; ++k) {
+            const char *name = cases ? k_cases[k].name : k_configs[k].name;
+            found = strlen(name) == n && strncmp(name, p, n) == 0;
+        }
+        if (!found) return 0;
+        if (p[n] == 0) return 1;
+        p += n + 1;
+    }
+}
+
 static void run_case(const ecase *c, const char *configs)
 {
     scene s;
@@ -359,6 +377,10 @@ int main(int argc, char **argv)
             fputs(usage, stdout);
             return 0;
         }
+        if (strcmp(a, "--size") && strcmp(a, "--ref-paths") && strcmp(a, "--iters") && strcmp(a, "--steps") &&
+            strcmp(a, "--time-iters") && strcmp(a, "--threads") && strcmp(a, "--cases") && strcmp(a, "--configs") &&
+            strcmp(a, "--cache"))
+            die("unknown option %s\n%s", a, usage);
         if (i + 1 >= argc) die("%s needs a value\n%s", a, usage);
         if (!strcmp(a, "--size")) g_size = atoi(argv[++i]);
         else if (!strcmp(a, "--ref-paths")) g_ref_paths = atoi(argv[++i]);
@@ -374,6 +396,7 @@ int main(int argc, char **argv)
     if (g_size < 8 || g_size > 4096 || g_ref_paths < 2 || g_iters < 1 || g_steps < 1 || g_time_iters < 1 ||
         g_threads < 0)
         die("bad value\n%s", usage);
+    if (!names_known(cases, 1) || !names_known(configs, 0)) die("unknown case or configuration\n%s", usage);
     if (mkdir(g_cache, 0777) != 0 && errno != EEXIST) die("cannot create %s", g_cache);
     printf("hdbench_energy: HD against PT_MS/PT_SS; extinction %.0f, albedo %.2f, 1 light; HD converged by "
            "multigrid CG, %d steps x %d iterations; references %d paths per pixel (2 halves)\n",
