@@ -330,9 +330,10 @@ typedef struct hd_params {
     int illumination_downsample; /* E and phi (and sigma_t for the diffusion) live on a grid of
                                the volume's dims divided by this factor per axis, rounded up,
                                sampled trilinearly by the projection: 1..8, 0 -> 2 (1/8 of the
-                               voxels to track and solve, no loss of PSNR against PT_MS on the
-                               measured volumes: docs/EVALUATION.md, "Defaults"; 1 is the
-                               paper's). Direct light is still tracked through the
+                               voxels to track and solve: 3-4x the iterations per second and
+                               closer to PT_MS than 1 in the first iterations; a small volume run
+                               to convergence can gain from 1, the paper's: docs/EVALUATION.md,
+                               "Defaults"). Direct light is still tracked through the
                                full-resolution volume. */
     int rgb_scattering;     /* 1: multiple scattering per colour channel: the diffusion uses
                                sigma_s,c = albedo * TF colour_c * sigma_t, so light that scatters
@@ -435,7 +436,7 @@ HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, co
 
 /* Sets the fields of *params that a preset names (illumination_downsample, diffusion_boundary,
    solver, diffusion_sweeps) and leaves the others as they are:
-      hd_params p = HD_PARAMS_INIT;  hd_params_preset(HD_PRESET_PAPER, &p);  (then desc.params = p)
+      hd_params p = HD_PARAMS_INIT;  hd_params_preset(HD_PRESET_PAPER, &p, NULL);  desc.params = p;
    HD_ERROR_NULL_POINTER or HD_ERROR_INVALID_ENUM (logged to log, which may be NULL). */
 HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_logger *log);
 
