@@ -1266,7 +1266,7 @@ static void run_multigrid_study(const ref_img *ref, const char *out, const char 
    (wall clock and process CPU time / cores) and followed by a comparison. OUT/defaults.md and
    defaults.csv: PSNR after 1..N iterations, it/s and its ratio to the paper's settings, and the
    PSNR of each at the time the paper's settings take for N/4 iterations. */
-enum { DF_CONFIGS = 6, DF_MARKS = 6 };
+enum { DF_CONFIGS = 6, DF_MARKS = 8 };
 typedef struct df_config {
     int downsample;
     hd_boundary boundary;
@@ -1284,7 +1284,7 @@ static void run_defaults_study(const ref_img *ref, const char *out)
         {1, HD_BOUNDARY_SURFACE, HD_SOLVER_RED_BLACK, 4},
         {1, HD_BOUNDARY_SURFACE, HD_SOLVER_MULTIGRID, 1},
     };
-    static const int marks[DF_MARKS] = {1, 2, 4, 8, 16, 32};
+    static const int marks[DF_MARKS] = {1, 2, 4, 8, 16, 32, 64, 128};
     size_t npix = (size_t)S.size * S.size;
     float *img = (float *)xmalloc(npix * 4 * sizeof(float));
     hd_context ctx[DF_CONFIGS];
