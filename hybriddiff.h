@@ -182,7 +182,8 @@ typedef enum hd_solver {
 } hd_solver;
 
 typedef enum hd_boundary {
-    HD_BOUNDARY_BOX = 0,     /* phi = 0 outside the volume box (docs/METHOD.md) */
+    HD_BOUNDARY_DEFAULT = 0, /* = SURFACE */
+    HD_BOUNDARY_BOX,         /* phi = 0 outside the volume box (docs/METHOD.md, the paper's) */
     HD_BOUNDARY_SURFACE,     /* Marshak vacuum condition at the medium's surface */
     HD_BOUNDARY_COUNT
 } hd_boundary;
@@ -192,6 +193,16 @@ typedef enum hd_precision {
     HD_PRECISION_FLOAT16,     /* IEEE binary16 storage, float32 arithmetic: half the bytes */
     HD_PRECISION_COUNT
 } hd_precision;
+
+/* Named settings of hd_params (hd_params_preset). */
+typedef enum hd_preset {
+    HD_PRESET_DEFAULT = 0, /* the library's defaults: the fields below set to 0 (filled in by
+                              hd_create and hd_set_params) */
+    HD_PRESET_PAPER,       /* the paper's settings (docs/METHOD.md): illumination grid at the
+                              data's resolution (illumination_downsample 1), phi = 0 outside the
+                              box (HD_BOUNDARY_BOX), 4 red-black sweeps per iteration */
+    HD_PRESET_COUNT
+} hd_preset;
 
 typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_log_level;
 
@@ -318,20 +329,25 @@ typedef struct hd_params {
     int max_bounces;        /* PT_MS bounce cap, 0 -> 64 */
     int illumination_downsample; /* E and phi (and sigma_t for the diffusion) live on a grid of
                                the volume's dims divided by this factor per axis, rounded up,
-                               sampled trilinearly by the projection: 1..8, 0 -> 1. Direct light
-                               is still tracked through the full-resolution volume. */
+                               sampled trilinearly by the projection: 1..8, 0 -> 2 (1/8 of the
+                               voxels to track and solve: 3-4x the iterations per second and
+                               closer to PT_MS than 1 in the first iterations; a small volume run
+                               to convergence can gain from 1, the paper's: docs/EVALUATION.md,
+                               "Defaults"). Direct light is still tracked through the
+                               full-resolution volume. */
     int rgb_scattering;     /* 1: multiple scattering per colour channel: the diffusion uses
                                sigma_s,c = albedo * TF colour_c * sigma_t, so light that scatters
                                deep takes the colour shift PT_MS shows (3 channels of E and phi and
                                a colour grid: +28 bytes per voxel). 0 (default): grey diffusion,
                                tinted once at projection, as in the paper. */
-    hd_boundary diffusion_boundary; /* where the diffusion's vacuum is: HD_BOUNDARY_BOX (default,
-                               docs/METHOD.md: phi = 0 outside the volume box, empty voxels solved
-                               with a floored D, so air drains light) or HD_BOUNDARY_SURFACE
-                               (the medium's surface carries the Marshak vacuum condition; empty
-                               voxels are not solved for and hold the Marshak extrapolation of
-                               their medium neighbours' phi, which the projection interpolates
-                               toward; closer to PT_MS, see docs/EVALUATION.md) */
+    hd_boundary diffusion_boundary; /* where the diffusion's vacuum is: HD_BOUNDARY_SURFACE
+                               (default: the medium's surface carries the Marshak vacuum
+                               condition; empty voxels are not solved for and hold the Marshak
+                               extrapolation of their medium neighbours' phi, which the
+                               projection interpolates toward; closer to PT_MS, see
+                               docs/EVALUATION.md, "Defaults") or HD_BOUNDARY_BOX (the paper's,
+                               docs/METHOD.md: phi = 0 outside the volume box, empty voxels
+                               solved with a floored D, so air drains light) */
     hd_precision illumination_precision; /* storage of E and phi (and Jacobi's buffer):
                                HD_PRECISION_FLOAT16 stores them as IEEE binary16, rounded to
                                nearest even, while every operation stays float32: 2 bytes per
@@ -419,6 +435,12 @@ HDDEF const char *hd_method_name(hd_method method);
 HDDEF const char *hd_backend_name(void);
 HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, const char *message,
                          const char *file, int line);
+
+/* Sets the fields of *params that a preset names (illumination_downsample, diffusion_boundary,
+   solver, diffusion_sweeps) and leaves the others as they are:
+      hd_params p = HD_PARAMS_INIT;  hd_params_preset(HD_PRESET_PAPER, &p, NULL);  desc.params = p;
+   HD_ERROR_NULL_POINTER or HD_ERROR_INVALID_ENUM (logged to log, which may be NULL). */
+HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_logger *log);
 
 HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx);
 HDDEF hd_result hd_destroy(hd_context ctx);

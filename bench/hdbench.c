@@ -3,8 +3,9 @@
      - the diffusion sweep's time and bytes/s as a share of the triad (box and surface boundary);
      - HD iterations/s and per-stage times on the head CT at 512^2 and 1024^2, 1 and 3 lights;
      - bytes per voxel of HD's state for 1, 3 and 16 lights.
-   Usage: hdbench [data/head.nrrd] [--quick] [--sweep]   (make data fetches the head CT;
-   --sweep: the triad and the sweeps only)
+   Usage: hdbench [data/head.nrrd] [--quick] [--sweep] [--defaults ROUNDS]   (make data fetches
+   the head CT; --sweep: the triad and the sweeps only; --defaults: only the paper's settings
+   against the library's defaults at 512^2, ROUNDS interleaved rounds)
    Figures, not a test: nothing here passes or fails. */
 #define HYBRIDDIFF_IMPLEMENTATION
 #ifndef HYBRIDDIFF_BACKEND_OPENCL
@@ -99,16 +100,81 @@ static void fill_desc(hd_desc *d, const hd_volume_file *vf, int size, int lights
     d->logger.func = hd_log_stderr;
 }
 
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* --defaults: HD at 512^2 with 1 light, the paper's settings (hd_params_preset) against the
+   library's defaults, in one process. After a warm-up iteration each, every round times one
+   hd_refine(ctx, 1) (light only) and one hd_iterate(ctx, 1) (light and a projection frame) of
+   each context in turn, so the load falls on both alike; medians over the rounds, by the wall
+   clock and by process CPU time / threads. */
+#define BENCH_ROUNDS_MAX 64
+static int bench_defaults(const hd_volume_file *vf, int rounds, int nthreads)
+{
+    static const char *const name[2] = {"paper (grid /1, box, red-black 4)", "defaults"};
+    double t[2][4][BENCH_ROUNDS_MAX], med[2][4];
+    hd_context ctx[2];
+    hd_desc d;
+    hd_stats st;
+    int k, r, m;
+    if (rounds > BENCH_ROUNDS_MAX) rounds = BENCH_ROUNDS_MAX;
+    for (k = 0; k < 2; ++k) {
+        fill_desc(&d, vf, 512, 1);
+        if (k == 0 && hd_params_preset(HD_PRESET_PAPER, &d.params, &d.logger) != HD_SUCCESS) return 1;
+        if (hd_create(&d, &ctx[k]) != HD_SUCCESS || hd_iterate(ctx[k], 1) != HD_SUCCESS) return 1;
+    }
+    for (r = 0; r < rounds; ++r)
+        for (m = 0; m < 2; ++m)
+            for (k = 0; k < 2; ++k) {
+                double w = hd__now(), c = cpu_seconds();
+                if ((m ? hd_iterate(ctx[k], 1) : hd_refine(ctx[k], 1)) != HD_SUCCESS) return 1;
+                t[k][2 * m][r] = hd__now() - w;
+                t[k][2 * m + 1][r] = (cpu_seconds() - c) / nthreads;
+            }
+    printf("\nHD at 512^2, 1 light, %d rounds interleaved: median ms per call (wall / CPU per thread)\n", rounds);
+    printf("| settings | illumination grid | bytes/voxel | hd_refine wall | CPU | hd_iterate wall | CPU | it/s (hd_iterate, wall) |\n");
+    printf("|---|---|---|---|---|---|---|---|\n");
+    for (k = 0; k < 2; ++k) {
+        for (m = 0; m < 4; ++m) med[k][m] = median(t[k][m], rounds);
+        hd_get_stats(ctx[k], &st);
+        printf("| %s | %dx%dx%d | %.2f | %.1f | %.1f | %.1f | %.1f | %.3f |\n", name[k], st.illumination_dims[0],
+               st.illumination_dims[1], st.illumination_dims[2],
+               (double)st.method_bytes / ((double)vf->desc.dims[0] * vf->desc.dims[1] * vf->desc.dims[2]),
+               med[k][0] * 1e3, med[k][1] * 1e3, med[k][2] * 1e3, med[k][3] * 1e3, 1.0 / med[k][2]);
+        hd_destroy(ctx[k]);
+    }
+    printf("| speed-up | | | %.2fx | %.2fx | %.2fx | %.2fx | |\n", med[0][0] / med[1][0], med[0][1] / med[1][1],
+           med[0][2] / med[1][2], med[0][3] / med[1][3]);
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd";
-    int quick = 0, sweep_only = 0, i, sizes[2] = {512, 1024}, si, li, nthreads;
+    int quick = 0, sweep_only = 0, defaults_rounds = 0, i, sizes[2] = {512, 1024}, si, li, nthreads;
     hd_volume_file vf;
     hd_result r;
     double triad, hd_rate[2][2] = {{0, 0}, {0, 0}};
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--quick") == 0) quick = 1;
         else if (strcmp(argv[i], "--sweep") == 0) sweep_only = 1;
+        else if (strcmp(argv[i], "--defaults") == 0 && i + 1 < argc) defaults_rounds = atoi(argv[++i]);
         else path = argv[i];
     }
     r = hd_volume_load_nrrd(path, &vf, NULL);
@@ -120,6 +186,11 @@ int main(int argc, char **argv)
     nthreads = (int)sysconf(_SC_NPROCESSORS_ONLN);
     printf("hdbench: backend %s, %d threads, volume %s %dx%dx%d\n", hd_backend_name(), nthreads, path,
            vf.desc.dims[0], vf.desc.dims[1], vf.desc.dims[2]);
+    if (defaults_rounds > 0) {
+        int rc = bench_defaults(&vf, defaults_rounds, nthreads);
+        hd_volume_free(&vf);
+        return rc;
+    }
     triad = hdbench_triad_bandwidth(nthreads);
     printf("STREAM triad: %.2f GB/s\n", triad * 1e-9);
 
@@ -142,6 +213,7 @@ int main(int argc, char **argv)
         for (solver = HD_SOLVER_RED_BLACK; solver <= HD_SOLVER_JACOBI; ++solver) {
             double t, nvox, bytes;
             fill_desc(&d, &vf, 64, 1);
+            d.params.illumination_downsample = 1; /* the sweep on the head's own grid */
             d.params.solver = (hd_solver)solver;
             d.params.diffusion_boundary = (hd_boundary)boundary;
             d.params.diffusion_sweeps = sweeps;

@@ -280,8 +280,8 @@ int main(int argc, char **argv)
         hd_get_stats(rb, &s_rb);
         hd_get_stats(mg, &s_mg);
         printf("| boundary | solver | steps | wall s | cpu s / thread | residual |\n|---|---|---|---|---|---|\n");
-        printf("| %s | red-black | %d sweeps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", a.steps, a.wall, a.cpu, a.res);
-        printf("| %s | multigrid | %d PCG steps | %.2f | %.2f | %.2e |\n", boundary ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
+        printf("| %s | red-black | %d sweeps | %.2f | %.2f | %.2e |\n", boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", a.steps, a.wall, a.cpu, a.res);
+        printf("| %s | multigrid | %d PCG steps | %.2f | %.2f | %.2e |\n", boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
         {
             hd__ctx *m = hd__lookup(mg, NULL);
             double vc = m && m->be->mg ? m->mg.vcycle_seconds : 0.0;

@@ -27,9 +27,9 @@ typedef struct hde_scene {
     char tf[512];
     float extinction, albedo, anisotropy, step, exposure, fov, lit_opacity;
     int max_bounces, diffusion_sweeps, frame_window;
-    int solver; /* HD and CD's diffusion solver: 0 = the library's default (red-black),
-                   1 = red-black, 2 = multigrid CG (HD_SOLVER_RED_BLACK / _MULTIGRID; the CPU
-                   backend only); diffusion_sweeps counts CG steps with multigrid */
+    int solver; /* HD and CD's diffusion solver: 0 (unset) or 1 = red-black, the paper's,
+                   2 = multigrid CG (HD_SOLVER_RED_BLACK / _MULTIGRID; the CPU backend only);
+                   diffusion_sweeps counts CG steps with multigrid */
     float eye[3], target[3], up[3];
     int light_count;
     float light_dir[HDE_MAX_LIGHTS][3], light_intensity[HDE_MAX_LIGHTS];

@@ -200,7 +200,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
     d.params.anisotropy = S.anisotropy;
     d.params.diffusion_sweeps = g_sweeps ? g_sweeps : S.diffusion_sweeps;
     d.params.solver = g_solver != HD_SOLVER_DEFAULT ? g_solver
-                      : S.solver == 2 ? HD_SOLVER_MULTIGRID : S.solver == 1 ? HD_SOLVER_RED_BLACK : HD_SOLVER_DEFAULT;
+                      : S.solver == 2 ? HD_SOLVER_MULTIGRID : HD_SOLVER_RED_BLACK;
     d.params.seed = seed;
     d.params.step = S.step;
     d.params.frame_window = S.frame_window;
@@ -1258,10 +1258,137 @@ static void run_multigrid_study(const ref_img *ref, const char *out, const char 
         for (k = 0; k < MG_CONFIGS; ++k) free(runs[b][k].c.p);
 }
 
+/* Which defaults serve users best: HD with 1 light against the 1-light PT_MS reference, for the
+   paper's settings (full-resolution illumination grid, box boundary, red-black sweeps) and the
+   candidates that change one or more of them (illumination_downsample 2, the surface boundary,
+   multigrid CG). Every setting has its own context and they run interleaved, one iteration each
+   per round, so the machine's load falls on all of them alike; each hd_iterate is timed alone
+   (wall clock and process CPU time / cores) and followed by a comparison. OUT/defaults.md and
+   defaults.csv: PSNR after 1..N iterations, it/s and its ratio to the paper's settings, and the
+   PSNR of each at the time the paper's settings take for N/4 iterations. */
+enum { DF_CONFIGS = 6, DF_MARKS = 8 };
+typedef struct df_config {
+    int downsample;
+    hd_boundary boundary;
+    hd_solver solver;
+    int steps;
+} df_config;
+
+static void run_defaults_study(const ref_img *ref, const char *out)
+{
+    static const df_config cfg[DF_CONFIGS] = {
+        {1, HD_BOUNDARY_BOX, HD_SOLVER_RED_BLACK, 4},       /* the paper's settings */
+        {2, HD_BOUNDARY_BOX, HD_SOLVER_RED_BLACK, 4},
+        {2, HD_BOUNDARY_SURFACE, HD_SOLVER_RED_BLACK, 4},
+        {2, HD_BOUNDARY_SURFACE, HD_SOLVER_MULTIGRID, 1},
+        {1, HD_BOUNDARY_SURFACE, HD_SOLVER_RED_BLACK, 4},
+        {1, HD_BOUNDARY_SURFACE, HD_SOLVER_MULTIGRID, 1},
+    };
+    static const int marks[DF_MARKS] = {1, 2, 4, 8, 16, 32, 64, 128};
+    size_t npix = (size_t)S.size * S.size;
+    float *img = (float *)xmalloc(npix * 4 * sizeof(float));
+    hd_context ctx[DF_CONFIGS];
+    curve c[DF_CONFIGS];
+    hd_stats st[DF_CONFIGS];
+    double nvox = (double)g_vol.desc.dims[0] * g_vol.desc.dims[1] * g_vol.desc.dims[2];
+    int n = S.iterations[HDE_HD], k, it, j;
+    double budget_cpu, budget_wall;
+    char load0[64], load1[64], path[1024];
+    FILE *md, *f;
+    load_average(load0, sizeof load0);
+    for (k = 0; k < DF_CONFIGS; ++k) {
+        g_downsample = cfg[k].downsample;
+        g_boundary = cfg[k].boundary;
+        g_solver = cfg[k].solver;
+        g_sweeps = cfg[k].steps;
+        ctx[k] = make_ctx(HDE_HD, 1, S.size, 1u);
+        memset(&c[k], 0, sizeof c[k]);
+        c[k].p = (point *)xmalloc((size_t)n * sizeof(point));
+    }
+    g_downsample = 1;
+    g_boundary = HD_BOUNDARY_BOX;
+    g_solver = HD_SOLVER_DEFAULT;
+    g_sweeps = 0;
+    for (it = 0; it < n; ++it)
+        for (k = 0; k < DF_CONFIGS; ++k) {
+            double a = now(), ca = cpu_now();
+            point *p = &c[k].p[it];
+            iterate(ctx[k], 1);
+            memset(p, 0, sizeof *p);
+            p->sec = (it ? c[k].p[it - 1].sec : 0.0) + cpu_now() - ca;
+            p->wall = (it ? c[k].p[it - 1].wall : 0.0) + now() - a;
+            p->it = it + 1;
+            read_image(ctx[k], img, S.size);
+            p->e[1] = compare(img, ref, npix);
+            c[k].n = it + 1;
+        }
+    load_average(load1, sizeof load1);
+    for (k = 0; k < DF_CONFIGS; ++k) {
+        if (hd_get_stats(ctx[k], &st[k]) != HD_SUCCESS) die("hd_get_stats");
+        hd_destroy(ctx[k]);
+    }
+    budget_cpu = c[0].p[(n + 3) / 4 - 1].sec;
+    budget_wall = c[0].p[(n + 3) / 4 - 1].wall;
+
+    md = open_w(out, "defaults.md", path);
+    fprintf(md, "HD, 1 light, %dx%d image, data %dx%dx%d, CPU backend, %d threads; PSNR (dB, all pixels) against the "
+                "1-light PT_MS reference (%d paths/pixel, its own noise %.1f dB). The settings ran interleaved, one "
+                "iteration each per round; it/s by the wall clock of hd_iterate and by process CPU time / %d; "
+                "'equal time': the PSNR of the last image finished within the time the first row takes for %d "
+                "iterations (CPU clock; wall clock in brackets). Load average %s at the start, %s at the end.\n\n",
+            S.size, S.size, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2], g_cores, ref->paths,
+            psnr(ref->noise_mse), g_cores, (n + 3) / 4, load0, load1);
+    fprintf(md, "| grid | boundary | solver | state B/voxel | it/s wall | it/s CPU | speed-up (CPU) |");
+    for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, " %d it |", marks[j]);
+    fprintf(md, " lit part, %d it | equal time |\n|---|---|---|---|---|---|---|", n);
+    for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, "---|");
+    fprintf(md, "---|---|\n");
+    f = open_w(out, "defaults.csv", NULL);
+    fprintf(f, "downsample,boundary,solver,steps,iteration,wall_seconds,cpu_seconds,psnr_vs_pt_ms,psnr_lit_vs_pt_ms\n");
+    for (k = 0; k < DF_CONFIGS; ++k) {
+        const point *last = &c[k].p[n - 1];
+        double eqc = -1.0, eqw = -1.0;
+        const char *sol = cfg[k].solver == HD_SOLVER_MULTIGRID ? "multigrid" : "red_black";
+        for (it = 0; it < n; ++it) {
+            const point *p = &c[k].p[it];
+            if (p->sec <= budget_cpu) eqc = psnr(p->e[1].mse);
+            if (p->wall <= budget_wall) eqw = psnr(p->e[1].mse);
+            fprintf(f, "%d,%s,%s,%d,%d,%.4f,%.4f,%.3f,%.3f\n", cfg[k].downsample,
+                    cfg[k].boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", sol, cfg[k].steps, p->it, p->wall,
+                    p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+        }
+        fprintf(md, "| %dx%dx%d | %s | %s, %d %s | %.2f | %.3f | %.3f | %.2fx |", st[k].illumination_dims[0],
+                st[k].illumination_dims[1], st[k].illumination_dims[2],
+                cfg[k].boundary == HD_BOUNDARY_SURFACE ? "surface" : "box",
+                cfg[k].solver == HD_SOLVER_MULTIGRID ? "multigrid CG" : "red-black", cfg[k].steps,
+                cfg[k].solver == HD_SOLVER_MULTIGRID ? "step" : "sweeps", (double)st[k].method_bytes / nvox,
+                n / last->wall, n / last->sec, c[0].p[n - 1].sec / last->sec);
+        for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, " %.2f |", psnr(c[k].p[marks[j] - 1].e[1].mse));
+        fprintf(md, " %.2f |", psnr(last->e[1].mse_lit));
+        if (eqc < 0) fprintf(md, " no image |");
+        else fprintf(md, " %.2f (%.2f) |", eqc, eqw);
+        fputc('\n', md);
+        check_line("defaults study: grid /%d, %s boundary, %s %d: %.3f it/s wall, %.3f it/s CPU/%d (%.2fx), "
+                   "PSNR vs PT_MS after 1 it %.2f dB, after %d it %.2f dB (lit %.2f); per it: direct %.3f s, "
+                   "diffusion %.3f s, projection %.3f s (wall)",
+                   cfg[k].downsample, cfg[k].boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", sol, cfg[k].steps,
+                   n / last->wall, n / last->sec, g_cores, c[0].p[n - 1].sec / last->sec, psnr(c[k].p[0].e[1].mse), n,
+                   psnr(last->e[1].mse), psnr(last->e[1].mse_lit), st[k].seconds_direct / n,
+                   st[k].seconds_diffusion / n, st[k].seconds_projection / n);
+        free(c[k].p);
+    }
+    check_line("defaults study: load average %s at the start, %s at the end", load0, load1);
+    fclose(f);
+    fclose(md);
+    say("wrote %s", path);
+    free(img);
+}
+
+
 static const char *usage =
     "usage: hdeval [SCENE] [--paper] [--out DIR] [--cache DIR] [--work DIR] [--size N] [--table-size N]\n"
     "              [--skip-table] [--downsample N] [--downsample-study] [--rgb-study] [--half-study]\n"
-    "              [--multigrid-study] [--study-seconds S]\n"
+    "              [--multigrid-study] [--study-seconds S] [--defaults-study]\n"
     "  SCENE           scene file (default examples/eval/head.scene): every setting\n"
     "  --paper         use the scene's paper.* settings (1024^2, paper-scale iterations/references)\n"
     "  --out DIR       tables, plots, figures (default docs/eval)\n"
@@ -1284,14 +1411,17 @@ static const char *usage =
     "                  1-light PT_MS reference over wall and CPU time (OUT/multigrid.md, .csv,\n"
     "                  multigrid_psnr_time.png), then stop; with --downsample 2 the first second\n"
     "                  holds several iterations\n"
-    "  --study-seconds S  how long each multigrid-study run lasts on both clocks (default 20)\n";
+    "  --study-seconds S  how long each multigrid-study run lasts on both clocks (default 20)\n"
+    "  --defaults-study  only HD with the paper's settings and the candidate defaults (grid /2,\n"
+    "                  surface boundary, multigrid CG), interleaved, against the 1-light PT_MS\n"
+    "                  reference (OUT/defaults.md, defaults.csv), then stop\n";
 
 int main(int argc, char **argv)
 {
     const char *scene_path = "examples/eval/head.scene", *out = "docs/eval", *cache = "out/eval-cache";
     const char *work = "out/eval-work";
     int paper = 0, size = 0, table_size = 0, skip_table = 0, downsample_study = 0, rgb_study = 0, i, m, li, k;
-    int half_study = 0, multigrid_study = 0;
+    int half_study = 0, multigrid_study = 0, defaults_study = 0;
     double study_seconds = 20.0;
     char err[1024];
     static ref_img refs[HDE_METHODS][2];
@@ -1316,6 +1446,7 @@ int main(int argc, char **argv)
         else if (!strcmp(a, "--rgb-study")) rgb_study = 1;
         else if (!strcmp(a, "--half-study")) half_study = 1;
         else if (!strcmp(a, "--multigrid-study")) multigrid_study = 1;
+        else if (!strcmp(a, "--defaults-study")) defaults_study = 1;
         else if (!strcmp(a, "--study-seconds")) study_seconds = atof(NEXT());
         else if (!strcmp(a, "--downsample")) g_downsample = atoi(NEXT());
         else if (a[0] == '-') { fprintf(stderr, "hdeval: unknown option %s\n%s", a, usage); return 2; }
@@ -1352,7 +1483,8 @@ int main(int argc, char **argv)
     if (g_tf.data_domain) hdx_tf_set_domain(&g_tf, g_vol.value_min, g_vol.value_max);
 
     g_checks = open_w(out, downsample_study ? "downsample-checks.txt" : rgb_study ? "rgb-checks.txt" :
-                           half_study ? "half-checks.txt" : multigrid_study ? "multigrid-checks.txt" : "checks.txt",
+                           half_study ? "half-checks.txt" : multigrid_study ? "multigrid-checks.txt" :
+                           defaults_study ? "defaults-checks.txt" : "checks.txt",
                      NULL);
     check_line("hdeval: %s%s, %s %dx%dx%d, tf %s, backend %s, curves %dx%d, table %dx%d", scene_path,
                paper ? " (--paper)" : "", S.volume, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2],
@@ -1364,6 +1496,12 @@ int main(int argc, char **argv)
                (double)S.anisotropy, (double)S.exposure, S.frame_window, S.diffusion_sweeps,
                S.solver == 2 ? " (multigrid CG steps)" : "", g_downsample);
 
+    if (defaults_study) {
+        ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
+        run_defaults_study(&refs[HDE_MS][0], out);
+        fclose(g_checks);
+        return 0;
+    }
     if (multigrid_study) {
         ref_get(&refs[HDE_MS][0], HDE_MS, 1, cache);
         run_multigrid_study(&refs[HDE_MS][0], out, work, study_seconds);

@@ -2,6 +2,8 @@
 # every voxel, in one process (bench/hdbench_direct.c, figures in docs/DESIGN-DIRECT.md).
 #   make bench-direct    build/hdbench_direct_{cpu,opencl,gl,vulkan} on the head CT, full grid,
 #                        ct-skin and ct-bone TFs; DIRECT_ITERS passes per block, DIRECT_REPS blocks
+#   make bench-rays      build/hdbench_rays: ratio against delta tracking for the direct light (cost,
+#                        noise, efficiency), CPU, head CT, default grid; RAYS_ARGS (--passes, --reps)
 DIRECT_BACKENDS := cpu opencl gl vulkan
 DIRECT_DEF_cpu := -DHYBRIDDIFF_BACKEND_CPU
 DIRECT_DEF_opencl := -DHYBRIDDIFF_BACKEND_OPENCL
@@ -14,10 +16,18 @@ DIRECT_LIB_vulkan := -lvulkan
 DIRECT_ITERS ?= 4
 DIRECT_REPS ?= 3
 
-.PHONY: bench-direct
+RAYS_ARGS ?= --passes 4 --reps 5
+
+.PHONY: bench-direct bench-rays
 
 $(B)/hdbench_direct_%: bench/hdbench_direct.c examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
 	$(CC) $(CPPFLAGS) $(DIRECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(DIRECT_LIB_$*)
 
 bench-direct: $(foreach b,$(DIRECT_BACKENDS),$(B)/hdbench_direct_$(b)) data
 	@for be in $(DIRECT_BACKENDS); do $(B)/hdbench_direct_$$be --iters $(DIRECT_ITERS) --reps $(DIRECT_REPS) data/head.nrrd || exit 1; done
+
+$(B)/hdbench_rays: bench/hdbench_rays.c examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+
+bench-rays: $(B)/hdbench_rays data
+	$(B)/hdbench_rays $(RAYS_ARGS) data/head.nrrd

@@ -186,8 +186,30 @@ static void hd__params_defaults(hd_params *p)
     if (p->frame_window == 0) p->frame_window = 8;
     if (p->exposure == 0.0f) p->exposure = 1.0f;
     if (p->max_bounces == 0) p->max_bounces = 64;
-    if (p->illumination_downsample == 0) p->illumination_downsample = 1;
+    if (p->illumination_downsample == 0) p->illumination_downsample = 2;
+    if (p->diffusion_boundary == HD_BOUNDARY_DEFAULT) p->diffusion_boundary = HD_BOUNDARY_SURFACE;
     if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
+}
+
+/* The defaults above were chosen by measurement against PT_MS (docs/EVALUATION.md, "Defaults");
+   the paper's preset keeps its settings reachable. */
+HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_logger *log)
+{
+    if (!params) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_params_preset: params is NULL");
+    if ((int)preset < 0 || preset >= HD_PRESET_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "hd_params_preset: preset %d is not a hd_preset", (int)preset);
+    if (preset == HD_PRESET_PAPER) {
+        params->illumination_downsample = 1;
+        params->diffusion_boundary = HD_BOUNDARY_BOX;
+        params->solver = HD_SOLVER_RED_BLACK;
+        params->diffusion_sweeps = 4;
+    } else {
+        params->illumination_downsample = 0;
+        params->diffusion_boundary = HD_BOUNDARY_DEFAULT;
+        params->solver = HD_SOLVER_DEFAULT;
+        params->diffusion_sweeps = 0;
+    }
+    return HD_SUCCESS;
 }
 
 /* Checks parameters whose defaults are filled in. */

@@ -39,6 +39,10 @@ static void make_desc(hd_desc *d, test_log *log)
     d->transfer_function.count = 3;
     d->camera.width = d->camera.height = 48;
     d->params.extinction = 40.0f;
+    /* the paper's grid and boundary: the cases are about the API, not the defaults (which
+       core_create_defaults and core_params_preset check) */
+    d->params.illumination_downsample = 1;
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
     if (log) {
         memset(log, 0, sizeof *log);
         d->logger.func = test_log_fn;
@@ -52,10 +56,13 @@ static void test_create_defaults(void)
     hd_context ctx;
     hd_stats s;
     make_desc(&d, NULL);
+    CHECK(hd_params_preset(HD_PRESET_DEFAULT, &d.params, NULL) == HD_SUCCESS);
     CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
     CHECK(hd_query_desc(ctx, &q) == HD_SUCCESS);
     CHECK(q.params.method == HD_METHOD_HD);
     CHECK(q.params.albedo == 0.9f && q.params.diffusion_sweeps == 4 && q.params.step == 0.5f);
+    CHECK(q.params.illumination_downsample == 2 && q.params.diffusion_boundary == HD_BOUNDARY_SURFACE);
+    CHECK(q.params.solver == HD_SOLVER_RED_BLACK);
     CHECK(q.light_count == 1 && q.lights[0].direction[2] == -1.0f && q.lights[0].intensity == 1.0f);
     CHECK(q.camera.fov_y == 40.0f && q.camera.eye[2] == 2.5f && q.camera.up[1] == 1.0f);
     CHECK(q.volume.spacing[0] == 1.0f && q.volume.value_range[1] == 255.0f);
@@ -63,8 +70,66 @@ static void test_create_defaults(void)
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 0);
     CHECK(hd_iterate(ctx, 3) == HD_SUCCESS);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 3 && s.frames == 3);
-    CHECK(s.illumination_dims[0] == N && s.illumination_channels == 1);
+    CHECK(s.illumination_dims[0] == N / 2 && s.illumination_channels == 1);
     CHECK(hd_destroy(ctx) == HD_SUCCESS);
+}
+
+/* hd_params_preset: the paper's settings (full grid, box boundary, 4 red-black sweeps) give the
+   image of a context with those fields spelled out, which differs from the defaults' image; the
+   default preset restores the defaults; other fields are left alone; bad input is refused with
+   its code and one log line. */
+static void test_params_preset(void)
+{
+    hd_desc d, q;
+    hd_context paper, spelled, dflt;
+    hd_params p;
+    test_log log;
+    size_t i, n = 48 * 48 * 4, differ = 0;
+    float *a = (float *)malloc(n * sizeof(float)), *b = (float *)malloc(n * sizeof(float));
+    float *c = (float *)malloc(n * sizeof(float));
+    make_desc(&d, &log);
+    d.params.seed = 5;
+    d.params.illumination_downsample = 0;
+    d.params.diffusion_boundary = HD_BOUNDARY_DEFAULT;
+    CHECK(hd_params_preset(HD_PRESET_PAPER, &d.params, &d.logger) == HD_SUCCESS);
+    CHECK(d.params.illumination_downsample == 1 && d.params.diffusion_boundary == HD_BOUNDARY_BOX);
+    CHECK(d.params.solver == HD_SOLVER_RED_BLACK && d.params.diffusion_sweeps == 4);
+    CHECK(d.params.seed == 5 && d.params.extinction == 40.0f && d.params.method == HD_METHOD_DEFAULT);
+    CHECK(hd_create(&d, &paper) == HD_SUCCESS);
+    CHECK(hd_query_desc(paper, &q) == HD_SUCCESS);
+    CHECK(q.params.illumination_downsample == 1 && q.params.diffusion_boundary == HD_BOUNDARY_BOX);
+    make_desc(&d, NULL); /* the paper's grid and boundary, spelled out */
+    d.params.seed = 5;
+    d.params.solver = HD_SOLVER_RED_BLACK;
+    d.params.diffusion_sweeps = 4;
+    CHECK(hd_create(&d, &spelled) == HD_SUCCESS);
+    p = d.params;
+    CHECK(hd_params_preset(HD_PRESET_DEFAULT, &p, NULL) == HD_SUCCESS);
+    CHECK(p.illumination_downsample == 0 && p.diffusion_boundary == HD_BOUNDARY_DEFAULT);
+    CHECK(p.solver == HD_SOLVER_DEFAULT && p.diffusion_sweeps == 0 && p.seed == 5);
+    d.params = p;
+    CHECK(hd_create(&d, &dflt) == HD_SUCCESS);
+    CHECK(hd_iterate(paper, 4) == HD_SUCCESS && hd_iterate(spelled, 4) == HD_SUCCESS && hd_iterate(dflt, 4) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(paper, a, n) == HD_SUCCESS && hd_read_image_f32(spelled, b, n) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(dflt, c, n) == HD_SUCCESS);
+    CHECK(memcmp(a, b, n * sizeof(float)) == 0);
+    for (i = 0; i < n; ++i) differ += a[i] != c[i];
+    CHECK(differ > 0);
+    make_desc(&d, &log);
+    CHECK(hd_params_preset(HD_PRESET_COUNT, &p, &d.logger) == HD_ERROR_INVALID_ENUM);
+    CHECK(log.count == 1 && log.last == HD_ERROR_INVALID_ENUM);
+    CHECK(hd_params_preset((hd_preset)-1, &p, &d.logger) == HD_ERROR_INVALID_ENUM);
+    CHECK(log.count == 2 && log.last == HD_ERROR_INVALID_ENUM);
+    CHECK(hd_params_preset(HD_PRESET_PAPER, NULL, &d.logger) == HD_ERROR_NULL_POINTER);
+    CHECK(log.count == 3 && log.last == HD_ERROR_NULL_POINTER);
+    CHECK(p.seed == 5 && p.illumination_downsample == 0); /* a refused preset writes nothing */
+    CHECK(hd_params_preset(HD_PRESET_PAPER, &p, NULL) == HD_SUCCESS && p.illumination_downsample == 1);
+    hd_destroy(paper);
+    hd_destroy(spelled);
+    hd_destroy(dflt);
+    free(a);
+    free(b);
+    free(c);
 }
 
 static float *render(int threads, uint32_t seed, int iters)
@@ -445,6 +510,7 @@ static void test_bad_calls(void)
 
 const hd_test_case hd_tests_core[] = {
     {"core_create_defaults", test_create_defaults},
+    {"core_params_preset", test_params_preset},
     {"core_determinism_threads_seed", test_determinism},
     {"core_camera_keeps_illumination", test_camera_keeps_illumination},
     {"core_invalidation", test_invalidation},

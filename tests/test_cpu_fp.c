@@ -23,6 +23,9 @@ static void bar_desc(hd_desc *d, int threads)
     int i;
     for (i = 0; i < BX * 16; ++i) bar[i] = (uint8_t)(i % BX < 4 ? 255 : 0);
     memset(d, 0, sizeof *d);
+    /* the paper's grid and boundary (hd_params_preset): these cases are not about the defaults */
+    d->params.illumination_downsample = 1;
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
     d->volume.type = HD_VOXEL_U8;
     d->volume.dims[0] = BX;
     d->volume.dims[1] = d->volume.dims[2] = 4;

@@ -108,6 +108,9 @@ static void half_desc(hd_desc *d, hd_light *l, hd_test_log *log)
                 half_blob[(z * HN + y) * HN + x] = (uint8_t)(r < 8 ? (r < 4 ? 255 : 120) : 0);
             }
     memset(d, 0, sizeof *d);
+    /* the paper's grid and boundary (hd_params_preset): these cases are not about the defaults */
+    d->params.illumination_downsample = 1;
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
     memset(l, 0, 2 * sizeof *l);
     d->volume.type = HD_VOXEL_U8;
     d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = HN;

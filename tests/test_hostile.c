@@ -37,6 +37,7 @@ static void hs_desc(hd_desc *d)
     d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = HS_N;
     d->volume.data = hs_vol;
     d->camera.width = d->camera.height = 8;
+    d->params.illumination_downsample = 1; /* the table's buffer sizes are the volume's */
     d->threads = 1;
     d->logger.func = hs_log;
     d->allocator.alloc = hs_alloc;

@@ -26,6 +26,9 @@ static void tm_desc(hd_desc *d, int dx, int dy, int dz, hd_method m, float extin
     size_t i, n = (size_t)dx * dy * dz;
     for (i = 0; i < n; ++i) tm_vol[i] = 255;
     memset(d, 0, sizeof *d);
+    /* the paper's grid and boundary (hd_params_preset): these cases are not about the defaults */
+    d->params.illumination_downsample = 1;
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
     d->volume.type = HD_VOXEL_U8;
     d->volume.dims[0] = dx; d->volume.dims[1] = dy; d->volume.dims[2] = dz;
     d->volume.data = tm_vol;

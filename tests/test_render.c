@@ -22,6 +22,9 @@ static void make_desc(hd_desc *d, hd_test_log *log)
                 vox[(z * N + y) * N + x] = (uint8_t)(r < 8 ? (r < 4 ? 255 : 128) : 0);
             }
     memset(d, 0, sizeof *d);
+    /* the paper's grid and boundary (hd_params_preset): these cases are not about the defaults */
+    d->params.illumination_downsample = 1;
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
     d->volume.type = HD_VOXEL_U8;
     d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = N;
     d->volume.data = vox;

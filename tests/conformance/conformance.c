@@ -101,6 +101,9 @@ static void scene_init(scene *s, hd_voxel_type type, int dx, int dy, int dz, int
     s->camera.width = 48; s->camera.height = 40;
     s->params.seed = 1234u;
     s->params.diffusion_sweeps = 4;
+    /* the paper's grid and boundary; the cases about other grids and boundaries set their own */
+    s->params.illumination_downsample = 1;
+    s->params.diffusion_boundary = HD_BOUNDARY_BOX;
 }
 
 static void scene_free(scene *s) { free(s->data); }

@@ -154,6 +154,8 @@ static void make_desc(hd_desc *d, uint8_t *vox, int n)
     d->camera.width = 48;
     d->camera.height = 40;
     d->params.seed = 7;
+    d->params.illumination_downsample = 1; /* the paper's grid and boundary: the buffer sizes below */
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
 }
 
 /* Every call a host app makes, with the host's state checked around it all. */

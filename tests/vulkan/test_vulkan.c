@@ -99,6 +99,8 @@ static hd_desc test_desc(void)
     d.volume.dims[0] = 24; d.volume.dims[1] = 20; d.volume.dims[2] = 16;
     d.volume.data = vox;
     d.camera.width = 32; d.camera.height = 24;
+    d.params.illumination_downsample = 1; /* the paper's grid and boundary: the buffer sizes below */
+    d.params.diffusion_boundary = HD_BOUNDARY_BOX;
     d.logger.func = count_log;
     return d;
 }
