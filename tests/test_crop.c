@@ -119,6 +119,56 @@ static void test_cropped_region_is_absent(void)
     free(c);
 }
 
+/* A crop face through uniform matter, inside a majorant cell (voxels 16..19 span x 0.5..0.625):
+   the light travelling +x is attenuated only from the face on, E = exp(-extinction (x - 0.53)),
+   and a ray along x through the box [0.53, 0.56] gains the opacity 1 - exp(-extinction 0.03). */
+static void test_crop_face_inside_cell(void)
+{
+    uint8_t *full = (uint8_t *)malloc(N * N * N);
+    outputs *o = (outputs *)malloc(sizeof *o);
+    hd_light l;
+    hd_desc d;
+    hd_context ctx;
+    int x, y, z, px, py;
+    double alpha = 0.0, want;
+    memset(full, 255, N * N * N);
+    make_desc(&d, full, &l, HD_METHOD_HD);
+    l.direction[1] = l.direction[2] = 0.0f;
+    d.params.extinction = 8.0f;
+    d.params.disable_diffusion = 1;
+    d.params.crop_min[0] = 0.53f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_iterate(ctx, 32) == HD_SUCCESS);
+    CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, o->e, (size_t)N * N * N) == HD_SUCCESS);
+    hd_destroy(ctx);
+    for (x = 17; x < 24; ++x) {
+        double mean = 0.0;
+        for (z = 0; z < N; ++z)
+            for (y = 0; y < N; ++y) mean += o->e[(z * N + y) * N + x];
+        mean /= (double)(N * N);
+        want = exp(-8.0 * (((double)x + 0.5) / N - 0.53));
+        CHECK_MSG(fabs(mean - want) < 0.02, "column x = %d: mean E %.4f, expected %.4f", x, mean, want);
+    }
+    /* the projection: a narrow view along +x through the slab [0.53, 0.56] */
+    d.params.crop_max[0] = 0.56f;
+    d.params.extinction = 20.0f;
+    d.params.step = 0.05f;
+    d.camera.eye[0] = -3.0f; d.camera.eye[1] = 0.0f; d.camera.eye[2] = 0.0f;
+    d.camera.up[2] = 1.0f;
+    d.camera.fov_y = 5.0f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_iterate(ctx, 8) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(ctx, o->img, sizeof o->img / sizeof o->img[0]) == HD_SUCCESS);
+    hd_destroy(ctx);
+    for (py = 8; py < 16; ++py)
+        for (px = 8; px < 16; ++px) alpha += o->img[(py * 24 + px) * 4 + 3];
+    alpha /= 64.0;
+    want = 1.0 - exp(-20.0 * 0.03);
+    CHECK_MSG(fabs(alpha - want) < 0.03, "opacity through the slab %.4f, expected %.4f", alpha, want);
+    free(full);
+    free(o);
+}
+
 /* A crop box set by hd_set_params after some iterations restarts the light and the image: the
    result is that of a context created with the box; and removing it again restores the first. */
 static void test_crop_change_restarts(void)
@@ -245,6 +295,7 @@ static void test_crop_bad_input(void)
 
 const hd_test_case hd_tests_crop[] = {
     {"crop_cropped_region_is_absent", test_cropped_region_is_absent},
+    {"crop_face_inside_cell", test_crop_face_inside_cell},
     {"crop_change_restarts", test_crop_change_restarts},
     {"crop_shrinks_direct_mask", test_crop_shrinks_direct_mask},
     {"crop_defaults", test_crop_defaults},
