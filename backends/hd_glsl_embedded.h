@@ -202,8 +202,8 @@ static const char *const hd__gl_source[] = {
 "HD_PARAM_F4(cam_w)      /* forward, unit */\n",
 "HD_PARAM_F4(background) /* rgb radiance behind the volume */\n",
 "HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */\n",
-"HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates (-1: no crop) */\n",
-"HD_PARAM_F4(crop_hi)    /* xyz = its high corner (2: no crop) */\n",
+"HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates; w = 1: on */\n",
+"HD_PARAM_F4(crop_hi)    /* xyz = its high corner */\n",
 "HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position, w = type */\n",
 "HD_PARAM_F4_ARRAY(light_b, HD_MAX_LIGHTS) /* rgb = colour * intensity (x only with 1 channel), w = 1/r^2 */\n",
 "HD_PARAMS_END\n",
@@ -320,9 +320,11 @@ static const char *const hd__gl_source[] = {
 "                 HD_GET1(tf, a + 3) + f * (HD_GET1(tf, b + 3) - HD_GET1(tf, a + 3)));\n",
 "}\n",
 "\n",
-"/* 1 inside the crop box (params.crop_min/max), 0 outside, where matter is absent. */\n",
+"/* 1 inside the crop box (params.crop_min/max), 0 outside, where matter is absent; crop_lo.w = 0\n",
+"   (a zeroed parameter block) is no crop box. */\n",
 "HD_FN int hd_in_crop(HD_KARGS hd_v3 u)\n",
 "{\n",
+"    if (HD_PRM(crop_lo).w == 0.0f) return 1;\n",
 "    return (u.x >= HD_PRM(crop_lo).x && u.x <= HD_PRM(crop_hi).x && u.y >= HD_PRM(crop_lo).y &&\n",
 "            u.y <= HD_PRM(crop_hi).y && u.z >= HD_PRM(crop_lo).z && u.z <= HD_PRM(crop_hi).z) ? 1 : 0;\n",
 "}\n",
@@ -2023,7 +2025,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1715 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1717 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

@@ -330,11 +330,12 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->background.y = ctx->params.background[1];
     k->background.z = ctx->params.background[2];
     k->chan_color.x = ctx->chan_color[0]; k->chan_color.y = ctx->chan_color[1]; k->chan_color.z = ctx->chan_color[2];
-    /* an axis the crop box spans whole gets bounds no sample reaches, so the uncropped volume
-       is sampled exactly as without a crop box */
+    /* the crop box is on when it cuts an axis; an axis it spans whole gets bounds no sample
+       reaches, so samples at the volume's faces stay as without a crop box */
     for (i = 0; i < 3; ++i) {
         (&k->crop_lo.x)[i] = ctx->params.crop_min[i] > 0.0f ? ctx->params.crop_min[i] : -1.0f;
         (&k->crop_hi.x)[i] = ctx->params.crop_max[i] < 1.0f ? ctx->params.crop_max[i] : 2.0f;
+        if (ctx->params.crop_min[i] > 0.0f || ctx->params.crop_max[i] < 1.0f) k->crop_lo.w = 1.0f;
     }
     for (i = 0; i < ctx->light_count; ++i) {
         const hd_light *l = &ctx->lights[i];
