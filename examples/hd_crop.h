@@ -8,12 +8,13 @@
 /* The head CT that scripts/fetch-data fetches (face +y, top +z) lies on the scanner's head rest,
    a U-shaped sheet that hugs the back of the head (low y) and rises beside it (low and high x).
    No box separates the two entirely: this one clears the rest from the default view (the face,
-   three-quarter) and from the sides, at the price of the back of the scalp and skull (y below
-   0.14, about 2 cm; seen only from behind) and the ears' outer 4-5 voxels. Fills p's crop box and
-   returns 1 for a known volume (file name and dims), else returns 0 and leaves p alone. */
+   three-quarter) and keeps the ears, at the price of the back of the scalp and skull (y below
+   0.165, about 3 cm; seen only from behind); thin strips of the rest's sides stay behind the
+   head, seen from the side or behind. Fills p's crop box and returns 1 for a known volume (file
+   name and dims), else returns 0 and leaves p alone. */
 static int hdx_known_crop(const char *path, const int dims[3], hd_params *p)
 {
-    static const float head_min[3] = {0.13f, 0.14f, 0.0f}, head_max[3] = {0.87f, 1.0f, 1.0f};
+    static const float head_min[3] = {0.11f, 0.165f, 0.0f}, head_max[3] = {0.89f, 1.0f, 1.0f};
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     if (strcmp(base, "head.nrrd") == 0 && dims[0] == 256 && dims[1] == 256 && dims[2] == 108) {

@@ -56,7 +56,7 @@ test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	{ xvfb-run -a -s "-screen 0 640x480x24" $(B)/hdview --size 256x256 --script tests/gl/hdview.script data/head.nrrd \
 	      2> $(B)/gl/hdview.log || { cat $(B)/gl/hdview.log; echo "test-hdview: hdview failed"; exit 1; }; } && \
 	grep -v " info: " $(B)/gl/hdview.log; \
-	{ grep -q "^hdview: crop box x 0.13-0.85 y 0.14-1.00 z 0.00-1.00" $(B)/gl/hdview.log || \
+	{ grep -q "^hdview: crop box x 0.11-0.87 y 0.17-1.00 z 0.00-1.00" $(B)/gl/hdview.log || \
 	  { echo "test-hdview: the crop box keys did not move the x+ face"; exit 1; }; } && \
 	$(B)/hdrender --quiet --size 256x256 --iterations 4 -o $(B)/gl/hdrender-cpu.png data/head.nrrd && \
 	$(B)/pngcmp --nonblank $(B)/gl/hdview-moved.png && \
