@@ -364,6 +364,12 @@ typedef struct hd_params {
     float render_budget;    /* seconds one hd_render call may spend refining light that has not
                                converged, before it projects its frame: 0 -> one light iteration
                                per call; must be finite and >= 0 */
+    float crop_min[3];      /* the crop box's low corner in box coordinates: 0 at the volume's
+                               low face, 1 at its high face, per axis x, y, z; default 0 */
+    float crop_max[3];      /* its high corner, 0 -> 1 per axis, so zeroed params crop nothing.
+                               Matter outside [crop_min, crop_max] is absent for every method
+                               and stage: it casts no shadow, scatters nothing and is not
+                               drawn. Per axis 0 <= min < max <= 1, finite */
 } hd_params;
 
 typedef struct hd_desc {

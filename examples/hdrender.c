@@ -27,6 +27,7 @@
 #define HYBRIDDIFF_IMPLEMENTATION
 #include "hybriddiff.h"
 #include "hd_tf.h"
+#include "hd_crop.h"
 
 #include <errno.h>
 #include <math.h>
@@ -98,6 +99,13 @@ static const char *usage_text =
     "\n";
 /* the rest of --help (one string would exceed the 4095 characters C99 guarantees) */
 static const char *usage_text_method =
+    "crop box (box coordinates: 0..1 along each volume axis x, y, z)\n"
+    "  --crop X0,Y0,Z0,X1,Y1,Z1\n"
+    "                          keep only the box [X0,X1] x [Y0,Y1] x [Z0,Z1]: the matter\n"
+    "                          outside casts no shadow, scatters nothing and is not drawn.\n"
+    "                          Default: the whole volume; for data/head.nrrd the head rest\n"
+    "                          behind the head is cut away (--crop 0,0,0,1,1,1 keeps it)\n"
+    "\n"
     "method\n"
     "  --method M              hd (hybrid diffusion, default), cd, pt_ss, pt_ms\n"
     "  --iterations N          hd, cd: N full iterations, each projecting a frame (default:\n"
@@ -651,7 +659,7 @@ int main(int argc, char **argv)
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
-    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0;
+    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0, crop_given = 0;
     double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -774,6 +782,17 @@ int main(int argc, char **argv)
             desc.camera.fov_y = parse_float(a, VAL(), 0.0f, 180.0f, 1, 1);
         } else if (IS("--size")) {
             parse_size(a, VAL(), &desc.camera.width, &desc.camera.height);
+        } else if (IS("--crop")) {
+            float box[6];
+            parse_floats(a, VAL(), box, 6);
+            for (k = 0; k < 3; ++k) {
+                if (!(box[k] >= 0.0f && box[k] < box[k + 3] && box[k + 3] <= 1.0f))
+                    fail(2, "--crop: '%s': need 0 <= min < max <= 1 on each axis (axis %d: %g, %g)", v, k,
+                         (double)box[k], (double)box[k + 3]);
+                desc.params.crop_min[k] = box[k];
+                desc.params.crop_max[k] = box[k + 3];
+            }
+            crop_given = 1;
         } else if (IS("--method")) {
             VAL();
             if (strcmp(v, "hd") == 0) desc.params.method = HD_METHOD_HD;
@@ -911,6 +930,7 @@ int main(int argc, char **argv)
         else histogram_tf(&vol, &tf);
     }
     if (!camera_given && !raw) known_volume_camera(input, &vol, &desc.camera);
+    if (!crop_given && !raw) hdx_known_crop(input, vol.desc.dims, &desc.params);
     if (tf.data_domain) {
         float lo = vol.value_min, hi = vol.value_max;
         if (!(hi > lo)) hi = lo + 1.0f;
@@ -945,6 +965,10 @@ int main(int argc, char **argv)
                 hd_backend_name(), desc.camera.width, desc.camera.height,
                 iterations ? "fixed iterations" : "light refined to convergence",
                 ls.device[0] ? ls.device : "(not named by the backend)");
+    if (!g_quiet && desc.params.crop_max[0] > 0.0f)
+        fprintf(stderr, "hdrender: crop box x %g..%g, y %g..%g, z %g..%g%s\n", (double)desc.params.crop_min[0],
+                (double)desc.params.crop_max[0], (double)desc.params.crop_min[1], (double)desc.params.crop_max[1],
+                (double)desc.params.crop_min[2], (double)desc.params.crop_max[2], crop_given ? "" : " (this volume's default)");
     hd_volume_free(&vol);
 
     t0 = now_seconds();

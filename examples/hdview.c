@@ -19,9 +19,13 @@
                backend that refuses it logs why and the viewer stays at float32)
      M         diffusion solver: red-black sweeps / multigrid (a backend without multigrid logs
                why and the viewer stays at red-black)
+     O / shift+O  select the next / previous face of the crop box (x-, x+, y-, y+, z-, z+)
+     I / shift+I  move the selected face 0.02 of the volume in / out (the box shrinks / grows)
+     U         crop box: the whole volume / the volume's default (data/head.nrrd: no head rest)
      Esc / Q   quit
    The title shows the method, whether the light has converged (its error estimate and
-   iterations; paths per pixel for PT), the frame time and the bytes the method holds.
+   iterations; paths per pixel for PT), the frame time, the bytes the method holds and the crop
+   box with its selected face in brackets.
 
    Scripted (for tests): --frames N runs N frames and exits; --screenshot FILE saves the last
    one; --script FILE runs the commands in FILE, one a line: `orbit DEG_X DEG_Y`, `pan DX DY`,
@@ -50,6 +54,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "hd_crop.h"
 #include "hd_dicom.h"
 #include "hd_png.h"
 
@@ -74,6 +79,8 @@ typedef struct viewer {
     double t_title, frame_ms; /* frame_ms: smoothed wall time of frame() */
     int idle, idle_titled;    /* idle: light converged and the image final (hd_render is a no-op) */
     int shots;
+    int crop_face;            /* the face I moves: 2 * axis + (0 low, 1 high) */
+    float crop_min[3], crop_max[3]; /* the volume's default crop box (U toggles to it) */
 } viewer;
 
 static void die(const char *what, hd_result r)
@@ -242,6 +249,43 @@ static void apply_params(viewer *v)
     if (r != HD_SUCCESS) die("hd_set_params", r);
 }
 
+static void crop_applied(viewer *v)
+{
+    const float *a = v->params.crop_min, *b = v->params.crop_max;
+    apply_params(v);
+    fprintf(stderr, "hdview: crop box x %.2f-%.2f y %.2f-%.2f z %.2f-%.2f\n", (double)a[0], (double)b[0], (double)a[1],
+            (double)b[1], (double)a[2], (double)b[2]);
+}
+
+/* Moves the selected face of the crop box by step toward the box's inside (step < 0: out),
+   keeping 0 <= min < max <= 1 with at least 0.02 between the faces. */
+static void crop_move(viewer *v, float step)
+{
+    int axis = v->crop_face / 2, high = v->crop_face % 2;
+    float *lo = &v->params.crop_min[axis], *hi = &v->params.crop_max[axis];
+    if (high) {
+        *hi -= step;
+        if (*hi > 1.0f) *hi = 1.0f;
+        if (*hi < *lo + 0.02f) *hi = *lo + 0.02f;
+    } else {
+        *lo += step;
+        if (*lo < 0.0f) *lo = 0.0f;
+        if (*lo > *hi - 0.02f) *lo = *hi - 0.02f;
+    }
+    crop_applied(v);
+}
+
+/* U: the whole volume, or the volume's default crop box when the whole volume is shown. */
+static void crop_toggle(viewer *v)
+{
+    static const float whole_min[3] = {0.0f, 0.0f, 0.0f}, whole_max[3] = {1.0f, 1.0f, 1.0f};
+    int whole = memcmp(v->params.crop_min, whole_min, sizeof whole_min) == 0 &&
+                memcmp(v->params.crop_max, whole_max, sizeof whole_max) == 0;
+    memcpy(v->params.crop_min, whole ? v->crop_min : whole_min, sizeof whole_min);
+    memcpy(v->params.crop_max, whole ? v->crop_max : whole_max, sizeof whole_max);
+    crop_applied(v);
+}
+
 /* One key as typed: shift gives the capital. */
 static void key_char(viewer *v, int c)
 {
@@ -281,6 +325,11 @@ static void key_char(viewer *v, int c)
         if ((r = hd_set_params(v->ctx, &v->params)) == HD_ERROR_UNSUPPORTED) v->params.solver = HD_SOLVER_RED_BLACK;
         else if (r != HD_SUCCESS) die("hd_set_params", r);
         break;
+    case 'o': v->crop_face = (v->crop_face + 1) % 6; v->t_title = 0.0; break;
+    case 'O': v->crop_face = (v->crop_face + 5) % 6; v->t_title = 0.0; break;
+    case 'i': crop_move(v, 0.02f); break;
+    case 'I': crop_move(v, -0.02f); break;
+    case 'u': case 'U': crop_toggle(v); break;
     case 's': case 'S':
         snprintf(name, sizeof name, "hdview-%d.png", v->shots++);
         screenshot(v, name);
@@ -359,17 +408,21 @@ static void frame(viewer *v)
     if (hd_get_stats(v->ctx, &st) != HD_SUCCESS) return;
     v->idle = st.light_converged && st.frames >= (uint64_t)v->params.frame_window;
     if (t - v->t_title > 0.5 || v->idle != v->idle_titled) {
-        char title[320], light[96];
+        static const char *faces[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+        char title[448], light[96];
+        const float *c0 = v->params.crop_min, *c1 = v->params.crop_max;
         if (st.method == HD_METHOD_HD || st.method == HD_METHOD_CD)
             snprintf(light, sizeof light, "light %s (error %.3g, %llu it)",
                      st.light_converged ? "converged" : "refining", st.light_error,
                      (unsigned long long)st.iterations);
         else
             snprintf(light, sizeof light, "%llu paths/pixel", (unsigned long long)st.iterations);
-        snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f",
+        snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f"
+                 " | crop x %.2f-%.2f y %.2f-%.2f z %.2f-%.2f [%s]",
                  hd_method_name(st.method), light, v->frame_ms, v->idle ? " (idle: image final)" : "",
                  (double)st.method_bytes / 1048576.0, v->tf.name, v->light_count, v->light_count == 1 ? "" : "s",
-                 (double)v->params.extinction, (double)v->params.albedo);
+                 (double)v->params.extinction, (double)v->params.albedo, (double)c0[0], (double)c1[0], (double)c0[1],
+                 (double)c1[1], (double)c0[2], (double)c1[2], faces[v->crop_face]);
         glfwSetWindowTitle(v->win, title);
         v->t_title = t;
         v->idle_titled = v->idle;
@@ -486,7 +539,8 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc && sscanf(argv[i + 1], "%dx%d", &w, &h) == 2) ++i;
         else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
             printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE] [FILE|DIR]\n"
-                   "(DIR: a DICOM series; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n");
+                   "(DIR: a DICOM series; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n"
+                   "crop box: O / shift+O select a face, I / shift+I move it in / out, U whole volume / default box\n");
             return 0;
         } else if (argv[i][0] == '-') { fprintf(stderr, "hdview: unknown option %s (--help)\n", argv[i]); return 2; }
         else input = argv[i];
@@ -534,6 +588,10 @@ int main(int argc, char **argv)
     desc.camera = v.cam;
     desc.params.exposure = 8.0f;
     desc.params.seed = seed;
+    if (!hdx_known_crop(input, vol.desc.dims, &desc.params)) /* the whole volume, filled in for U */
+        desc.params.crop_max[0] = desc.params.crop_max[1] = desc.params.crop_max[2] = 1.0f;
+    memcpy(v.crop_min, desc.params.crop_min, sizeof v.crop_min);
+    memcpy(v.crop_max, desc.params.crop_max, sizeof v.crop_max);
     desc.logger = logger;
     desc.gl.use_current_context = 1;
     desc.gl.get_proc_address = glfwGetProcAddress;

@@ -45,9 +45,10 @@ hdview: $(B)/hdview
 $(B)/pngcmp: tests/gl/pngcmp.c | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ -lm
 
-# hdview under Xvfb: camera moves, then a restart at the default camera and 4 frames; the
-# screenshot must not be blank and must match hdrender on the CPU backend, same scene, seed and
-# iterations (tests/gl/pngcmp.c: within 1/255 per channel, and why). 256x256 on the head CT.
+# hdview under Xvfb: camera moves and the crop box keys (the x+ face moved in, logged, then the
+# default box back), then a restart at the default camera and 4 frames; the screenshot must not
+# be blank and must match hdrender on the CPU backend, same scene, seed and iterations
+# (tests/gl/pngcmp.c: within 1/255 per channel, and why). 256x256 on the head CT.
 # `data` first: make test (and so CI) fetches the head CT, so this test runs rather than skips.
 test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	@if [ ! -f data/head.nrrd ]; then echo "test-hdview SKIPPED: no data/head.nrrd (make data)"; exit 0; fi; \
@@ -55,6 +56,8 @@ test-hdview: $(B)/hdview $(B)/hdrender $(B)/pngcmp data
 	{ xvfb-run -a -s "-screen 0 640x480x24" $(B)/hdview --size 256x256 --script tests/gl/hdview.script data/head.nrrd \
 	      2> $(B)/gl/hdview.log || { cat $(B)/gl/hdview.log; echo "test-hdview: hdview failed"; exit 1; }; } && \
 	grep -v " info: " $(B)/gl/hdview.log; \
+	{ grep -q "^hdview: crop box x 0.11-0.87 y 0.17-1.00 z 0.00-1.00" $(B)/gl/hdview.log || \
+	  { echo "test-hdview: the crop box keys did not move the x+ face"; exit 1; }; } && \
 	$(B)/hdrender --quiet --size 256x256 --iterations 4 -o $(B)/gl/hdrender-cpu.png data/head.nrrd && \
 	$(B)/pngcmp --nonblank $(B)/gl/hdview-moved.png && \
 	$(B)/pngcmp --nonblank $(B)/gl/hdview.png && \

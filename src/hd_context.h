@@ -154,14 +154,35 @@ static float hd__range_majorant(const hd__ctx *ctx, float lo, float hi)
     return m > 0.0f ? m * ctx->params.extinction * (1.0f + 1e-5f) + 1e-30f : 0.0f;
 }
 
+/* Whether the texture-coordinate interval [a, b] along axis d meets the crop box, widened by
+   eps voxels for the kernels' rounding of a sample's coordinates. */
+static int hd__crop_meets(const hd__ctx *ctx, int d, double a, double b, double eps)
+{
+    double e = eps / (double)ctx->dims[d];
+    return b + e >= (double)ctx->params.crop_min[d] && a - e <= (double)ctx->params.crop_max[d];
+}
+
+#define HD__CROP_CELL_EPS 0.25 /* voxels: a sample the DDA places in a cell may lie this far out */
+
+/* The majorant per cell; 0 in a cell outside the crop box, which holds no medium, so tracking
+   and the projection skip it. max_sigma stays that of the whole volume, so the limits on a
+   global majorant do not move with the crop box. */
 static void hd__build_majorants(hd__ctx *ctx)
 {
-    size_t i, ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    int cx, cy, cz, c = HD__MAJORANT_CELL;
+    size_t i;
     ctx->max_sigma = 0.0f;
-    for (i = 0; i < ncell; ++i) {
-        ctx->majorant[i] = hd__range_majorant(ctx, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]);
-        if (ctx->majorant[i] > ctx->max_sigma) ctx->max_sigma = ctx->majorant[i];
-    }
+    for (cz = 0, i = 0; cz < ctx->mdims[2]; ++cz)
+        for (cy = 0; cy < ctx->mdims[1]; ++cy)
+            for (cx = 0; cx < ctx->mdims[0]; ++cx, ++i) {
+                float m = hd__range_majorant(ctx, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]);
+                if (m > ctx->max_sigma) ctx->max_sigma = m;
+                if (!hd__crop_meets(ctx, 0, (double)(cx * c) / ctx->dims[0], (double)((cx + 1) * c) / ctx->dims[0], HD__CROP_CELL_EPS) ||
+                    !hd__crop_meets(ctx, 1, (double)(cy * c) / ctx->dims[1], (double)((cy + 1) * c) / ctx->dims[1], HD__CROP_CELL_EPS) ||
+                    !hd__crop_meets(ctx, 2, (double)(cz * c) / ctx->dims[2], (double)((cz + 1) * c) / ctx->dims[2], HD__CROP_CELL_EPS))
+                    m = 0.0f;
+                ctx->majorant[i] = m;
+            }
 }
 
 /* ---- inputs --------------------------------------------------------------------------------- */
@@ -309,6 +330,13 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->background.y = ctx->params.background[1];
     k->background.z = ctx->params.background[2];
     k->chan_color.x = ctx->chan_color[0]; k->chan_color.y = ctx->chan_color[1]; k->chan_color.z = ctx->chan_color[2];
+    /* the crop box is on when it cuts an axis; an axis it spans whole gets bounds no sample
+       reaches, so samples at the volume's faces stay as without a crop box */
+    for (i = 0; i < 3; ++i) {
+        (&k->crop_lo.x)[i] = ctx->params.crop_min[i] > 0.0f ? ctx->params.crop_min[i] : -1.0f;
+        (&k->crop_hi.x)[i] = ctx->params.crop_max[i] < 1.0f ? ctx->params.crop_max[i] : 2.0f;
+        if (ctx->params.crop_min[i] > 0.0f || ctx->params.crop_max[i] < 1.0f) k->crop_lo.w = 1.0f;
+    }
     for (i = 0; i < ctx->light_count; ++i) {
         const hd_light *l = &ctx->lights[i];
         hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];
@@ -496,7 +524,8 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
     if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
     o = &ctx->params;
     if (p.method != o->method) ctx->dirty |= HD__DIRTY_ALL;
-    if (p.extinction != o->extinction || p.majorant != o->majorant)
+    if (p.extinction != o->extinction || p.majorant != o->majorant ||
+        memcmp(p.crop_min, o->crop_min, sizeof p.crop_min) != 0 || memcmp(p.crop_max, o->crop_max, sizeof p.crop_max) != 0)
         ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     if (p.seed != o->seed) ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     if (p.albedo != o->albedo || p.anisotropy != o->anisotropy || p.disable_diffusion != o->disable_diffusion ||
@@ -535,7 +564,8 @@ static size_t hd__illum_floats(const hd__ctx *ctx)
    level of the volume's dual cells (the 8 voxels a trilinear sample interpolates): a cell is
    empty when its 8 values lie in one run of TF entries whose alpha is 0, widened by
    HD__DL_VALUE_EPS for the kernels' rounding of the interpolation, or when they are 8 equal
-   values (interpolated exactly) where alpha is 0; a grid voxel is tracked when
+   values (interpolated exactly) where alpha is 0, or when no sample it holds lies in the crop
+   box (with HD__DL_COORD_EPS); a grid voxel is tracked when
    an interpolation that reads it (weight 0 included) can sample a non-empty cell. */
 #define HD__DL_VALUE_EPS 1e-5f
 #define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
@@ -583,14 +613,14 @@ static void hd__direct_mask_free(hd__ctx *ctx)
     ctx->dl_count = 0;
 }
 
-/* Builds dl_bits and dl_idx for the current TF, extinction and grid. */
+/* Builds dl_bits and dl_idx for the current TF, extinction, crop box and grid. */
 static hd_result hd__direct_mask(hd__ctx *ctx)
 {
     const int *n = ctx->dims, *g = ctx->gdims;
     int dn[3], d, x, y, z, j;
     size_t gvox = (size_t)g[0] * g[1] * g[2], ndual, i, k;
     int32_t *entry_run = NULL, *run = NULL;
-    uint8_t *cell = NULL, *ax = NULL, *ay = NULL;
+    uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL;
     int (*span)[2] = NULL;
     hd_result r = HD_SUCCESS;
     hd__direct_mask_free(ctx);
@@ -603,7 +633,8 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
     ax = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * dn[1] * dn[2]);
     ay = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * g[1] * dn[2]);
     span = (int (*)[2])hd__alloc(ctx, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
-    if (!ctx->dl_bits || !entry_run || !run || !cell || !ax || !ay || !span) {
+    crop = (uint8_t *)hd__alloc(ctx, (size_t)(dn[0] + dn[1] + dn[2]));
+    if (!ctx->dl_bits || !entry_run || !run || !cell || !ax || !ay || !span || !crop) {
         r = HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
         goto done;
     }
@@ -614,6 +645,12 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
         entry_run[j] = zero ? (int32_t)k : 0;
     }
     for (i = 0; i < ctx->nvox; ++i) run[i] = hd__dl_run(entry_run, ctx->tf_count, ctx->vol[i]);
+    /* dual cells per axis that meet the crop box: cell j holds the samples at u n - 0.5 in
+       [j, j + 1], the first and last also those the clamp folds onto them */
+    for (d = 0, k = 0; d < 3; ++d)
+        for (j = 0; j < dn[d]; ++j, ++k)
+            crop[k] = (uint8_t)hd__crop_meets(ctx, d, j == 0 ? -1.0 : ((double)j + 0.5) / n[d],
+                                              j == dn[d] - 1 ? 2.0 : ((double)j + 1.5) / n[d], HD__DL_COORD_EPS);
     /* a dual cell is empty when its 8 voxels share one zero run */
     for (z = 0, k = 0; z < dn[2]; ++z)
         for (y = 0; y < dn[1]; ++y)
@@ -631,6 +668,7 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
                     vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
                     !(hd__tf_alpha(ctx, v) * ctx->params.extinction > 0.0f))
                     cell[k] = 0;
+                if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) cell[k] = 0;
             }
     /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
     for (d = 0, k = 0; d < 3; ++d)
@@ -677,6 +715,7 @@ done:
     hd__free(ctx, ax);
     hd__free(ctx, ay);
     hd__free(ctx, span);
+    hd__free(ctx, crop);
     if (r != HD_SUCCESS) hd__direct_mask_free(ctx);
     ctx->dl_gen++;
     return r;

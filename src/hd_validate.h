@@ -174,6 +174,26 @@ static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
     return HD_SUCCESS;
 }
 
+/* The crop box: a zero high corner is the volume's high face, per axis. */
+static void hd__crop_defaults(hd_params *p)
+{
+    int i;
+    for (i = 0; i < 3; ++i)
+        if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
+}
+
+static hd_result hd__check_crop(const hd_params *p, const hd_logger *log)
+{
+    int i;
+    for (i = 0; i < 3; ++i)
+        if (!hd__finite(p->crop_min[i]) || !hd__finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
+            !(p->crop_max[i] <= 1.0f) || !(p->crop_min[i] < p->crop_max[i]))
+            return HD__ERR(log, HD_ERROR_INVALID_PARAMETER,
+                           "params.crop_min[%d] = %g, crop_max[%d] = %g: need 0 <= min < max <= 1", i,
+                           (double)p->crop_min[i], i, (double)p->crop_max[i]);
+    return HD_SUCCESS;
+}
+
 static void hd__params_defaults(hd_params *p)
 {
     if (p->method == HD_METHOD_DEFAULT) p->method = HD_METHOD_HD;
@@ -189,6 +209,7 @@ static void hd__params_defaults(hd_params *p)
     if (p->illumination_downsample == 0) p->illumination_downsample = 2;
     if (p->diffusion_boundary == HD_BOUNDARY_DEFAULT) p->diffusion_boundary = HD_BOUNDARY_SURFACE;
     if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
+    hd__crop_defaults(p);
 }
 
 /* The defaults above were chosen by measurement against PT_MS (docs/EVALUATION.md, "Defaults");
@@ -260,5 +281,5 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
     /* the multigrid levels (src/hd_multigrid.h) restrict and prolong float32 fine grids */
     if (p->illumination_precision == HD_PRECISION_FLOAT16 && p->solver == HD_SOLVER_MULTIGRID)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 with solver MULTIGRID is not available (float32 levels only)");
-    return HD_SUCCESS;
+    return hd__check_crop(p, log);
 }

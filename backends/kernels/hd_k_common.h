@@ -110,9 +110,19 @@ HD_FN hd_v4 hd_tf(HD_KARGS float v)
                  HD_GET1(tf, a + 3) + f * (HD_GET1(tf, b + 3) - HD_GET1(tf, a + 3)));
 }
 
-/* Extinction at a texture coordinate. */
+/* 1 inside the crop box (params.crop_min/max), 0 outside, where matter is absent; crop_lo.w = 0
+   (a zeroed parameter block) is no crop box. */
+HD_FN int hd_in_crop(HD_KARGS hd_v3 u)
+{
+    if (HD_PRM(crop_lo).w == 0.0f) return 1;
+    return (u.x >= HD_PRM(crop_lo).x && u.x <= HD_PRM(crop_hi).x && u.y >= HD_PRM(crop_lo).y &&
+            u.y <= HD_PRM(crop_hi).y && u.z >= HD_PRM(crop_lo).z && u.z <= HD_PRM(crop_hi).z) ? 1 : 0;
+}
+
+/* Extinction at a texture coordinate: 0 outside the crop box. */
 HD_FN float hd_sigma_t(HD_KARGS hd_v3 u)
 {
+    if (hd_in_crop(HD_KPASS u) == 0) return 0.0f;
     return hd_tf(HD_KPASS hd_sample_value(HD_KPASS u)).w * HD_PRM(medium).x;
 }
 

@@ -94,6 +94,7 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
     hd_v4 c;    /* rgb: the emission's colour weights */
     float e;    /* the emission's scale: transmittance so far (and opacity, albedo / (4 pi)) */
     float keep; /* the share of T the step keeps */
+    if (hd_in_crop(HD_KPASS u) == 0) return; /* no medium outside the crop box */
 #ifdef HD_PRELUDE_PROJECT_TABLE
     if (HD_PROJECT_TABLE_READY) {
         c = hd_project_lookup(HD_KPASS hd_sample_value(HD_KPASS u));

@@ -10,7 +10,7 @@
    Output: one line per case with its errors, then "N passed, N failed". A backend whose runtime
    or device is missing is reported SKIPPED with the reason (exit 0, or 1 when the environment
    sets HD_CONFORMANCE_REQUIRE=1, as CI does). `conformance-opencl --quick`: one case per stage
-   (what `make valgrind-opencl` runs). */
+   (what `make valgrind-opencl` runs); `--crop`: the crop box cases only. */
 #include "hd_api.h"
 #include <math.h>
 #include <stdio.h>
@@ -597,6 +597,52 @@ static void case_render(hd_method method, hd_voxel_type type, const int *d, int 
     scene_free(&s);
 }
 
+/* A crop box (params.crop_min/max) through the blob and its shell, set at create or by
+   hd_set_params halfway through the run; whole iterations of the method. CD is deterministic,
+   the others stochastic (E, phi and the image; the path tracers the image). */
+static void case_crop(hd_method method, hd_voxel_type type, const int *d, int lights, int halfway, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    int det = method == HD_METHOD_CD, pt = method == HD_METHOD_PT_SS || method == HD_METHOD_PT_MS;
+    static const float lo[3] = {0.2f, 0.35f, 0.0f}, hi[3] = {0.85f, 0.0f, 0.6f};
+    hd_params cropped;
+    scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
+    s.params.method = method;
+    cropped = s.params;
+    memcpy(cropped.crop_min, lo, sizeof lo);
+    memcpy(cropped.crop_max, hi, sizeof hi);
+    if (!halfway) s.params = cropped;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s x%d %s %dx%dx%d %dL crop box%s", hd_api_cpu.method_name(method), n, type_name(type),
+             d[0], d[1], d[2], lights, halfway ? " set halfway" : "");
+    if (pair_create(&p, &s)) {
+        if (halfway) {
+            hd_params before = cropped;
+            BOTH(&p, iterate, (p.ref, n / 2), (p.dut, n / 2));
+            BOTH(&p, set_params, (p.ref, &cropped), (p.dut, &cropped));
+            if (memcmp(&before, &cropped, sizeof cropped) != 0) pair_fail(&p, "set_params changed its input", HD_SUCCESS);
+        }
+        BOTH(&p, iterate, (p.ref, n - n / 2), (p.dut, n - n / 2));
+        pair_compare(&p, pt ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, det);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
+static void crop_cases(const int *odd, const int *other)
+{
+    case_crop(HD_METHOD_HD, HD_VOXEL_U8, odd, 3, 0, 8);
+    case_crop(HD_METHOD_HD, HD_VOXEL_F32, other, 1, 1, 8);
+    case_crop(HD_METHOD_CD, HD_VOXEL_U16, other, 1, 0, 8);
+    case_crop(HD_METHOD_PT_MS, HD_VOXEL_U8, odd, 3, 0, 8);
+}
+
 /* ---- main ----------------------------------------------------------------------------------- */
 /* Creates one backend context: if the runtime or a device is missing, the backend is skipped. */
 /* A volume that is mostly empty: a thin spherical shell and a small off-centre blob in air
@@ -724,17 +770,21 @@ int main(int argc, char **argv)
 {
     static const int odd[3] = {37, 53, 29}, other[3] = {24, 17, 33};
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
-    int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0;
+    int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available()) {
         const char *req = getenv("HD_CONFORMANCE_REQUIRE");
         printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed)\n", hd_api_backend.backend_name());
         return req && req[0] == '1' ? 1 : 0;
     }
-    if (quick) { /* one case per stage, for valgrind */
-        case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
-        case_project(HD_VOXEL_U16, odd, 1, 1);
-        case_iterate(HD_VOXEL_F32, other, 3, 1, 1, CHANGE_CAMERA, 2);
+    if (quick || crop) { /* quick: one case per stage, for valgrind; crop: the crop box cases */
+        if (quick) {
+            case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
+            case_project(HD_VOXEL_U16, odd, 1, 1);
+            case_iterate(HD_VOXEL_F32, other, 3, 1, 1, CHANGE_CAMERA, 2);
+        } else {
+            crop_cases(odd, other);
+        }
         printf("%d passed, %d failed\n", n_passed, n_failed);
         return n_failed == 0 ? 0 : 1;
     }
@@ -778,6 +828,7 @@ int main(int argc, char **argv)
     case_method(HD_METHOD_PT_SS, HD_VOXEL_F32, other, 3, 1, 1, 8);
     case_method(HD_METHOD_PT_MS, HD_VOXEL_U16, odd, 3, 0, 1, 8);
     case_method(HD_METHOD_PT_MS, HD_VOXEL_U8, other, 16, 1, 1, 8);
+    crop_cases(odd, other);
     /* the per-frame API */
     case_render(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 6);
     case_render(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 6);
