@@ -981,8 +981,8 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
     hd__free(ctx, be->ptab_host);
     be->ptab_host = NULL;
     be->ptab_n = 0;
-    if ((r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table")) !=
-        HD_SUCCESS) {
+    r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");
+    if (r != HD_SUCCESS) {
         hd__free(ctx, t);
         return r;
     }

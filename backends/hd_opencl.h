@@ -49,7 +49,8 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_direct_half", "hd_k_diffuse_half", "hd_k_diffuse_rgb_half", "hd_k_diffuse_surface_half",
     "hd_k_diffuse_surface_rgb_half", "hd_k_diffuse_jacobi_half", "hd_k_diffuse_jacobi_rgb_half",
     "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
-    "hd_k_sum_light_half", "hd_k_light_sum", "hd_k_light_sum_half", "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
+    "hd_k_sum_light_half", "hd_k_light_sum", "hd_k_light_sum_half",
+    "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
     "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict_line", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
     "hd_k_mg_extrap"};
@@ -645,7 +646,8 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
         be->lsum_ok = 1;
     }
     t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
-    if (!t) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the projection's TF table (%d entries)", n);
+    if (!t)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the projection's TF table (%d entries)", n);
     hd__project_table(ctx, t, n);
     if (n != be->ptab_n || memcmp(t, be->ptab_host, (size_t)n * 4 * sizeof(float)) != 0) {
         hd__cl_release(&be->ptab);

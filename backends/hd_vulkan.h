@@ -1536,7 +1536,8 @@ static hd_result hd__be_project(hd__ctx *ctx)
     hd_result r;
     HD__VK_LOST_CHECK(ctx);
     if (!be->ptab.map || be->ptab_cap != n)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)", n);
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
+                       n);
     if (!(t = (float *)hd__alloc(ctx, bytes)))
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the projection's TF table (%d entries)", n);
     hd__project_table(ctx, t, n);
@@ -1552,8 +1553,8 @@ static hd_result hd__be_project(hd__ctx *ctx)
         (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)
         return r;
     if (!be->lsum_ok) {
-        if ((r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0)) != HD_SUCCESS)
-            return r;
+        r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0);
+        if (r != HD_SUCCESS) return r;
         be->lsum_ok = 1;
     }
     if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
