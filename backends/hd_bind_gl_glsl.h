@@ -6,9 +6,10 @@
    at z + c * dz); the small 1D arrays (TF, majorant grid, image accumulation) are storage buffers.
    GL keeps separate binding points per kind, numbered within GL 4.3's minimums (8 image units,
    8 storage buffers): uniform block 0 the parameter block (hd_prelude_glsl.h); image units
-   0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written; storage
-   buffers 0 TF, 1 majorants, 2 image accumulation, 4 the direct light's list of voxels
-   (hd_context.h, hd__direct_mask; hd_pc.x its length in the direct stage). GL has no push
+   0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written, 7 the
+   projection's E + phi (always r32f); storage buffers 0 TF, 1 majorants, 2 image accumulation,
+   4 the direct light's list of voxels (hd_context.h, hd__direct_mask; hd_pc.x its length in the
+   direct stage), 5 the projection's TF table (hd_pc.x its entries in the projection stage). GL has no push
    constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
    uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision
    FLOAT16): E, phi and phi2 are r16f (GL_R16F textures, core in GL 4.3), converted by imageLoad /
@@ -32,13 +33,24 @@ layout(std430, binding = 2) buffer hd_b_img { float img[]; };
 layout(std430, binding = 4) readonly buffer hd_b_dl { uint dl[]; };
 layout(binding = 5, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 6, r32f) uniform image3D hd_i_lv2;
+layout(binding = 7, r32f) uniform image3D hd_i_lsum;
+layout(std430, binding = 5) readonly buffer hd_b_ptab { float ptab[]; };
 layout(location = 0) uniform ivec4 hd_pc;
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4(HD_STV_##buf(v), 0.0f, 0.0f, 0.0f))
 #define HD_STV_sig(v) (v)
 #define HD_STV_lv2(v) (v)
+#define HD_STV_lsum(v) (v)
 #define HD_STV_E(v) HD_ILLUM_ROUND(v)
 #define HD_STV_phi(v) HD_ILLUM_ROUND(v)
 #define HD_STV_phi2(v) HD_ILLUM_ROUND(v)
+/* The projection reads the summed light grid (hd_i_lsum, written by the light-sum stage) and the
+   step's TF table (ptab, hd_pc.x entries in the projection stage); the backend keeps both up to
+   date before every projection. */
+#define HD_PRELUDE_LIGHT_SUM 1
+#define HD_LIGHT_SUM_READY true
+#define HD_PRELUDE_PROJECT_TABLE 1
+#define HD_PROJECT_TABLE_READY true
+#define HD_PTAB_N hd_pc.x
 #define HD_GET1(buf, i) buf[(i)]
 #define HD_SET1(buf, i, v) buf[(i)] = (v)

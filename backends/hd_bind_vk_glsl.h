@@ -23,7 +23,8 @@
    compiled with HD_MG_STAGE = n and HD_STAGE 0); its passes' flags, like the diffusion stage's,
    are hd_sc_flags, and their beta / alpha come in the push constants (HD_MG_PUSH_SCALARS).
    Binding 12: the direct light's list of voxels (hd_context.h, hd__direct_mask); the direct
-   stage's push constant x is its length. */
+   stage's push constant x is its length. Binding 13: the projection's TF table (the projection
+   stage's push constant x is its entries); 14: the projection's E + phi, r32f at any precision. */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 #extension GL_EXT_control_flow_attributes : require
 #define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
@@ -45,6 +46,8 @@ layout(std430, binding = 8) buffer hd_b_img { float img[]; };
 layout(binding = 9, r32f) uniform readonly image3D hd_i_lv;
 layout(binding = 10, r32f) uniform image3D hd_i_lv2;
 layout(std430, binding = 12) readonly buffer hd_b_dl { uint dl[]; };
+layout(std430, binding = 13) readonly buffer hd_b_ptab { float ptab[]; };
+layout(binding = 14, r32f) uniform image3D hd_i_lsum;
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;
@@ -61,8 +64,17 @@ layout(constant_id = 3) const int hd_sc_yk = 1;
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4(HD_STV_##buf(v), 0.0f, 0.0f, 0.0f))
 #define HD_STV_sig(v) (v)
 #define HD_STV_lv2(v) (v)
+#define HD_STV_lsum(v) (v)
 #define HD_STV_E(v) HD_ILLUM_ROUND(v)
 #define HD_STV_phi(v) HD_ILLUM_ROUND(v)
 #define HD_STV_phi2(v) HD_ILLUM_ROUND(v)
+/* The projection reads the summed light grid (hd_i_lsum, written by the light-sum stage) and the
+   step's TF table (ptab, hd_pc.x entries in the projection stage); the backend keeps both up to
+   date before every projection. */
+#define HD_PRELUDE_LIGHT_SUM 1
+#define HD_LIGHT_SUM_READY true
+#define HD_PRELUDE_PROJECT_TABLE 1
+#define HD_PROJECT_TABLE_READY true
+#define HD_PTAB_N hd_pc.x
 #define HD_GET1(buf, i) buf[(i)]
 #define HD_SET1(buf, i, v) buf[(i)] = (v)

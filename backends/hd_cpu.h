@@ -969,28 +969,19 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { return hd__be_diffus
 /* One row (channel c, z, y: r = (c * gz + z) * gy + y) of lsum = E + phi, x-fastest. */
 static void hd__cpu_lsum_row(hd__backend *be, int r)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], y = r % gy, zz = r / gy, x;
-    float *dst = be->lsum + (size_t)r * (size_t)gx;
-    const float *E = be->E, *phi = be->phi;
-    const uint16_t *Eh = be->Eh, *phih = be->phih;
-    for (x = 0; x < gx; ++x) {
-        size_t s = hd__split_slot(gx, gy, x, y, zz);
-        dst[x] = Eh ? hd_h2f(Eh[s]) + hd_h2f(phih[s]) : E[s] + phi[s];
-    }
+    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    hd__kctx k = be->k;
+    k.lsum = be->lsum;
+    for (x = 0; x < gx; ++x) hd_light_sum_voxel(&k, x, r % gy, r / gy);
 }
 
 /* The projection's inputs: lsum (after any pass that changed E or phi) and the TF table for the
-   current TF, step and medium (entries as hd_project_lookup reads them; n - 1 a multiple of the
-   TF's segments, at least HD__CPU_PTAB_MIN of them). Without room for either the projection
-   reads E, phi and the TF directly, as the GPU backends do. */
-#define HD__CPU_PTAB_MIN 4096
+   current TF, step and medium (hd__project_table). Without room for either the projection reads
+   E, phi and the TF directly. */
 static void hd__cpu_project_prepare(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    const hd__kctx *K = &be->k;
-    int segs = ctx->tf_count - 1, m = segs < HD__CPU_PTAB_MIN ? (HD__CPU_PTAB_MIN + segs - 1) / segs : 1;
-    int n = segs * m + 1, j;
-    float dt = ctx->kp.march.x, k = ctx->kp.medium.y * ctx->kp.box.w;
+    int n = hd__project_table_n(ctx);
     size_t rows = (size_t)ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
     if (!be->lsum && (be->E || be->Eh))
         be->lsum = (float *)hd__alloc(ctx, rows * (size_t)ctx->gdims[0] * sizeof(float));
@@ -1003,14 +994,7 @@ static void hd__cpu_project_prepare(hd__ctx *ctx)
         be->ptab = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
         be->ptab_cap = be->ptab ? n : 0;
     }
-    for (j = 0; be->ptab && j < n; ++j) {
-        hd_v4 c = hd_tf(K, (float)j / (float)(n - 1));
-        float a = 1.0f - hd_exp(-(c.w * ctx->kp.medium.x) * dt);
-        be->ptab[j * 4] = c.x * a * k;
-        be->ptab[j * 4 + 1] = c.y * a * k;
-        be->ptab[j * 4 + 2] = c.z * a * k;
-        be->ptab[j * 4 + 3] = a;
-    }
+    if (be->ptab) hd__project_table(ctx, be->ptab, n);
     be->ptab_n = n;
 }
 

@@ -9,7 +9,7 @@
     __global float *restrict img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
+    k.phi2 = phi2; k.img = img; k.lsum = 0; k.ptab = 0; k.ptab_n = 0; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
     k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0; \
     k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
@@ -84,16 +84,30 @@ HD__CL_DIRECT(hd_k_direct_half, 1)
 HD__CL_DIFFUSE_SET(, 0)
 HD__CL_DIFFUSE_SET(_half, 1)
 
-/* One work-item per pixel (x, y). */
+/* One work-item per pixel (x, y); lsum and the table (ptab_n entries) as hd_k_project.h reads
+   them. */
 #define HD__CL_PROJECT(name, is16) \
-    __kernel void name(HD__CL_BUFFERS) \
+    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n) \
     { \
         HD__CL_KCTX; \
         k.f16 = (is16); \
+        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
         hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
     }
 HD__CL_PROJECT(hd_k_project, 0)
 HD__CL_PROJECT(hd_k_project_half, 1)
+
+/* lsum = E + phi: one work-item per voxel, global size = illumination grid (x, y, z * channels). */
+#define HD__CL_LIGHT_SUM(name, is16) \
+    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum) \
+    { \
+        HD__CL_KCTX; \
+        k.f16 = (is16); \
+        k.lsum = lsum; \
+        hd_light_sum_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); \
+    }
+HD__CL_LIGHT_SUM(hd_k_light_sum, 0)
+HD__CL_LIGHT_SUM(hd_k_light_sum_half, 1)
 
 /* CD: one upwind convection step of light l, reading lv and writing lv2; one work-item per
    voxel (global size = illumination grid). */

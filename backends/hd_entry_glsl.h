@@ -9,6 +9,7 @@
 #define HD_STAGE_CONVECT 5
 #define HD_STAGE_SUM_LIGHT 6
 #define HD_STAGE_PATH 7
+#define HD_STAGE_LIGHT_SUM 8
 #ifndef HD_DIFFUSE_ZK
 #define HD_DIFFUSE_ZK 1 /* slices per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
 #endif
@@ -145,6 +146,9 @@ void main()
     if (x < g.x && y < g.y && z < g.z) hd_sum_light_voxel(x, y, z, hd_pc.z, hd_pc.w);
 #elif HD_STAGE == HD_STAGE_PATH
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) hd_path_pixel(x, y);
+#elif HD_STAGE == HD_STAGE_LIGHT_SUM
+    /* z over the channels' slices (z + c * gz) */
+    if (x < g.x && y < g.y && z < g.z * g.w) hd_light_sum_voxel(x, y, z);
 #else
 #error "hd_entry_glsl.h: define HD_STAGE"
 #endif

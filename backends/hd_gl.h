@@ -89,9 +89,9 @@ typedef struct hd__gl_fns {
 } hd__gl_fns;
 
 enum { HD__GL_CLASSIFY, HD__GL_DIRECT, HD__GL_DIFFUSE, HD__GL_PROJECT, HD__GL_CONVECT, HD__GL_SUM_LIGHT,
-       HD__GL_PATH, HD__GL_TO_TEXTURE, HD__GL_PROGRAM_COUNT };
+       HD__GL_PATH, HD__GL_LIGHT_SUM, HD__GL_TO_TEXTURE, HD__GL_PROGRAM_COUNT };
 static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
-    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "render_to_texture"};
+    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "light_sum", "render_to_texture"};
 /* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
    surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
@@ -104,7 +104,8 @@ static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
 #define HD__GL_SLOTS (2 * HD__GL_SLOTS_F32)
 static int hd__gl_touches_illum(int stage)
 {
-    return stage == HD__GL_DIRECT || stage == HD__GL_DIFFUSE || stage == HD__GL_PROJECT || stage == HD__GL_SUM_LIGHT;
+    return stage == HD__GL_DIRECT || stage == HD__GL_DIFFUSE || stage == HD__GL_PROJECT || stage == HD__GL_SUM_LIGHT ||
+           stage == HD__GL_LIGHT_SUM;
 }
 static int hd__gl_diffuse_flags(int variant)
 {
@@ -122,8 +123,9 @@ static int hd__gl_diffuse_slot(int counts_z)
    block loads the texels its voxels share once (docs/DESIGN-GL.md). */
 #define HD__GL_DIFFUSE_ZK 4
 #define HD__GL_DIFFUSE_YK 2
-#define HD__GL_IMAGE_UNITS 7 /* hd_bind_gl_glsl.h: image units 0..6 */
-#define HD__GL_SSBOS 5       /* storage buffers 0..4 (3: multigrid's row sums, 4: the direct light's list) */
+#define HD__GL_IMAGE_UNITS 8 /* hd_bind_gl_glsl.h: image units 0..7, GL 4.3's minimum */
+#define HD__GL_SSBOS 6       /* storage buffers 0..5 (3: multigrid's row sums, 4: the direct light's list,
+                                5: the projection's TF table) */
 
 /* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..9), each in the
    4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
@@ -175,6 +177,13 @@ struct hd__backend {
     int f16;                    /* E, phi, phi2 are GL_R16F (params.illumination_precision) */
     hd__gl_tex *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
+    /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
+       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (storage
+       buffer 5), uploaded when its host copy ptab_host (ptab_n entries) changes */
+    hd__gl_tex lsum;
+    GLuint ptab;
+    int lsum_ok, ptab_n;
+    float *ptab_host;
     size_t illum_floats, img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
@@ -589,6 +598,7 @@ static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const h
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->maj ? be->maj : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, be->dl ? be->dl : be->dummy_buffer);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, be->ptab ? be->ptab : be->dummy_buffer);
     for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
         hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
@@ -610,6 +620,7 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     b.img[0] = &be->vol; b.img[1] = &be->sig; b.img[2] = &be->E; b.img[3] = &be->phi; b.img[4] = &be->phi2;
     b.img[5] = be->lv && light < be->nlv ? &be->lv[light] : NULL;
     b.img[6] = be->lv ? &be->lv[be->nlv] : NULL;
+    b.img[7] = &be->lsum;
     b.half = half;
     return hd__gl_run(ctx, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
 }
@@ -731,7 +742,8 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_mg_free(ctx);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
-        hd__gl_free_buffer(be, &be->dl);
+        hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab);
+        hd__gl_free_tex(be, &be->lsum);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
         hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2); hd__gl_free_tex(be, &be->dummy);
         hd__gl_free_tex(be, &be->dummy16);
@@ -739,6 +751,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_leave(ctx, HD_SUCCESS);
     }
     hd__gl_mg_free_host(ctx); /* left when GL was unreachable */
+    hd__free(ctx, be->ptab_host);
     hd__free(ctx, be->lv);
     if (be->own && be->egl) {
         if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
@@ -838,12 +851,15 @@ static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
     hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
     hd__gl_mg_free(ctx); /* its fine grid is this one */
+    hd__gl_free_tex(be, &be->lsum);
+    be->lsum_ok = 0;
     be->illum_floats = 0;
     be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     if (illum_floats == 0) return HD_SUCCESS;
     if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, NULL, "sigma_t")) != HD_SUCCESS) return r;
     if ((r = hd__gl_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
     if ((r = hd__gl_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(ctx, &be->lsum, g[0], g[1], g[2] * ctx->channels, NULL, "the summed light")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
     return HD_SUCCESS;
 }
@@ -884,6 +900,7 @@ static hd_result hd__gl_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r;
+    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
     if ((what & HD__DIRTY_DIRECT) && (r = hd__gl_tex_zero(ctx, &be->E)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi2)) != HD_SUCCESS) return r;
@@ -914,6 +931,7 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    ctx->be->lsum_ok = 0;
     HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0));
 }
 
@@ -927,6 +945,7 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
        (uniform hd_pc.z, hd_entry_glsl.h) */
     int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int nz = nzb * ctx->channels, parity;
+    be->lsum_ok = 0;
     if (jacobi) {
         hd__gl_tex t;
         if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
@@ -940,10 +959,46 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
 }
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { HD__GL_STAGE(ctx, hd__gl_diffuse(ctx, jacobi)); }
 
-static hd_result hd__be_project(hd__ctx *ctx)
+/* The projection's inputs: lsum rebuilt (the light-sum stage) after a pass that changed E or phi,
+   and the TF table (hd__project_table) uploaded when it differs from the one in the buffer. */
+static hd_result hd__gl_project_prepare(hd__ctx *ctx)
 {
-    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0));
+    hd__backend *be = ctx->be;
+    int n = hd__project_table_n(ctx);
+    float *t;
+    hd_result r;
+    if (!be->lsum_ok) {
+        if ((r = hd__gl_dispatch(ctx, HD__GL_LIGHT_SUM, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0,
+                                 0, 0)) != HD_SUCCESS)
+            return r;
+        be->lsum_ok = 1;
+    }
+    t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
+    if (!t) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the projection's TF table (%d entries)", n);
+    hd__project_table(ctx, t, n);
+    if (n == be->ptab_n && memcmp(t, be->ptab_host, (size_t)n * 4 * sizeof(float)) == 0) {
+        hd__free(ctx, t);
+        return HD_SUCCESS;
+    }
+    hd__free(ctx, be->ptab_host);
+    be->ptab_host = NULL;
+    be->ptab_n = 0;
+    r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");
+    if (r != HD_SUCCESS) {
+        hd__free(ctx, t);
+        return r;
+    }
+    be->ptab_host = t;
+    be->ptab_n = n;
+    return HD_SUCCESS;
 }
+static hd_result hd__gl_project(hd__ctx *ctx)
+{
+    hd_result r = hd__gl_project_prepare(ctx);
+    if (r != HD_SUCCESS) return r;
+    return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, ctx->be->ptab_n, 0, 0, 0);
+}
+static hd_result hd__be_project(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_project(ctx)); }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
 static hd_result hd__gl_read_image(hd__ctx *ctx, float *dst)
@@ -1013,6 +1068,7 @@ static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float
 }
 HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
+    ctx->be->lsum_ok = 0;
     HD__GL_STAGE(ctx, hd__gl_write_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src));
 }
 static hd_result hd__gl_finish_now(hd__ctx *ctx)
@@ -1066,7 +1122,11 @@ static hd_result hd__gl_sum_lights(hd__ctx *ctx)
             return r;
     return HD_SUCCESS;
 }
-static hd_result hd__be_sum_lights(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_sum_lights(ctx)); }
+static hd_result hd__be_sum_lights(hd__ctx *ctx)
+{
+    ctx->be->lsum_ok = 0;
+    HD__GL_STAGE(ctx, hd__gl_sum_lights(ctx));
+}
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
@@ -1425,6 +1485,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
     hd_result r;
+    be->lsum_ok = 0;
     if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
     return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
                           mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
@@ -1435,6 +1496,7 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = be->mg;
+    be->lsum_ok = 0;
     return hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
                           mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
 }

@@ -34,7 +34,7 @@
    (hd__cl_k picks them), the diffusion's in the same order */
 enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_DIFFUSE + 8, HD__CL_CONVECT,
        HD__CL_SUM_LIGHT, HD__CL_PATH, HD__CL_DIRECT_HALF, HD__CL_DIFFUSE_HALF,
-       HD__CL_PROJECT_HALF = HD__CL_DIFFUSE_HALF + 8, HD__CL_SUM_LIGHT_HALF,
+       HD__CL_PROJECT_HALF = HD__CL_DIFFUSE_HALF + 8, HD__CL_SUM_LIGHT_HALF, HD__CL_LIGHT_SUM, HD__CL_LIGHT_SUM_HALF,
        /* HD_SOLVER_MULTIGRID's passes (hd_entry_cl.h); the residuals in four variants each, indexed
           by 2 * surface boundary + RGB scattering; those from HD__CL_MG_RES_F64 on compute in
           double and exist only on a device with cl_khr_fp64 */
@@ -49,7 +49,8 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_direct_half", "hd_k_diffuse_half", "hd_k_diffuse_rgb_half", "hd_k_diffuse_surface_half",
     "hd_k_diffuse_surface_rgb_half", "hd_k_diffuse_jacobi_half", "hd_k_diffuse_jacobi_rgb_half",
     "hd_k_diffuse_jacobi_surface_half", "hd_k_diffuse_jacobi_surface_rgb_half", "hd_k_project_half",
-    "hd_k_sum_light_half", "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
+    "hd_k_sum_light_half", "hd_k_light_sum", "hd_k_light_sum_half",
+    "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
     "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict_line", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
     "hd_k_mg_extrap"};
@@ -68,6 +69,12 @@ struct hd__backend {
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
     cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
     cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
+    /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
+       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table, uploaded when
+       its host copy ptab_host (ptab_n entries) changes */
+    cl_mem lsum, ptab;
+    int lsum_ok, ptab_n;
+    float *ptab_host;
     int nlv;
     size_t tf_bytes, illum_floats, img_floats;
     size_t illum_slots;      /* elements of E, phi, phi2 in the colour layout (>= illum_floats) */
@@ -322,6 +329,8 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
     hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
     hd__cl_release(&be->dl);
+    hd__cl_release(&be->lsum); hd__cl_release(&be->ptab);
+    hd__free(ctx, be->ptab_host);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
@@ -410,6 +419,7 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
     if (k == HD__CL_DIRECT) return HD__CL_DIRECT_HALF;
     if (k == HD__CL_PROJECT) return HD__CL_PROJECT_HALF;
     if (k == HD__CL_SUM_LIGHT) return HD__CL_SUM_LIGHT_HALF;
+    if (k == HD__CL_LIGHT_SUM) return HD__CL_LIGHT_SUM_HALF;
     if (k >= HD__CL_DIFFUSE && k < HD__CL_DIFFUSE + 8) return k - HD__CL_DIFFUSE + HD__CL_DIFFUSE_HALF;
     return k;
 }
@@ -422,6 +432,8 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     HD__CL_LOST_CHECK(ctx);
     hd__cl_mg_free(ctx); /* its fine grid is this one */
     hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
+    hd__cl_release(&be->lsum);
+    be->lsum_ok = 0;
     be->illum_floats = 0;
     be->illum_slots = 0;
     be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
@@ -431,6 +443,8 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
         return r;
     if ((r = hd__cl_buffer(ctx, &be->E, bytes, NULL, "E")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(ctx, &be->phi, bytes, NULL, "phi")) != HD_SUCCESS) return r;
+    if (illum_floats && (r = hd__cl_buffer(ctx, &be->lsum, illum_floats * sizeof(float), NULL, "the summed light")) != HD_SUCCESS)
+        return r;
     be->illum_floats = illum_floats;
     be->illum_slots = slots;
     return HD_SUCCESS;
@@ -463,6 +477,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     hd_result r = HD_SUCCESS;
     size_t n = hd__cl_illum_bytes(be, be->illum_slots) / sizeof(float); /* in floats' worth of bytes */
     HD__CL_LOST_CHECK(ctx);
+    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
     if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, n)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, n)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi2, n)) != HD_SUCCESS) return r;
@@ -595,6 +610,7 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd_result r;
     int k = hd__cl_k(ctx, HD__CL_DIRECT);
     cl_int count = (cl_int)ctx->dl_count;
+    ctx->be->lsum_ok = 0;
     HD__CL_ARG(ctx, k, 10, count);
     if ((r = hd__cl_mems(ctx, k, 9, 1, ctx->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS)
         return r;
@@ -607,17 +623,62 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
     hd_result r;
+    be->lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(ctx, k, ctx->gdims, ctx->channels, 9, 0, 2)) != HD_SUCCESS)
         return r;
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
     return hd__cl_finish(ctx);
 }
 
+/* The projection's inputs: lsum rebuilt (hd_k_light_sum) after a pass that changed E or phi, and
+   the TF table (hd__project_table) uploaded when it differs from the one on the device. */
+static hd_result hd__cl_project_prepare(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    int n = hd__project_table_n(ctx), k = hd__cl_k(ctx, HD__CL_LIGHT_SUM);
+    float *t;
+    hd_result r;
+    if (!be->lsum_ok) {
+        if ((r = hd__cl_mems(ctx, k, 9, 1, be->lsum)) != HD_SUCCESS ||
+            (r = hd__cl_bind_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1],
+                                 (size_t)ctx->gdims[2] * (size_t)ctx->channels)) != HD_SUCCESS)
+            return r;
+        be->lsum_ok = 1;
+    }
+    t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
+    if (!t)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the projection's TF table (%d entries)", n);
+    hd__project_table(ctx, t, n);
+    if (n != be->ptab_n || memcmp(t, be->ptab_host, (size_t)n * 4 * sizeof(float)) != 0) {
+        hd__cl_release(&be->ptab);
+        hd__free(ctx, be->ptab_host);
+        be->ptab_host = NULL;
+        be->ptab_n = 0;
+        if ((r = hd__cl_buffer(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, "the projection's TF table")) != HD_SUCCESS) {
+            hd__free(ctx, t);
+            return r;
+        }
+        be->ptab_host = t;
+        be->ptab_n = n;
+    } else {
+        hd__free(ctx, t);
+    }
+    return HD_SUCCESS;
+}
+
 static hd_result hd__be_project(hd__ctx *ctx)
 {
+    hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, HD__CL_PROJECT);
-    hd_result r = hd__cl_bind_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1);
-    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
+    cl_int n;
+    hd_result r;
+    if ((r = hd__cl_project_prepare(ctx)) != HD_SUCCESS) return r;
+    n = be->ptab_n;
+    HD__CL_ARG(ctx, k, 11, n);
+    if ((r = hd__cl_mems(ctx, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS ||
+        (r = hd__cl_bind_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS)
+        return r;
+    return hd__cl_finish(ctx);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------ */
@@ -692,6 +753,7 @@ static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination w
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
+    ctx->be->lsum_ok = 0;
     return hd__cl_copy_illumination(ctx, which, src, NULL, NULL, 0);
 }
 
@@ -740,6 +802,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     int k = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
     hd_result r;
     int l;
+    be->lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
     for (l = 0; l < be->nlv; ++l) {
         cl_int li = l, first = l == 0;
@@ -1072,6 +1135,7 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     hd__backend *be = ctx->be;
+    be->lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
     return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->mg->channels, 4, be->mg->lv[0].params, be->phi, be->mg->lo, be->mg->p);
 }
@@ -1080,6 +1144,7 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     hd__backend *be = ctx->be;
     cl_int c = colour;
+    be->lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
     return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->mg->channels, 5, be->params, be->sig, be->E, be->phi, be->mg->lo);
 }

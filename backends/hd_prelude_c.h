@@ -154,7 +154,7 @@ typedef struct hd__kctx {
                           float pointers are NULL); see HD_GET */
     uint16_t *Eh, *phih, *phi2h;
     float *img;        /* RGBA float accumulation, width*height*4 */
-    const float *lsum; /* projection: E + phi summed, x-fastest channel-planar (NULL: read both) */
+    float *lsum;       /* projection: E + phi summed, x-fastest channel-planar (NULL: read both) */
     const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries (NULL: TF and exp) */
     int ptab_n;
     const float *lv;   /* CD: the light volume being read (one light's rho) */
@@ -187,6 +187,8 @@ typedef struct hd__kctx {
 #define HD__LD_vol(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->vol[(i)])
 #define HD__LD_lv(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv[(i)])
 #define HD__LD_lv2(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv2[(i)])
+#define HD__LD_lsum(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lsum[(i)])
+#define HD__ST_lsum(i, x, y, z, v) ((void)(x), (void)(y), (void)(z), K->lsum[(i)] = (v))
 #define HD__ST_lv2(i, x, y, z, v) ((void)(x), (void)(y), (void)(z), K->lv2[(i)] = (v))
 #define HD__LD_sig(i, x, y, z) ((void)(i), K->sig[HD__C_AT(x, y, z)])
 #define HD__ST_sig(i, x, y, z, v) ((void)(i), K->sig[HD__C_AT(x, y, z)] = (v))

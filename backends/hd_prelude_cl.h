@@ -104,6 +104,9 @@ typedef struct hd__kctx {
     __global half *phi2h;
     int f16;
     __global float *img;
+    __global float *lsum;       /* projection: E + phi, x-fastest (hd_light_sum_voxel) */
+    __global const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries */
+    int ptab_n;
     __global const float *lv;   /* CD: the light volume being read */
     __global float *lv2;        /* CD: the light volume being written */
     int flags;                  /* what the diffusion reads as HD_DIFFUSE_FLAGS */
@@ -114,6 +117,14 @@ typedef struct hd__kctx {
     int hx, gy, cx, cp;
     size_t cid;
 } hd__kctx;
+
+/* The projection reads the summed light grid and the step's TF table (hd_k_project.h); the
+   backend keeps both up to date before every projection. */
+#define HD_PRELUDE_LIGHT_SUM 1
+#define HD_LIGHT_SUM_READY 1
+#define HD_PRELUDE_PROJECT_TABLE 1
+#define HD_PROJECT_TABLE_READY 1
+#define HD_PTAB_N (K->ptab_n)
 
 /* The diffusion's flags come from K, so a kernel can make them literals (hd_entry_cl.h). */
 #define HD_DIFFUSE_FLAGS (K->flags)
@@ -145,6 +156,8 @@ typedef struct hd__kctx {
 #define HD__LD_vol(i, x, y, z) (K->vol[(i)])
 #define HD__LD_lv(i, x, y, z) (K->lv[(i)])
 #define HD__LD_lv2(i, x, y, z) (K->lv2[(i)])
+#define HD__LD_lsum(i, x, y, z) (K->lsum[(i)])
+#define HD__ST_lsum(i, x, y, z, v) (K->lsum[(i)] = (v))
 #define HD__ST_lv2(i, x, y, z, v) (K->lv2[(i)] = (v))
 #define HD__LD_sig(i, x, y, z) HD__CL_COL(sig, x, y, z)
 #define HD__ST_sig(i, x, y, z, v) (HD__CL_COL(sig, x, y, z) = (v))

@@ -99,13 +99,13 @@ typedef struct hd__vk_fns {
 } hd__vk_fns;
 
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
-       HD__VK_PATH, HD__VK_PIPELINE_COUNT };
+       HD__VK_PATH, HD__VK_LIGHT_SUM, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 #define HD__VK_DIFFUSE_VARIANTS 160 /* diffusion pipelines per context, one per flags value, solver and precision
                                      (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
-#define HD__VK_BINDINGS 13
+#define HD__VK_BINDINGS 15
 #define HD__VK_MG_PIPELINES (9 * 4) /* HD_SOLVER_MULTIGRID: 9 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
@@ -177,6 +177,14 @@ struct hd__backend {
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
     int nlv;
+    /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
+       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (binding 13,
+       host-visible, ptab_cap entries, sized with the TF), written when its host copy ptab_host
+       (ptab_n entries) changes */
+    hd__vk_image lsum;
+    hd__vk_buffer ptab;
+    int lsum_ok, ptab_n, ptab_cap;
+    float *ptab_host;
     size_t illum_floats, img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
     unsigned long submits, lose_at; /* queue submissions so far; HD_VK_LOSE_DEVICE (0: off) */
@@ -883,12 +891,15 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
 static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jacobi, int half, VkPipeline *out)
 {
     static const uint32_t *const code[2][HD__VK_PIPELINE_COUNT] = {
-        {hd__spv_classify, hd__spv_direct, hd__spv_diffuse, hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path},
-        {NULL, hd__spv_direct_half, hd__spv_diffuse_half, hd__spv_project_half, NULL, hd__spv_sum_light_half, NULL}};
+        {hd__spv_classify, hd__spv_direct, hd__spv_diffuse, hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path,
+         hd__spv_light_sum},
+        {NULL, hd__spv_direct_half, hd__spv_diffuse_half, hd__spv_project_half, NULL, hd__spv_sum_light_half, NULL,
+         hd__spv_light_sum_half}};
     static const size_t size[2][HD__VK_PIPELINE_COUNT] = {
         {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse, sizeof hd__spv_project,
-         sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path},
-        {0, sizeof hd__spv_direct_half, sizeof hd__spv_diffuse_half, sizeof hd__spv_project_half, 0, sizeof hd__spv_sum_light_half, 0}};
+         sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path, sizeof hd__spv_light_sum},
+        {0, sizeof hd__spv_direct_half, sizeof hd__spv_diffuse_half, sizeof hd__spv_project_half, 0, sizeof hd__spv_sum_light_half, 0,
+         sizeof hd__spv_light_sum_half}};
     half = half && code[1][p] != NULL;
     return hd__vk_pipeline_code(ctx, code[half][p], size[half][p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
 }
@@ -899,7 +910,7 @@ static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    if (!be->f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT)) {
+    if (!be->f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
         *out = be->pipelines[p];
         return HD_SUCCESS;
     }
@@ -978,7 +989,7 @@ static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uin
 }
 
 /* A descriptor pool for `sets` sets of the backend's set layout (hd__vk_pipelines' types: per set
-   1 dynamic uniform buffer, 7 storage images, 5 storage buffers): the backend's sets and the
+   1 dynamic uniform buffer, 8 storage images, 6 storage buffers): the backend's sets and the
    multigrid's (HD_SOLVER_MULTIGRID) each have one. */
 static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool)
 {
@@ -986,8 +997,8 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     VkDescriptorPoolSize ps[3];
     VkDescriptorPoolCreateInfo dpci;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = sets;
-    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 7 * sets;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 5 * sets;
+    ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 8 * sets;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 6 * sets;
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = sets;
@@ -1029,14 +1040,16 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
     hd_result r;
     int i;
-    /* the set's storage buffers (TF, majorants, image, row sums, direct light's list): one above
-       Vulkan's guaranteed minimum of 4 per stage */
-    if (be->limits.maxPerStageDescriptorStorageBuffers < 5)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: the device binds %u storage buffers per shader stage; 5 needed",
-                       be->limits.maxPerStageDescriptorStorageBuffers);
+    /* the set's storage buffers (TF, majorants, image, row sums, direct light's list, the
+       projection's TF table) and storage images (volume, sigma_t, E, phi, phi2, two light volumes,
+       the projection's E + phi): above Vulkan's guaranteed minimum of 4 per stage each */
+    if (be->limits.maxPerStageDescriptorStorageBuffers < 6 || be->limits.maxPerStageDescriptorStorageImages < 8)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
+                       "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 6 and 8 needed",
+                       be->limits.maxPerStageDescriptorStorageBuffers, be->limits.maxPerStageDescriptorStorageImages);
     if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
@@ -1081,11 +1094,11 @@ static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buf
 }
 
 /* The buffers every set binds (TF, majorants, image; binding 11, multigrid's row sums, a
-   placeholder unless given; 12, the direct light's list) into bu. */
+   placeholder unless given; 12, the direct light's list; 13, the projection's TF table) into bu. */
 static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, const hd__vk_buffer *dot)
 {
     bu[2] = &be->tf; bu[3] = &be->maj; bu[8] = &be->img; bu[11] = dot ? dot : &be->dummy_buffer;
-    bu[12] = &be->dl;
+    bu[12] = &be->dl; bu[13] = &be->ptab;
 }
 
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
@@ -1109,6 +1122,7 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
         im[1] = &be->vol; im[4] = &be->sig; im[5] = &be->E; im[6] = &be->phi; im[7] = &be->phi2;
         im[9] = be->nlv > 0 ? &be->lv[s] : &be->dummy;
         im[10] = be->nlv > 0 ? &be->lv[be->nlv] : &be->dummy;
+        im[14] = &be->lsum;
         hd__vk_write_set(ctx, be->sets[s], &be->params, im, bu);
     }
     be->sets_valid = 1;
@@ -1226,7 +1240,8 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__vk_free_image(ctx, &be->dummy16);
         hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
-        hd__vk_free_buffer(ctx, &be->dl);
+        hd__vk_free_buffer(ctx, &be->dl); hd__vk_free_buffer(ctx, &be->ptab);
+        hd__vk_free_image(ctx, &be->lsum);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -1245,6 +1260,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->messenger) be->fn.vkDestroyDebugUtilsMessengerEXT(be->instance, be->messenger, NULL);
         be->fn.vkDestroyInstance(be->instance, NULL);
     }
+    hd__free(ctx, be->ptab_host);
     hd__free(ctx, be);
     ctx->be = NULL;
 }
@@ -1399,6 +1415,16 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     }
     memcpy(be->tf.map, ctx->tf, tf_bytes);
     memcpy(be->maj.map, ctx->majorant, ncell * sizeof(float));
+    /* the projection's TF table has as many entries as long as the TF has as many: sized here, while
+       nothing is being recorded; written by hd__vk_project */
+    if (hd__project_table_n(ctx) != be->ptab_cap) {
+        hd__vk_free_buffer(ctx, &be->ptab);
+        be->ptab_n = be->ptab_cap = 0;
+        if ((r = hd__vk_buffer_create(ctx, &be->ptab, (size_t)hd__project_table_n(ctx) * 4 * sizeof(float),
+                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the projection's TF table")) != HD_SUCCESS)
+            return r;
+        be->ptab_cap = hd__project_table_n(ctx);
+    }
     return HD_SUCCESS;
 }
 
@@ -1410,6 +1436,8 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     HD__VK_IDLE(ctx);
     hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
     hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
+    hd__vk_free_image(ctx, &be->lsum);
+    be->lsum_ok = 0;
     be->illum_floats = 0;
     if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r; /* after hd_set_params */
     be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
@@ -1418,6 +1446,7 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS) return r;
     if ((r = hd__vk_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
     if ((r = hd__vk_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(ctx, &be->lsum, g[0], g[1], g[2] * ctx->channels, "the summed light")) != HD_SUCCESS) return r;
     be->illum_floats = illum_floats;
     return hd__vk_flush(ctx);
 }
@@ -1459,6 +1488,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     hd__vk_image *ims[3];
     int i, n = 0;
     HD__VK_LOST_CHECK(ctx);
+    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
     if ((what & HD__DIRTY_DIRECT) && be->E.image) ims[n++] = &be->E;
     if ((what & HD__DIRTY_PHI) && be->phi.image) ims[n++] = &be->phi;
     if ((what & HD__DIRTY_PHI) && be->phi2.image) ims[n++] = &be->phi2;
@@ -1510,6 +1540,7 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    ctx->be->lsum_ok = 0;
     return hd__vk_stage(ctx, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
 }
 
@@ -1526,6 +1557,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int nz = nzb * ctx->channels;
     VkPipeline pipe;
+    be->lsum_ok = 0;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
@@ -1540,9 +1572,43 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     return hd__vk_flush(ctx);
 }
 
+/* The projection, after its inputs: lsum rebuilt (the light-sum stage) when a pass changed E or
+   phi since, and the TF table (hd__project_table) written when it differs from the one in the
+   buffer. A recorded frame reads the table as it is when the command buffer runs, as the TF. */
 static hd_result hd__be_project(hd__ctx *ctx)
 {
-    return hd__vk_stage(ctx, HD__VK_PROJECT, ctx->kp.image.x, ctx->kp.image.y, 1, 0);
+    hd__backend *be = ctx->be;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkPipeline sum, proj;
+    int n = hd__project_table_n(ctx);
+    size_t bytes = (size_t)n * 4 * sizeof(float);
+    float *t;
+    hd_result r;
+    HD__VK_LOST_CHECK(ctx);
+    if (!be->ptab.map || be->ptab_cap != n)
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
+                       n);
+    if (!(t = (float *)hd__alloc(ctx, bytes)))
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the projection's TF table (%d entries)", n);
+    hd__project_table(ctx, t, n);
+    if (n != be->ptab_n || memcmp(t, be->ptab_host, bytes) != 0) {
+        memcpy(be->ptab.map, t, bytes);
+        hd__free(ctx, be->ptab_host);
+        be->ptab_host = t;
+        be->ptab_n = n;
+    } else {
+        hd__free(ctx, t);
+    }
+    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
+        (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)
+        return r;
+    if (!be->lsum_ok) {
+        r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0);
+        if (r != HD_SUCCESS) return r;
+        be->lsum_ok = 1;
+    }
+    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
+    return hd__vk_flush(ctx);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
@@ -1582,6 +1648,7 @@ static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination w
 HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
     HD__VK_LOST_CHECK(ctx);
+    ctx->be->lsum_ok = 0;
     return hd__vk_upload_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
 }
 
@@ -1628,6 +1695,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     hd_result r;
     int l;
     VkPipeline pipe;
+    ctx->be->lsum_ok = 0;
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     for (l = 0; l < ctx->be->nlv; ++l)
@@ -2070,6 +2138,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     uint64_t u;
     int i;
     /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
+    ctx->be->lsum_ok = 0;
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
     return hd__vk_mg_fine(ctx, HD__VK_MG_UPDATE, ctx->be->mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
@@ -2079,6 +2148,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     struct hd__vk_mg *mg = ctx->be->mg;
+    ctx->be->lsum_ok = 0;
     return hd__vk_mg_fine(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, colour, 0);
 }
 

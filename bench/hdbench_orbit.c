@@ -19,7 +19,12 @@
       Writes --csv (every view), --out/orbit-mean.csv and --out/orbit-psnr.png (gnuplot), and
       prints the crossover budget: the smallest budget from which on PT_MS has an image in
       every view and a mean PSNR above HD's (or HD lacks an image in some view).
-   The clock runs only inside hd_render / hd_iterate calls; reading the image back for the PSNR
+   --single-view: instead of the orbit, one view (azimuth 0) at --size from a fresh context, as
+   hdrender renders it: HD refines the light until it converges (hd_refine, no frames), then
+   projects frame_window frames (hd_render); PT_MS, also fresh, iterates until its PSNR reaches
+   HD's (or --pt-cap times HD's time passes). Prints both times against the same PT_MS
+   reference (another seed) and which method got there first.
+   The clock runs only inside hd_render / hd_refine / hd_iterate calls; reading the image back for the PSNR
    is outside it. It is, by default, process CPU time over the online cores (see bench_clock;
    --clock wall for the wall clock), the time the work takes on otherwise idle cores. Run `hdbench_orbit --help` for the knobs. */
 #ifndef _POSIX_C_SOURCE
@@ -39,7 +44,8 @@
 static struct {
     const char *data, *csv, *out, *cache;
     int views, size, frame_size, ref_iters, light_iters, psnr, downsample, surface;
-    int nb, wall;
+    int nb, wall, single;
+    double pt_cap;
     double budgets[MAX_BUDGETS];
 } O;
 
@@ -84,6 +90,9 @@ static void usage(int code)
             "  --clock cpu|wall   what the budgets measure: process CPU time / online cores\n"
             "                     (default; load-independent on a shared machine) or wall time\n"
             "  --no-psnr          frame time only (what the GPU backends' builds run)\n"
+            "  --single-view      one view at --size, hdrender's schedule against PT_MS afresh:\n"
+            "                     the time each needs to reach HD's converged PSNR\n"
+            "  --pt-cap X         single view: PT_MS stops after X times HD's time (default 8)\n"
             "  --csv FILE         per-view results (default docs/orbit/orbit.csv)\n"
             "  --out DIR          the plot (default docs/orbit)\n"
             "  --cache DIR        reference images (default build/orbit-cache)\n");
@@ -117,6 +126,7 @@ static void parse_args(int argc, char **argv)
     O.light_iters = -1;
     O.psnr = 1;
     O.downsample = 1;
+    O.pt_cap = 8.0;
     {
         static const double def[] = {0.05, 0.1, 0.25, 0.5, 1, 2, 5};
         O.nb = 7;
@@ -133,6 +143,16 @@ static void parse_args(int argc, char **argv)
         else if (!strcmp(a, "--light-iters")) O.light_iters = parse_int(NEXT(), 1, 1 << 20);
         else if (!strcmp(a, "--downsample")) O.downsample = parse_int(NEXT(), 1, 8);
         else if (!strcmp(a, "--no-psnr")) O.psnr = 0;
+        else if (!strcmp(a, "--single-view")) O.single = 1;
+        else if (!strcmp(a, "--pt-cap")) {
+            char *e;
+            const char *v = NEXT();
+            O.pt_cap = strtod(v, &e);
+            if (e == v || *e || !(O.pt_cap >= 1.0) || O.pt_cap > 1e4) {
+                fprintf(stderr, "hdbench_orbit: --pt-cap: a number in 1..10000\n");
+                exit(2);
+            }
+        }
         else if (!strcmp(a, "--clock")) {
             const char *v = NEXT();
             if (!strcmp(v, "wall")) O.wall = 1;
@@ -272,6 +292,81 @@ static void budget_run(hd_context c, int hd_mode, const float *ref, float *img, 
     }
 }
 
+/* --single-view: hdrender's schedule for HD against PT_MS on one view, both from a fresh
+   context, each against the PT_MS reference of view 0 at --size. */
+static int single_view(const hdo_scene *s)
+{
+    size_t npix = (size_t)O.size * (size_t)O.size;
+    float *ref = (float *)malloc(npix * 4 * sizeof(float)), *img = (float *)malloc(npix * 4 * sizeof(float));
+    hd_desc d = s->desc;
+    hd_context c;
+    hd_stats st;
+    double t = 0.0, ts, hd_psnr, pt_psnr = NAN, t_light, t_hd, t_pt = -1.0;
+    int it = 0, paths = 0;
+    if (!ref || !img) { fprintf(stderr, "hdbench_orbit: out of memory\n"); return 1; }
+    reference(s, 0, ref);
+    /* HD: light to convergence without frames, then the frames (examples/hdrender.c) */
+    d.camera = hdo_orbit_camera(0.0, O.size);
+    check(hd_create(&d, &c), "hd_create (HD)");
+    do {
+        ts = bench_clock();
+        check(hd_refine(c, 1), "hd_refine");
+        t += bench_clock() - ts;
+        check(hd_get_stats(c, &st), "hd_get_stats");
+    } while (!st.light_converged && ++it < O.light_iters);
+    t_light = t;
+    check(hd_query_desc(c, &d), "hd_query_desc");
+    do {
+        ts = bench_clock();
+        check(hd_render(c), "hd_render");
+        t += bench_clock() - ts;
+        check(hd_get_stats(c, &st), "hd_get_stats");
+    } while (st.frames < (uint64_t)d.params.frame_window);
+    read_tonemapped(c, img, npix);
+    hd_psnr = hdo_psnr(img, ref, npix);
+    printf("single view: %s backend, head CT, %dx%d, %s clock\n", hd_backend_name(), O.size, O.size,
+           O.wall ? "wall" : "CPU time / cores");
+    printf("  HD     %.2f dB after %.2f s (light: %llu iterations, %.2f s, %s, light_error %.4g; then %llu "
+           "frames, %.2f s)\n", hd_psnr, t, (unsigned long long)st.iterations, t_light,
+           st.light_converged ? "converged" : "iteration cap", st.light_error, (unsigned long long)st.frames,
+           t - t_light);
+    fflush(stdout);
+    hd_destroy(c);
+    /* PT_MS from scratch until it reaches HD's PSNR */
+    t_hd = t;
+    d = s->desc;
+    d.camera = hdo_orbit_camera(0.0, O.size);
+    d.params.method = HD_METHOD_PT_MS;
+    check(hd_create(&d, &c), "hd_create (PT_MS)");
+    t = 0.0;
+    for (;;) {
+        ts = bench_clock();
+        check(hd_iterate(c, 1), "hd_iterate (PT_MS)");
+        t += bench_clock() - ts;
+        ++paths;
+        read_tonemapped(c, img, npix);
+        pt_psnr = hdo_psnr(img, ref, npix);
+        if (pt_psnr >= hd_psnr) { t_pt = t; break; }
+        if (t > O.pt_cap * t_hd) break;
+    }
+    hd_destroy(c);
+    if (t_pt >= 0.0)
+        printf("  PT_MS  %.2f dB after %.2f s (%d paths/pixel): HD's PSNR reached\n", pt_psnr, t_pt, paths);
+    else
+        printf("  PT_MS  %.2f dB after %.2f s (%d paths/pixel): below HD's PSNR when stopped (--pt-cap %g)\n",
+               pt_psnr, t, paths, O.pt_cap);
+    printf("  reference: PT_MS, %d paths/pixel, another seed\n", O.ref_iters);
+    if (t_pt >= 0.0 && t_pt < t_hd)
+        printf("  PT_MS first: it reached HD's PSNR in %.2f s, HD took %.2f s (%.2fx)\n", t_pt, t_hd, t_hd / t_pt);
+    else if (t_pt >= 0.0)
+        printf("  HD first: %.2f s, PT_MS needed %.2f s for the same PSNR (%.2fx)\n", t_hd, t_pt, t_pt / t_hd);
+    else
+        printf("  HD first: %.2f s, PT_MS below HD's PSNR after %.2f s (> %.2fx)\n", t_hd, t, t / t_hd);
+    free(ref);
+    free(img);
+    return 0;
+}
+
 static void plot(const char *mean_csv, const char *png)
 {
     char script[4600], cmd[4800];
@@ -307,6 +402,11 @@ int main(int argc, char **argv)
     if (!hdo_scene_load(&s, O.data, O.frame_size, &log)) return 1;
     s.desc.params.illumination_downsample = O.downsample;
     s.desc.params.diffusion_boundary = O.surface ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+    if (O.single) {
+        int r = single_view(&s);
+        hd_volume_free(&s.vol);
+        return r;
+    }
     check(hd_create(&s.desc, &hd), "hd_create");
 
     /* 1. converge the light */

@@ -7,8 +7,10 @@
    median and the best ms per frame. --save writes the image after the timed frames as raw
    float RGBA, --compare prints the PSNR of this run's image against such a file (peak: the
    reference's largest RGB value), --png writes it as a PNG to look at.
-   Usage: hdbench_project [--make-light FILE ITERS] [--light FILE] [--size N] [--frames F]
-                          [--save F32] [--compare F32] [--png PNG] [--tag WORD] [data/head.nrrd]
+   Usage: hdbench_project [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
+                          [--width W] [--height H] [--frames F] [--save F32] [--compare F32]
+                          [--png PNG] [--tag WORD] [data/head.nrrd]
+   --size N is an N x N frame; --size 1920x1080 (or --width / --height) any other.
    Figures, not a test: nothing here passes or fails. */
 #define HYBRIDDIFF_IMPLEMENTATION
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_GL) && \
@@ -29,7 +31,7 @@ static const float bench_tf[] = {
     0.93f, 0.73f, 0.62f, 0.05f, 1.0f, 0.98f, 0.9f, 0.5f,    1.0f, 1.0f, 1.0f, 1.0f,
     1.0f, 1.0f, 1.0f, 1.0f,     1.0f, 1.0f, 1.0f, 1.0f,     1.0f, 1.0f, 1.0f, 1.0f};
 
-static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *light, int size)
+static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *light, int width, int height)
 {
     memset(d, 0, sizeof *d);
     d->volume = vf->desc;
@@ -41,7 +43,8 @@ static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *ligh
     d->light_count = 1;
     d->camera.eye[1] = 2.3f; d->camera.eye[2] = 0.3f; d->camera.up[2] = 1.0f;
     d->camera.fov_y = 30.0f;
-    d->camera.width = d->camera.height = size;
+    d->camera.width = width;
+    d->camera.height = height;
     d->logger.func = hd_log_stderr;
 }
 
@@ -60,7 +63,7 @@ static int make_light(const hd_volume_file *vf, const hd_light *light, const cha
     float *buf;
     int32_t n;
     FILE *f;
-    fill_desc(&d, vf, light, 64); /* small image: the iterations' projections cost little */
+    fill_desc(&d, vf, light, 64, 64); /* small image: the iterations' projections cost little */
     if (hd_create(&d, &ctx) != HD_SUCCESS || hd_iterate(ctx, iters) != HD_SUCCESS) return 1;
     hd_get_stats(ctx, &st);
     n = (int32_t)((size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels);
@@ -99,7 +102,7 @@ int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd", *light_path = "build/bench_project_light.f32", *save = NULL;
     const char *compare = NULL, *png = NULL, *tag = "";
-    int size = 512, frames = 8, make_iters = 0, i;
+    int width = 512, height = 512, frames = 8, make_iters = 0, i;
     hd_volume_file vf;
     hd_light light;
     hd_desc d;
@@ -113,7 +116,12 @@ int main(int argc, char **argv)
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--make-light") == 0 && i + 2 < argc) { light_path = argv[++i]; make_iters = atoi(argv[++i]); }
         else if (strcmp(argv[i], "--light") == 0 && i + 1 < argc) light_path = argv[++i];
-        else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) size = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
+            const char *x = strchr(argv[++i], 'x');
+            width = atoi(argv[i]);
+            height = x ? atoi(x + 1) : width;
+        } else if (strcmp(argv[i], "--width") == 0 && i + 1 < argc) width = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--height") == 0 && i + 1 < argc) height = atoi(argv[++i]);
         else if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = atoi(argv[++i]);
         else if (strcmp(argv[i], "--save") == 0 && i + 1 < argc) save = argv[++i];
         else if (strcmp(argv[i], "--compare") == 0 && i + 1 < argc) compare = argv[++i];
@@ -122,7 +130,10 @@ int main(int argc, char **argv)
         else if (argv[i][0] == '-') { fprintf(stderr, "hdbench_project: unknown option %s\n", argv[i]); return 2; }
         else path = argv[i];
     }
-    if (size < 1 || frames < 1) { fprintf(stderr, "hdbench_project: --size and --frames must be >= 1\n"); return 2; }
+    if (width < 1 || height < 1 || frames < 1) {
+        fprintf(stderr, "hdbench_project: --size, --width, --height and --frames must be >= 1\n");
+        return 2;
+    }
     if (hd_volume_load_nrrd(path, &vf, NULL) != HD_SUCCESS) {
         fprintf(stderr, "hdbench_project: cannot load %s (run `make data` first)\n", path);
         return 2;
@@ -134,7 +145,7 @@ int main(int argc, char **argv)
     lightbuf = read_floats(light_path, &nlight);
     if (!lightbuf || nlight < 1) { fprintf(stderr, "hdbench_project: cannot read %s (--make-light first)\n", light_path); return 2; }
     memcpy(&n, lightbuf, sizeof n);
-    fill_desc(&d, &vf, &light, size);
+    fill_desc(&d, &vf, &light, width, height);
     if (hd_create(&d, &ctx) != HD_SUCCESS) return 1;
     hd_get_stats(ctx, &st);
     if ((size_t)n != (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels ||
@@ -155,9 +166,11 @@ int main(int argc, char **argv)
     }
     cpu_ms = (double)(clock() - cpu0) * 1e3 / (double)CLOCKS_PER_SEC / (double)frames;
     qsort(ms, (size_t)frames, sizeof(double), cmp_double);
-    printf("%-4s %-7s %4d^2  projection %8.1f ms/frame (median of %d, best %.1f; process CPU %.1f ms/frame)", tag,
-           hd_backend_name(), size, ms[frames / 2], frames, ms[0], cpu_ms);
-    npix = (size_t)size * size;
+    if (width == height) printf("%-4s %-7s %4d^2     ", tag, hd_backend_name(), width);
+    else printf("%-4s %-7s %4dx%-4d ", tag, hd_backend_name(), width, height);
+    printf(" projection %8.1f ms/frame (median of %d, best %.1f; process CPU %.1f ms/frame)", ms[frames / 2], frames, ms[0],
+           cpu_ms);
+    npix = (size_t)width * height;
     img = (float *)malloc(npix * 4 * sizeof(float));
     if (!img || hd_read_image_f32(ctx, img, npix * 4) != HD_SUCCESS) return 1;
     if (compare) {
@@ -185,7 +198,7 @@ int main(int argc, char **argv)
     if (png) {
         uint8_t *rgba = (uint8_t *)malloc(npix * 4);
         if (!rgba || hd_read_image_rgba8(ctx, rgba, npix * 4) != HD_SUCCESS ||
-            !stbi_write_png(png, size, size, 4, rgba, size * 4)) {
+            !stbi_write_png(png, width, height, 4, rgba, width * 4)) {
             fprintf(stderr, "hdbench_project: cannot write %s\n", png);
             return 2;
         }

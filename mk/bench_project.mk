@@ -1,12 +1,12 @@
 # mk/bench_project.mk - the projection's frame time per backend, old against new in one run.
 #   make bench-project    bench/hdbench_project.c built twice per backend (CPU, OpenCL, GL,
 #                         Vulkan): against this tree and against the tree of PROJECT_BASE (the
-#                         projection with the empty-space skip, before the summed light grid and
-#                         the TF table; override to compare others),
+#                         projection with the summed light grid and the TF table on the CPU
+#                         backend only; override to compare others),
 #                         runs interleaved old/new per backend and size, on one light converged
 #                         once (build/bench_project_light.f32); prints ms per frame and the PSNR
 #                         of the new image against the old; PNGs in build/bench_project/.
-PROJECT_BASE ?= aa5914a
+PROJECT_BASE ?= 42a803d
 PROJECT_OLD := $(B)/proj-old
 PROJECT_BACKENDS := cpu opencl gl vulkan
 PROJECT_DEF_cpu := -DHYBRIDDIFF_BACKEND_CPU

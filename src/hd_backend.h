@@ -143,4 +143,34 @@ HD__MAYBE_UNUSED static hd_result hd__be_diffuse_each(hd__ctx *ctx, int jacobi, 
     return r;
 }
 
+/* The projection's TF table for the current TF, step and medium, as hd_project_lookup reads it
+   (hd_k_project.h): entry j at value j / (n - 1) is (rgb * a * albedo / (4 pi), a), a = 1 -
+   exp(-sigma_t dt). n - 1 is a multiple of the TF's segments and at least HD__PTAB_MIN, so each
+   table segment lies inside one TF segment. Every backend builds it here, so all of them read
+   the same table. hd__project_table_n: its entries; hd__project_table: fills dst (n * 4 floats). */
+#define HD__PTAB_MIN 4096
+HD__MAYBE_UNUSED static int hd__project_table_n(const hd__ctx *ctx)
+{
+    int segs = ctx->tf_count - 1, m = segs < HD__PTAB_MIN ? (HD__PTAB_MIN + segs - 1) / segs : 1;
+    return segs * m + 1;
+}
+HD__MAYBE_UNUSED static void hd__project_table(const hd__ctx *ctx, float *dst, int n)
+{
+    hd__kctx k;
+    hd__kctx *K = &k;
+    float dt = ctx->kp.march.x, s = ctx->kp.medium.y * ctx->kp.box.w;
+    int j;
+    memset(&k, 0, sizeof k);
+    k.p = &ctx->kp;
+    k.tf = ctx->tf;
+    for (j = 0; j < n; ++j) {
+        hd_v4 c = hd_tf(K, (float)j / (float)(n - 1));
+        float a = 1.0f - hd_exp(-(c.w * ctx->kp.medium.x) * dt);
+        dst[j * 4] = c.x * a * s;
+        dst[j * 4 + 1] = c.y * a * s;
+        dst[j * 4 + 2] = c.z * a * s;
+        dst[j * 4 + 3] = a;
+    }
+}
+
 #endif

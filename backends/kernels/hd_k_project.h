@@ -18,12 +18,13 @@ HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
     int r00 = (za * ny + y0) * nx, r10 = (za * ny + y1) * nx;
     int r01 = (zb * ny + y0) * nx, r11 = (zb * ny + y1) * nx;
 #ifdef HD_PRELUDE_LIGHT_SUM
-    /* a backend that keeps E + phi summed in one x-fastest grid: the same sums, half the loads */
+    /* a backend that keeps E + phi summed in one grid (hd_light_sum_voxel): the same sums, half
+       the loads */
     if (HD_LIGHT_SUM_READY) {
-        float s000 = HD_GET1(lsum, r00 + x0), s100 = HD_GET1(lsum, r00 + x1);
-        float s010 = HD_GET1(lsum, r10 + x0), s110 = HD_GET1(lsum, r10 + x1);
-        float s001 = HD_GET1(lsum, r01 + x0), s101 = HD_GET1(lsum, r01 + x1);
-        float s011 = HD_GET1(lsum, r11 + x0), s111 = HD_GET1(lsum, r11 + x1);
+        float s000 = HD_GET(lsum, r00 + x0, x0, y0, za), s100 = HD_GET(lsum, r00 + x1, x1, y0, za);
+        float s010 = HD_GET(lsum, r10 + x0, x0, y1, za), s110 = HD_GET(lsum, r10 + x1, x1, y1, za);
+        float s001 = HD_GET(lsum, r01 + x0, x0, y0, zb), s101 = HD_GET(lsum, r01 + x1, x1, y0, zb);
+        float s011 = HD_GET(lsum, r11 + x0, x0, y1, zb), s111 = HD_GET(lsum, r11 + x1, x1, y1, zb);
         float d00 = s000 + wx * (s100 - s000), d10 = s010 + wx * (s110 - s010);
         float d01 = s001 + wx * (s101 - s001), d11 = s011 + wx * (s111 - s011);
         float d0 = d00 + wy * (d10 - d00), d1 = d01 + wy * (d11 - d01);
@@ -42,6 +43,17 @@ HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
     float c01 = v001 + wx * (v101 - v001), c11 = v011 + wx * (v111 - v011);
     float c0 = c00 + wy * (c10 - c00), c1 = c01 + wy * (c11 - c01);
     return c0 + wz * (c1 - c0);
+}
+#endif
+
+#ifdef HD_PRELUDE_LIGHT_SUM
+/* lsum = E + phi at voxel (x, y, zz) of the illumination grid (zz = z + c * gz for channel c),
+   stored x-fastest at (zz * gy + y) * gx + x: rebuilt by the backend after a pass that changed E
+   or phi, read by hd_sample_light. */
+HD_FN void hd_light_sum_voxel(HD_KARGS int x, int y, int zz)
+{
+    int i = (zz * HD_PRM(gdims).y + y) * HD_PRM(gdims).x + x;
+    HD_SET(lsum, i, x, y, zz, HD_GET(E, i, x, y, zz) + HD_GET(phi, i, x, y, zz));
 }
 #endif
 

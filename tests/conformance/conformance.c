@@ -335,6 +335,48 @@ static void case_project(hd_voxel_type type, const int *d, int channels, int fra
     scene_free(&s);
 }
 
+/* The projection after what its own inputs are made from changed between frames: E, then phi
+   rewritten (a backend's summed light grid must follow), then the step and the albedo (its TF
+   table must follow; the albedo resets the light, written again). Compared after each change. */
+static void case_project_refresh(hd_voxel_type type, const int *d, int channels)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    hd_params q;
+    scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "project refresh %s %dx%dx%d %dch", type_name(type), d[0], d[1], d[2], channels);
+    if (pair_create(&p, &s)) {
+        q = s.params;
+        write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
+        write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
+        BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
+        write_pattern(&p, HD_ILLUMINATION_DIRECT, 3.0f);
+        BOTH(&p, test_project, (p.ref, 1), (p.dut, 1));
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.1f);
+        BOTH(&p, test_project, (p.ref, 1), (p.dut, 1));
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        q.step = 1.7f;
+        BOTH(&p, set_params, (p.ref, &q), (p.dut, &q));
+        BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        q.albedo = 0.4f;
+        BOTH(&p, set_params, (p.ref, &q), (p.dut, &q));
+        write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
+        write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
+        BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, 1);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
 /* HD direct light alone, n passes with identical seeds. */
 static void case_direct(hd_voxel_type type, const int *d, int lights, int mixed, int point, hd_tracking tracking,
                         float majorant, int n)
@@ -798,6 +840,8 @@ int main(int argc, char **argv)
     case_diffusion(HD_VOXEL_F32, other, HD_SOLVER_JACOBI, 200, 1);
     case_diffusion(HD_VOXEL_U8, other, HD_SOLVER_RED_BLACK, 50, 3);
     case_project(HD_VOXEL_U8, other, 3, 4);
+    case_project_refresh(HD_VOXEL_U16, odd, 1);
+    case_project_refresh(HD_VOXEL_U8, other, 3);
     /* stochastic: direct light with identical seeds */
     for (t = 0; t < 3; ++t) case_direct(types[t], odd, 1, 0, 0, HD_TRACKING_RATIO, 0.0f, 16);
     case_direct(HD_VOXEL_U8, odd, 1, 0, 1, HD_TRACKING_RATIO, 0.0f, 16);

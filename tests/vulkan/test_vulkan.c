@@ -483,8 +483,9 @@ static void test_multigrid(void)
         ok = 0;
     }
     /* out of device memory inside the levels' allocation: limits from below red-black's needs
-       (about 280 KB here, staging buffer included) to above multigrid's (about 500 KB), 20 KB apart */
-    for (k = 0; k < 16; ++k) {
+       (staging buffer, the projection's summed light and TF table included) to above
+       multigrid's, 20 KB apart */
+    for (k = 0; k < 24; ++k) {
         snprintf(n, sizeof n, "%d", 240000 + 20000 * k);
         setenv("HD_VK_MEMORY_LIMIT", n, 1);
         d.params.solver = HD_SOLVER_RED_BLACK;
