@@ -47,6 +47,8 @@ static void make_desc(hd_desc *d, const uint8_t *vox, hd_light *light, hd_method
     d->params.method = method;
     d->params.extinction = 20.0f;
     d->params.seed = 77u;
+    d->params.illumination_downsample = 1; /* E voxel for voxel, compared per voxel below */
+    d->params.diffusion_boundary = HD_BOUNDARY_BOX;
 }
 
 typedef struct outputs {
