@@ -783,7 +783,7 @@ static hd_result hd__conv_alloc(hd__ctx *ctx)
             for (x = 0; x < ctx->gdims[0]; ++x) n += (size_t)hd__conv_in_medium(ctx, x, y, step / 2 + j * step);
     ctx->conv_idx = (uint32_t *)hd__alloc(ctx, (n ? n : 1) * sizeof(uint32_t));
     ctx->conv_prev = (float *)hd__calloc(ctx, (n ? n : 1) * 2 * (size_t)ctx->channels, sizeof(float));
-    ctx->conv_tmp = (float *)hd__alloc(ctx, (size_t)nz * slice * sizeof(float));
+    ctx->conv_tmp = (float *)hd__alloc(ctx, (size_t)nz * (size_t)ctx->channels * slice * sizeof(float));
     ctx->conv_zz = (int *)hd__alloc(ctx, (size_t)nz * (size_t)ctx->channels * sizeof(int));
     ctx->conv_off = (size_t *)hd__alloc(ctx, ((size_t)nz + 1) * sizeof(size_t));
     if (!ctx->conv_idx || !ctx->conv_prev || !ctx->conv_tmp || !ctx->conv_zz || !ctx->conv_off) {
@@ -804,8 +804,9 @@ static hd_result hd__conv_alloc(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Reads the measured slices of one illumination volume into the measured voxels' copies: *dsq
-   gets the sum of squared changes; for phi (read after E) *lsq gets the sum of squares of E + phi. */
+/* Reads the measured slices of one illumination volume, every channel in one read, into the
+   measured voxels' copies: *dsq gets the sum of squared changes; for phi (read after E) *lsq gets
+   the sum of squares of E + phi. */
 static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq, double *lsq)
 {
     hd_result r;
@@ -814,11 +815,11 @@ static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq,
     float *prev = ctx->conv_prev + (which == HD_ILLUMINATION_DIRECT ? 0 : m);
     double d = 0.0, l = 0.0;
     int c, j, nz = ctx->conv_nz;
-    for (c = 0; c < ctx->channels; ++c) {
-        if ((r = hd__be_read_illumination_slices(ctx, which, ctx->conv_zz + c * nz, nz, ctx->conv_tmp)) != HD_SUCCESS) return r;
+    if ((r = hd__be_read_illumination_slices(ctx, which, ctx->conv_zz, nz * ctx->channels, ctx->conv_tmp)) != HD_SUCCESS) return r;
+    for (c = 0; c < ctx->channels; ++c)
         for (j = 0; j < nz; ++j)
             for (i = ctx->conv_off[j]; i < ctx->conv_off[j + 1]; ++i) {
-                float v = ctx->conv_tmp[(size_t)j * slice + ctx->conv_idx[i]];
+                float v = ctx->conv_tmp[((size_t)c * nz + j) * slice + ctx->conv_idx[i]];
                 float e = v - prev[(size_t)c * n + i];
                 d += (double)e * e;
                 prev[(size_t)c * n + i] = v;
@@ -827,7 +828,6 @@ static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq,
                     l += t * t;
                 }
             }
-    }
     *dsq = d;
     *lsq = l;
     return HD_SUCCESS;

@@ -91,7 +91,7 @@ typedef struct hd__ctx {
     size_t *conv_off;        /* conv_nz + 1 starts in conv_idx, one per measured slice */
     int conv_nz;             /* measured slices per channel */
     float *conv_prev;        /* conv_count * channels values of E, then the same of phi */
-    float *conv_tmp;         /* the measured slices of one illumination volume read back */
+    float *conv_tmp;         /* the measured slices of one illumination volume read back, all channels */
     int conv_have_prev;      /* conv_prev holds the previous iteration */
     int conv_below;          /* light iterations in a row with light_error below the tolerance */
     double conv_dphi;        /* |phi_n - phi_n-1| of the previous iteration */
