@@ -14,6 +14,7 @@
 #include "hybriddiff.h"
 
 #include "hdbench_triad.h"
+#include "hd_bench_median.h"
 
 /* The plain constant-coefficient 7-point Jacobi stencil the issue's 70 % target was set with:
    b = (sum of a's 6 neighbours) / 7 over the grid's interior, zero boundary, z-slabs per
@@ -107,18 +108,6 @@ static double cpu_seconds(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
 /* --defaults: HD at 512^2 with 1 light, the paper's settings (hd_params_preset) against the
    library's defaults, in one process. After a warm-up iteration each, every round times one
    hd_refine(ctx, 1) (light only) and one hd_iterate(ctx, 1) (light and a projection frame) of
@@ -151,7 +140,7 @@ static int bench_defaults(const hd_volume_file *vf, int rounds, int nthreads)
     printf("| settings | illumination grid | bytes/voxel | hd_refine wall | CPU | hd_iterate wall | CPU | it/s (hd_iterate, wall) |\n");
     printf("|---|---|---|---|---|---|---|---|\n");
     for (k = 0; k < 2; ++k) {
-        for (m = 0; m < 4; ++m) med[k][m] = median(t[k][m], rounds);
+        for (m = 0; m < 4; ++m) med[k][m] = hdb_median(t[k][m], rounds);
         hd_get_stats(ctx[k], &st);
         printf("| %s | %dx%dx%d | %.2f | %.1f | %.1f | %.1f | %.1f | %.3f |\n", name[k], st.illumination_dims[0],
                st.illumination_dims[1], st.illumination_dims[2],

@@ -18,20 +18,9 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include "hd_bench_median.h"
 
 #define MAX_REPS 32
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* ms per direct pass over `iters` passes, the device drained before and after. */
 static double time_passes(hd_context h, int iters, int *ok)
@@ -91,7 +80,7 @@ static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int
             if (hd__direct_mask(ctx) != HD_SUCCESS) ok = 0;
             b[rep] = (hd__now() - t0) * 1e3;
         }
-        build = median(b, 3);
+        build = hdb_median(b, 3);
     }
     /* one untimed pass each: kernels compiled, pipelines made */
     for (m = 0; m < 2; ++m)
@@ -110,7 +99,7 @@ static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int
         if ((ctx->dl_bits[k >> 3] >> (k & 7) & 1u) ? e[0][i] != e[1][i] : e[0][i] != 0.0f) ++mismatch;
     }
     {
-        double a = median(ms[0], reps), b = median(ms[1], reps);
+        double a = hdb_median(ms[0], reps), b = hdb_median(ms[1], reps);
         printf("%-7s %-8s grid %dx%dx%d  tracked %zu of %zu voxels (%.1f %%), list %.2f bytes/voxel, mask build %.0f ms\n",
                hd_backend_name(), preset, st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2], tracked,
                gvox, 100.0 * (double)tracked / (double)gvox, 4.0 * (double)tracked / (double)gvox, build);

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "hd_bench_median.h"
 
 static const float mg_tf[] = {
     0.0f, 0.0f, 0.0f, 0.0f,     0.0f, 0.0f, 0.0f, 0.0f,       /* -1024, -512: air */
@@ -27,18 +28,6 @@ static double now(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 /* rel L2 of phi between the two contexts (n floats each). */
@@ -118,8 +107,8 @@ static int run_case(const hd_volume_file *vf, int boundary, int downsample, int 
     memset(&st, 0, sizeof st);
     hd_api_cpu.get_stats(h[0], &st);
     printf("%3dx%3dx%3d %-7s %10.1f %12.1f %8.2f %10.2e\n", st.illumination_dims[0], st.illumination_dims[1],
-           st.illumination_dims[2], boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", 1e3 * median(t[0], rounds),
-           1e3 * median(t[1], rounds), sum[1] / sum[0],
+           st.illumination_dims[2], boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", 1e3 * hdb_median(t[0], rounds),
+           1e3 * hdb_median(t[1], rounds), sum[1] / sum[0],
            phi_rel_l2(h[0], h[1], (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2]));
     fflush(stdout);
     api[0]->destroy(h[0]);

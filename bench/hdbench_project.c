@@ -24,6 +24,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
+#include "hd_bench_median.h"
 
 /* A CT transfer function over HU -1024..3071 (bench/hdbench.c's): skin faint, bone dense. */
 static const float bench_tf[] = {
@@ -46,12 +47,6 @@ static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *ligh
     d->camera.width = width;
     d->camera.height = height;
     d->logger.func = hd_log_stderr;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y ? 1 : 0);
 }
 
 /* File layout: int32 voxel count n, then E (n floats), then phi (n floats). */
@@ -165,7 +160,7 @@ int main(int argc, char **argv)
         ms[i] = (hd__now() - t) * 1e3;
     }
     cpu_ms = (double)(clock() - cpu0) * 1e3 / (double)CLOCKS_PER_SEC / (double)frames;
-    qsort(ms, (size_t)frames, sizeof(double), cmp_double);
+    qsort(ms, (size_t)frames, sizeof(double), hdb_cmp_double);
     if (width == height) printf("%-4s %-7s %4d^2     ", tag, hd_backend_name(), width);
     else printf("%-4s %-7s %4dx%-4d ", tag, hd_backend_name(), width, height);
     printf(" projection %8.1f ms/frame (median of %d, best %.1f; process CPU %.1f ms/frame)", ms[frames / 2], frames, ms[0],

@@ -20,21 +20,10 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include "hd_bench_median.h"
 
 #define MAX_REPS 32
 enum { EST = 2 };
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : (x > y ? 1 : 0);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 int main(int argc, char **argv)
 {
@@ -115,7 +104,7 @@ int main(int argc, char **argv)
     }
     printf("| estimator | ms per pass (median of %d) | relative noise of one pass | mean E | efficiency |\n|---|---|---|---|---|\n", reps);
     for (k = 0; k < EST; ++k) {
-        double m = median(ms[k], reps), noise1 = sqrt(var[k] * reps * passes), eff = 1.0 / (noise1 * noise1 * m);
+        double m = hdb_median(ms[k], reps), noise1 = sqrt(var[k] * reps * passes), eff = 1.0 / (noise1 * noise1 * m);
         if (k == 0) eff0 = eff;
         printf("| %s | %.1f | %.4f | %.6f | %.2f |\n", est_name[k], m, noise1, mean[k], eff / eff0);
     }

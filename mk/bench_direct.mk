@@ -20,13 +20,13 @@ RAYS_ARGS ?= --passes 4 --reps 5
 
 .PHONY: bench-direct bench-rays
 
-$(B)/hdbench_direct_%: bench/hdbench_direct.c examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
+$(B)/hdbench_direct_%: bench/hdbench_direct.c bench/hd_bench_median.h examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
 	$(CC) $(CPPFLAGS) $(DIRECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(DIRECT_LIB_$*)
 
 bench-direct: $(foreach b,$(DIRECT_BACKENDS),$(B)/hdbench_direct_$(b)) data
 	@for be in $(DIRECT_BACKENDS); do $(B)/hdbench_direct_$$be --iters $(DIRECT_ITERS) --reps $(DIRECT_REPS) data/head.nrrd || exit 1; done
 
-$(B)/hdbench_rays: bench/hdbench_rays.c examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
+$(B)/hdbench_rays: bench/hdbench_rays.c bench/hd_bench_median.h examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 bench-rays: $(B)/hdbench_rays data

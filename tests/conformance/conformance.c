@@ -262,6 +262,20 @@ static void report(const char *name, const pair *p, const guard *g, double l2, d
     else ++n_failed;
 }
 
+/* A whole-iteration case: a fresh pair runs n iterations, the selected outputs compared and
+   reported. */
+static void iterate_case(const char *name, const scene *s, const guard *g, int n, int what, int deterministic)
+{
+    pair p;
+    double l2 = 0.0, linf = 0.0;
+    if (pair_create(&p, s)) {
+        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
+        pair_compare(&p, what, &l2, &linf);
+    }
+    report(name, &p, g, l2, linf, deterministic);
+    pair_destroy(&p);
+}
+
 /* Identical E and phi written into both contexts: a hash pattern, so every voxel differs. */
 static void write_pattern(pair *p, hd_illumination which, float scale)
 {
@@ -453,9 +467,7 @@ static void case_downsample(hd_voxel_type type, const int *d, int factor, int rg
 {
     scene s;
     guard g;
-    pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
     scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
     s.params.illumination_downsample = factor;
     s.params.rgb_scattering = rgb;
@@ -463,12 +475,7 @@ static void case_downsample(hd_voxel_type type, const int *d, int factor, int rg
     guard_take(&g, &s);
     snprintf(name, sizeof name, "iterate x%d %s %dx%dx%d %dL grid /%d%s%s", n, type_name(type), d[0], d[1], d[2], lights, factor,
              rgb ? " rgb-scattering" : "", surface ? " surface-boundary" : "");
-    if (pair_create(&p, &s)) {
-        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
-    }
-    report(name, &p, &g, l2, linf, 0);
-    pair_destroy(&p);
+    iterate_case(name, &s, &g, n, CMP_E | CMP_PHI | CMP_IMAGE, 0);
     guard_free(&g);
     scene_free(&s);
 }
@@ -491,7 +498,6 @@ static void case_half(hd_method method, hd_voxel_type type, const int *d, int li
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
     hd_desc desc;
     hd_result r;
     scene_init(&s, type, d[0], d[1], d[2], lights, rgb, 1);
@@ -510,12 +516,7 @@ static void case_half(hd_method method, hd_voxel_type type, const int *d, int li
         ++n_skipped;
     } else {
         if (r == HD_SUCCESS) hd_api_backend.destroy(p.dut);
-        if (pair_create(&p, &s)) {
-            BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-            pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
-        }
-        report(name, &p, &g, l2, linf, 0);
-        pair_destroy(&p);
+        iterate_case(name, &s, &g, n, CMP_E | CMP_PHI | CMP_IMAGE, 0);
     }
     guard_free(&g);
     scene_free(&s);
@@ -582,21 +583,14 @@ static void case_method(hd_method method, hd_voxel_type type, const int *d, int 
 {
     scene s;
     guard g;
-    pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
     int det = method == HD_METHOD_CD;
     scene_init(&s, type, d[0], d[1], d[2], lights, mixed, point);
     s.params.method = method;
     guard_take(&g, &s);
     snprintf(name, sizeof name, "%s x%d %s %dx%dx%d %dL %s%s", hd_api_cpu.method_name(method), n, type_name(type), d[0], d[1], d[2],
              lights, point ? "dir+point" : "dir", mixed ? " rgb" : "");
-    if (pair_create(&p, &s)) {
-        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-        pair_compare(&p, det ? CMP_E | CMP_PHI | CMP_IMAGE : CMP_IMAGE, &l2, &linf);
-    }
-    report(name, &p, &g, l2, linf, det);
-    pair_destroy(&p);
+    iterate_case(name, &s, &g, n, det ? CMP_E | CMP_PHI | CMP_IMAGE : CMP_IMAGE, det);
     guard_free(&g);
     scene_free(&s);
 }
@@ -759,9 +753,7 @@ static void case_shell(hd_voxel_type type, const int *d, int factor, int surface
 {
     scene s;
     guard g;
-    pair p;
     char name[128], why[128];
-    double l2 = 0.0, linf = 0.0;
     const hd_api *api[2] = {&hd_api_cpu, &hd_api_backend};
     int a;
     shell_init(&s, type, d, lights);
@@ -782,12 +774,7 @@ static void case_shell(hd_voxel_type type, const int *d, int factor, int surface
     }
     snprintf(name, sizeof name, "shell iterate x%d %s %dx%dx%d %dL grid /%d%s", n, type_name(type), d[0], d[1], d[2], lights,
              factor, surface ? " surface-boundary" : "");
-    if (pair_create(&p, &s)) {
-        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
-    }
-    report(name, &p, &g, l2, linf, 0);
-    pair_destroy(&p);
+    iterate_case(name, &s, &g, n, CMP_E | CMP_PHI | CMP_IMAGE, 0);
     guard_free(&g);
     scene_free(&s);
 }
