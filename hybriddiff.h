@@ -660,6 +660,7 @@ extern char *realpath(const char *path, char *resolved);
 #include "backends/hd_cpu.h"
 #include "backends/hd_cpu_multigrid.h"
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
+#include "src/hd_gpu.h"
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
 #include "backends/hd_vulkan.h"

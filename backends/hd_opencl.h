@@ -55,8 +55,23 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
     "hd_k_mg_extrap"};
 
-struct hd__cl_mg; /* HD_SOLVER_MULTIGRID's levels and vectors (the hd__be_mg_* primitives, at the end) */
-static void hd__cl_mg_free(hd__ctx *ctx);
+/* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
+typedef struct hd__cl_level {
+    int dims[3];
+    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    int kp_sent;             /* params holds kp */
+    cl_mem params;
+    cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
+    cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
+} hd__cl_level;
+
+struct hd__cl_mg {
+    hd__cl_level lv[HD__MG_MAX_LEVELS];
+    cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
+    cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
+    cl_mem line;             /* the restriction's row buffer: a fine row's shares per coarse row */
+    double *host_dot;        /* their host copy, one row sum per fine row */
+};
 
 struct hd__backend {
     hd__ctx *ctx;
@@ -68,23 +83,22 @@ struct hd__backend {
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
     cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
-    cl_mem *lv;              /* CD: nlv light volumes + one spare (the ping-pong buffer) */
+    cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
        lsum_ok (cleared by every pass that writes E or phi), and the step's TF table, uploaded when
        its host copy ptab_host (ptab_n entries) changes */
     cl_mem lsum, ptab;
     int lsum_ok, ptab_n;
     float *ptab_host;
-    int nlv;
-    size_t tf_bytes, illum_floats, img_floats;
-    size_t illum_slots;      /* elements of E, phi, phi2 in the colour layout (>= illum_floats) */
+    size_t tf_bytes, img_floats;
     int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
     int params_valid;
     int lost;                /* a call reported a lost device: every later call fails fast */
     int fp64;                /* the device has cl_khr_fp64 (multigrid's double passes) */
-    struct hd__cl_mg *mg;    /* multigrid levels, NULL until first used */
+    hd__gpu_grids gg;        /* what the grids are made for (src/hd_gpu.h) */
+    struct hd__cl_mg mg;     /* multigrid's extras and grids while gg.levels */
 };
 
 static const char *hd__be_name(void) { return "opencl"; }
@@ -305,15 +319,34 @@ static hd_result hd__cl_zero(hd__ctx *ctx, cl_mem m, size_t floats)
     return HD_SUCCESS;
 }
 
-static void hd__cl_free_lights(hd__ctx *ctx)
+/* Grid id's buffer (src/hd_gpu.h). */
+static cl_mem *hd__cl_grid(hd__backend *be, int id)
 {
-    hd__backend *be = ctx->be;
-    int l;
-    if (!be->lv) return;
-    for (l = 0; l <= be->nlv; ++l) hd__cl_release(&be->lv[l]);
-    hd__free(ctx, be->lv);
-    be->lv = NULL;
-    be->nlv = 0;
+    cl_mem *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
+    hd__cl_level *L = &be->mg.lv[HD__G_LEVEL_OF(id)];
+    cl_mem *level[4] = {&L->sig, &L->rhs, &L->phi, &L->res}; /* by HD__G_MG_SIG, _RHS, _PHI, _RES */
+    return id < HD__G_MG_LEVELS ? named[id] : id >= HD__G_LIGHT ? &be->lv[id - HD__G_LIGHT] : level[(id - HD__G_MG_LEVELS) % 4];
+}
+
+/* E, phi, phi2: in the colour layout (hd__split_slots), 2 bytes per binary16 element rounded up
+   to whole floats (hd__cl_buffer's 4-byte fill reaches the end); sigma_t and the multigrid's
+   grids in the colour layout too; the summed light and the light volumes x-fastest floats. */
+static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+{
+    size_t n = id == HD__G_LSUM || id >= HD__G_LIGHT ? (size_t)w * h * d : hd__split_slots(w, h, (size_t)d);
+    int half = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2;
+    hd__cl_release(hd__cl_grid(ctx->be, id));
+    return hd__cl_buffer(ctx, hd__cl_grid(ctx->be, id), half ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float), NULL, what);
+}
+
+static void hd__gpu_grid_free(hd__ctx *ctx, int id) { hd__cl_release(hd__cl_grid(ctx->be, id)); }
+
+static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
+{
+    cl_mem m = *hd__cl_grid(ctx->be, id);
+    size_t bytes = 0;
+    if (m) HD__CL_TRY(ctx, clGetMemObjectInfo(m, CL_MEM_SIZE, sizeof bytes, &bytes, NULL), "clGetMemObjectInfo(CL_MEM_SIZE)");
+    return hd__cl_zero(ctx, m, bytes / sizeof(float));
 }
 
 /* ---- life cycle -------------------------------------------------------------------------- */
@@ -323,13 +356,9 @@ static void hd__be_destroy(hd__ctx *ctx)
     int k;
     if (!be) return;
     if (be->queue) clFinish(be->queue);
-    hd__cl_free_lights(ctx);
-    hd__cl_mg_free(ctx);
-    hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf);
-    hd__cl_release(&be->maj); hd__cl_release(&be->sig); hd__cl_release(&be->E);
-    hd__cl_release(&be->phi); hd__cl_release(&be->phi2); hd__cl_release(&be->img);
-    hd__cl_release(&be->dl);
-    hd__cl_release(&be->lsum); hd__cl_release(&be->ptab);
+    hd__gpu_free(ctx, &be->gg);
+    hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf); hd__cl_release(&be->maj);
+    hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab);
     hd__free(ctx, be->ptab_host);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
@@ -390,13 +419,6 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Bytes of an illumination buffer (E, phi, phi2) of n elements: 4 per float, 2 per binary16,
-   rounded up to whole floats so hd__cl_buffer's and hd__cl_zero's 4-byte fill reaches the end. */
-static size_t hd__cl_illum_bytes(const hd__backend *be, size_t n)
-{
-    return be->f16 ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float);
-}
-
 /* Elements of a colour-layout grid of `slices` z-slices (gz per channel): each row of gx voxels
    takes 2 * ((gx + 1) / 2) slots, one of them padding when gx is odd. */
 #define HD__BE_SPLIT_LAYOUT 1 /* hd_get_stats counts the layout's padding slots */
@@ -426,37 +448,16 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
 
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
-    hd__backend *be = ctx->be;
-    size_t slots = illum_floats ? hd__cl_slots(ctx, (size_t)ctx->gdims[2] * (size_t)ctx->channels) : 0, bytes;
-    hd_result r;
     HD__CL_LOST_CHECK(ctx);
-    hd__cl_mg_free(ctx); /* its fine grid is this one */
-    hd__cl_release(&be->sig); hd__cl_release(&be->E); hd__cl_release(&be->phi); hd__cl_release(&be->phi2);
-    hd__cl_release(&be->lsum);
-    be->lsum_ok = 0;
-    be->illum_floats = 0;
-    be->illum_slots = 0;
-    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    bytes = hd__cl_illum_bytes(be, slots);
-    if ((r = hd__cl_buffer(ctx, &be->sig, hd__cl_slots(ctx, (size_t)ctx->gdims[2] * (size_t)ctx->sig_channels) * sizeof(float),
-                           NULL, "sigma_t")) != HD_SUCCESS)
-        return r;
-    if ((r = hd__cl_buffer(ctx, &be->E, bytes, NULL, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->phi, bytes, NULL, "phi")) != HD_SUCCESS) return r;
-    if (illum_floats && (r = hd__cl_buffer(ctx, &be->lsum, illum_floats * sizeof(float), NULL, "the summed light")) != HD_SUCCESS)
-        return r;
-    be->illum_floats = illum_floats;
-    be->illum_slots = slots;
-    return HD_SUCCESS;
+    ctx->be->lsum_ok = 0;
+    ctx->be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
 }
 
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
-    hd__backend *be = ctx->be;
     HD__CL_LOST_CHECK(ctx);
-    hd__cl_release(&be->phi2);
-    if (!enable) return HD_SUCCESS;
-    return hd__cl_buffer(ctx, &be->phi2, hd__cl_illum_bytes(be, be->illum_slots), NULL, "Jacobi's buffer");
+    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
 }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
@@ -474,15 +475,11 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
-    hd_result r = HD_SUCCESS;
-    size_t n = hd__cl_illum_bytes(be, be->illum_slots) / sizeof(float); /* in floats' worth of bytes */
+    hd_result r;
     HD__CL_LOST_CHECK(ctx);
     if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((what & HD__DIRTY_DIRECT) && (r = hd__cl_zero(ctx, be->E, n)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi, n)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__cl_zero(ctx, be->phi2, n)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_IMAGE) && (r = hd__cl_zero(ctx, be->img, be->img_floats)) != HD_SUCCESS) return r;
-    return r;
+    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    return (what & HD__DIRTY_IMAGE) ? hd__cl_zero(ctx, be->img, be->img_floats) : HD_SUCCESS;
 }
 
 /* ---- dispatch ------------------------------------------------------------------------------ */
@@ -697,7 +694,7 @@ static hd_result hd__cl_map_illumination(hd__ctx *ctx, hd_illumination which, cl
     hd__backend *be = ctx->be;
     cl_int e;
     *out = clEnqueueMapBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, flags, 0,
-                              be->illum_slots * (be->f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
+                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
     if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
     return HD_SUCCESS;
 }
@@ -758,26 +755,10 @@ HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_ill
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
-/* Frees the old light volumes and allocates count + 1 zeroed ones (count lights and a spare that
-   rotates through them as the ping-pong buffer); count 0 frees them. As hd_cpu.h. */
 static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 {
-    hd__backend *be = ctx->be;
-    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
-    hd_result r;
-    int l;
     HD__CL_LOST_CHECK(ctx);
-    hd__cl_free_lights(ctx);
-    if (count <= 0) return HD_SUCCESS;
-    be->lv = (cl_mem *)hd__calloc(ctx, (size_t)count + 1, sizeof(cl_mem));
-    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate %d light volume handles", count);
-    be->nlv = count;
-    for (l = 0; l <= count; ++l)
-        if ((r = hd__cl_buffer(ctx, &be->lv[l], gvox * sizeof(float), NULL, "a CD light volume")) != HD_SUCCESS) {
-            hd__cl_free_lights(ctx);
-            return r;
-        }
-    return HD_SUCCESS;
+    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
 }
 
 /* One convection step of light `light`: reads its volume, writes the spare, the two swap. */
@@ -788,10 +769,10 @@ static hd_result hd__be_convect(hd__ctx *ctx, int light)
     cl_mem t;
     hd_result r;
     HD__CL_ARG(ctx, HD__CL_CONVECT, 11, l);
-    if ((r = hd__cl_mems(ctx, HD__CL_CONVECT, 9, 2, be->lv[light], be->lv[be->nlv])) != HD_SUCCESS ||
+    if ((r = hd__cl_mems(ctx, HD__CL_CONVECT, 9, 2, be->lv[light], be->lv[be->gg.nlv])) != HD_SUCCESS ||
         (r = hd__cl_bind_run(ctx, HD__CL_CONVECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
         return r;
-    t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
+    t = be->lv[light]; be->lv[light] = be->lv[be->gg.nlv]; be->lv[be->gg.nlv] = t;
     return hd__cl_finish(ctx);
 }
 
@@ -804,7 +785,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     int l;
     be->lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
-    for (l = 0; l < be->nlv; ++l) {
+    for (l = 0; l < be->gg.nlv; ++l) {
         cl_int li = l, first = l == 0;
         HD__CL_ARG(ctx, k, 10, li);
         HD__CL_ARG(ctx, k, 11, first);
@@ -837,117 +818,66 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { r
    operations in the same order, so the result has the CPU's bits wherever the kernels do (the
    conformance suite measures it). */
 
-typedef struct hd__cl_level {
-    int dims[3];
-    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    int kp_sent;             /* params holds kp */
-    cl_mem params;
-    cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
-    cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
-} hd__cl_level;
-
-struct hd__cl_mg {
-    hd__cl_level lv[HD__MG_MAX_LEVELS];
-    int levels, channels, sig_channels, fine[3];
-    cl_mem p, lo;            /* the search direction; the iterate's low part (phi + lo) */
-    cl_mem dot_a, dot_b;     /* per-row partial sums (double) */
-    cl_mem line;             /* the restriction's row buffer: a fine row's shares per coarse row */
-    double *host_dot;        /* their host copy, one row sum per fine row */
-};
-
 static size_t hd__cl_mg_slots(const int *d, int channels)
 {
     return hd__split_slots(d[0], d[1], (size_t)channels * d[2]);
 }
-static size_t hd__cl_mg_rows(const struct hd__cl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
+static size_t hd__cl_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
 /* The restriction's row buffer: a padded fine row per coarse row of level 1, the largest. */
-static size_t hd__cl_mg_line_floats(const struct hd__cl_mg *mg)
+static size_t hd__cl_mg_line_floats(const hd__gpu_grids *g)
 {
-    return 2 * (((size_t)mg->fine[0] + 1) / 2) * (size_t)(mg->fine[1] / 2) * (size_t)(mg->fine[2] / 2) * (size_t)mg->channels;
-}
-
-static void hd__cl_mg_free(hd__ctx *ctx)
-{
-    struct hd__cl_mg *mg = ctx->be->mg;
-    int l;
-    if (!mg) return;
-    for (l = 0; l < mg->levels; ++l) {
-        hd__cl_level *L = &mg->lv[l];
-        hd__cl_release(&L->params); hd__cl_release(&L->sig); hd__cl_release(&L->rhs);
-        hd__cl_release(&L->phi); hd__cl_release(&L->res);
-    }
-    hd__cl_release(&mg->p); hd__cl_release(&mg->lo); hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b);
-    hd__cl_release(&mg->line);
-    hd__free(ctx, mg->host_dot);
-    hd__free(ctx, mg);
-    ctx->be->mg = NULL;
+    return 2 * (((size_t)g->fine[0] + 1) / 2) * (size_t)(g->fine[1] / 2) * (size_t)(g->fine[2] / 2) * (size_t)g->channels;
 }
 
 /* Bytes the solver holds on the device (as the CPU's hd__be_solver_bytes: counted in
-   method_bytes); 0 without it. */
+   method_bytes); 0 without it. Its grids are padded to the colour layout. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 {
-    const struct hd__cl_mg *mg = ctx->be->mg;
+    const hd__gpu_grids *g = &ctx->be->gg;
     size_t b;
-    int l;
-    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    b = 2 * sizeof(double) * hd__cl_mg_rows(mg) + 2 * sizeof(float) * hd__cl_mg_slots(mg->fine, mg->channels);
-    b += sizeof(float) * hd__cl_mg_line_floats(mg);
-    for (l = 0; l < mg->levels; ++l) {
-        b += 3 * sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->channels);
-        if (l > 0) b += sizeof(float) * hd__cl_mg_slots(mg->lv[l].dims, mg->sig_channels);
+    int l, d[3];
+    if (!g->levels || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    b = 2 * sizeof(double) * hd__cl_mg_rows(g) + 2 * sizeof(float) * hd__cl_mg_slots(g->fine, g->channels);
+    b += sizeof(float) * hd__cl_mg_line_floats(g);
+    for (l = 0; l < g->levels; ++l) {
+        hd__mg_level_dims(g->fine, l, d);
+        b += 3 * sizeof(float) * hd__cl_mg_slots(d, g->channels);
+        if (l > 0) b += sizeof(float) * hd__cl_mg_slots(d, g->sig_channels);
     }
     return b;
 }
 
-/* The levels (hd__mg_levels) and CG's vectors, zeroed. */
-static hd_result hd__cl_mg_alloc(hd__ctx *ctx)
+/* The levels' dims and parameter blocks, the row sums (device and host) and the row buffer. */
+static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg;
-    int l, i, n, d[3];
-    hd_result r;
-    size_t rows;
-    be->mg = mg = (struct hd__cl_mg *)hd__calloc(ctx, 1, sizeof *mg);
-    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the multigrid levels");
-    mg->channels = ctx->channels;
-    mg->sig_channels = ctx->sig_channels;
-    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
-    rows = hd__cl_mg_rows(mg);
-    mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double));
-    if (!mg->host_dot) { hd__cl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows"); }
-    if ((r = hd__cl_buffer(ctx, &mg->p, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's p")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->lo, hd__cl_mg_slots(d, mg->channels) * sizeof(float), NULL, "multigrid's lo")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(mg) * sizeof(float), NULL, "multigrid's row buffer")) != HD_SUCCESS) {
-        hd__cl_mg_free(ctx);
-        return r;
-    }
-    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
+    struct hd__cl_mg *mg = &be->mg;
+    size_t rows = hd__cl_mg_rows(&be->gg);
+    hd_result r = HD_SUCCESS;
+    int l;
+    for (l = 0; l < be->gg.levels; ++l) {
         hd__cl_level *L = &mg->lv[l];
-        size_t bytes;
-        hd__mg_level_dims(mg->fine, l, d);
-        bytes = hd__cl_mg_slots(d, mg->channels) * sizeof(float);
-        memcpy(L->dims, d, sizeof d);
-        mg->levels = l + 1;
-        if ((r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters")) != HD_SUCCESS ||
-            (r = hd__cl_buffer(ctx, &L->rhs, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__cl_buffer(ctx, &L->phi, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__cl_buffer(ctx, &L->res, bytes, NULL, "a multigrid level")) != HD_SUCCESS ||
-            (l > 0 && (r = hd__cl_buffer(ctx, &L->sig, hd__cl_mg_slots(d, mg->sig_channels) * sizeof(float), NULL,
-                                         "a multigrid level's sigma_t")) != HD_SUCCESS)) {
-            hd__cl_mg_free(ctx);
-            return r;
-        }
+        hd__cl_release(&L->params);
+        L->kp_sent = 0;
+        hd__mg_level_dims(be->gg.fine, l, L->dims);
+        if (make && r == HD_SUCCESS) r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters");
     }
-    return HD_SUCCESS;
+    hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b); hd__cl_release(&mg->line);
+    hd__free(ctx, mg->host_dot);
+    mg->host_dot = NULL;
+    if (!make || r != HD_SUCCESS) return r;
+    if (!(mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double))))
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows");
+    if ((r = hd__cl_buffer(ctx, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS)
+        return r;
+    return hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(&be->gg) * sizeof(float), NULL, "multigrid's row buffer");
 }
 
 /* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
 static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
 {
-    hd__cl_level *L = &ctx->be->mg->lv[l];
+    hd__cl_level *L = &ctx->be->mg.lv[l];
     hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
     if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
     HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, L->params, CL_TRUE, 0, sizeof kp, &kp, 0, NULL, NULL), "clEnqueueWriteBuffer(multigrid level parameters)");
@@ -957,13 +887,13 @@ static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
 }
 
 /* Level l's sigma_t buffer. */
-static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg->lv[l].sig; }
+static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg.lv[l].sig; }
 
 /* Kernel k over level l's voxels (channels of them stacked in z), its first n arguments the
    buffers following n. */
 static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n, ...)
 {
-    const int *d = ctx->be->mg->lv[l].dims;
+    const int *d = ctx->be->mg.lv[l].dims;
     va_list ap;
     hd_result r;
     va_start(ap, n);
@@ -975,7 +905,7 @@ static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n,
 /* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
 static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
 {
-    return hd__cl_colour_passes(ctx, k, ctx->be->mg->lv[l].dims, ctx->be->mg->channels, arg, first, n);
+    return hd__cl_colour_passes(ctx, k, ctx->be->mg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
 }
 
 /* n colour passes of kernel k with level l bound to its nine HD__CL_BUFFERS arguments: sigma_t,
@@ -984,7 +914,7 @@ static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int f
 static hd_result hd__cl_mg_level_passes(hd__ctx *ctx, int k, int l, int first, int n)
 {
     hd__backend *be = ctx->be;
-    hd__cl_level *L = &be->mg->lv[l];
+    hd__cl_level *L = &be->mg.lv[l];
     hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, hd__cl_mg_sig(be, l), L->rhs, L->phi, L->res, be->img);
     return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, l, 9, first, n);
 }
@@ -1004,8 +934,9 @@ static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
    argument 5 of the first is the transfers' mask, the fine sigma_t (hd_mg_medium). */
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
+    struct hd__cl_mg *mg = &be->mg;
     hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
     hd_result r;
     cl_int parity;
@@ -1015,16 +946,16 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
     for (parity = 0; parity < 2; ++parity) {
         HD__CL_ARG(ctx, HD__CL_MG_RESTRICT_LINE, 4, parity);
         if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
-                            (size_t)C->dims[2] * (size_t)mg->channels)) != HD_SUCCESS)
+                            (size_t)C->dims[2] * (size_t)g->channels)) != HD_SUCCESS)
             return r;
     }
-    return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, mg->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, g->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
 }
 
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    hd__cl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
+    hd__cl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
     hd_result r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, L->params, C->params, C->phi, L->phi);
     if (r == HD_SUCCESS) r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, hd__cl_mg_sig(be, l));
     return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, l, 4, 0, 2);
@@ -1039,16 +970,17 @@ static hd_result hd__cl_mg_res_f64(hd__ctx *ctx, cl_mem params, cl_mem E, cl_mem
     hd_result r;
     HD__CL_ARG(ctx, k, 7, use_lo);
     HD__CL_ARG(ctx, k, 8, negate);
-    if ((r = hd__cl_mems(ctx, k, 0, 6, params, be->sig, E, phi, be->mg->lo, out)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_mems(ctx, k, 0, 6, params, be->sig, E, phi, be->mg.lo, out)) != HD_SUCCESS) return r;
     return hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
 }
 
 /* Enqueues <a, b> per fine row into dot (double per row). */
 static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot)
 {
-    struct hd__cl_mg *mg = ctx->be->mg;
+    const hd__gpu_grids *g = &ctx->be->gg;
+    struct hd__cl_mg *mg = &ctx->be->mg;
     hd_result r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, mg->lv[0].params, a, b, dot);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)mg->fine[1], (size_t)mg->fine[2] * (size_t)mg->channels, 1);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)g->fine[1], (size_t)g->fine[2] * (size_t)g->channels, 1);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1060,10 +992,8 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     HD__CL_LOST_CHECK(ctx);
     if (!be->fp64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if (be->mg && hd__mg_stale(ctx, be->mg->fine, be->mg->channels, be->mg->sig_channels)) hd__cl_mg_free(ctx);
-    *fresh = !be->mg;
-    if (!be->mg && (r = hd__cl_mg_alloc(ctx)) != HD_SUCCESS) return r;
-    for (l = 0; l < be->mg->levels; ++l)
+    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
+    for (l = 0; l < be->gg.levels; ++l)
         if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
     return hd__cl_send_params(ctx);
 }
@@ -1076,39 +1006,40 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    return hd__cl_mg_pass(ctx, HD__CL_MG_SIG, l, mg->sig_channels, 4, mg->lv[l - 1].params, mg->lv[l].params,
+    struct hd__cl_mg *mg = &be->mg;
+    return hd__cl_mg_pass(ctx, HD__CL_MG_SIG, l, ctx->be->gg.sig_channels, 4, mg->lv[l - 1].params, mg->lv[l].params,
                           hd__cl_mg_sig(be, l - 1), mg->lv[l].sig);
 }
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
 {
-    struct hd__cl_mg *mg = ctx->be->mg;
-    return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(mg->fine, mg->channels));
+    const hd__gpu_grids *g = &ctx->be->gg;
+    struct hd__cl_mg *mg = &ctx->be->mg;
+    return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(g->fine, g->channels));
 }
 
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    return hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, be->mg->lv[0].rhs, 1, 0);
+    return hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, be->mg.lv[0].rhs, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 {
-    struct hd__cl_mg *mg = ctx->be->mg;
+    struct hd__cl_mg *mg = &ctx->be->mg;
     return hd__cl_mg_dot_rows(ctx, mg->lv[0].rhs, mg->lv[0].phi, mg->dot_a);
 }
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
-    struct hd__cl_mg *mg = ctx->be->mg;
+    struct hd__cl_mg *mg = &ctx->be->mg;
     HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, beta);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_DIR, 0, mg->channels, 3, mg->lv[0].params, mg->lv[0].phi, mg->p);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_DIR, 0, ctx->be->gg.channels, 3, mg->lv[0].params, mg->lv[0].phi, mg->p);
 }
 
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
-    struct hd__cl_mg *mg = ctx->be->mg;
+    struct hd__cl_mg *mg = &ctx->be->mg;
     hd__cl_level *L = &mg->lv[0];
     hd_result r;
     if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS ||
@@ -1121,8 +1052,8 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
     hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = be->mg;
-    size_t rows = hd__cl_mg_rows(mg);
+    struct hd__cl_mg *mg = &be->mg;
+    size_t rows = hd__cl_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i)
         HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, i ? mg->dot_b : mg->dot_a, CL_TRUE, 0, rows * sizeof(double),
@@ -1137,7 +1068,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     hd__backend *be = ctx->be;
     be->lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->mg->channels, 4, be->mg->lv[0].params, be->phi, be->mg->lo, be->mg->p);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->gg.channels, 4, be->mg.lv[0].params, be->phi, be->mg.lo, be->mg.p);
 }
 
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
@@ -1146,5 +1077,5 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
     cl_int c = colour;
     be->lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->mg->channels, 5, be->params, be->sig, be->E, be->phi, be->mg->lo);
+    return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->gg.channels, 5, be->params, be->sig, be->E, be->phi, be->mg.lo);
 }

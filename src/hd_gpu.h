@@ -1,0 +1,165 @@
+/* hd_gpu.h - the grids of the GPU backends (hd_opencl.h, hd_vulkan.h, hd_gl.h), made, zeroed and
+   freed once here over three primitives each of them defines: sigma_t, E, phi, phi2, the
+   projection's summed light, CD's light volumes and HD_SOLVER_MULTIGRID's levels and vectors.
+   A grid is named by its id (HD__G_*); the backend keeps it in its own form (a buffer, a 3D
+   texture or image) and chooses the format from the id: E, phi and phi2 at the illumination
+   precision, the others float. What the backend makes besides (parameter blocks, row sums,
+   descriptor sets) follows the levels through hd__gpu_mg_extras.
+   Included before the GPU backend, after src/hd_backend.h; it calls only the primitives below. */
+#ifndef HD_GPU_H
+#define HD_GPU_H
+
+/* The grids' ids: the illumination grids, multigrid's p and lo, level l's grids (HD__G_MG), CD's
+   light volumes (HD__G_LIGHT + l; l = nlv is the spare the convection writes). */
+enum { HD__G_SIG, HD__G_E, HD__G_PHI, HD__G_PHI2, HD__G_LSUM, HD__G_MG_P, HD__G_MG_LO, HD__G_MG_LEVELS,
+       HD__G_LIGHT = HD__G_MG_LEVELS + 4 * HD__MG_MAX_LEVELS };
+/* level l's sigma_t (l >= 1; level 0 reads HD__G_SIG), right-hand side, correction, residual */
+enum { HD__G_MG_SIG, HD__G_MG_RHS, HD__G_MG_PHI, HD__G_MG_RES };
+#define HD__G_MG(l, k) (HD__G_MG_LEVELS + 4 * (l) + (k))
+/* The level of a level's grid id, 0 for the other ids (a backend's lookup indexes its levels by it). */
+#define HD__G_LEVEL_OF(id) ((id) >= HD__G_MG_LEVELS && (id) < HD__G_LIGHT ? ((id) - HD__G_MG_LEVELS) / 4 : 0)
+
+/* What the grids are made for: E and phi's values (0: none, the path tracers), CD's lights and
+   the multigrid's levels (0: none) on fine grid `fine` with channels and sig_channels. */
+typedef struct hd__gpu_grids {
+    size_t illum_floats;
+    int nlv;
+    int levels, channels, sig_channels, fine[3];
+} hd__gpu_grids;
+
+/* ---- the primitives a GPU backend defines -------------------------------------------------- */
+/* Grid id as w x h x d values (channels stacked in d), zeroed (a device backend may record the
+   zeroing for its next submission). A grid id already holds is freed first. */
+static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what);
+/* Frees grid id (first submitting what the backend recorded that may use it); nothing when it
+   holds none. */
+static void hd__gpu_grid_free(hd__ctx *ctx, int id);
+/* Zeroes grid id; nothing when it holds none. */
+static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id);
+/* The backend's own multigrid objects for the levels its hd__gpu_grids describes: made (make = 1; on failure
+   hd__gpu_mg_free follows) or freed (make = 0, also when partly made). */
+static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make);
+
+/* ---- the life cycle, for the backends' hd__be_alloc_* and hd__be_clear ---------------------- */
+/* Frees the multigrid's levels, vectors and extras. */
+static void hd__gpu_mg_free(hd__ctx *ctx, hd__gpu_grids *g)
+{
+    int l, k;
+    if (!g->levels) return;
+    hd__gpu_mg_extras(ctx, 0);
+    for (l = 0; l < g->levels; ++l)
+        for (k = 0; k < 4; ++k) hd__gpu_grid_free(ctx, HD__G_MG(l, k));
+    hd__gpu_grid_free(ctx, HD__G_MG_P);
+    hd__gpu_grid_free(ctx, HD__G_MG_LO);
+    g->levels = 0;
+}
+
+/* The multigrid's grids for ctx's grid and channels: kept when they fit (*fresh = 0), else made
+   anew, zeroed, with the backend's extras (*fresh = 1). */
+static hd_result hd__gpu_mg_ready(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
+{
+    int l, n, d[3];
+    hd_result r;
+    if (g->levels && hd__mg_stale(ctx, g->fine, g->channels, g->sig_channels)) hd__gpu_mg_free(ctx, g);
+    *fresh = !g->levels;
+    if (g->levels) return HD_SUCCESS;
+    g->channels = ctx->channels;
+    g->sig_channels = ctx->sig_channels;
+    memcpy(g->fine, ctx->gdims, sizeof g->fine);
+    g->levels = 1; /* from here on hd__gpu_mg_free frees what was made */
+    r = hd__gpu_grid_new(ctx, HD__G_MG_P, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's p");
+    if (r == HD_SUCCESS) r = hd__gpu_grid_new(ctx, HD__G_MG_LO, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's lo");
+    for (l = 0, n = hd__mg_levels(g->fine); l < n && r == HD_SUCCESS; ++l) {
+        hd__mg_level_dims(g->fine, l, d);
+        g->levels = l + 1;
+        if ((r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_RHS), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+                HD_SUCCESS &&
+            (r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_PHI), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+                HD_SUCCESS &&
+            (r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_RES), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+                HD_SUCCESS &&
+            l > 0)
+            r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_SIG), d[0], d[1], d[2] * g->sig_channels, "a multigrid level's sigma_t");
+    }
+    if (r == HD_SUCCESS) r = hd__gpu_mg_extras(ctx, 1);
+    if (r != HD_SUCCESS) hd__gpu_mg_free(ctx, g);
+    return r;
+}
+
+/* Bytes of the multigrid's state on a backend whose grids are unpadded (hd__mg_bytes); 0 without
+   it or with another solver. */
+HD__MAYBE_UNUSED static size_t hd__gpu_solver_bytes(const hd__ctx *ctx, const hd__gpu_grids *g)
+{
+    if (!g->levels || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    return hd__mg_bytes(g->fine, g->levels, g->channels, g->sig_channels);
+}
+
+/* hd__be_alloc_illumination: sigma_t, E, phi (at the precision the backend chose) and the
+   summed light anew for ctx's grid, or none (illum_floats 0); phi2 and the levels go with them. */
+static hd_result hd__gpu_alloc_illumination(hd__ctx *ctx, hd__gpu_grids *g, size_t illum_floats)
+{
+    const int *gd = ctx->gdims;
+    hd_result r;
+    int id;
+    hd__gpu_mg_free(ctx, g); /* its fine grid is this one */
+    for (id = HD__G_SIG; id <= HD__G_LSUM; ++id) hd__gpu_grid_free(ctx, id);
+    g->illum_floats = 0;
+    if (illum_floats == 0) return HD_SUCCESS;
+    if ((r = hd__gpu_grid_new(ctx, HD__G_SIG, gd[0], gd[1], gd[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(ctx, HD__G_E, gd[0], gd[1], gd[2] * ctx->channels, "E")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(ctx, HD__G_PHI, gd[0], gd[1], gd[2] * ctx->channels, "phi")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(ctx, HD__G_LSUM, gd[0], gd[1], gd[2] * ctx->channels, "the summed light")) != HD_SUCCESS)
+        return r;
+    g->illum_floats = illum_floats;
+    return HD_SUCCESS;
+}
+
+/* hd__be_alloc_jacobi: phi2 while enabled and the illumination grids exist. */
+static hd_result hd__gpu_alloc_jacobi(hd__ctx *ctx, const hd__gpu_grids *g, int enable)
+{
+    hd__gpu_grid_free(ctx, HD__G_PHI2);
+    if (!enable || g->illum_floats == 0) return HD_SUCCESS;
+    return hd__gpu_grid_new(ctx, HD__G_PHI2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, "Jacobi's buffer");
+}
+
+/* CD's light volumes freed. */
+static void hd__gpu_free_lights(hd__ctx *ctx, hd__gpu_grids *g)
+{
+    int l;
+    for (l = 0; g->nlv > 0 && l <= g->nlv; ++l) hd__gpu_grid_free(ctx, HD__G_LIGHT + l);
+    g->nlv = 0;
+}
+
+/* hd__be_alloc_lights: count + 1 dark light volumes (the lights and the convection's spare), as
+   the CPU backend; count 0 frees them. */
+static hd_result hd__gpu_alloc_lights(hd__ctx *ctx, hd__gpu_grids *g, int count)
+{
+    hd_result r = HD_SUCCESS;
+    int l;
+    hd__gpu_free_lights(ctx, g);
+    for (l = 0; l <= count && count > 0 && r == HD_SUCCESS; ++l) {
+        g->nlv = count;
+        r = hd__gpu_grid_new(ctx, HD__G_LIGHT + l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], "a CD light volume");
+    }
+    if (r != HD_SUCCESS) hd__gpu_free_lights(ctx, g);
+    return r;
+}
+
+/* Every grid freed (hd__be_destroy). */
+static void hd__gpu_free(hd__ctx *ctx, hd__gpu_grids *g)
+{
+    hd__gpu_alloc_illumination(ctx, g, 0);
+    hd__gpu_free_lights(ctx, g);
+}
+
+/* hd__be_clear's grids: E (HD__DIRTY_DIRECT), phi and phi2 (HD__DIRTY_PHI) zeroed. */
+static hd_result hd__gpu_clear(hd__ctx *ctx, unsigned what)
+{
+    hd_result r = HD_SUCCESS;
+    if (what & HD__DIRTY_DIRECT) r = hd__gpu_grid_zero(ctx, HD__G_E);
+    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI);
+    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI2);
+    return r;
+}
+
+#endif
