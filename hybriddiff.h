@@ -665,6 +665,7 @@ extern char *realpath(const char *path, char *resolved);
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
 #include "backends/hd_vulkan.h"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
+#include "src/hd_gpu.h"
 #include "backends/hd_gl.h"
 #endif
 #include "src/hd_multigrid.h"

@@ -131,12 +131,28 @@ static int hd__gl_diffuse_slot(int counts_z)
    4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
 #define HD__GL_MG_STAGES 9
 #define HD__GL_MG_PROGRAMS (4 * HD__GL_MG_STAGES)
-struct hd__gl_mg;
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
     GLenum format; /* GL_R32F, or GL_R16F (E / phi / phi2 at float16) */
 } hd__gl_tex;
+
+/* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
+typedef struct hd__gl_level {
+    int dims[3];
+    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    int kp_sent;             /* params holds kp */
+    GLuint params;
+    hd__gl_tex sig;          /* coarse levels only (level 0 reads the backend's sigma_t) */
+    hd__gl_tex rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
+} hd__gl_level;
+
+struct hd__gl_mg {
+    hd__gl_level lv[HD__MG_MAX_LEVELS];
+    hd__gl_tex p, lo;        /* the search direction; the iterate's low part (phi + lo) */
+    GLuint dot_a, dot_b;     /* per-row partial sums (double) */
+    double *host_dot;        /* their host copy */
+};
 
 /* The host state a call may touch (saved on entry, restored on exit). */
 typedef struct hd__gl_state {
@@ -175,8 +191,7 @@ struct hd__backend {
     GLuint dl;                  /* the direct light's list of voxels (ctx->dl_idx), storage buffer 4 */
     hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
     int f16;                    /* E, phi, phi2 are GL_R16F (params.illumination_precision) */
-    hd__gl_tex *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
-    int nlv;
+    hd__gl_tex lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
        lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (storage
        buffer 5), uploaded when its host copy ptab_host (ptab_n entries) changes */
@@ -184,10 +199,11 @@ struct hd__backend {
     GLuint ptab;
     int lsum_ok, ptab_n;
     float *ptab_host;
-    size_t illum_floats, img_floats, tf_bytes;
+    size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
-    struct hd__gl_mg *mg;       /* multigrid levels, NULL until first used */
+    hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
+    struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
     GLuint mg_programs[HD__GL_MG_PROGRAMS]; /* by HD_MG_STAGE - 1, then the 4 flag variants */
 };
 
@@ -534,18 +550,27 @@ static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d
     return hd__gl_tex_new_as(ctx, t, w, h, d, GL_R32F, src, what);
 }
 
-/* E, phi, phi2: GL_R16F at float16 storage, else GL_R32F. */
-static hd_result hd__gl_illum_new(hd__ctx *ctx, hd__gl_tex *t, const char *what)
-{
-    return hd__gl_tex_new_as(ctx, t, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels,
-                             ctx->be->f16 ? GL_R16F : GL_R32F, NULL, what);
-}
-
 static hd_result hd__gl_tex_zero(hd__ctx *ctx, hd__gl_tex *t)
 {
     if (!t->name) return HD_SUCCESS;
     return hd__gl_tex_new_as(ctx, t, t->extent[0], t->extent[1], t->extent[2], t->format, NULL, "clearing an illumination grid");
 }
+
+/* Grid id's texture (src/hd_gpu.h): E, phi, phi2 GL_R16F at float16 storage, the others GL_R32F. */
+static hd__gl_tex *hd__gl_grid(hd__backend *be, int id)
+{
+    hd__gl_tex *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
+    hd__gl_level *L = &be->mg.lv[HD__G_LEVEL_OF(id)];
+    hd__gl_tex *level[4] = {&L->sig, &L->rhs, &L->phi, &L->res}; /* by HD__G_MG_SIG, _RHS, _PHI, _RES */
+    return id < HD__G_MG_LEVELS ? named[id] : id >= HD__G_LIGHT ? &be->lv[id - HD__G_LIGHT] : level[(id - HD__G_MG_LEVELS) % 4];
+}
+static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+{
+    GLenum fmt = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2 ? GL_R16F : GL_R32F;
+    return hd__gl_tex_new_as(ctx, hd__gl_grid(ctx->be, id), w, h, d, fmt, NULL, what);
+}
+static void hd__gpu_grid_free(hd__ctx *ctx, int id) { hd__gl_free_tex(ctx->be, hd__gl_grid(ctx->be, id)); }
+static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id) { return hd__gl_tex_zero(ctx, hd__gl_grid(ctx->be, id)); }
 
 static hd_result hd__gl_buffer_data(hd__ctx *ctx, GLuint *b, size_t bytes, const void *src, GLenum usage, const char *what)
 {
@@ -618,8 +643,8 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     hd__gl_send_params(ctx);
     b.params = be->params;
     b.img[0] = &be->vol; b.img[1] = &be->sig; b.img[2] = &be->E; b.img[3] = &be->phi; b.img[4] = &be->phi2;
-    b.img[5] = be->lv && light < be->nlv ? &be->lv[light] : NULL;
-    b.img[6] = be->lv ? &be->lv[be->nlv] : NULL;
+    b.img[5] = light < be->gg.nlv ? &be->lv[light] : NULL;
+    b.img[6] = be->gg.nlv ? &be->lv[be->gg.nlv] : NULL;
     b.img[7] = &be->lsum;
     b.half = half;
     return hd__gl_run(ctx, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
@@ -717,18 +742,6 @@ static hd_result hd__gl_egl_context(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-static void hd__gl_free_lights(hd__backend *be)
-{
-    int l;
-    if (be->lv)
-        for (l = 0; l <= be->nlv; ++l) hd__gl_free_tex(be, &be->lv[l]);
-    hd__free(be->ctx, be->lv);
-    be->lv = NULL;
-    be->nlv = 0;
-}
-
-static void hd__gl_mg_free(hd__ctx *ctx);
-static void hd__gl_mg_free_host(hd__ctx *ctx);
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -739,20 +752,15 @@ static void hd__be_destroy(hd__ctx *ctx)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
         for (i = 0; i < HD__GL_MG_PROGRAMS; ++i)
             if (be->mg_programs[i]) be->gl.DeleteProgram(be->mg_programs[i]);
-        hd__gl_mg_free(ctx);
+        hd__gpu_free(ctx, &be->gg);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab);
-        hd__gl_free_tex(be, &be->lsum);
-        hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
-        hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2); hd__gl_free_tex(be, &be->dummy);
-        hd__gl_free_tex(be, &be->dummy16);
-        hd__gl_free_lights(be);
+        hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
         hd__gl_leave(ctx, HD_SUCCESS);
     }
-    hd__gl_mg_free_host(ctx); /* left when GL was unreachable */
+    hd__free(ctx, be->mg.host_dot); /* left when GL was unreachable */
     hd__free(ctx, be->ptab_host);
-    hd__free(ctx, be->lv);
     if (be->own && be->egl) {
         if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(be->dpy, be->egl);
@@ -845,37 +853,15 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_u
 
 static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
-    hd__backend *be = ctx->be;
-    hd_result r;
-    int *g = ctx->gdims;
-    hd__gl_free_tex(be, &be->sig); hd__gl_free_tex(be, &be->E);
-    hd__gl_free_tex(be, &be->phi); hd__gl_free_tex(be, &be->phi2);
-    hd__gl_mg_free(ctx); /* its fine grid is this one */
-    hd__gl_free_tex(be, &be->lsum);
-    be->lsum_ok = 0;
-    be->illum_floats = 0;
-    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    if (illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__gl_tex_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, NULL, "sigma_t")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_tex_new(ctx, &be->lsum, g[0], g[1], g[2] * ctx->channels, NULL, "the summed light")) != HD_SUCCESS) return r;
-    be->illum_floats = illum_floats;
-    return HD_SUCCESS;
+    ctx->be->lsum_ok = 0;
+    ctx->be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
 }
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     HD__GL_STAGE(ctx, hd__gl_alloc_illumination(ctx, illum_floats));
 }
-
-static hd_result hd__gl_alloc_jacobi(hd__ctx *ctx, int enable)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_free_tex(be, &be->phi2);
-    if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    return hd__gl_illum_new(ctx, &be->phi2, "Jacobi's buffer");
-}
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gl_alloc_jacobi(ctx, enable)); }
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)); }
 
 static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height)
 {
@@ -901,9 +887,7 @@ static hd_result hd__gl_clear(hd__ctx *ctx, unsigned what)
     hd__backend *be = ctx->be;
     hd_result r;
     if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((what & HD__DIRTY_DIRECT) && (r = hd__gl_tex_zero(ctx, &be->E)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi)) != HD_SUCCESS) return r;
-    if ((what & HD__DIRTY_PHI) && (r = hd__gl_tex_zero(ctx, &be->phi2)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img) {
         be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->img);
         be->gl.ClearBufferData(GL_COPY_WRITE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, NULL);
@@ -1010,42 +994,35 @@ static hd_result hd__gl_read_image(hd__ctx *ctx, float *dst)
 }
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst) { HD__GL_STAGE(ctx, hd__gl_read_image(ctx, dst)); }
 
-/* GL_R16F grids come back widened to float by the GL, exactly (every half is a float). */
-static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, float *dst)
-{
-    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    ctx->be->gl.GetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, dst);
-    return hd__gl_check(ctx, "reading an illumination grid", __LINE__);
-}
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
-{
-    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst));
-}
-
-/* Slices of a grid, one glGetTextureSubImage each; without GL 4.5 the whole grid is read and
-   the slices copied out of it. */
-static hd_result hd__gl_read_tex_slices(hd__ctx *ctx, const hd__gl_tex *t, const int *list, int count, float *dst)
+/* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
+   glGetTextureSubImage each, or without GL 4.5 the whole grid read and the slices copied out of
+   it. GL_R16F grids come back widened to float by the GL, exactly (every half is a float). */
+static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, const int *list, int count, float *dst)
 {
     size_t slice = (size_t)t->extent[0] * t->extent[1];
-    float *all;
-    hd_result r;
+    float *all = dst;
     int k;
-    if (ctx->be->gl.GetTextureSubImage) {
+    if (list && ctx->be->gl.GetTextureSubImage) {
         for (k = 0; k < count; ++k)
             ctx->be->gl.GetTextureSubImage(t->name, 0, 0, 0, list[k], t->extent[0], t->extent[1], 1, GL_RED, GL_FLOAT,
                                            (GLsizei)(slice * sizeof(float)), dst + (size_t)k * slice);
         return hd__gl_check(ctx, "reading illumination slices", __LINE__);
     }
-    if (!(all = (float *)hd__alloc(ctx, slice * (size_t)t->extent[2] * sizeof(float))))
+    if (list && !(all = (float *)hd__alloc(ctx, slice * (size_t)t->extent[2] * sizeof(float))))
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to read an illumination grid");
-    if ((r = hd__gl_read_tex(ctx, t, all)) == HD_SUCCESS)
-        for (k = 0; k < count; ++k) memcpy(dst + (size_t)k * slice, all + (size_t)list[k] * slice, slice * sizeof(float));
-    hd__free(ctx, all);
-    return r;
+    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    ctx->be->gl.GetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, all);
+    for (k = 0; list && k < count; ++k) memcpy(dst + (size_t)k * slice, all + (size_t)list[k] * slice, slice * sizeof(float));
+    if (list) hd__free(ctx, all);
+    return hd__gl_check(ctx, "reading an illumination grid", __LINE__);
+}
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+{
+    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, NULL, 0, dst));
 }
 static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
-    HD__GL_STAGE(ctx, hd__gl_read_tex_slices(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst));
+    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst));
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
@@ -1080,24 +1057,7 @@ static hd_result hd__gl_finish_now(hd__ctx *ctx)
 HD__MAYBE_UNUSED static hd_result hd__gl_finish(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_finish_now(ctx)); }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
-static hd_result hd__gl_alloc_lights(hd__ctx *ctx, int count)
-{
-    hd__backend *be = ctx->be;
-    hd_result r;
-    int l;
-    hd__gl_free_lights(be);
-    if (count <= 0) return HD_SUCCESS;
-    be->lv = (hd__gl_tex *)hd__calloc(ctx, (size_t)count + 1, sizeof(hd__gl_tex));
-    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate %d light volume handles", count);
-    be->nlv = count;
-    for (l = 0; l <= count; ++l)
-        if ((r = hd__gl_tex_new(ctx, &be->lv[l], ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], NULL, "a CD light volume")) != HD_SUCCESS) {
-            hd__gl_free_lights(be);
-            return r;
-        }
-    return HD_SUCCESS;
-}
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { HD__GL_STAGE(ctx, hd__gl_alloc_lights(ctx, count)); }
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { HD__GL_STAGE(ctx, hd__gpu_alloc_lights(ctx, &ctx->be->gg, count)); }
 
 /* One convection step of light `light`: its volume -> the spare, and the two swap names. */
 static hd_result hd__gl_convect(hd__ctx *ctx, int light)
@@ -1107,7 +1067,7 @@ static hd_result hd__gl_convect(hd__ctx *ctx, int light)
     hd__gl_tex t;
     if ((r = hd__gl_dispatch(ctx, HD__GL_CONVECT, light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
         return r;
-    t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
+    t = be->lv[light]; be->lv[light] = be->lv[be->gg.nlv]; be->lv[be->gg.nlv] = t;
     return HD_SUCCESS;
 }
 static hd_result hd__be_convect(hd__ctx *ctx, int light) { HD__GL_STAGE(ctx, hd__gl_convect(ctx, light)); }
@@ -1117,7 +1077,7 @@ static hd_result hd__gl_sum_lights(hd__ctx *ctx)
 {
     hd_result r;
     int l;
-    for (l = 0; l < ctx->be->nlv; ++l)
+    for (l = 0; l < ctx->be->gg.nlv; ++l)
         if ((r = hd__gl_dispatch(ctx, HD__GL_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return HD_SUCCESS;
@@ -1144,112 +1104,42 @@ static const char *const hd__gl_mg_names[HD__GL_MG_STAGES] = {
     "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
     "multigrid extrapolation"};
 
-typedef struct hd__gl_level {
-    int dims[3];
-    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    int kp_sent;             /* params holds kp */
-    GLuint params;
-    hd__gl_tex sig;          /* coarse levels only (level 0 reads the backend's sigma_t) */
-    hd__gl_tex rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
-} hd__gl_level;
-
-struct hd__gl_mg {
-    hd__gl_level lv[HD__MG_MAX_LEVELS];
-    int levels, channels, sig_channels, fine[3];
-    hd__gl_tex p, lo;        /* the search direction; the iterate's low part (phi + lo) */
-    GLuint dot_a, dot_b;     /* per-row partial sums (double) */
-    double *host_dot;        /* their host copy */
-};
-
-static size_t hd__gl_mg_rows(const struct hd__gl_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
-
-static void hd__gl_mg_free(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
-    int l;
-    if (!mg) return;
-    for (l = 0; l < mg->levels; ++l) {
-        hd__gl_level *L = &mg->lv[l];
-        hd__gl_free_buffer(be, &L->params);
-        hd__gl_free_tex(be, &L->sig); hd__gl_free_tex(be, &L->rhs); hd__gl_free_tex(be, &L->phi); hd__gl_free_tex(be, &L->res);
-    }
-    hd__gl_free_tex(be, &mg->p); hd__gl_free_tex(be, &mg->lo);
-    hd__gl_free_buffer(be, &mg->dot_a); hd__gl_free_buffer(be, &mg->dot_b);
-    hd__free(ctx, mg->host_dot);
-    hd__free(ctx, mg);
-    be->mg = NULL;
-}
-
-/* The host side only (hd__be_destroy, when GL is unreachable). */
-static void hd__gl_mg_free_host(hd__ctx *ctx)
-{
-    struct hd__gl_mg *mg = ctx->be->mg;
-    if (!mg) return;
-    hd__free(ctx, mg->host_dot);
-    hd__free(ctx, mg);
-    ctx->be->mg = NULL;
-}
+static size_t hd__gl_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
 
 /* Bytes the solver holds on the GPU (counted in method_bytes); 0 without it. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx)
-{
-    const struct hd__gl_mg *mg = ctx->be->mg;
-    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
-}
+static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
 
-/* A level's grid of `channels` channels stacked in z, zeroed. */
-static hd_result hd__gl_mg_tex(hd__ctx *ctx, hd__gl_tex *t, const int *d, int channels, const char *what)
-{
-    return hd__gl_tex_new(ctx, t, d[0], d[1], d[2] * channels, NULL, what);
-}
-
-/* The levels (hd__mg_levels) and CG's vectors, zeroed. */
-static hd_result hd__gl_mg_alloc(hd__ctx *ctx)
+/* The levels' dims and parameter buffers and the row sums (device and host). */
+static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg;
-    int l, i, n, d[3];
+    struct hd__gl_mg *mg = &be->mg;
+    size_t rows = hd__gl_mg_rows(&be->gg);
     hd_result r;
-    size_t rows;
-    be->mg = mg = (struct hd__gl_mg *)hd__calloc(ctx, 1, sizeof *mg);
-    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the multigrid levels");
-    mg->channels = ctx->channels;
-    mg->sig_channels = ctx->sig_channels;
-    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
-    rows = hd__gl_mg_rows(mg);
-    mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double));
-    if (!mg->host_dot) { hd__gl_mg_free(ctx); return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows"); }
-    if ((r = hd__gl_mg_tex(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
-        (r = hd__gl_mg_tex(ctx, &mg->lo, d, mg->channels, "multigrid's lo")) != HD_SUCCESS ||
-        (r = hd__gl_buffer_data(ctx, &mg->dot_a, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__gl_buffer_data(ctx, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS) {
-        hd__gl_mg_free(ctx);
-        return r;
-    }
-    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
+    int l;
+    for (l = 0; l < be->gg.levels; ++l) {
         hd__gl_level *L = &mg->lv[l];
-        hd__mg_level_dims(mg->fine, l, d);
-        memcpy(L->dims, d, sizeof d);
-        mg->levels = l + 1;
-        be->gl.GenBuffers(1, &L->params);
-        if ((r = hd__gl_mg_tex(ctx, &L->rhs, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__gl_mg_tex(ctx, &L->phi, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__gl_mg_tex(ctx, &L->res, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (l > 0 && (r = hd__gl_mg_tex(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS)) {
-            hd__gl_mg_free(ctx);
-            return r;
-        }
+        hd__gl_free_buffer(be, &L->params);
+        L->kp_sent = 0;
+        hd__mg_level_dims(be->gg.fine, l, L->dims);
+        if (make) be->gl.GenBuffers(1, &L->params);
     }
-    return HD_SUCCESS;
+    hd__gl_free_buffer(be, &mg->dot_a); hd__gl_free_buffer(be, &mg->dot_b);
+    hd__free(ctx, mg->host_dot);
+    mg->host_dot = NULL;
+    if (!make) return HD_SUCCESS;
+    if (!(mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double))))
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows");
+    if ((r = hd__gl_buffer_data(ctx, &mg->dot_a, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS)
+        return r;
+    return hd__gl_buffer_data(ctx, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums");
 }
 
 /* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
 static hd_result hd__gl_mg_params(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg->lv[l];
+    hd__gl_level *L = &be->mg.lv[l];
     hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
     if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
     be->gl.BindBuffer(GL_UNIFORM_BUFFER, L->params);
@@ -1260,7 +1150,7 @@ static hd_result hd__gl_mg_params(hd__ctx *ctx, int l)
 }
 
 /* Level l's sigma_t. */
-static const hd__gl_tex *hd__gl_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg->lv[l].sig; }
+static const hd__gl_tex *hd__gl_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
 
 /* The program of multigrid stage `stage` for the flags in counts_z (RGB, surface), compiled on
    first use: hd__gl_source up to hd_entry_glsl.h, then hd_entry_glsl_multigrid.h. */
@@ -1324,7 +1214,7 @@ static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double 
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg->lv[l];
+    hd__gl_level *L = &be->mg.lv[l];
     int slot = hd__gl_diffuse_slot(L->kp.counts.z), s, h;
     int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     hd__gl_binds b;
@@ -1336,7 +1226,7 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h)
             if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (L->dims[0] + 1) / 2, ny,
-                                nzb * be->mg->channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
+                                nzb * be->gg.channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     return HD_SUCCESS;
 }
@@ -1344,8 +1234,8 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg->lv[l];
-    int ch = be->mg->channels;
+    hd__gl_level *L = &be->mg.lv[l];
+    int ch = be->gg.channels;
     return hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, L->dims[0],
                           L->dims[1], L->dims[2] * ch, 0, 0, 0, ch);
 }
@@ -1353,8 +1243,8 @@ static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
-    int ch = be->mg->channels;
+    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
+    int ch = be->gg.channels;
     return hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
                           C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch);
 }
@@ -1362,8 +1252,8 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg->lv[l], *C = &be->mg->lv[l + 1];
-    int ch = be->mg->channels;
+    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
+    int ch = be->gg.channels;
     return hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0],
                           L->dims[1], L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch);
 }
@@ -1373,19 +1263,21 @@ static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex *E, const hd__gl_tex *phi,
                                    const hd__gl_tex *out, int use_lo, int negate)
 {
-    struct hd__gl_mg *mg = ctx->be->mg;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, use_lo, negate, 0, mg->channels);
+    const hd__gpu_grids *g = &ctx->be->gg;
+    struct hd__gl_mg *mg = &ctx->be->mg;
+    return hd__gl_mg_pass(ctx, HD__GL_MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, g->fine[0], g->fine[1],
+                          g->fine[2] * g->channels, use_lo, negate, 0, g->channels);
 }
 
 /* <a, b> per fine row into dot (storage buffer 3). */
 static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
+    struct hd__gl_mg *mg = &be->mg;
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
-    return hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, mg->fine[1], mg->fine[2] * mg->channels, 1,
-                          0, 0, 0, mg->channels);
+    return hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, g->fine[1], g->fine[2] * g->channels, 1,
+                          0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1393,18 +1285,12 @@ static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_t
    levels and sends their parameter blocks. */
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
-    hd__backend *be;
-    struct hd__gl_mg *mg;
+    hd__backend *be = ctx->be;
     hd_result r = hd__gl_enter(ctx);
     int l;
     if (r != HD_SUCCESS) return r;
-    be = ctx->be;
-    mg = be->mg;
-    if (mg && hd__mg_stale(ctx, mg->fine, mg->channels, mg->sig_channels)) hd__gl_mg_free(ctx);
-    *fresh = !be->mg;
-    if (!be->mg && (r = hd__gl_mg_alloc(ctx)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
-    mg = be->mg;
-    for (l = 0; l < mg->levels; ++l)
+    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
+    for (l = 0; l < be->gg.levels; ++l)
         if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
     hd__gl_send_params(ctx);
     return HD_SUCCESS;
@@ -1422,39 +1308,41 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
+    struct hd__gl_mg *mg = &be->mg;
     const int *d = mg->lv[l].dims;
     return hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
-                          d[1], d[2] * mg->sig_channels, d[0], d[1], d[2], mg->sig_channels);
+                          d[1], d[2] * g->sig_channels, d[0], d[1], d[2], g->sig_channels);
 }
 
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gl_tex_zero(ctx, &ctx->be->mg->lo); }
+static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gl_tex_zero(ctx, &ctx->be->mg.lo); }
 
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    return hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &be->mg->lv[0].rhs, 1, 0);
+    return hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &be->mg.lv[0].rhs, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 {
-    struct hd__gl_mg *mg = ctx->be->mg;
+    struct hd__gl_mg *mg = &ctx->be->mg;
     return hd__gl_mg_dot(ctx, &mg->lv[0].rhs, &mg->lv[0].phi, mg->dot_a);
 }
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
-    struct hd__gl_mg *mg = ctx->be->mg;
+    const hd__gpu_grids *g = &ctx->be->gg;
+    struct hd__gl_mg *mg = &ctx->be->mg;
     hd_result r;
     if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
+    return hd__gl_mg_pass(ctx, HD__GL_MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, g->fine[0], g->fine[1],
+                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
 }
 
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
-    struct hd__gl_mg *mg = ctx->be->mg;
+    struct hd__gl_mg *mg = &ctx->be->mg;
     hd__gl_level *L = &mg->lv[0];
     hd_result r;
     if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS ||
@@ -1467,8 +1355,8 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
-    size_t rows = hd__gl_mg_rows(mg);
+    struct hd__gl_mg *mg = &be->mg;
+    size_t rows = hd__gl_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i) {
         be->gl.BindBuffer(GL_COPY_READ_BUFFER, i ? mg->dot_b : mg->dot_a);
@@ -1482,23 +1370,25 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
+    struct hd__gl_mg *mg = &be->mg;
     hd_result r;
     be->lsum_ok = 0;
     if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, 0, 0, 0, mg->channels);
+    return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
+                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
 }
 
 /* The fine parameters (no right-hand-side flag). */
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = be->mg;
+    struct hd__gl_mg *mg = &be->mg;
     be->lsum_ok = 0;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, mg->fine[0], mg->fine[1],
-                          mg->fine[2] * mg->channels, colour, 0, 0, mg->channels);
+    return hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
+                          g->fine[2] * g->channels, colour, 0, 0, g->channels);
 }
 
 /* The single-level solver's sweeps: each its own dispatches. */
