@@ -663,6 +663,7 @@ extern char *realpath(const char *path, char *resolved);
 #include "src/hd_gpu.h"
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
+#include "src/hd_gpu.h"
 #include "backends/hd_vulkan.h"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
 #include "src/hd_gpu.h"

@@ -124,6 +124,33 @@ typedef struct hd__vk_image {
     int texel; /* bytes per texel: 2 (r16f), 4 (r32f), 8 (rg32f) */
 } hd__vk_image;
 
+/* CG's passes' sets (level 0 and the backend's grids) */
+enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
+       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
+#define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
+
+typedef struct hd__vk_level {
+    int dims[3];
+    hd__kparams kp;           /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
+    hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
+    hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
+    /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
+    VkDescriptorSet smooth, restrict_to, prolong_from, coarsen;
+} hd__vk_level;
+
+/* HD_SOLVER_MULTIGRID's objects besides the grids (hd__gpu_mg_extras) and its grids */
+struct hd__vk_mg {
+    hd__vk_level lv[HD__MG_MAX_LEVELS];
+    hd__vk_image p, lo;       /* the search direction; the iterate's low part (phi + lo) */
+    hd__vk_buffer dot_a, dot_b; /* per-row partial sums (double), host-visible */
+    hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
+    VkDeviceSize slot_bytes;
+    VkDescriptorPool pool;
+    VkDescriptorSet cg_sets[HD__VK_MG_CG_SETS];
+    unsigned sets_gen;        /* be->sets_gen the sets were written at */
+    int sets_valid;
+};
+
 struct hd__backend {
     hd__ctx *ctx;
     hd__vk_fns fn;
@@ -172,11 +199,11 @@ struct hd__backend {
     int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
-    struct hd__vk_mg *mg;         /* HD_SOLVER_MULTIGRID's levels, CG vectors and sets, or NULL */
+    hd__gpu_grids gg;             /* what the grids are made for (src/hd_gpu.h) */
+    struct hd__vk_mg mg;          /* HD_SOLVER_MULTIGRID's extras and grids while gg.levels */
     VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
-    hd__vk_image *lv;             /* CD: nlv light volumes + a spare at lv[nlv] */
-    int nlv;
+    hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
        lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (binding 13,
        host-visible, ptab_cap entries, sized with the TF), written when its host copy ptab_host
@@ -185,7 +212,7 @@ struct hd__backend {
     hd__vk_buffer ptab;
     int lsum_ok, ptab_n, ptab_cap;
     float *ptab_host;
-    size_t illum_floats, img_floats, tf_bytes;
+    size_t img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
     unsigned long submits, lose_at; /* queue submissions so far; HD_VK_LOSE_DEVICE (0: off) */
     int lost;
@@ -728,11 +755,37 @@ static hd_result hd__vk_image_new(hd__ctx *ctx, hd__vk_image *im, int w, int h, 
     return hd__vk_image_new_as(ctx, im, w, h, d, VK_FORMAT_R32_SFLOAT, what);
 }
 
-/* E, phi, phi2: r16f at float16 storage, else r32f. */
-static hd_result hd__vk_illum_new(hd__ctx *ctx, hd__vk_image *im, const char *what)
+/* Grid id's image (src/hd_gpu.h): E, phi, phi2 r16f at float16 storage, the others r32f. */
+static hd__vk_image *hd__vk_grid(hd__backend *be, int id)
 {
-    return hd__vk_image_new_as(ctx, im, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels,
-                               ctx->be->f16 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT, what);
+    hd__vk_image *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
+    hd__vk_level *L = &be->mg.lv[HD__G_LEVEL_OF(id)];
+    hd__vk_image *level[4] = {&L->sig, &L->rhs, &L->phi, &L->res}; /* by HD__G_MG_SIG, _RHS, _PHI, _RES */
+    return id < HD__G_MG_LEVELS ? named[id] : id >= HD__G_LIGHT ? &be->lv[id - HD__G_LIGHT] : level[(id - HD__G_MG_LEVELS) % 4];
+}
+/* What was recorded is submitted first: it may name the image (a new one's zeroing). */
+static void hd__gpu_grid_free(hd__ctx *ctx, int id)
+{
+    hd__vk_image *im = hd__vk_grid(ctx->be, id);
+    if (im->image && ctx->be->open && !ctx->be->lost) hd__vk_flush(ctx);
+    hd__vk_free_image(ctx, im);
+}
+static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+{
+    VkFormat fmt = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
+    hd__gpu_grid_free(ctx, id);
+    return hd__vk_image_new_as(ctx, hd__vk_grid(ctx->be, id), w, h, d, fmt, what);
+}
+static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
+{
+    const hd__vk_image *im = hd__vk_grid(ctx->be, id);
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if (!im->image) return HD_SUCCESS;
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    hd__vk_barrier(ctx->be, cb);
+    hd__vk_zero_image(ctx->be, cb, im->image, HD__VK_G);
+    return HD_SUCCESS;
 }
 
 static hd_result hd__vk_staging(hd__ctx *ctx, VkDeviceSize bytes)
@@ -1011,6 +1064,7 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
 /* The most sets one pool holds: the backend's (a set per light); the multigrid's fit too (checked
    where HD__VK_MG_SETS is defined). */
 #define HD__VK_POOL_SETS_MAX HD_MAX_LIGHTS
+typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 /* Empties `pool` and allocates n (<= HD__VK_POOL_SETS_MAX) sets of the backend's set layout from
    it into sets[]; reset_name and alloc_name name the calls in a failure's log line. */
@@ -1109,7 +1163,7 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    int n = be->nlv > 0 ? be->nlv : 1, s;
+    int n = be->gg.nlv > 0 ? be->gg.nlv : 1, s;
     if (be->sets_valid) return HD_SUCCESS;
     if ((r = hd__vk_pool_sets(ctx, be->dpool, n, be->sets, "vkResetDescriptorPool", "vkAllocateDescriptorSets")) != HD_SUCCESS)
         return r;
@@ -1120,8 +1174,8 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
         memset(bu, 0, sizeof bu);
         hd__vk_common_buffers(be, bu, NULL);
         im[1] = &be->vol; im[4] = &be->sig; im[5] = &be->E; im[6] = &be->phi; im[7] = &be->phi2;
-        im[9] = be->nlv > 0 ? &be->lv[s] : &be->dummy;
-        im[10] = be->nlv > 0 ? &be->lv[be->nlv] : &be->dummy;
+        im[9] = be->gg.nlv > 0 ? &be->lv[s] : &be->dummy;
+        im[10] = be->gg.nlv > 0 ? &be->lv[be->gg.nlv] : &be->dummy;
         im[14] = &be->lsum;
         hd__vk_write_set(ctx, be->sets[s], &be->params, im, bu);
     }
@@ -1211,20 +1265,6 @@ static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
 }
 
 /* ---- life cycle -------------------------------------------------------------------------------- */
-static void hd__vk_free_lights(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    int l;
-    if (!be->lv) return;
-    for (l = 0; l <= be->nlv; ++l) hd__vk_free_image(ctx, &be->lv[l]);
-    hd__free(ctx, be->lv);
-    be->lv = NULL;
-    be->nlv = 0;
-    be->sets_valid = 0;
-}
-
-static void hd__vk_mg_free(hd__ctx *ctx);
-
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1233,15 +1273,11 @@ static void hd__be_destroy(hd__ctx *ctx)
     if (be->device && be->fn.vkDeviceWaitIdle) {
         if (be->open && !be->lost) hd__vk_flush(ctx);
         be->fn.vkDeviceWaitIdle(be->device); /* also after a lost device: then it returns at once */
-        hd__vk_free_lights(ctx);
-        hd__vk_mg_free(ctx);
-        hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
-        hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2); hd__vk_free_image(ctx, &be->dummy);
-        hd__vk_free_image(ctx, &be->dummy16);
+        hd__gpu_free(ctx, &be->gg);
+        hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->dummy); hd__vk_free_image(ctx, &be->dummy16);
         hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
         hd__vk_free_buffer(ctx, &be->dl); hd__vk_free_buffer(ctx, &be->ptab);
-        hd__vk_free_image(ctx, &be->lsum);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -1432,33 +1468,23 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    int *g = ctx->gdims;
     HD__VK_IDLE(ctx);
-    hd__vk_free_image(ctx, &be->sig); hd__vk_free_image(ctx, &be->E);
-    hd__vk_free_image(ctx, &be->phi); hd__vk_free_image(ctx, &be->phi2);
-    hd__vk_free_image(ctx, &be->lsum);
     be->lsum_ok = 0;
-    be->illum_floats = 0;
-    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r; /* after hd_set_params */
-    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     be->sets_valid = 0; /* the placeholders bound for absent E / phi / phi2 follow the precision */
-    if (illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__vk_image_new(ctx, &be->sig, g[0], g[1], g[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_illum_new(ctx, &be->E, "E")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_illum_new(ctx, &be->phi, "phi")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_new(ctx, &be->lsum, g[0], g[1], g[2] * ctx->channels, "the summed light")) != HD_SUCCESS) return r;
-    be->illum_floats = illum_floats;
+    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) { /* after hd_set_params */
+        hd__gpu_alloc_illumination(ctx, &be->gg, 0);
+        return r;
+    }
+    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    if ((r = hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
-    hd__backend *be = ctx->be;
     hd_result r;
     HD__VK_IDLE(ctx);
-    hd__vk_free_image(ctx, &be->phi2);
-    if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__vk_illum_new(ctx, &be->phi2, "Jacobi's buffer")) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1485,18 +1511,14 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    hd__vk_image *ims[3];
-    int i, n = 0;
     HD__VK_LOST_CHECK(ctx);
     if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((what & HD__DIRTY_DIRECT) && be->E.image) ims[n++] = &be->E;
-    if ((what & HD__DIRTY_PHI) && be->phi.image) ims[n++] = &be->phi;
-    if ((what & HD__DIRTY_PHI) && be->phi2.image) ims[n++] = &be->phi2;
-    if (n == 0 && !((what & HD__DIRTY_IMAGE) && be->img.buffer)) return HD_SUCCESS;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_barrier(be, cb);
-    for (i = 0; i < n; ++i) hd__vk_zero_image(be, cb, ims[i]->image, HD__VK_G);
-    if ((what & HD__DIRTY_IMAGE) && be->img.buffer) be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
+    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((what & HD__DIRTY_IMAGE) && be->img.buffer) {
+        if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+        hd__vk_barrier(be, cb);
+        be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
+    }
     return hd__vk_flush(ctx);
 }
 
@@ -1653,24 +1675,11 @@ HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_ill
 }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
-/* count + 1 zeroed light volumes (count lights and a spare); count 0 frees them. As hd_cpu.h. */
 static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 {
-    hd__backend *be = ctx->be;
     hd_result r;
-    int l;
     HD__VK_IDLE(ctx);
-    hd__vk_free_lights(ctx);
-    if (count <= 0) return HD_SUCCESS;
-    be->lv = (hd__vk_image *)hd__calloc(ctx, (size_t)count + 1, sizeof(hd__vk_image));
-    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate %d light volume handles", count);
-    be->nlv = count;
-    for (l = 0; l <= count; ++l)
-        if ((r = hd__vk_image_new(ctx, &be->lv[l], ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], "a CD light volume")) != HD_SUCCESS) {
-            hd__vk_flush(ctx);
-            hd__vk_free_lights(ctx);
-            return r;
-        }
+    if ((r = hd__gpu_alloc_lights(ctx, &ctx->be->gg, count)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
 }
 
@@ -1684,7 +1693,7 @@ static hd_result hd__be_convect(hd__ctx *ctx, int light)
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CONVECT], light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
         return r;
-    hd__vk_copy_image(be, cb, &be->lv[be->nlv], &be->lv[light]);
+    hd__vk_copy_image(be, cb, &be->lv[be->gg.nlv], &be->lv[light]);
     return hd__vk_flush(ctx);
 }
 
@@ -1698,7 +1707,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     ctx->be->lsum_ok = 0;
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    for (l = 0; l < ctx->be->nlv; ++l)
+    for (l = 0; l < ctx->be->gg.nlv; ++l)
         if ((r = hd__vk_dispatch(ctx, cb, pipe, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return hd__vk_flush(ctx);
@@ -1728,131 +1737,45 @@ static hd_result hd__be_path(hd__ctx *ctx)
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROLONG, HD__VK_MG_DIR, HD__VK_MG_RES_F64,
        HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_EXTRAP, HD__VK_MG_STAGES = HD__VK_MG_EXTRAP };
-/* CG's passes' sets (level 0 and the backend's grids) */
-enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
-       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
-#define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
-typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
-
-typedef struct hd__vk_level {
-    int dims[3];
-    hd__kparams kp;           /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
-    hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
-    /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
-    VkDescriptorSet smooth, restrict_to, prolong_from, coarsen;
-} hd__vk_level;
-
-struct hd__vk_mg {
-    hd__vk_level lv[HD__MG_MAX_LEVELS];
-    int levels, channels, sig_channels, fine[3];
-    hd__vk_image p, lo;       /* the search direction; the iterate's low part (phi + lo) */
-    hd__vk_buffer dot_a, dot_b; /* per-row partial sums (double), host-visible */
-    hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
-    VkDeviceSize slot_bytes;
-    VkDescriptorPool pool;
-    VkDescriptorSet cg_sets[HD__VK_MG_CG_SETS];
-    unsigned sets_gen;        /* be->sets_gen the sets were written at */
-    int sets_valid;
-};
-
 static const char *const hd__vk_mg_names[HD__VK_MG_STAGES] = {
     "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
     "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
     "multigrid extrapolation"};
 
-static size_t hd__vk_mg_rows(const struct hd__vk_mg *mg) { return (size_t)mg->fine[1] * mg->fine[2] * mg->channels; }
-
-/* Frees the levels, vectors, buffers and sets; nothing of theirs may be in flight (the callers
-   flushed, or hd__be_destroy waited for the device). */
-static void hd__vk_mg_free(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg = be->mg;
-    int l;
-    if (!mg) return;
-    for (l = 0; l < mg->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l];
-        hd__vk_free_image(ctx, &L->sig); hd__vk_free_image(ctx, &L->rhs); hd__vk_free_image(ctx, &L->phi); hd__vk_free_image(ctx, &L->res);
-    }
-    hd__vk_free_image(ctx, &mg->p); hd__vk_free_image(ctx, &mg->lo);
-    hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
-    if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
-    hd__free(ctx, mg);
-    be->mg = NULL;
-}
+static size_t hd__vk_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
 
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx)
-{
-    const struct hd__vk_mg *mg = ctx->be->mg;
-    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    return hd__mg_bytes(mg->fine, mg->levels, mg->channels, mg->sig_channels);
-}
+static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
 
-/* A level's grid of `channels` channels stacked in z, zeroed (by the next submission). */
-static hd_result hd__vk_mg_image(hd__ctx *ctx, hd__vk_image *im, const int *d, int channels, const char *what)
-{
-    return hd__vk_image_new(ctx, im, d[0], d[1], d[2] * channels, what);
-}
-
-/* The levels (hd__mg_levels), CG's vectors (zeroed), the row-sum buffers, the parameter
-   slots and the set pool. On failure everything made so far is freed again. */
-static hd_result hd__vk_mg_alloc_parts(hd__ctx *ctx)
+/* The levels' dims, the row-sum buffers, the parameter slots and the set pool; nothing of theirs
+   may be in flight when they are freed (each step ends waited for). */
+static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg = be->mg;
+    struct hd__vk_mg *mg = &be->mg;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
-    size_t rows = hd__vk_mg_rows(mg);
-    int l, i, n, d[3];
+    size_t rows = hd__vk_mg_rows(&be->gg);
     hd_result r;
-    for (i = 0; i < 3; ++i) d[i] = mg->fine[i];
-    if ((r = hd__vk_mg_image(ctx, &mg->p, d, mg->channels, "multigrid's p")) != HD_SUCCESS ||
-        (r = hd__vk_mg_image(ctx, &mg->lo, d, mg->channels, "multigrid's lo")) != HD_SUCCESS ||
-        (r = hd__vk_buffer_create(ctx, &mg->dot_a, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+    int l;
+    for (l = 0; l < be->gg.levels; ++l) hd__mg_level_dims(be->gg.fine, l, mg->lv[l].dims);
+    hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
+    if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
+    mg->pool = VK_NULL_HANDLE;
+    mg->sets_valid = 0;
+    if (!make) return HD_SUCCESS;
+    mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
+    if ((r = hd__vk_buffer_create(ctx, &mg->dot_a, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "multigrid's row sums")) != HD_SUCCESS ||
         (r = hd__vk_buffer_create(ctx, &mg->dot_b, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
-                                  "multigrid's row sums")) != HD_SUCCESS)
-        return r;
-    for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
-        hd__vk_level *L = &mg->lv[l];
-        hd__mg_level_dims(mg->fine, l, d);
-        memcpy(L->dims, d, sizeof d);
-        mg->levels = l + 1;
-        if ((r = hd__vk_mg_image(ctx, &L->rhs, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__vk_mg_image(ctx, &L->phi, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (r = hd__vk_mg_image(ctx, &L->res, d, mg->channels, "a multigrid level")) != HD_SUCCESS ||
-            (l > 0 && (r = hd__vk_mg_image(ctx, &L->sig, d, mg->sig_channels, "a multigrid level's sigma_t")) != HD_SUCCESS))
-            return r;
-    }
-    mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
-    if ((r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(mg->levels + 1),
+                                  "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(be->gg.levels + 1),
                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
         return r;
     return hd__vk_pool(ctx, HD__VK_MG_SETS, &mg->pool);
 }
 
-static hd_result hd__vk_mg_alloc(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg;
-    hd_result r;
-    int i;
-    be->mg = mg = (struct hd__vk_mg *)hd__calloc(ctx, 1, sizeof *mg);
-    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the multigrid levels");
-    mg->channels = ctx->channels;
-    mg->sig_channels = ctx->sig_channels;
-    for (i = 0; i < 3; ++i) mg->fine[i] = ctx->gdims[i];
-    if ((r = hd__vk_mg_alloc_parts(ctx)) != HD_SUCCESS) {
-        hd__vk_flush(ctx); /* the new images' clears were recorded: submit them before the images go */
-        hd__vk_mg_free(ctx);
-        return r;
-    }
-    return HD_SUCCESS;
-}
-
 /* Level l's sigma_t. */
-static const hd__vk_image *hd__vk_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg->lv[l].sig; }
+static const hd__vk_image *hd__vk_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
 
 /* Writes one multigrid set: sigma_t, E, phi, phi2 (bindings 4..7), the other grid (10) and the
    row sums (11); NULL binds a placeholder. */
@@ -1867,26 +1790,27 @@ static void hd__vk_mg_write(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_imag
     memset(bu, 0, sizeof bu);
     hd__vk_common_buffers(be, bu, dot);
     im[1] = &be->vol; im[4] = sig; im[5] = E; im[6] = phi; im[7] = phi2; im[10] = other;
-    hd__vk_write_set(ctx, set, &be->mg->params, im, bu);
+    hd__vk_write_set(ctx, set, &be->mg.params, im, bu);
 }
 
 /* Every pass's set (hd_gl.h's bindings per pass), written when the levels are new or the
    backend's sets were rebuilt since (its grids may be new). Nothing is in flight. */
 static hd_result hd__vk_mg_sets(hd__ctx *ctx)
 {
+    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg = be->mg;
+    struct hd__vk_mg *mg = &be->mg;
     VkDescriptorSet sets[HD__VK_MG_SETS];
     hd__vk_level *L0 = &mg->lv[0];
     hd_result r;
-    int n = 4 * mg->levels + HD__VK_MG_CG_SETS, i, l;
+    int n = 4 * g->levels + HD__VK_MG_CG_SETS, i, l;
     if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
     mg->sets_valid = 0;
     if ((r = hd__vk_pool_sets(ctx, mg->pool, n, sets, "vkResetDescriptorPool (multigrid)",
                               "vkAllocateDescriptorSets (multigrid)")) != HD_SUCCESS)
         return r;
-    for (l = 0; l < mg->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l], *C = l + 1 < mg->levels ? &mg->lv[l + 1] : NULL;
+    for (l = 0; l < g->levels; ++l) {
+        hd__vk_level *L = &mg->lv[l], *C = l + 1 < g->levels ? &mg->lv[l + 1] : NULL;
         L->smooth = sets[4 * l];
         L->restrict_to = sets[4 * l + 1];
         L->prolong_from = sets[4 * l + 2];
@@ -1899,7 +1823,7 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
         }
         if (l > 0) hd__vk_mg_write(ctx, L->coarsen, hd__vk_mg_sig(be, l - 1), NULL, NULL, NULL, &L->sig, NULL);
     }
-    for (i = 0; i < HD__VK_MG_CG_SETS; ++i) mg->cg_sets[i] = sets[4 * mg->levels + i];
+    for (i = 0; i < HD__VK_MG_CG_SETS; ++i) mg->cg_sets[i] = sets[4 * g->levels + i];
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], &be->sig, &be->E, &be->phi, &mg->lo, &L0->rhs, NULL);
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], &be->sig, &L0->phi, &mg->p, &mg->lo, &L0->res, NULL);
     hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RZ], NULL, &L0->rhs, &L0->phi, NULL, NULL, &mg->dot_a);
@@ -1917,15 +1841,16 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
    (nothing is in flight: each step ends waited for). */
 static void hd__vk_mg_params(hd__ctx *ctx)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
+    const hd__gpu_grids *g = &ctx->be->gg;
+    struct hd__vk_mg *mg = &ctx->be->mg;
     int l;
-    for (l = 0; l < mg->levels; ++l) {
+    for (l = 0; l < g->levels; ++l) {
         hd__vk_level *L = &mg->lv[l];
         hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
         L->kp = kp;
         memcpy((char *)mg->params.map + (size_t)l * mg->slot_bytes, &kp, sizeof kp);
     }
-    memcpy((char *)mg->params.map + (size_t)mg->levels * mg->slot_bytes, &ctx->kp, sizeof ctx->kp);
+    memcpy((char *)mg->params.map + (size_t)g->levels * mg->slot_bytes, &ctx->kp, sizeof ctx->kp);
 }
 
 /* The flags the passes' pipelines are specialized for: RGB scattering and the boundary (the
@@ -1971,7 +1896,7 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
     hd_result r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
-    hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg->slot_bytes), nx, ny, nz, pc);
+    hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg.slot_bytes), nx, ny, nz, pc);
     return HD_SUCCESS;
 }
 
@@ -1979,7 +1904,7 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
    level's dims, or with dims_pc 0 zeros, and channels). */
 static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int l, int channels, int dims_pc)
 {
-    const int *d = ctx->be->mg->lv[l].dims;
+    const int *d = ctx->be->mg.lv[l].dims;
     return hd__vk_mg_pass(ctx, stage, set, slot, d[0], d[1], d[2] * channels, dims_pc ? d[0] : 0, dims_pc ? d[1] : 0,
                           dims_pc ? d[2] : 0, channels);
 }
@@ -1987,8 +1912,8 @@ static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, i
 /* Pass `stage` over the fine grid, push constants (pc0, pc1, 0, channels). */
 static hd_result hd__vk_mg_fine(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int32_t pc0, int32_t pc1)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, stage, set, slot, mg->fine[0], mg->fine[1], mg->fine[2] * mg->channels, pc0, pc1, 0, mg->channels);
+    const hd__gpu_grids *g = &ctx->be->gg;
+    return hd__vk_mg_pass(ctx, stage, set, slot, g->fine[0], g->fine[1], g->fine[2] * g->channels, pc0, pc1, 0, g->channels);
 }
 
 /* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
@@ -1996,10 +1921,10 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd__vk_level *L = &be->mg->lv[l];
+    hd__vk_level *L = &be->mg.lv[l];
     int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
-    uint32_t offset = (uint32_t)((VkDeviceSize)l * be->mg->slot_bytes);
+    uint32_t offset = (uint32_t)((VkDeviceSize)l * be->mg.slot_bytes);
     VkPipeline pipe;
     hd_result r;
     int s, h;
@@ -2008,34 +1933,34 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
             pc[0] = first ^ h; pc[1] = 0; pc[2] = nzb; pc[3] = 0;
-            hd__vk_record_dispatch(be, cb, pipe, L->smooth, offset, (L->dims[0] + 1) / 2, ny, nzb * be->mg->channels, pc);
+            hd__vk_record_dispatch(be, cb, pipe, L->smooth, offset, (L->dims[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
         }
     return HD_SUCCESS;
 }
 
 static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_RESIDUAL, mg->lv[l].smooth, l, l, mg->channels, 0);
+    struct hd__vk_mg *mg = &ctx->be->mg;
+    return hd__vk_mg_level(ctx, HD__VK_MG_RESIDUAL, mg->lv[l].smooth, l, l, ctx->be->gg.channels, 0);
 }
 
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, mg->channels, 1);
+    struct hd__vk_mg *mg = &ctx->be->mg;
+    return hd__vk_mg_level(ctx, HD__VK_MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, ctx->be->gg.channels, 1);
 }
 
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, mg->channels, 1);
+    struct hd__vk_mg *mg = &ctx->be->mg;
+    return hd__vk_mg_level(ctx, HD__VK_MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, ctx->be->gg.channels, 1);
 }
 
 /* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
 static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_DOT, set, 0, mg->fine[1], mg->fine[2] * mg->channels, 1, 0, 0, 0, mg->channels);
+    const hd__gpu_grids *g = &ctx->be->gg;
+    return hd__vk_mg_pass(ctx, HD__VK_MG_DOT, set, 0, g->fine[1], g->fine[2] * g->channels, 1, 0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -2045,7 +1970,6 @@ static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
     hd__backend *be = ctx->be;
-    struct hd__vk_mg *mg = be->mg;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     HD__VK_LOST_CHECK(ctx);
@@ -2055,9 +1979,7 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if (mg && hd__mg_stale(ctx, mg->fine, mg->channels, mg->sig_channels)) hd__vk_mg_free(ctx);
-    *fresh = !be->mg;
-    if (!be->mg && (r = hd__vk_mg_alloc(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
     hd__vk_mg_params(ctx);
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
     return hd__vk_mg_sets(ctx);
@@ -2073,8 +1995,8 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, l, mg->sig_channels, 1);
+    struct hd__vk_mg *mg = &ctx->be->mg;
+    return hd__vk_mg_level(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, l, ctx->be->gg.sig_channels, 1);
 }
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
@@ -2082,33 +2004,33 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_zero_image(ctx->be, cb, ctx->be->mg->lo.image, HD__VK_G);
+    hd__vk_zero_image(ctx->be, cb, ctx->be->mg.lo.image, HD__VK_G);
     return HD_SUCCESS;
 }
 
 /* The fine residual in double (hd_mg_res_f64), f - A (phi + lo): the fine slot, use_lo. */
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
-    return hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], mg->levels, 1, 0);
+    struct hd__vk_mg *mg = &ctx->be->mg;
+    return hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], ctx->be->gg.levels, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
 {
-    return hd__vk_mg_dot(ctx, ctx->be->mg->cg_sets[HD__VK_MG_SET_DOT_RZ]);
+    return hd__vk_mg_dot(ctx, ctx->be->mg.cg_sets[HD__VK_MG_SET_DOT_RZ]);
 }
 
 static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
     int32_t bits;
     memcpy(&bits, &beta, sizeof beta);
-    return hd__vk_mg_fine(ctx, HD__VK_MG_DIR, ctx->be->mg->cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_DIR, ctx->be->mg.cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
 }
 
 /* q = A p: the double residual with negate on level 0's slot (E = z = 0, phi = p). */
 static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
+    struct hd__vk_mg *mg = &ctx->be->mg;
     hd_result r;
     if ((r = hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
         (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
@@ -2120,7 +2042,7 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
    in the host-visible buffers themselves. */
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
+    struct hd__vk_mg *mg = &ctx->be->mg;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     (void)n;
@@ -2141,15 +2063,15 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     ctx->be->lsum_ok = 0;
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    return hd__vk_mg_fine(ctx, HD__VK_MG_UPDATE, ctx->be->mg->cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
 }
 
 /* The fine parameters: slot `levels` (no right-hand-side flag). */
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
-    struct hd__vk_mg *mg = ctx->be->mg;
+    struct hd__vk_mg *mg = &ctx->be->mg;
     ctx->be->lsum_ok = 0;
-    return hd__vk_mg_fine(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], mg->levels, colour, 0);
+    return hd__vk_mg_fine(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
 }
 
 /* The single-level solver's sweeps: each its own submission. */
