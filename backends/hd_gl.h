@@ -127,10 +127,9 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_SSBOS 6       /* storage buffers 0..5 (3: multigrid's row sums, 4: the direct light's list,
                                 5: the projection's TF table) */
 
-/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE 1..9), each in the
-   4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
-#define HD__GL_MG_STAGES 9
-#define HD__GL_MG_PROGRAMS (4 * HD__GL_MG_STAGES)
+/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE, src/hd_gpu.h's HD__MG_*),
+   each in the 4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
+#define HD__GL_MG_PROGRAMS (4 * HD__MG_STAGES)
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
@@ -1097,15 +1096,6 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
    residual and CG's p and lo are r32f 3D textures like the backend's own; the double passes are
    GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
    storage buffer 3) and the rows in row order by the core, as on the CPU. */
-enum { HD__GL_MG_SIG = 1, HD__GL_MG_RESIDUAL, HD__GL_MG_RESTRICT, HD__GL_MG_PROLONG, HD__GL_MG_DIR, HD__GL_MG_RES_F64,
-       HD__GL_MG_DOT, HD__GL_MG_UPDATE, HD__GL_MG_EXTRAP };
-static const char *const hd__gl_mg_names[HD__GL_MG_STAGES] = {
-    "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
-    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
-    "multigrid extrapolation"};
-
-static size_t hd__gl_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
-
 /* Bytes the solver holds on the GPU (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
 
@@ -1114,7 +1104,7 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = &be->mg;
-    size_t rows = hd__gl_mg_rows(&be->gg);
+    size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
     int l;
     for (l = 0; l < be->gg.levels; ++l) {
@@ -1168,12 +1158,12 @@ static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint
         snprintf(prefix, sizeof prefix,
                  "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE 0\n#define HD_MG_STAGE %d\n"
                  "#define HD_DIFFUSE_FLAGS %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                 HD_MAX_LIGHTS, stage, hd__gl_diffuse_flags(variant) | (stage == HD__GL_MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0),
+                 HD_MAX_LIGHTS, stage, hd__gl_diffuse_flags(variant) | (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0),
                  HD__GL_LOCAL_X);
         src[0] = prefix;
         for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
         for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];
-        r = hd__gl_build(ctx, src, (GLsizei)(1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES), hd__gl_mg_names[stage - 1], slot);
+        r = hd__gl_build(ctx, src, (GLsizei)(1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES), hd__mg_stage_names[stage - 1], slot);
         if (r != HD_SUCCESS) return r;
     }
     *out = *slot;
@@ -1194,7 +1184,7 @@ static hd_result hd__gl_mg_pass(hd__ctx *ctx, int stage, GLuint params, const hd
     memset(&b, 0, sizeof b);
     b.params = params;
     b.img[0] = &be->vol; b.img[1] = sig; b.img[2] = E; b.img[3] = phi; b.img[4] = phi2; b.img[6] = other;
-    return hd__gl_run(ctx, prog, hd__gl_mg_names[stage - 1], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
+    return hd__gl_run(ctx, prog, hd__mg_stage_names[stage - 1], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
 }
 
 /* Sets the direction's beta or the update's alpha (hd_entry_glsl_multigrid.h, locations 1, 2) on
@@ -1205,7 +1195,7 @@ static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double 
     GLuint prog;
     hd_result r;
     if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
-    if (stage == HD__GL_MG_DIR) be->gl.ProgramUniform1f(prog, 1, beta);
+    if (stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, beta);
     else be->gl.ProgramUniform1d(prog, 2, alpha);
     return hd__gl_check(ctx, "multigrid's uniforms", __LINE__);
 }
@@ -1236,7 +1226,7 @@ static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
     hd__backend *be = ctx->be;
     hd__gl_level *L = &be->mg.lv[l];
     int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, L->dims[0],
+    return hd__gl_mg_pass(ctx, HD__MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, L->dims[0],
                           L->dims[1], L->dims[2] * ch, 0, 0, 0, ch);
 }
 
@@ -1245,7 +1235,7 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
     hd__backend *be = ctx->be;
     hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
     int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
+    return hd__gl_mg_pass(ctx, HD__MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
                           C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch);
 }
 
@@ -1254,7 +1244,7 @@ static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
     hd__backend *be = ctx->be;
     hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
     int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0],
+    return hd__gl_mg_pass(ctx, HD__MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0],
                           L->dims[1], L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch);
 }
 
@@ -1265,7 +1255,7 @@ static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex
 {
     const hd__gpu_grids *g = &ctx->be->gg;
     struct hd__gl_mg *mg = &ctx->be->mg;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, g->fine[0], g->fine[1],
+    return hd__gl_mg_pass(ctx, HD__MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, g->fine[0], g->fine[1],
                           g->fine[2] * g->channels, use_lo, negate, 0, g->channels);
 }
 
@@ -1276,7 +1266,7 @@ static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_t
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = &be->mg;
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
-    return hd__gl_mg_pass(ctx, HD__GL_MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, g->fine[1], g->fine[2] * g->channels, 1,
+    return hd__gl_mg_pass(ctx, HD__MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, g->fine[1], g->fine[2] * g->channels, 1,
                           0, 0, 0, g->channels);
 }
 
@@ -1312,7 +1302,7 @@ static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = &be->mg;
     const int *d = mg->lv[l].dims;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
+    return hd__gl_mg_pass(ctx, HD__MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
                           d[1], d[2] * g->sig_channels, d[0], d[1], d[2], g->sig_channels);
 }
 
@@ -1335,8 +1325,8 @@ static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
     const hd__gpu_grids *g = &ctx->be->gg;
     struct hd__gl_mg *mg = &ctx->be->mg;
     hd_result r;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, g->fine[0], g->fine[1],
+    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
+    return hd__gl_mg_pass(ctx, HD__MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, g->fine[0], g->fine[1],
                           g->fine[2] * g->channels, 0, 0, 0, g->channels);
 }
 
@@ -1356,7 +1346,7 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 {
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = &be->mg;
-    size_t rows = hd__gl_mg_rows(&be->gg);
+    size_t rows = hd__gpu_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i) {
         be->gl.BindBuffer(GL_COPY_READ_BUFFER, i ? mg->dot_b : mg->dot_a);
@@ -1375,8 +1365,8 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     struct hd__gl_mg *mg = &be->mg;
     hd_result r;
     be->lsum_ok = 0;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__GL_MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
+    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
+    return hd__gl_mg_pass(ctx, HD__MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
                           g->fine[2] * g->channels, 0, 0, 0, g->channels);
 }
 
@@ -1387,7 +1377,7 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
     hd__backend *be = ctx->be;
     struct hd__gl_mg *mg = &be->mg;
     be->lsum_ok = 0;
-    return hd__gl_mg_pass(ctx, HD__GL_MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
+    return hd__gl_mg_pass(ctx, HD__MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
                           g->fine[2] * g->channels, colour, 0, 0, g->channels);
 }
 

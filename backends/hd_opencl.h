@@ -822,7 +822,6 @@ static size_t hd__cl_mg_slots(const int *d, int channels)
 {
     return hd__split_slots(d[0], d[1], (size_t)channels * d[2]);
 }
-static size_t hd__cl_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
 /* The restriction's row buffer: a padded fine row per coarse row of level 1, the largest. */
 static size_t hd__cl_mg_line_floats(const hd__gpu_grids *g)
 {
@@ -837,7 +836,7 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     size_t b;
     int l, d[3];
     if (!g->levels || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
-    b = 2 * sizeof(double) * hd__cl_mg_rows(g) + 2 * sizeof(float) * hd__cl_mg_slots(g->fine, g->channels);
+    b = 2 * sizeof(double) * hd__gpu_mg_rows(g) + 2 * sizeof(float) * hd__cl_mg_slots(g->fine, g->channels);
     b += sizeof(float) * hd__cl_mg_line_floats(g);
     for (l = 0; l < g->levels; ++l) {
         hd__mg_level_dims(g->fine, l, d);
@@ -852,7 +851,7 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = &be->mg;
-    size_t rows = hd__cl_mg_rows(&be->gg);
+    size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r = HD_SUCCESS;
     int l;
     for (l = 0; l < be->gg.levels; ++l) {
@@ -1053,7 +1052,7 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 {
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = &be->mg;
-    size_t rows = hd__cl_mg_rows(&be->gg);
+    size_t rows = hd__gpu_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i)
         HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, i ? mg->dot_b : mg->dot_a, CL_TRUE, 0, rows * sizeof(double),

@@ -106,7 +106,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 15
-#define HD__VK_MG_PIPELINES (9 * 4) /* HD_SOLVER_MULTIGRID: 9 passes (HD__VK_MG_STAGES) x 4 flag variants (RGB, surface) */
+#define HD__VK_MG_PIPELINES (HD__MG_STAGES * 4) /* HD_SOLVER_MULTIGRID: its passes (src/hd_gpu.h) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -1735,15 +1735,6 @@ static hd_result hd__be_path(hd__ctx *ctx)
    The passes are recorded into the backend's command buffer (hd__vk_cmd) and submitted at each
    read-back of the row sums and at the end: three submissions a step, each waited for, so
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
-enum { HD__VK_MG_SIG = 1, HD__VK_MG_RESIDUAL, HD__VK_MG_RESTRICT, HD__VK_MG_PROLONG, HD__VK_MG_DIR, HD__VK_MG_RES_F64,
-       HD__VK_MG_DOT, HD__VK_MG_UPDATE, HD__VK_MG_EXTRAP, HD__VK_MG_STAGES = HD__VK_MG_EXTRAP };
-static const char *const hd__vk_mg_names[HD__VK_MG_STAGES] = {
-    "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
-    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
-    "multigrid extrapolation"};
-
-static size_t hd__vk_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
-
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
 
@@ -1754,7 +1745,7 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = &be->mg;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
-    size_t rows = hd__vk_mg_rows(&be->gg);
+    size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
     int l;
     for (l = 0; l < be->gg.levels; ++l) hd__mg_level_dims(be->gg.fine, l, mg->lv[l].dims);
@@ -1863,10 +1854,10 @@ static int hd__vk_mg_variant(int counts_z)
 /* The pipeline of multigrid pass `stage` for the current flags, made on first use. */
 static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
 {
-    static const uint32_t *const code[HD__VK_MG_STAGES] = {hd__spv_mg_sig, hd__spv_mg_residual, hd__spv_mg_restrict,
+    static const uint32_t *const code[HD__MG_STAGES] = {hd__spv_mg_sig, hd__spv_mg_residual, hd__spv_mg_restrict,
                                                            hd__spv_mg_prolong, hd__spv_mg_dir, hd__spv_mg_res_f64,
                                                            hd__spv_mg_dot, hd__spv_mg_update, hd__spv_mg_extrap};
-    static const size_t size[HD__VK_MG_STAGES] = {sizeof hd__spv_mg_sig, sizeof hd__spv_mg_residual, sizeof hd__spv_mg_restrict,
+    static const size_t size[HD__MG_STAGES] = {sizeof hd__spv_mg_sig, sizeof hd__spv_mg_residual, sizeof hd__spv_mg_restrict,
                                                   sizeof hd__spv_mg_prolong, sizeof hd__spv_mg_dir, sizeof hd__spv_mg_res_f64,
                                                   sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update,
                                                   sizeof hd__spv_mg_extrap};
@@ -1874,10 +1865,10 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
     int variant = hd__vk_mg_variant(ctx->kp.counts.z);
     VkPipeline *slot = &be->mg_pipes[(stage - 1) * 4 + variant];
     int32_t flags = (int32_t)(((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0) |
-                              (stage == HD__VK_MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0));
+                              (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0));
     hd_result r;
     if (!*slot && (r = hd__vk_pipeline_code(ctx, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
-        HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__vk_mg_names[stage - 1]);
+        HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__mg_stage_names[stage - 1]);
         return r;
     }
     *out = *slot;
@@ -1941,26 +1932,26 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_RESIDUAL, mg->lv[l].smooth, l, l, ctx->be->gg.channels, 0);
+    return hd__vk_mg_level(ctx, HD__MG_RESIDUAL, mg->lv[l].smooth, l, l, ctx->be->gg.channels, 0);
 }
 
 static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, ctx->be->gg.channels, 1);
+    return hd__vk_mg_level(ctx, HD__MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, ctx->be->gg.channels, 1);
 }
 
 static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, ctx->be->gg.channels, 1);
+    return hd__vk_mg_level(ctx, HD__MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, ctx->be->gg.channels, 1);
 }
 
 /* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
 static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
 {
     const hd__gpu_grids *g = &ctx->be->gg;
-    return hd__vk_mg_pass(ctx, HD__VK_MG_DOT, set, 0, g->fine[1], g->fine[2] * g->channels, 1, 0, 0, 0, g->channels);
+    return hd__vk_mg_pass(ctx, HD__MG_DOT, set, 0, g->fine[1], g->fine[2] * g->channels, 1, 0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1996,7 +1987,7 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__VK_MG_SIG, mg->lv[l].coarsen, l - 1, l, ctx->be->gg.sig_channels, 1);
+    return hd__vk_mg_level(ctx, HD__MG_SIG, mg->lv[l].coarsen, l - 1, l, ctx->be->gg.sig_channels, 1);
 }
 
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
@@ -2012,7 +2003,7 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
 static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], ctx->be->gg.levels, 1, 0);
+    return hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], ctx->be->gg.levels, 1, 0);
 }
 
 static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
@@ -2024,7 +2015,7 @@ static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
 {
     int32_t bits;
     memcpy(&bits, &beta, sizeof beta);
-    return hd__vk_mg_fine(ctx, HD__VK_MG_DIR, ctx->be->mg.cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
+    return hd__vk_mg_fine(ctx, HD__MG_DIR, ctx->be->mg.cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
 }
 
 /* q = A p: the double residual with negate on level 0's slot (E = z = 0, phi = p). */
@@ -2032,7 +2023,7 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
     hd_result r;
-    if ((r = hd__vk_mg_fine(ctx, HD__VK_MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
+    if ((r = hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
         (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
         return r;
     return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
@@ -2063,7 +2054,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     ctx->be->lsum_ok = 0;
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    return hd__vk_mg_fine(ctx, HD__VK_MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
+    return hd__vk_mg_fine(ctx, HD__MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
 }
 
 /* The fine parameters: slot `levels` (no right-hand-side flag). */
@@ -2071,7 +2062,7 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
     ctx->be->lsum_ok = 0;
-    return hd__vk_mg_fine(ctx, HD__VK_MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
+    return hd__vk_mg_fine(ctx, HD__MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
 }
 
 /* The single-level solver's sweeps: each its own submission. */

@@ -19,6 +19,15 @@ enum { HD__G_MG_SIG, HD__G_MG_RHS, HD__G_MG_PHI, HD__G_MG_RES };
 /* The level of a level's grid id, 0 for the other ids (a backend's lookup indexes its levels by it). */
 #define HD__G_LEVEL_OF(id) ((id) >= HD__G_MG_LEVELS && (id) < HD__G_LIGHT ? ((id) - HD__G_MG_LEVELS) / 4 : 0)
 
+/* HD_SOLVER_MULTIGRID's passes as hd_entry_glsl_multigrid.h numbers them (HD_MG_STAGE: the GL
+   backend's programs, the Vulkan backend's SPIR-V), and their names in the log. */
+enum { HD__MG_SIG = 1, HD__MG_RESIDUAL, HD__MG_RESTRICT, HD__MG_PROLONG, HD__MG_DIR, HD__MG_RES_F64, HD__MG_DOT,
+       HD__MG_UPDATE, HD__MG_EXTRAP, HD__MG_STAGES = HD__MG_EXTRAP };
+HD__MAYBE_UNUSED static const char *const hd__mg_stage_names[HD__MG_STAGES] = {
+    "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
+    "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
+    "multigrid extrapolation"};
+
 /* What the grids are made for: E and phi's values (0: none, the path tracers), CD's lights and
    the multigrid's levels (0: none) on fine grid `fine` with channels and sig_channels. */
 typedef struct hd__gpu_grids {
@@ -26,6 +35,9 @@ typedef struct hd__gpu_grids {
     int nlv;
     int levels, channels, sig_channels, fine[3];
 } hd__gpu_grids;
+
+/* The multigrid's fine rows (a row sum each): y, z and channels. */
+static size_t hd__gpu_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1] * g->fine[2] * g->channels; }
 
 /* ---- the primitives a GPU backend defines -------------------------------------------------- */
 /* Grid id as w x h x d values (channels stacked in d), zeroed (a device backend may record the
@@ -36,8 +48,8 @@ static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, con
 static void hd__gpu_grid_free(hd__ctx *ctx, int id);
 /* Zeroes grid id; nothing when it holds none. */
 static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id);
-/* The backend's own multigrid objects for the levels its hd__gpu_grids describes: made (make = 1; on failure
-   hd__gpu_mg_free follows) or freed (make = 0, also when partly made). */
+/* The backend's own multigrid objects for the levels its hd__gpu_grids describes: made (make =
+   1; on failure hd__gpu_mg_free follows) or freed (make = 0, also when partly made). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make);
 
 /* ---- the life cycle, for the backends' hd__be_alloc_* and hd__be_clear ---------------------- */
