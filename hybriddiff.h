@@ -370,7 +370,21 @@ typedef struct hd_params {
                                Matter outside [crop_min, crop_max] is absent for every method
                                and stage: it casts no shadow, scatters nothing and is not
                                drawn. Per axis 0 <= min < max <= 1, finite */
+    int render_scale;       /* projection frames at 1/s of the camera's resolution per axis: s = 1..8
+                               marches ceil(width / s) x ceil(height / s) rays and fills the full
+                               image by a bilinear upsample on the device (the image read back stays
+                               width x height); 0 -> 1. HD_RENDER_SCALE_AUTO: each new image (camera
+                               move, setter, reset) starts at a reduced scale, then every further
+                               frame doubles the resolution up to full frames, which then
+                               accumulate as usual (a moving camera gets cheap frames, a still one
+                               converges to the full image). The first scale is the smallest power
+                               of two whose predicted frame time (from the last frame measured) fits
+                               render_budget, or 4 while render_budget is 0 or nothing is measured.
+                               A change of scale restarts the running mean. The path tracers ignore
+                               it. Else HD_ERROR_INVALID_PARAMETER */
 } hd_params;
+
+#define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
 
 typedef struct hd_desc {
     hd_volume_desc volume;
@@ -429,6 +443,8 @@ typedef struct hd_stats {
        two iterations. */
     double light_error;
     int light_converged;      /* light_error < params.light_tolerance twice in a row */
+    int render_scale;         /* the divisor of the current image's frames (params.render_scale);
+                                 1 for full-resolution frames and for the path tracers */
 } hd_stats;
 
 typedef struct hd_context {

@@ -1465,7 +1465,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 {
     hd__backend *be = ctx->be;
-    VkDeviceSize bytes = (VkDeviceSize)width * height * 4 * sizeof(float);
+    VkDeviceSize bytes = (VkDeviceSize)hd__image_floats(width, height) * sizeof(float);
     hd_result r;
     HD__VK_IDLE(ctx);
     hd__vk_free_buffer(ctx, &be->img);
@@ -1476,7 +1476,7 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
     if ((r = hd__vk_buffer_create(ctx, &be->img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, "the image")) != HD_SUCCESS)
         return r;
-    be->img_floats = (size_t)width * height * 4;
+    be->img_floats = hd__image_floats(width, height);
     return HD_SUCCESS;
 }
 

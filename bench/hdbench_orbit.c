@@ -40,10 +40,11 @@
 
 #define MAX_VIEWS 360
 #define MAX_BUDGETS 32
+#define MAX_FRAMES 256
 
 static struct {
     const char *data, *csv, *out, *cache;
-    int views, size, frame_size, ref_iters, light_iters, psnr, downsample, surface;
+    int views, size, frame_size, ref_iters, light_iters, psnr, downsample, boundary, paper;
     int nb, wall, single;
     double pt_cap;
     double budgets[MAX_BUDGETS];
@@ -85,8 +86,11 @@ static void usage(int code)
             "  --light-iters N    cap on HD light iterations while converging (default 24; 2 with\n"
             "                     --no-psnr); past it light_tolerance is raised to the error\n"
             "                     reached, so frames stay projections (said in the output)\n"
-            "  --boundary box|surface   HD's diffusion boundary (default box, hdrender's)\n"
-            "  --downsample N     HD's illumination grid divisor (default 1, hdrender's)\n"
+            "  --preset default|paper   HD's settings: the library's defaults (zeroed hd_params:\n"
+            "                     grid /2, surface boundary; default, hdrender's) or the paper's\n"
+            "                     (hd_params_preset: full grid, box boundary, 4 sweeps)\n"
+            "  --boundary box|surface   HD's diffusion boundary (default: the preset's)\n"
+            "  --downsample N     HD's illumination grid divisor (default: the preset's)\n"
             "  --clock cpu|wall   what the budgets measure: process CPU time / online cores\n"
             "                     (default; load-independent on a shared machine) or wall time\n"
             "  --no-psnr          frame time only (what the GPU backends' builds run)\n"
@@ -125,7 +129,7 @@ static void parse_args(int argc, char **argv)
     O.ref_iters = 128;
     O.light_iters = -1;
     O.psnr = 1;
-    O.downsample = 1;
+    O.downsample = 0;
     O.pt_cap = 8.0;
     {
         static const double def[] = {0.05, 0.1, 0.25, 0.5, 1, 2, 5};
@@ -164,9 +168,14 @@ static void parse_args(int argc, char **argv)
         else if (!strcmp(a, "--cache")) O.cache = NEXT();
         else if (!strcmp(a, "--boundary")) {
             const char *v = NEXT();
-            if (!strcmp(v, "box")) O.surface = 0;
-            else if (!strcmp(v, "surface")) O.surface = 1;
+            if (!strcmp(v, "box")) O.boundary = HD_BOUNDARY_BOX;
+            else if (!strcmp(v, "surface")) O.boundary = HD_BOUNDARY_SURFACE;
             else { fprintf(stderr, "hdbench_orbit: --boundary: box or surface\n"); exit(2); }
+        } else if (!strcmp(a, "--preset")) {
+            const char *v = NEXT();
+            if (!strcmp(v, "default")) O.paper = 0;
+            else if (!strcmp(v, "paper")) O.paper = 1;
+            else { fprintf(stderr, "hdbench_orbit: --preset: default or paper\n"); exit(2); }
         } else if (!strcmp(a, "--budgets")) {
             const char *s = NEXT();
             O.nb = 0;
@@ -302,7 +311,9 @@ static int single_view(const hdo_scene *s)
     hd_context c;
     hd_stats st;
     double t = 0.0, ts, hd_psnr, pt_psnr = NAN, t_light, t_hd, t_pt = -1.0;
-    int it = 0, paths = 0;
+    /* after frame k + 1: HD's time and PSNR, and when PT_MS first reached that PSNR */
+    double fr_t[MAX_FRAMES], fr_psnr[MAX_FRAMES], fr_pt[MAX_FRAMES];
+    int fr_paths[MAX_FRAMES], nfr = 0, it = 0, paths = 0, k;
     if (!ref || !img) { fprintf(stderr, "hdbench_orbit: out of memory\n"); return 1; }
     reference(s, 0, ref);
     /* HD: light to convergence without frames, then the frames (examples/hdrender.c) */
@@ -321,8 +332,14 @@ static int single_view(const hdo_scene *s)
         check(hd_render(c), "hd_render");
         t += bench_clock() - ts;
         check(hd_get_stats(c, &st), "hd_get_stats");
+        read_tonemapped(c, img, npix);
+        if (nfr < MAX_FRAMES) {
+            fr_t[nfr] = t;
+            fr_psnr[nfr] = hdo_psnr(img, ref, npix);
+            fr_pt[nfr] = -1.0;
+            fr_paths[nfr++] = 0;
+        }
     } while (st.frames < (uint64_t)d.params.frame_window);
-    read_tonemapped(c, img, npix);
     hd_psnr = hdo_psnr(img, ref, npix);
     printf("single view: %s backend, head CT, %dx%d, %s clock\n", hd_backend_name(), O.size, O.size,
            O.wall ? "wall" : "CPU time / cores");
@@ -346,6 +363,8 @@ static int single_view(const hdo_scene *s)
         ++paths;
         read_tonemapped(c, img, npix);
         pt_psnr = hdo_psnr(img, ref, npix);
+        for (k = 0; k < nfr; ++k)
+            if (fr_pt[k] < 0.0 && pt_psnr >= fr_psnr[k]) { fr_pt[k] = t; fr_paths[k] = paths; }
         if (pt_psnr >= hd_psnr) { t_pt = t; break; }
         if (t > O.pt_cap * t_hd) break;
     }
@@ -356,6 +375,14 @@ static int single_view(const hdo_scene *s)
         printf("  PT_MS  %.2f dB after %.2f s (%d paths/pixel): below HD's PSNR when stopped (--pt-cap %g)\n",
                pt_psnr, t, paths, O.pt_cap);
     printf("  reference: PT_MS, %d paths/pixel, another seed\n", O.ref_iters);
+    printf("  HD after each frame (the light's time included) and PT_MS's time to that PSNR:\n"
+           "  frames  HD s     HD dB   PT_MS s  paths\n");
+    for (k = 0; k < nfr; ++k) {
+        if (fr_pt[k] >= 0.0)
+            printf("  %6d  %7.2f  %6.2f  %7.2f  %5d\n", k + 1, fr_t[k], fr_psnr[k], fr_pt[k], fr_paths[k]);
+        else
+            printf("  %6d  %7.2f  %6.2f  not reached\n", k + 1, fr_t[k], fr_psnr[k]);
+    }
     if (t_pt >= 0.0 && t_pt < t_hd)
         printf("  PT_MS first: it reached HD's PSNR in %.2f s, HD took %.2f s (%.2fx)\n", t_pt, t_hd, t_hd / t_pt);
     else if (t_pt >= 0.0)
@@ -400,8 +427,13 @@ int main(int argc, char **argv)
     parse_args(argc, argv);
     log.func = NULL; /* info lines would drown the table; errors come back as results */
     if (!hdo_scene_load(&s, O.data, O.frame_size, &log)) return 1;
-    s.desc.params.illumination_downsample = O.downsample;
-    s.desc.params.diffusion_boundary = O.surface ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+    check(hd_params_preset(O.paper ? HD_PRESET_PAPER : HD_PRESET_DEFAULT, &s.desc.params, NULL),
+          "hd_params_preset");
+    if (O.downsample) s.desc.params.illumination_downsample = O.downsample;
+    if (O.boundary) s.desc.params.diffusion_boundary = (hd_boundary)O.boundary;
+    printf("HD settings: %s preset, illumination grid /%d, %s boundary\n", O.paper ? "paper" : "default",
+           s.desc.params.illumination_downsample ? s.desc.params.illumination_downsample : 2,
+           s.desc.params.diffusion_boundary == HD_BOUNDARY_BOX ? "box" : "surface");
     if (O.single) {
         int r = single_view(&s);
         hd_volume_free(&s.vol);
