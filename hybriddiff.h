@@ -503,7 +503,10 @@ HDDEF hd_result hd_refine(hd_context ctx, int n);
              the projection alone, and when the frame_window frames since the convergence are in
              the image (it is done), nothing at all until a setter invalidates something.
      PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
-   A camera move (hd_set_camera) keeps converged light: the next call projects at once.
+   A camera move (hd_set_camera) keeps converged light: the next call projects at once. For a
+   frame budget below one projection's time, params.render_scale projects at reduced resolution
+   (HD_RENDER_SCALE_AUTO: coarse frames at each new view, full ones once the camera rests); the
+   image read back keeps the camera's size.
 
       for (;;) {                              // the application's frame loop
           if (camera_moved) hd_set_camera(ctx, &cam);
