@@ -2181,7 +2181,8 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
        recorded, each with its own parameter slot */
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_ring(ctx, 2u * (uint32_t)n + 2u)) != HD_SUCCESS) return r; /* light and frame */
+    /* light, frame and a reduced frame's upsample pass (params.render_scale) */
+    if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
     if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
     be->next_slot = 0;
     be->have_slot = 0;
