@@ -370,7 +370,21 @@ typedef struct hd_params {
                                Matter outside [crop_min, crop_max] is absent for every method
                                and stage: it casts no shadow, scatters nothing and is not
                                drawn. Per axis 0 <= min < max <= 1, finite */
+    int render_scale;       /* projection frames at 1/s of the camera's resolution per axis: s = 1..8
+                               marches ceil(width / s) x ceil(height / s) rays and fills the full
+                               image by a bilinear upsample on the device (the image read back stays
+                               width x height); 0 -> 1. HD_RENDER_SCALE_AUTO: each new image (camera
+                               move, setter, reset) starts at a reduced scale, then every further
+                               frame doubles the resolution up to full frames, which then
+                               accumulate as usual (a moving camera gets cheap frames, a still one
+                               converges to the full image). The first scale is the smallest power
+                               of two whose predicted frame time (from the last frame measured) fits
+                               render_budget, or 4 while render_budget is 0 or nothing is measured.
+                               A change of scale restarts the running mean. The path tracers ignore
+                               it. Else HD_ERROR_INVALID_PARAMETER */
 } hd_params;
+
+#define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
 
 typedef struct hd_desc {
     hd_volume_desc volume;
@@ -429,6 +443,8 @@ typedef struct hd_stats {
        two iterations. */
     double light_error;
     int light_converged;      /* light_error < params.light_tolerance twice in a row */
+    int render_scale;         /* the divisor of the current image's frames (params.render_scale);
+                                 1 for full-resolution frames and for the path tracers */
 } hd_stats;
 
 typedef struct hd_context {
@@ -487,7 +503,10 @@ HDDEF hd_result hd_refine(hd_context ctx, int n);
              the projection alone, and when the frame_window frames since the convergence are in
              the image (it is done), nothing at all until a setter invalidates something.
      PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
-   A camera move (hd_set_camera) keeps converged light: the next call projects at once.
+   A camera move (hd_set_camera) keeps converged light: the next call projects at once. For a
+   frame budget below one projection's time, params.render_scale projects at reduced resolution
+   (HD_RENDER_SCALE_AUTO: coarse frames at each new view, full ones once the camera rests); the
+   image read back keeps the camera's size.
 
       for (;;) {                              // the application's frame loop
           if (camera_moved) hd_set_camera(ctx, &cam);

@@ -316,7 +316,7 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 {
     hd__backend *be = ctx->be;
     hd__free(ctx, be->img);
-    be->img = be->k.img = (float *)hd__calloc(ctx, (size_t)width * height * 4, sizeof(float));
+    be->img = be->k.img = (float *)hd__calloc(ctx, hd__image_floats(width, height), sizeof(float));
     if (!be->img) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image", width, height);
     return HD_SUCCESS;
 }
@@ -910,7 +910,9 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
     k.lsum = be->lsum_ok ? be->lsum : NULL;
     k.ptab = be->ptab;
     k.ptab_n = be->ptab_n;
-    if (k.f16) {
+    if (be->ctx->kp.counts.z & HD_FLAG_UPSAMPLE) { /* a reduced frame's upsample pass */
+        for (px = 0; px < w; ++px) hd_upsample_pixel(&k, px, py);
+    } else if (k.f16) {
         k.f16 = 1;
         for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
     } else {

@@ -85,14 +85,18 @@ HD__CL_DIFFUSE_SET(, 0)
 HD__CL_DIFFUSE_SET(_half, 1)
 
 /* One work-item per pixel (x, y); lsum and the table (ptab_n entries) as hd_k_project.h reads
-   them. */
+   them. With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass
+   (hd_k_upsample.h). */
 #define HD__CL_PROJECT(name, is16) \
     __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n) \
     { \
         HD__CL_KCTX; \
         k.f16 = (is16); \
         k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
-        hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
+        if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
+            hd_upsample_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
+        else \
+            hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
     }
 HD__CL_PROJECT(hd_k_project, 0)
 HD__CL_PROJECT(hd_k_project_half, 1)

@@ -139,7 +139,11 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
-    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hd_project_pixel(x, y);
+    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h) */
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
+        if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);
+        else hd_project_pixel(x, y);
+    }
 #elif HD_STAGE == HD_STAGE_CONVECT
     if (x < g.x && y < g.y && z < g.z) hd_convect_voxel(x, y, z, hd_pc.z);
 #elif HD_STAGE == HD_STAGE_SUM_LIGHT

@@ -865,7 +865,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ct
 static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height)
 {
     hd__backend *be = ctx->be;
-    size_t bytes = (size_t)width * height * 4 * sizeof(float);
+    size_t bytes = hd__image_floats(width, height) * sizeof(float);
     hd_result r;
     hd__gl_free_buffer(be, &be->img);
     be->img_floats = 0;
@@ -873,7 +873,7 @@ static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
                        width, height, bytes, (int)be->max_ssbo_block);
     if ((r = hd__gl_buffer_data(ctx, &be->img, bytes, NULL, GL_DYNAMIC_COPY, "the image")) != HD_SUCCESS) return r;
-    be->img_floats = (size_t)width * height * 4;
+    be->img_floats = hd__image_floats(width, height);
     return HD_SUCCESS;
 }
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)

@@ -11,10 +11,11 @@
      7: backends/kernels/hd_k_diffuse.h
      8: backends/kernels/hd_k_multigrid.h
      9: backends/kernels/hd_k_project.h
-     10: backends/kernels/hd_k_convect.h
-     11: backends/kernels/hd_k_path.h
-     12: backends/hd_entry_glsl.h
-     13: backends/hd_entry_glsl_multigrid.h
+     10: backends/kernels/hd_k_upsample.h
+     11: backends/kernels/hd_k_convect.h
+     12: backends/kernels/hd_k_path.h
+     13: backends/hd_entry_glsl.h
+     14: backends/hd_entry_glsl_multigrid.h
    */
 #ifndef HD_GLSL_EMBEDDED_H
 #define HD_GLSL_EMBEDDED_H
@@ -29,6 +30,7 @@ static const char *const hd__gl_source_files[] = {
     "backends/kernels/hd_k_diffuse.h",
     "backends/kernels/hd_k_multigrid.h",
     "backends/kernels/hd_k_project.h",
+    "backends/kernels/hd_k_upsample.h",
     "backends/kernels/hd_k_convect.h",
     "backends/kernels/hd_k_path.h",
     "backends/hd_entry_glsl.h",
@@ -1402,11 +1404,12 @@ static const char *const hd__gl_source[] = {
 "    return hd_normalize(d);\n",
 "}\n",
 "\n",
-"/* Folds one frame value into the running mean of pixel i (RGBA). */\n",
+"/* Folds one frame value into the running mean of pixel i (RGBA) of the image region that\n",
+"   starts at pixel image.w (0; a reduced frame's region: hd_k_upsample.h). */\n",
 "HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)\n",
 "{\n",
 "    float w = HD_PRM(march).y;\n",
-"    int b = i * 4;\n",
+"    int b = (i + HD_PRM(image).w) * 4;\n",
 "    HD_SET1(img, b, HD_GET1(img, b) + (v.x - HD_GET1(img, b)) * w);\n",
 "    HD_SET1(img, b + 1, HD_GET1(img, b + 1) + (v.y - HD_GET1(img, b + 1)) * w);\n",
 "    HD_SET1(img, b + 2, HD_GET1(img, b + 2) + (v.z - HD_GET1(img, b + 2)) * w);\n",
@@ -1531,6 +1534,36 @@ static const char *const hd__gl_source[] = {
 "                                          b + T * HD_PRM(background).z, 1.0f - T));\n",
 "}\n",
 "#line 1 10\n",
+"/* hd_k_upsample.h - the reduced-resolution frame's upsample pass (shared source). A frame at\n",
+"   render scale s marches ceil(w / s) x ceil(h / s) rays (hd_project_pixel with image.x, y the\n",
+"   reduced size) into the image buffer's second region, which starts after the w x h image\n",
+"   (image.w = w h, the pixel offset hd_accumulate_pixel adds), as a running mean of its own. This\n",
+"   pass then fills the full image from that region by bilinear interpolation, so the image read\n",
+"   back is always w x h. The backends run it through the projection's entry point when\n",
+"   counts.z has HD_FLAG_UPSAMPLE (image.x, y = w, h; image.w = s). */\n",
+"#define HD_FLAG_UPSAMPLE 32\n",
+"\n",
+"/* Full-image pixel (px, py) from the reduced region: pixel centres map onto the reduced grid's\n",
+"   extent (the reduced frame covers the same field of view), clamped at its edges. */\n",
+"HD_FN void hd_upsample_pixel(HD_KARGS int px, int py)\n",
+"{\n",
+"    int w = HD_PRM(image).x, h = HD_PRM(image).y, s = HD_PRM(image).w;\n",
+"    int lw = (w + s - 1) / s, lh = (h + s - 1) / s;\n",
+"    float fx = hd_clampf((HD_F(px) + 0.5f) * HD_F(lw) / HD_F(w) - 0.5f, 0.0f, HD_F(lw - 1));\n",
+"    float fy = hd_clampf((HD_F(py) + 0.5f) * HD_F(lh) / HD_F(h) - 0.5f, 0.0f, HD_F(lh - 1));\n",
+"    int x0 = hd_mini(HD_I(fx), lw - 1), y0 = hd_mini(HD_I(fy), lh - 1);\n",
+"    int x1 = hd_mini(x0 + 1, lw - 1), y1 = hd_mini(y0 + 1, lh - 1);\n",
+"    float wx = fx - HD_F(x0), wy = fy - HD_F(y0);\n",
+"    int a = (w * h + y0 * lw + x0) * 4, b = (w * h + y0 * lw + x1) * 4;\n",
+"    int c = (w * h + y1 * lw + x0) * 4, d = (w * h + y1 * lw + x1) * 4;\n",
+"    int o = (py * w + px) * 4, k;\n",
+"    for (k = 0; k < 4; ++k) {\n",
+"        float top = HD_GET1(img, a + k) + wx * (HD_GET1(img, b + k) - HD_GET1(img, a + k));\n",
+"        float bot = HD_GET1(img, c + k) + wx * (HD_GET1(img, d + k) - HD_GET1(img, c + k));\n",
+"        HD_SET1(img, o + k, top + wy * (bot - top));\n",
+"    }\n",
+"}\n",
+"#line 1 11\n",
 "/* hd_k_convect.h - stage 1 of CD (convection-diffusion, Zhang & Ma 2013): direct light by\n",
 "   convection, one light volume per light (shared source).\n",
 "\n",
@@ -1637,7 +1670,7 @@ static const char *const hd__gl_source[] = {
 "        HD_SET(E, ic, x, y, z + c * gz, e + hd_light_channel(HD_KPASS l, c) * falloff * rho);\n",
 "    }\n",
 "}\n",
-"#line 1 11\n",
+"#line 1 12\n",
 "/* hd_k_path.h - PT_SS and PT_MS: camera path tracing, one full path per pixel per iteration\n",
 "   (shared source).\n",
 "\n",
@@ -1776,7 +1809,7 @@ static const char *const hd__gl_source[] = {
 "    }\n",
 "    hd_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));\n",
 "}\n",
-"#line 1 12\n",
+"#line 1 13\n",
 "/* hd_entry_glsl.h - GLSL 4.50 text, not C: the compute entry points of the Vulkan backend, one\n",
 "   per SPIR-V module, selected by -DHD_STAGE=n (scripts/build-spirv). Each calls one shared stage\n",
 "   function; the math is all in backends/kernels/. Work groups are 64 x 1 x 1 along x (the\n",
@@ -1918,7 +1951,11 @@ static const char *const hd__gl_source[] = {
 "#elif HD_STAGE == HD_STAGE_DIFFUSE\n",
 "    hd_diffuse_block(x, y, z);\n",
 "#elif HD_STAGE == HD_STAGE_PROJECT\n",
-"    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hd_project_pixel(x, y);\n",
+"    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h) */\n",
+"    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {\n",
+"        if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);\n",
+"        else hd_project_pixel(x, y);\n",
+"    }\n",
 "#elif HD_STAGE == HD_STAGE_CONVECT\n",
 "    if (x < g.x && y < g.y && z < g.z) hd_convect_voxel(x, y, z, hd_pc.z);\n",
 "#elif HD_STAGE == HD_STAGE_SUM_LIGHT\n",
@@ -1934,7 +1971,7 @@ static const char *const hd__gl_source[] = {
 "}\n",
 };
 static const char *const hd__gl_source_mg[] = {
-"#line 1 13\n",
+"#line 1 14\n",
 "/* hd_entry_glsl_multigrid.h - GLSL text, not C: HD_SOLVER_MULTIGRID's passes, one program (GL,\n",
 "   hd_gl.h; 4.30, scripts/embed-glsl) or SPIR-V module (Vulkan, hd_vulkan.h; 4.50,\n",
 "   scripts/build-spirv) each, selected by HD_MG_STAGE=n, in place of hd_entry_glsl.h. The math is\n",
@@ -2053,7 +2090,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1741 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1772 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

@@ -467,8 +467,8 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
     HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->img);
     be->img_floats = 0;
-    if ((r = hd__cl_buffer(ctx, &be->img, (size_t)width * height * 4 * sizeof(float), NULL, "the image")) != HD_SUCCESS) return r;
-    be->img_floats = (size_t)width * height * 4;
+    if ((r = hd__cl_buffer(ctx, &be->img, hd__image_floats(width, height) * sizeof(float), NULL, "the image")) != HD_SUCCESS) return r;
+    be->img_floats = hd__image_floats(width, height);
     return HD_SUCCESS;
 }
 

@@ -1491,7 +1491,7 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 {
     hd__backend *be = ctx->be;
-    VkDeviceSize bytes = (VkDeviceSize)width * height * 4 * sizeof(float);
+    VkDeviceSize bytes = (VkDeviceSize)hd__image_floats(width, height) * sizeof(float);
     hd_result r;
     HD__VK_IDLE(ctx);
     hd__vk_free_buffer(ctx, &be->img);
@@ -1502,7 +1502,7 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
     if ((r = hd__vk_buffer_create(ctx, &be->img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, "the image")) != HD_SUCCESS)
         return r;
-    be->img_floats = (size_t)width * height * 4;
+    be->img_floats = hd__image_floats(width, height);
     return HD_SUCCESS;
 }
 
@@ -2094,7 +2094,8 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
        recorded, each with its own parameter slot */
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_ring(ctx, 2u * (uint32_t)n + 2u)) != HD_SUCCESS) return r; /* light and frame */
+    /* light, frame and a reduced frame's upsample pass (params.render_scale) */
+    if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
     if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
     be->next_slot = 0;
     be->have_slot = 0;

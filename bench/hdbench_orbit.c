@@ -4,12 +4,14 @@
    1. Converge HD's light once (hd_refine until hd_stats.light_converged; past --light-iters
       iterations light_tolerance is raised to the error reached: bench/hd_orbit_scene.h).
    2. Frame time: K views of an orbit around the head (azimuth 360 k / K), hd_set_camera +
-      hd_render each, at --frame-size; prints ms per orbit frame and the light work they did
-      (none once the light has converged). Built once per backend (mk/bench.mk).
+      hd_render each, at --frame-size, at render_scale 1, 2 and 4; prints ms per orbit frame and
+      the light work they did (none once the light has converged). Built once per backend
+      (mk/bench.mk).
    3. Quality per time budget (unless --no-psnr), at --size: for each view k and each per-view
       budget b (--budgets, seconds of this machine):
         HD     the converged light, camera at view k, as many hd_render calls as finish within b
-               (projection frames, averaged over frame_window);
+               (projection frames, averaged over frame_window; by default render_scale
+               HD_RENDER_SCALE_AUTO: a 1/4 and a 1/2 resolution frame, then full frames);
         PT_MS  started afresh at view k (the camera change restarts it), as many path iterations
                as finish within b;
       each against a PT_MS reference of view k (--ref-iters paths per pixel, another seed; cached
@@ -40,11 +42,12 @@
 
 #define MAX_VIEWS 360
 #define MAX_BUDGETS 32
+#define MAX_FRAMES 256
 
 static struct {
     const char *data, *csv, *out, *cache;
-    int views, size, frame_size, ref_iters, light_iters, psnr, downsample, surface;
-    int nb, wall, single;
+    int views, size, frame_size, ref_iters, light_iters, psnr, downsample, boundary, paper;
+    int nb, wall, single, scale, window;
     double pt_cap;
     double budgets[MAX_BUDGETS];
 } O;
@@ -85,8 +88,14 @@ static void usage(int code)
             "  --light-iters N    cap on HD light iterations while converging (default 24; 2 with\n"
             "                     --no-psnr); past it light_tolerance is raised to the error\n"
             "                     reached, so frames stay projections (said in the output)\n"
-            "  --boundary box|surface   HD's diffusion boundary (default box, hdrender's)\n"
-            "  --downsample N     HD's illumination grid divisor (default 1, hdrender's)\n"
+            "  --preset default|paper   HD's settings: the library's defaults (zeroed hd_params:\n"
+            "                     grid /2, surface boundary; default, hdrender's) or the paper's\n"
+            "                     (hd_params_preset: full grid, box boundary, 4 sweeps)\n"
+            "  --boundary box|surface   HD's diffusion boundary (default: the preset's)\n"
+            "  --downsample N     HD's illumination grid divisor (default: the preset's)\n"
+            "  --render-scale S   HD's frames in the PSNR part: auto (default: HD_RENDER_SCALE_AUTO,\n"
+            "                     1/4, 1/2, then full frames at each view) or a divisor 1..8\n"
+            "  --frame-window N   HD's frame_window (default 0: the library's, 8)\n"
             "  --clock cpu|wall   what the budgets measure: process CPU time / online cores\n"
             "                     (default; load-independent on a shared machine) or wall time\n"
             "  --no-psnr          frame time only (what the GPU backends' builds run)\n"
@@ -125,8 +134,9 @@ static void parse_args(int argc, char **argv)
     O.ref_iters = 128;
     O.light_iters = -1;
     O.psnr = 1;
-    O.downsample = 1;
+    O.downsample = 0;
     O.pt_cap = 8.0;
+    O.scale = HD_RENDER_SCALE_AUTO;
     {
         static const double def[] = {0.05, 0.1, 0.25, 0.5, 1, 2, 5};
         O.nb = 7;
@@ -142,6 +152,11 @@ static void parse_args(int argc, char **argv)
         else if (!strcmp(a, "--ref-iters")) O.ref_iters = parse_int(NEXT(), 1, 1 << 24);
         else if (!strcmp(a, "--light-iters")) O.light_iters = parse_int(NEXT(), 1, 1 << 20);
         else if (!strcmp(a, "--downsample")) O.downsample = parse_int(NEXT(), 1, 8);
+        else if (!strcmp(a, "--frame-window")) O.window = parse_int(NEXT(), 1, 1 << 20);
+        else if (!strcmp(a, "--render-scale")) {
+            const char *v = NEXT();
+            O.scale = !strcmp(v, "auto") ? HD_RENDER_SCALE_AUTO : parse_int(v, 1, 8);
+        }
         else if (!strcmp(a, "--no-psnr")) O.psnr = 0;
         else if (!strcmp(a, "--single-view")) O.single = 1;
         else if (!strcmp(a, "--pt-cap")) {
@@ -164,9 +179,14 @@ static void parse_args(int argc, char **argv)
         else if (!strcmp(a, "--cache")) O.cache = NEXT();
         else if (!strcmp(a, "--boundary")) {
             const char *v = NEXT();
-            if (!strcmp(v, "box")) O.surface = 0;
-            else if (!strcmp(v, "surface")) O.surface = 1;
+            if (!strcmp(v, "box")) O.boundary = HD_BOUNDARY_BOX;
+            else if (!strcmp(v, "surface")) O.boundary = HD_BOUNDARY_SURFACE;
             else { fprintf(stderr, "hdbench_orbit: --boundary: box or surface\n"); exit(2); }
+        } else if (!strcmp(a, "--preset")) {
+            const char *v = NEXT();
+            if (!strcmp(v, "default")) O.paper = 0;
+            else if (!strcmp(v, "paper")) O.paper = 1;
+            else { fprintf(stderr, "hdbench_orbit: --preset: default or paper\n"); exit(2); }
         } else if (!strcmp(a, "--budgets")) {
             const char *s = NEXT();
             O.nb = 0;
@@ -268,7 +288,7 @@ static void reference(const hdo_scene *s, int k, float *img)
 
 /* Runs step() (one hd_render or one PT iteration) while the budgets last; psnr[j] and count[j]:
    the image after the last step that finished within budgets[j]. hd_mode: stop once the image is
-   final (light converged, frame_window frames: further calls change nothing). */
+   final (light converged, frame_window frames at the final scale: further calls change nothing). */
 static void budget_run(hd_context c, int hd_mode, const float *ref, float *img, double *psnr,
                        int *count)
 {
@@ -287,7 +307,8 @@ static void budget_run(hd_context c, int hd_mode, const float *ref, float *img, 
         read_tonemapped(c, img, npix);
         last = hdo_psnr(img, ref, npix);
         check(hd_get_stats(c, &st), "hd_get_stats");
-        if (hd_mode && st.light_converged && st.frames >= (uint64_t)d.params.frame_window)
+        if (hd_mode && st.light_converged && st.frames >= (uint64_t)d.params.frame_window &&
+            (d.params.render_scale != HD_RENDER_SCALE_AUTO || st.render_scale == 1))
             while (j < O.nb) { psnr[j] = last; count[j] = n; ++j; }
     }
 }
@@ -302,7 +323,9 @@ static int single_view(const hdo_scene *s)
     hd_context c;
     hd_stats st;
     double t = 0.0, ts, hd_psnr, pt_psnr = NAN, t_light, t_hd, t_pt = -1.0;
-    int it = 0, paths = 0;
+    /* after frame k + 1: HD's time and PSNR, and when PT_MS first reached that PSNR */
+    double fr_t[MAX_FRAMES], fr_psnr[MAX_FRAMES], fr_pt[MAX_FRAMES];
+    int fr_paths[MAX_FRAMES], nfr = 0, it = 0, paths = 0, k;
     if (!ref || !img) { fprintf(stderr, "hdbench_orbit: out of memory\n"); return 1; }
     reference(s, 0, ref);
     /* HD: light to convergence without frames, then the frames (examples/hdrender.c) */
@@ -321,8 +344,14 @@ static int single_view(const hdo_scene *s)
         check(hd_render(c), "hd_render");
         t += bench_clock() - ts;
         check(hd_get_stats(c, &st), "hd_get_stats");
+        read_tonemapped(c, img, npix);
+        if (nfr < MAX_FRAMES) {
+            fr_t[nfr] = t;
+            fr_psnr[nfr] = hdo_psnr(img, ref, npix);
+            fr_pt[nfr] = -1.0;
+            fr_paths[nfr++] = 0;
+        }
     } while (st.frames < (uint64_t)d.params.frame_window);
-    read_tonemapped(c, img, npix);
     hd_psnr = hdo_psnr(img, ref, npix);
     printf("single view: %s backend, head CT, %dx%d, %s clock\n", hd_backend_name(), O.size, O.size,
            O.wall ? "wall" : "CPU time / cores");
@@ -346,6 +375,8 @@ static int single_view(const hdo_scene *s)
         ++paths;
         read_tonemapped(c, img, npix);
         pt_psnr = hdo_psnr(img, ref, npix);
+        for (k = 0; k < nfr; ++k)
+            if (fr_pt[k] < 0.0 && pt_psnr >= fr_psnr[k]) { fr_pt[k] = t; fr_paths[k] = paths; }
         if (pt_psnr >= hd_psnr) { t_pt = t; break; }
         if (t > O.pt_cap * t_hd) break;
     }
@@ -356,6 +387,14 @@ static int single_view(const hdo_scene *s)
         printf("  PT_MS  %.2f dB after %.2f s (%d paths/pixel): below HD's PSNR when stopped (--pt-cap %g)\n",
                pt_psnr, t, paths, O.pt_cap);
     printf("  reference: PT_MS, %d paths/pixel, another seed\n", O.ref_iters);
+    printf("  HD after each frame (the light's time included) and PT_MS's time to that PSNR:\n"
+           "  frames  HD s     HD dB   PT_MS s  paths\n");
+    for (k = 0; k < nfr; ++k) {
+        if (fr_pt[k] >= 0.0)
+            printf("  %6d  %7.2f  %6.2f  %7.2f  %5d\n", k + 1, fr_t[k], fr_psnr[k], fr_pt[k], fr_paths[k]);
+        else
+            printf("  %6d  %7.2f  %6.2f  not reached\n", k + 1, fr_t[k], fr_psnr[k]);
+    }
     if (t_pt >= 0.0 && t_pt < t_hd)
         printf("  PT_MS first: it reached HD's PSNR in %.2f s, HD took %.2f s (%.2fx)\n", t_pt, t_hd, t_hd / t_pt);
     else if (t_pt >= 0.0)
@@ -395,13 +434,21 @@ int main(int argc, char **argv)
     hd_context hd;
     hd_stats st;
     double t0, c0, l0, ms, cms, lit, conv_s;
-    int k, conv;
+    int k, conv, scale;
 
     parse_args(argc, argv);
     log.func = NULL; /* info lines would drown the table; errors come back as results */
     if (!hdo_scene_load(&s, O.data, O.frame_size, &log)) return 1;
-    s.desc.params.illumination_downsample = O.downsample;
-    s.desc.params.diffusion_boundary = O.surface ? HD_BOUNDARY_SURFACE : HD_BOUNDARY_BOX;
+    check(hd_params_preset(O.paper ? HD_PRESET_PAPER : HD_PRESET_DEFAULT, &s.desc.params, NULL),
+          "hd_params_preset");
+    if (O.downsample) s.desc.params.illumination_downsample = O.downsample;
+    if (O.boundary) s.desc.params.diffusion_boundary = (hd_boundary)O.boundary;
+    s.desc.params.frame_window = O.window;
+    printf("HD settings: %s preset, illumination grid /%d, %s boundary, frame_window %d; orbit PSNR part: "
+           "render_scale %s\n", O.paper ? "paper" : "default",
+           s.desc.params.illumination_downsample ? s.desc.params.illumination_downsample : 2,
+           s.desc.params.diffusion_boundary == HD_BOUNDARY_BOX ? "box" : "surface", O.window ? O.window : 8,
+           O.scale == HD_RENDER_SCALE_AUTO ? "auto" : (char[2]){(char)('0' + O.scale), 0});
     if (O.single) {
         int r = single_view(&s);
         hd_volume_free(&s.vol);
@@ -417,23 +464,35 @@ int main(int argc, char **argv)
            "%.4g%s)\n", hd_backend_name(), conv ? "converged" : "accepted", (unsigned long long)st.iterations,
            conv_s, st.light_error, conv ? "" : "; --light-iters cap, light_tolerance raised to it");
 
-    /* 2. frame time over the orbit */
-    set_view(hd, 0, O.frame_size);
-    check(hd_render(hd), "hd_render"); /* warm-up: the image at this size */
-    l0 = light_seconds(hd);
-    t0 = hdo_now();
-    c0 = bench_clock();
-    for (k = 0; k < O.views; ++k) {
-        set_view(hd, k, O.frame_size);
-        check(hd_render(hd), "hd_render");
+    /* 2. frame time over the orbit, full frames and render_scale 2 and 4 */
+    for (scale = 1; scale <= 4; scale *= 2) {
+        hd_desc q;
+        check(hd_query_desc(hd, &q), "hd_query_desc");
+        q.params.render_scale = scale;
+        check(hd_set_params(hd, &q.params), "hd_set_params");
+        set_view(hd, 0, O.frame_size);
+        check(hd_render(hd), "hd_render"); /* warm-up: the image at this size */
+        l0 = light_seconds(hd);
+        t0 = hdo_now();
+        c0 = bench_clock();
+        for (k = 0; k < O.views; ++k) {
+            set_view(hd, k, O.frame_size);
+            check(hd_render(hd), "hd_render");
+        }
+        ms = 1e3 * (hdo_now() - t0) / O.views;
+        cms = 1e3 * (bench_clock() - c0) / O.views;
+        lit = light_seconds(hd) - l0;
+        printf("orbit: %s backend, %dx%d, render_scale %d, %d views: %.1f ms per orbit frame (set_camera + "
+               "hd_render; wall; %s %.1f ms), light work during them %.3f s\n", hd_backend_name(), O.frame_size,
+               O.frame_size, scale, O.views, ms, O.wall ? "wall" : "CPU time / cores", cms, lit);
+        fflush(stdout);
     }
-    ms = 1e3 * (hdo_now() - t0) / O.views;
-    cms = 1e3 * (bench_clock() - c0) / O.views;
-    lit = light_seconds(hd) - l0;
-    printf("orbit: %s backend, %dx%d, %d views: %.1f ms per orbit frame (set_camera + hd_render; "
-           "wall; %s %.1f ms), light work during them %.3f s\n", hd_backend_name(), O.frame_size,
-           O.frame_size, O.views, ms, O.wall ? "wall" : "CPU time / cores", cms, lit);
-    fflush(stdout);
+    {
+        hd_desc q;
+        check(hd_query_desc(hd, &q), "hd_query_desc");
+        q.params.render_scale = O.scale;
+        check(hd_set_params(hd, &q.params), "hd_set_params");
+    }
 
     /* 3. PSNR per view and budget */
     if (O.psnr) {

@@ -22,6 +22,9 @@
      O / shift+O  select the next / previous face of the crop box (x-, x+, y-, y+, z-, z+)
      I / shift+I  move the selected face 0.02 of the volume in / out (the box shrinks / grows)
      U         crop box: the whole volume / the volume's default (data/head.nrrd: no head rest)
+     P         preview on / off: while the camera moves, frames at reduced resolution (render_scale
+               HD_RENDER_SCALE_AUTO, the scale whose frame time fits 50 ms), refined to full
+               resolution when it stops; on by default in the window, off in scripted runs
      Esc / Q   quit
    The title shows the method, whether the light has converged (its error estimate and
    iterations; paths per pixel for PT), the frame time, the bytes the method holds and the crop
@@ -31,7 +34,9 @@
    one; --script FILE runs the commands in FILE, one a line: `orbit DEG_X DEG_Y`, `pan DX DY`,
    `zoom FACTOR`, `home` (the default camera), `key CHARS` (as typed), `restart`, `frames N`, `screenshot FILE`,
    `tolerance T` (light_tolerance), `converge N` (hd_refine until converged, at most N iterations), `expect-light-idle N` (N frames
-   that must do no light work, else exit 1); with --script
+   that must do no light work, else exit 1), `preview on|off` (P, with no frame budget: each new
+   view starts at 1/4 resolution), `expect-scale S` (the image's frames are at 1/S resolution,
+   else exit 1); with --script
    the window closes when the script ends. --size WxH sets the window (and image) size, --seed N
    the seed; the rest of the scene is hdrender's default (camera, 1 key light, ct-skin or ramp,
    exposure 8), so `hdrender --size WxH --iterations N` renders what hdview shows after a
@@ -78,6 +83,7 @@ typedef struct viewer {
     int dragging, panning;
     double t_title, frame_ms; /* frame_ms: smoothed wall time of frame() */
     int idle, idle_titled;    /* idle: light converged and the image final (hd_render is a no-op) */
+    int preview;              /* render_scale HD_RENDER_SCALE_AUTO: reduced frames while the camera moves */
     int shots;
     int crop_face;            /* the face I moves: 2 * axis + (0 low, 1 high) */
     float crop_min[3], crop_max[3]; /* the volume's default crop box (U toggles to it) */
@@ -249,6 +255,19 @@ static void apply_params(viewer *v)
     if (r != HD_SUCCESS) die("hd_set_params", r);
 }
 
+/* Preview on: params.render_scale HD_RENDER_SCALE_AUTO with a frame budget of budget s, so
+   each new view (a drag moves the camera every frame) starts at the reduced scale whose
+   predicted frame time fits the budget (1/4 with budget 0), and a camera at rest refines to full
+   frames, doubling the resolution per frame. Off: every frame at full resolution. */
+#define PREVIEW_BUDGET 0.05f
+static void set_preview(viewer *v, int on, float budget)
+{
+    v->preview = on;
+    v->params.render_scale = on ? HD_RENDER_SCALE_AUTO : 1;
+    v->params.render_budget = on ? budget : 0.0f;
+    apply_params(v);
+}
+
 static void crop_applied(viewer *v)
 {
     const float *a = v->params.crop_min, *b = v->params.crop_max;
@@ -330,6 +349,7 @@ static void key_char(viewer *v, int c)
     case 'i': crop_move(v, 0.02f); break;
     case 'I': crop_move(v, -0.02f); break;
     case 'u': case 'U': crop_toggle(v); break;
+    case 'p': case 'P': set_preview(v, !v->preview, PREVIEW_BUDGET); break;
     case 's': case 'S':
         snprintf(name, sizeof name, "hdview-%d.png", v->shots++);
         screenshot(v, name);
@@ -406,7 +426,7 @@ static void frame(viewer *v)
     t = now_seconds();
     v->frame_ms = v->frame_ms > 0.0 ? 0.8 * v->frame_ms + 0.2 * 1e3 * (t - t0) : 1e3 * (t - t0);
     if (hd_get_stats(v->ctx, &st) != HD_SUCCESS) return;
-    v->idle = st.light_converged && st.frames >= (uint64_t)v->params.frame_window;
+    v->idle = st.light_converged && st.frames >= (uint64_t)v->params.frame_window && st.render_scale == 1;
     if (t - v->t_title > 0.5 || v->idle != v->idle_titled) {
         static const char *faces[6] = {"x-", "x+", "y-", "y+", "z-", "z+"};
         char title[448], light[96];
@@ -417,9 +437,11 @@ static void frame(viewer *v)
                      (unsigned long long)st.iterations);
         else
             snprintf(light, sizeof light, "%llu paths/pixel", (unsigned long long)st.iterations);
-        snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f"
+        char scale[32] = "";
+        if (st.render_scale > 1) snprintf(scale, sizeof scale, " at 1/%d res", st.render_scale);
+        snprintf(title, sizeof title, "hdview - %s | %s | %.1f ms/frame%s%s | %.1f MB | tf %s | %d light%s | ext %.0f albedo %.2f"
                  " | crop x %.2f-%.2f y %.2f-%.2f z %.2f-%.2f [%s]",
-                 hd_method_name(st.method), light, v->frame_ms, v->idle ? " (idle: image final)" : "",
+                 hd_method_name(st.method), light, v->frame_ms, scale, v->idle ? " (idle: image final)" : "",
                  (double)st.method_bytes / 1048576.0, v->tf.name, v->light_count, v->light_count == 1 ? "" : "s",
                  (double)v->params.extinction, (double)v->params.albedo, (double)c0[0], (double)c1[0], (double)c0[1],
                  (double)c1[1], (double)c0[2], (double)c1[2], faces[v->crop_face]);
@@ -483,6 +505,20 @@ static void expect_light_idle(viewer *v, int n)
 }
 
 /* The screenshot is read from the back buffer: draw the current image once more first. */
+/* Script command: the image's frames must be at render scale s (hd_stats.render_scale), else
+   exit 1. */
+static void expect_scale(viewer *v, int s)
+{
+    hd_stats st;
+    hd_result r;
+    if ((r = hd_get_stats(v->ctx, &st)) != HD_SUCCESS) die("hd_get_stats", r);
+    if (st.render_scale != s) {
+        fprintf(stderr, "hdview: expect-scale: the frames are at 1/%d resolution, not 1/%d\n", st.render_scale, s);
+        exit(1);
+    }
+    fprintf(stderr, "hdview: frames at 1/%d resolution (%.1f ms/frame)\n", s, v->frame_ms);
+}
+
 static void scripted_screenshot(viewer *v, const char *path)
 {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, v->fbo);
@@ -514,6 +550,8 @@ static void run_script(viewer *v, const char *path)
         else if (strcmp(cmd, "tolerance") == 0 && sscanf(arg, "%f", &a) == 1) set_tolerance(v, a);
         else if (strcmp(cmd, "converge") == 0 && sscanf(arg, "%d", &n) == 1) converge(v, n);
         else if (strcmp(cmd, "expect-light-idle") == 0 && sscanf(arg, "%d", &n) == 1) expect_light_idle(v, n);
+        else if (strcmp(cmd, "expect-scale") == 0 && sscanf(arg, "%d", &n) == 1) expect_scale(v, n);
+        else if (strcmp(cmd, "preview") == 0 && (!strcmp(arg, "on") || !strcmp(arg, "off"))) set_preview(v, !strcmp(arg, "on"), 0.0f);
         else if (strcmp(cmd, "screenshot") == 0 && arg[0]) scripted_screenshot(v, arg);
         else { fprintf(stderr, "hdview: %s:%d: cannot read '%s'\n", path, lineno, line); exit(2); }
     }
@@ -600,6 +638,7 @@ int main(int argc, char **argv)
     hd_query_desc(v.ctx, &desc);
     v.params = desc.params;
     v.camera_dirty = 0;
+    if (!script && frames < 0) set_preview(&v, 1, PREVIEW_BUDGET); /* interactive: reduced frames while moving */
     fprintf(stderr, "hdview: %s, %dx%d, backend %s on %s\n", input, w, h, hd_backend_name(), (const char *)glGetString(GL_RENDERER));
 
     glfwSetKeyCallback(v.win, on_key);

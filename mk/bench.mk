@@ -7,9 +7,11 @@
 #                       on demand, when missing (root). Knobs: PEER_ARGS (see vtk_peer.py),
 #                       HDPEER_LIGHT_ITERS (light iteration cap, default 64).
 #   make bench-orbit    bench/hdbench_orbit.c: converge HD's light once, then an orbit of K views:
-#                       ms per orbit frame on every backend (CPU, OpenCL, Vulkan, GL), and on the
-#                       CPU backend HD's and PT_MS's PSNR per per-view time budget against PT_MS
-#                       references -> docs/orbit/ (CSV, gnuplot PNG), the crossover budget.
+#                       ms per orbit frame on every backend (CPU, OpenCL, Vulkan, GL) at
+#                       render_scale 1, 2 and 4, and on the CPU backend HD's (render_scale auto)
+#                       and PT_MS's PSNR per per-view time budget against PT_MS references ->
+#                       docs/orbit/ (CSV, gnuplot PNG), the crossover budget. The library's
+#                       default hd_params; ORBIT_ARGS="--preset paper" for the paper's.
 #                       Default ~10 min on 2 cores (256^2 PSNR part, references cached in
 #                       build/orbit-cache); ORBIT_ARGS for the full run, e.g.
 #                       ORBIT_ARGS="--size 512 --ref-iters 1024 --views 16".

@@ -531,7 +531,7 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
     if (p.albedo != o->albedo || p.anisotropy != o->anisotropy || p.disable_diffusion != o->disable_diffusion ||
         p.diffusion_boundary != o->diffusion_boundary)
         ctx->dirty |= HD__DIRTY_PHI | HD__DIRTY_IMAGE;
-    if (p.step != o->step || p.frame_window != o->frame_window ||
+    if (p.step != o->step || p.frame_window != o->frame_window || p.render_scale != o->render_scale ||
         memcmp(p.background, o->background, sizeof p.background) != 0)
         ctx->dirty |= HD__DIRTY_IMAGE;
     if ((p.solver == HD_SOLVER_JACOBI) != (o->solver == HD_SOLVER_JACOBI)) ctx->dirty |= HD__DIRTY_JACOBI;
@@ -896,7 +896,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
     }
     ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
     if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
-    if (dirty & HD__DIRTY_IMAGE) ctx->frames = ctx->converged_frames = 0;
+    if (dirty & HD__DIRTY_IMAGE) {
+        ctx->frames = ctx->converged_frames = 0;
+        ctx->frame_scale = 0;
+    }
     /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
     if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
     if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) {
@@ -970,15 +973,63 @@ static hd_result hd__light_iteration(hd__ctx *ctx)
     return r;
 }
 
-/* One projection frame from the current E and phi into the image's running mean. */
+/* The render scale of the next projection frame (params.render_scale). HD_RENDER_SCALE_AUTO: a
+   new image's first frame at the coarsest scale render_budget asks for (4 without a budget or a
+   measured frame), then half the divisor per frame down to 1. */
+static int hd__next_scale(const hd__ctx *ctx)
+{
+    int s;
+    if (hd__method_is_pt(ctx->params.method)) return 1;
+    if (ctx->params.render_scale != HD_RENDER_SCALE_AUTO) return ctx->params.render_scale;
+    if (ctx->frame_scale > 0)
+        return ctx->frames > 0 && ctx->frame_scale > 1 ? ctx->frame_scale / 2 : ctx->frame_scale;
+    if (!(ctx->params.render_budget > 0.0f) || !(ctx->frame_cost > 0.0)) return 4;
+    for (s = 1; s < HD__MAX_RENDER_SCALE; s *= 2)
+        if (ctx->frame_cost / (double)(s * s) <= (double)ctx->params.render_budget) break;
+    return s;
+}
+
+/* Makes s the scale of the image's frames; frames at another scale are dropped (the running
+   mean restarts). */
+static void hd__use_scale(hd__ctx *ctx, int s)
+{
+    if (ctx->frames > 0 && s != ctx->frame_scale) ctx->frames = ctx->converged_frames = 0;
+    ctx->frame_scale = s;
+}
+
+/* One projection frame from the current E and phi into the image's running mean. At render
+   scale s > 1 the march covers the reduced size into the image buffer's second region, then the
+   upsample pass (the projection's entry with HD_FLAG_UPSAMPLE, hd_k_upsample.h) fills the full
+   image from it; the parameter block is left describing the full image. */
 static hd_result hd__project_frame(hd__ctx *ctx)
 {
     hd_result r;
-    double t0 = hd__now();
+    double t0 = hd__now(), dt;
+    int s;
+    hd__use_scale(ctx, hd__next_scale(ctx));
+    s = ctx->frame_scale;
     ctx->frames++;
     hd__fill_kparams(ctx);
-    r = hd__be_project(ctx);
-    ctx->seconds[2] += hd__now() - t0;
+    if (s > 1) {
+        int w = ctx->kp.image.x, h = ctx->kp.image.y;
+        ctx->kp.image.x = (w + s - 1) / s;
+        ctx->kp.image.y = (h + s - 1) / s;
+        ctx->kp.image.w = w * h;
+        r = hd__be_project(ctx);
+        if (r == HD_SUCCESS) {
+            ctx->kp.image.x = w;
+            ctx->kp.image.y = h;
+            ctx->kp.image.w = s;
+            ctx->kp.counts.z |= HD_FLAG_UPSAMPLE;
+            r = hd__be_project(ctx);
+        }
+        hd__fill_kparams(ctx);
+    } else {
+        r = hd__be_project(ctx);
+    }
+    dt = hd__now() - t0;
+    ctx->seconds[2] += dt;
+    if (r == HD_SUCCESS) ctx->frame_cost = dt * (double)(s * s);
     return r;
 }
 
@@ -1091,7 +1142,10 @@ HDDEF hd_result hd_render(hd_context h)
         if (hd__now() - t0 + last > budget) break;
     }
     if (hd__light_converged(ctx)) {
-        if (ctx->converged_frames >= (uint64_t)ctx->params.frame_window) return HD_SUCCESS; /* the image is done */
+        /* the image is done once frame_window frames at its final scale are in */
+        int s = hd__next_scale(ctx);
+        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->params.frame_window) return HD_SUCCESS;
+        hd__use_scale(ctx, s);
         ctx->converged_frames++;
     }
     return hd__project_frame(ctx);
@@ -1191,6 +1245,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations;
     if (hd__method_is_pt(ctx->params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
+    out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;
     /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
        plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
 #ifdef HD__BE_SPLIT_LAYOUT /* the colour layout: one padding slot per row when gx is odd */
@@ -1204,7 +1259,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (multigrid levels) */
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
-    out->image_bytes = (size_t)ctx->camera.width * ctx->camera.height * 4 * sizeof(float);
+    out->image_bytes = hd__image_floats(ctx->camera.width, ctx->camera.height) * sizeof(float);
     /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */
     out->volume_bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
                         (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);

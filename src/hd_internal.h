@@ -17,6 +17,7 @@
 #endif
 /* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
 #define HD__MAX_VOXELS (1u << 30)
+#define HD__MAX_RENDER_SCALE 8 /* params.render_scale's largest divisor */
 #define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
                                 majorants and few DDA steps (docs/DESIGN-CPU.md) */
 
@@ -98,6 +99,10 @@ typedef struct hd__ctx {
     double conv_q;           /* the solver's observed contraction of that change */
     double light_error;
     uint64_t converged_frames; /* projection frames since the light converged */
+    int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
+                                was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
+    double frame_cost;       /* seconds of the last projection frame scaled to full resolution
+                                (its time times its scale squared); 0 before the first */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */

@@ -209,6 +209,7 @@ static void hd__params_defaults(hd_params *p)
     if (p->illumination_downsample == 0) p->illumination_downsample = 2;
     if (p->diffusion_boundary == HD_BOUNDARY_DEFAULT) p->diffusion_boundary = HD_BOUNDARY_SURFACE;
     if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
+    if (p->render_scale == 0) p->render_scale = 1;
     hd__crop_defaults(p);
 }
 
@@ -276,6 +277,9 @@ static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.light_tolerance = %g must be >= 0 and finite", (double)p->light_tolerance);
     if (!hd__finite(p->render_budget) || p->render_budget < 0.0f)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_budget = %g s must be >= 0 and finite", (double)p->render_budget);
+    if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > HD__MAX_RENDER_SCALE))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_scale = %d must be 1..%d or HD_RENDER_SCALE_AUTO (-1)",
+                       p->render_scale, HD__MAX_RENDER_SCALE);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
     /* the multigrid levels (src/hd_multigrid.h) restrict and prolong float32 fine grids */

@@ -308,6 +308,148 @@ static void test_render_bad_input(void)
     CHECK(hd_render(stale) == HD_ERROR_INVALID_HANDLE);
 }
 
+/* render_scale 2: the frame is the projection at half the size (the same rays as a context of
+   that size: same field of view, pixel index and frame), upsampled bilinearly to the camera's
+   size; the image read back has the full size. The test's own bilinear upsample of the half-size
+   context's image must match the library's within rounding. */
+static void test_render_scale_upsample(void)
+{
+    enum { H = W / 2 };
+    float *full = (float *)malloc(W * W * 16), *half = (float *)malloc(H * H * 16), *plain = (float *)malloc(W * W * 16);
+    hd_desc d, dh;
+    hd_context a, b, c;
+    hd_stats s;
+    double worst = 0.0, diff = 0.0;
+    int x, y, k, f;
+    make_desc(&d, NULL);
+    d.params.light_tolerance = 1e6f; /* converged within 3 iterations: hd_render only projects */
+    dh = d;
+    dh.camera.width = dh.camera.height = H;
+    d.params.render_scale = 2;
+    CHECK(hd_create(&d, &a) == HD_SUCCESS);
+    CHECK(hd_create(&dh, &b) == HD_SUCCESS);
+    d.params.render_scale = 0; /* the default: full frames */
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_refine(a, 3) == HD_SUCCESS && hd_refine(b, 3) == HD_SUCCESS && hd_refine(c, 3) == HD_SUCCESS);
+    for (f = 0; f < 3; ++f) /* three jittered frames into each running mean */
+        CHECK(hd_render(a) == HD_SUCCESS && hd_render(b) == HD_SUCCESS && hd_render(c) == HD_SUCCESS);
+    CHECK(hd_get_stats(a, &s) == HD_SUCCESS && s.frames == 3 && s.render_scale == 2);
+    CHECK(s.image_bytes == (size_t)(W * W + H * H) * 16); /* the image and the half-size frame */
+    CHECK(hd_read_image_f32(a, full, W * W * 4) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(b, half, H * H * 4) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(c, plain, W * W * 4) == HD_SUCCESS);
+    CHECK(hd_get_stats(c, &s) == HD_SUCCESS && s.render_scale == 1);
+    for (y = 0; y < W; ++y)
+        for (x = 0; x < W; ++x) {
+            float fx = (x + 0.5f) * 0.5f - 0.5f, fy = (y + 0.5f) * 0.5f - 0.5f;
+            int x0, y0, x1, y1;
+            fx = fx < 0.0f ? 0.0f : (fx > H - 1 ? (float)(H - 1) : fx);
+            fy = fy < 0.0f ? 0.0f : (fy > H - 1 ? (float)(H - 1) : fy);
+            x0 = (int)fx; y0 = (int)fy;
+            x1 = x0 + 1 < H ? x0 + 1 : H - 1; y1 = y0 + 1 < H ? y0 + 1 : H - 1;
+            for (k = 0; k < 4; ++k) {
+                float t = half[(y0 * H + x0) * 4 + k] + (fx - x0) * (half[(y0 * H + x1) * 4 + k] - half[(y0 * H + x0) * 4 + k]);
+                float u = half[(y1 * H + x0) * 4 + k] + (fx - x0) * (half[(y1 * H + x1) * 4 + k] - half[(y1 * H + x0) * 4 + k]);
+                double e = fabs((double)(t + (fy - y0) * (u - t)) - full[(y * W + x) * 4 + k]);
+                if (e > worst) worst = e;
+                diff += fabs((double)plain[(y * W + x) * 4 + k] - full[(y * W + x) * 4 + k]);
+            }
+        }
+    CHECK_MSG(worst < 1e-6, "the scale-2 frame differs from the half-size projection upsampled by %g", worst);
+    CHECK(diff > 0.0); /* and it is not the full-resolution frame */
+    hd_destroy(a);
+    hd_destroy(b);
+    hd_destroy(c);
+    free(full); free(half); free(plain);
+}
+
+/* HD_RENDER_SCALE_AUTO: a new image starts at 1/4, then 1/2, then full frames accumulate to
+   frame_window; a camera move starts coarse again; with a budget the full frame fits in, the
+   first frame is already full. No light work once converged. */
+static void test_render_scale_auto(void)
+{
+    static const int want_scale[12] = {4, 2, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    static const int want_frames[12] = {1, 1, 1, 2, 3, 4, 5, 6, 7, 8, 8, 8};
+    hd_desc d;
+    hd_context ctx;
+    hd_stats s, s0;
+    hd_camera cam;
+    hd_params p;
+    int i;
+    make_desc(&d, NULL);
+    d.params.light_tolerance = 1e6f;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_refine(ctx, 3) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s0) == HD_SUCCESS && s0.light_converged);
+    for (i = 0; i < 12; ++i) {
+        CHECK(hd_render(ctx) == HD_SUCCESS);
+        CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS);
+        CHECK_MSG(s.render_scale == want_scale[i] && s.frames == (uint64_t)want_frames[i],
+                  "call %d: scale %d, %llu frames; want %d, %d", i, s.render_scale, (unsigned long long)s.frames,
+                  want_scale[i], want_frames[i]);
+    }
+    CHECK(s.seconds_direct == s0.seconds_direct && s.seconds_diffusion == s0.seconds_diffusion);
+    cam = d.camera;
+    cam.eye[0] = 2.0f; cam.eye[1] = 0.7f; cam.eye[2] = 1.2f;
+    CHECK(hd_set_camera(ctx, &cam) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 4 && s.frames == 1);
+    /* a budget far above the measured frame time: full frames from the first */
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
+    p = d.params;
+    CHECK(p.render_scale == HD_RENDER_SCALE_AUTO);
+    p.render_budget = 100.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    cam.eye[0] = -2.0f; /* another view */
+    CHECK(hd_set_camera(ctx, &cam) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 1 && s.frames == 1, "with a budget: scale %d, %llu frames",
+              s.render_scale, (unsigned long long)s.frames);
+    /* a fixed scale: every frame at it; changing it restarts the image */
+    p.render_scale = 4;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS && hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 4 && s.frames == 2);
+    /* the path tracers ignore it (no budget: one path per call) */
+    p.method = HD_METHOD_PT_MS;
+    p.render_budget = 0.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 1 && s.frames == 1);
+    hd_destroy(ctx);
+}
+
+/* render_scale outside 1..8 and HD_RENDER_SCALE_AUTO: HD_ERROR_INVALID_PARAMETER, one line. */
+static void test_render_scale_bad_input(void)
+{
+    static const int bad[5] = {9, -2, 1000, -1000000, 0x7fffffff};
+    hd_test_log log;
+    hd_desc d;
+    hd_context ctx;
+    hd_params p;
+    int i;
+    for (i = 0; i < 5; ++i) {
+        make_desc(&d, &log);
+        d.params.render_scale = bad[i];
+        CHECK_MSG(hd_create(&d, &ctx) == HD_ERROR_INVALID_PARAMETER && log.errors == 1 && strstr(log.last, "render_scale"),
+                  "render_scale %d", bad[i]);
+    }
+    make_desc(&d, &log);
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS && d.params.render_scale == 1); /* 0 -> 1 */
+    p = d.params;
+    for (i = 0; i < 5; ++i) {
+        p.render_scale = bad[i];
+        CHECK(hd_set_params(ctx, &p) == HD_ERROR_INVALID_PARAMETER && log.errors == i + 1 && strstr(log.last, "render_scale"));
+    }
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS && d.params.render_scale == 1); /* unchanged */
+    p.render_scale = 8;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS && log.errors == 5);
+    CHECK(hd_render(ctx) == HD_SUCCESS); /* a 4 x 4 frame of a 32 x 32 image */
+    hd_destroy(ctx);
+}
+
 const hd_test_case hd_tests_render[] = {
     {"render_refine_is_iterate_without_frames", test_refine_is_iterate_without_frames},
     {"render_light_error_falls", test_light_error_falls},
@@ -316,5 +458,8 @@ const hd_test_case hd_tests_render[] = {
     {"render_budget", test_render_budget},
     {"render_follows_light", test_render_follows_light},
     {"render_bad_input", test_render_bad_input},
+    {"render_scale_upsample", test_render_scale_upsample},
+    {"render_scale_auto", test_render_scale_auto},
+    {"render_scale_bad_input", test_render_scale_bad_input},
 };
 const int hd_tests_render_count = sizeof hd_tests_render / sizeof hd_tests_render[0];

@@ -6,5 +6,6 @@
 #include "hd_k_diffuse.h"
 #include "hd_k_multigrid.h"
 #include "hd_k_project.h"
+#include "hd_k_upsample.h"
 #include "hd_k_convect.h"
 #include "hd_k_path.h"

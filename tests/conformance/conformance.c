@@ -633,6 +633,47 @@ static void case_render(hd_method method, hd_voxel_type type, const int *d, int 
     scene_free(&s);
 }
 
+/* params.render_scale: frames marched at the reduced size and upsampled on the device (the
+   projection's entry point with HD_FLAG_UPSAMPLE, hd_k_upsample.h), a fixed divisor (3: 48x40 ->
+   16x14, not a divisor of the height) or HD_RENDER_SCALE_AUTO (1/4, 1/2, then full frames), before
+   and after a camera move; both sides must agree on the full-size image, the frame counts and
+   the scale. */
+static void case_render_scale(hd_method method, hd_voxel_type type, const int *d, int lights, int scale, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    double l2 = 0.0, linf = 0.0;
+    int k;
+    scene_init(&s, type, d[0], d[1], d[2], lights, 0, 0);
+    s.params.method = method;
+    s.params.light_tolerance = 1000.0f; /* converged after the first two estimates */
+    s.params.render_scale = scale;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s render_scale %d, camera move %s %dx%dx%d %dL", hd_api_cpu.method_name(method), scale,
+             type_name(type), d[0], d[1], d[2], lights);
+    if (pair_create(&p, &s)) {
+        hd_stats a, b;
+        hd_camera cam = s.camera;
+        BOTH(&p, refine, (p.ref, n), (p.dut, n));
+        for (k = 0; k < 2; ++k) BOTH(&p, render, (p.ref), (p.dut));
+        cam.eye[0] = -1.5f; cam.eye[1] = 0.3f; cam.eye[2] = 1.4f;
+        BOTH(&p, set_camera, (p.ref, &cam), (p.dut, &cam));
+        for (k = 0; k < 2; ++k) BOTH(&p, render, (p.ref), (p.dut));
+        hd_api_cpu.get_stats(p.ref, &a);
+        hd_api_backend.get_stats(p.dut, &b);
+        if (p.ok && (b.frames != a.frames || b.render_scale != a.render_scale || b.image_bytes != a.image_bytes ||
+                     a.render_scale != (scale > 0 ? scale : 2)))
+            pair_fail(&p, "frame counts, render scale or image size differ", HD_SUCCESS);
+        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+    }
+    report(name, &p, &g, l2, linf, method == HD_METHOD_CD);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
 /* A crop box (params.crop_min/max) through the blob and its shell, set at create or by
    hd_set_params halfway through the run; whole iterations of the method. CD is deterministic,
    the others stochastic (E, phi and the image; the path tracers the image). */
@@ -779,6 +820,17 @@ static void case_shell(hd_voxel_type type, const int *d, int factor, int surface
     scene_free(&s);
 }
 
+/* the per-frame API */
+static void render_cases(const int *odd, const int *other)
+{
+    case_render(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 6);
+    case_render(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 6);
+    case_render_scale(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 3, 4);
+    case_render_scale(HD_METHOD_CD, HD_VOXEL_F32, other, 3, 2, 4);
+    case_render_scale(HD_METHOD_HD, HD_VOXEL_U16, odd, 1, HD_RENDER_SCALE_AUTO, 6);
+    case_render_scale(HD_METHOD_HD, HD_VOXEL_U8, other, 3, 8, 6);
+}
+
 static int backend_available(void)
 {
     scene s;
@@ -800,14 +852,18 @@ int main(int argc, char **argv)
     static const int odd[3] = {37, 53, 29}, other[3] = {24, 17, 33};
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
+    int render = argc > 1 && strcmp(argv[1], "--render") == 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available()) {
         const char *req = getenv("HD_CONFORMANCE_REQUIRE");
         printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed)\n", hd_api_backend.backend_name());
         return req && req[0] == '1' ? 1 : 0;
     }
-    if (quick || crop) { /* quick: one case per stage, for valgrind; crop: the crop box cases */
-        if (quick) {
+    if (quick || crop || render) { /* quick: one case per stage, for valgrind; crop: the crop box
+                                      cases; render: the per-frame API's */
+        if (render) {
+            render_cases(odd, other);
+        } else if (quick) {
             case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
             case_project(HD_VOXEL_U16, odd, 1, 1);
             case_iterate(HD_VOXEL_F32, other, 3, 1, 1, CHANGE_CAMERA, 2);
@@ -860,9 +916,7 @@ int main(int argc, char **argv)
     case_method(HD_METHOD_PT_MS, HD_VOXEL_U16, odd, 3, 0, 1, 8);
     case_method(HD_METHOD_PT_MS, HD_VOXEL_U8, other, 16, 1, 1, 8);
     crop_cases(odd, other);
-    /* the per-frame API */
-    case_render(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 6);
-    case_render(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 6);
+    render_cases(odd, other);
     /* binary16 illumination storage */
     case_half(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 0, HD_SOLVER_RED_BLACK, 8);
     case_half(HD_METHOD_HD, HD_VOXEL_U16, odd, 3, 1, 0, HD_SOLVER_RED_BLACK, 8);
