@@ -35,6 +35,7 @@
 #define HYBRIDDIFF_IMPLEMENTATION
 #include "hybriddiff.h"
 #include "hd_orbit_scene.h"
+#include "hd_frames.h"
 
 #include <errno.h>
 #include <sys/stat.h>
@@ -325,8 +326,9 @@ static int single_view(const hdo_scene *s)
     double t = 0.0, ts, hd_psnr, pt_psnr = NAN, t_light, t_hd, t_pt = -1.0;
     /* after frame k + 1: HD's time and PSNR, and when PT_MS first reached that PSNR */
     double fr_t[MAX_FRAMES], fr_psnr[MAX_FRAMES], fr_pt[MAX_FRAMES];
-    int fr_paths[MAX_FRAMES], nfr = 0, it = 0, paths = 0, k;
-    if (!ref || !img) { fprintf(stderr, "hdbench_orbit: out of memory\n"); return 1; }
+    int fr_paths[MAX_FRAMES], nfr = 0, it = 0, paths = 0, k, stop = -1;
+    uint8_t *prev8 = (uint8_t *)malloc(npix * 4), *cur8 = (uint8_t *)malloc(npix * 4);
+    if (!ref || !img || !prev8 || !cur8) { fprintf(stderr, "hdbench_orbit: out of memory\n"); return 1; }
     reference(s, 0, ref);
     /* HD: light to convergence without frames, then the frames (examples/hdrender.c) */
     d.camera = hdo_orbit_camera(0.0, O.size);
@@ -339,11 +341,20 @@ static int single_view(const hdo_scene *s)
     } while (!st.light_converged && ++it < O.light_iters);
     t_light = t;
     check(hd_query_desc(c, &d), "hd_query_desc");
+    /* hdrender's stop (examples/hd_frames.h) unless --frame-window is given; the frames after it
+       are still projected for the per-frame table */
     do {
         ts = bench_clock();
         check(hd_render(c), "hd_render");
-        t += bench_clock() - ts;
         check(hd_get_stats(c, &st), "hd_get_stats");
+        if (stop < 0 && !O.window && st.frames < (uint64_t)d.params.frame_window) {
+            uint8_t *tmp;
+            check(hd_read_image_rgba8(c, cur8, npix * 4), "hd_read_image_rgba8");
+            if (hdx_frames_noise_left(prev8, cur8, npix, st.frames) < HDX_FRAMES_NOISE_DONE && nfr < MAX_FRAMES)
+                stop = nfr;
+            tmp = prev8, prev8 = cur8, cur8 = tmp;
+        }
+        t += bench_clock() - ts;
         read_tonemapped(c, img, npix);
         if (nfr < MAX_FRAMES) {
             fr_t[nfr] = t;
@@ -352,17 +363,20 @@ static int single_view(const hdo_scene *s)
             fr_paths[nfr++] = 0;
         }
     } while (st.frames < (uint64_t)d.params.frame_window);
-    hd_psnr = hdo_psnr(img, ref, npix);
+    if (stop < 0) stop = nfr - 1;
+    hd_psnr = fr_psnr[stop];
     printf("single view: %s backend, head CT, %dx%d, %s clock\n", hd_backend_name(), O.size, O.size,
            O.wall ? "wall" : "CPU time / cores");
-    printf("  HD     %.2f dB after %.2f s (light: %llu iterations, %.2f s, %s, light_error %.4g; then %llu "
-           "frames, %.2f s)\n", hd_psnr, t, (unsigned long long)st.iterations, t_light,
-           st.light_converged ? "converged" : "iteration cap", st.light_error, (unsigned long long)st.frames,
-           t - t_light);
+    t_hd = fr_t[stop];
+    printf("  HD     %.2f dB after %.2f s (light: %llu iterations, %.2f s, %s, light_error %.4g; then %d "
+           "frames, %.2f s%s)\n", hd_psnr, t_hd, (unsigned long long)st.iterations, t_light,
+           st.light_converged ? "converged" : "iteration cap", st.light_error, stop + 1, t_hd - t_light,
+           O.window ? "" : ", hdrender's stop");
     fflush(stdout);
     hd_destroy(c);
+    free(prev8);
+    free(cur8);
     /* PT_MS from scratch until it reaches HD's PSNR */
-    t_hd = t;
     d = s->desc;
     d.camera = hdo_orbit_camera(0.0, O.size);
     d.params.method = HD_METHOD_PT_MS;

@@ -28,6 +28,7 @@
 #include "hybriddiff.h"
 #include "hd_tf.h"
 #include "hd_crop.h"
+#include "hd_frames.h"
 
 #include <errno.h>
 #include <math.h>
@@ -545,6 +546,32 @@ static void image_brightness(const uint8_t *rgba, size_t npix, double *mean, dou
     *lit = npix ? (double)n / (double)npix : 0.0;
 }
 
+/* The single view's frames over converged light: hd_render until the frame window is full or,
+   unless --frame-window was given, until the jitter noise left in the image is below one 8-bit
+   level (examples/hd_frames.h). */
+static void render_frames(hd_context ctx, log_state *ls, const hd_desc *desc, int window_given, hd_stats *stats)
+{
+    size_t npix = (size_t)desc->camera.width * desc->camera.height;
+    uint8_t *prev = window_given ? NULL : (uint8_t *)malloc(npix * 4);
+    uint8_t *cur = window_given ? NULL : (uint8_t *)malloc(npix * 4);
+    uint64_t window = (uint64_t)desc->params.frame_window + (desc->params.frame_window ? 0 : 8);
+    hd_result r;
+    if (!window_given && (!prev || !cur)) fail(1, "out of memory for a %dx%d image", desc->camera.width,
+                                               desc->camera.height);
+    do {
+        uint8_t *t;
+        ls->last[0] = 0;
+        if ((r = hd_render(ctx)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_render", NULL);
+        hd_get_stats(ctx, stats);
+        if (!cur || stats->frames >= window) continue;
+        if ((r = hd_read_image_rgba8(ctx, cur, npix * 4)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_read_image_rgba8", NULL);
+        if (hdx_frames_noise_left(prev, cur, npix, stats->frames) < HDX_FRAMES_NOISE_DONE) break;
+        t = prev, prev = cur, cur = t;
+    } while (stats->frames < window);
+    free(prev);
+    free(cur);
+}
+
 /* ---- backends -------------------------------------------------------------------------------- */
 static const char *const backend_names[] = {"cpu", "opencl", "vulkan", "gl"};
 
@@ -659,7 +686,7 @@ int main(int argc, char **argv)
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
-    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0, crop_given = 0;
+    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0, crop_given = 0, window_given = 0;
     double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -846,6 +873,7 @@ int main(int argc, char **argv)
             for (k = 0; k < 3; ++k)
                 if (desc.params.background[k] < 0.0f) fail(2, "--background: '%s' is negative", v);
         } else if (IS("--frame-window")) {
+            window_given = 1;
             desc.params.frame_window = (int)parse_int(a, VAL(), 1, 1000000);
         } else if (IS("--rgb-scattering")) {
             desc.params.rgb_scattering = 1;
@@ -992,11 +1020,7 @@ int main(int argc, char **argv)
         if (!stats.light_converged && !g_quiet)
             fprintf(stderr, "hdrender: the light did not converge in %d iterations (estimated error %.4f)\n", done,
                     stats.light_error);
-        do {
-            ls.last[0] = 0;
-            if ((r = hd_render(ctx)) != HD_SUCCESS) fail_lib(1, &ls, r, "hd_render", NULL);
-            hd_get_stats(ctx, &stats);
-        } while (stats.frames < (uint64_t)desc.params.frame_window + (desc.params.frame_window ? 0 : 8));
+        render_frames(ctx, &ls, &desc, window_given, &stats);
         done = iterations = (int)stats.iterations;
     }
     /* ---- fixed iterations, in chunks of about 0.2 s ---- */
@@ -1039,8 +1063,9 @@ int main(int argc, char **argv)
                             desc.camera.width * 3);
     if (!status) fail(1, "cannot write %s", out_path);
     if (!g_quiet && hd_get_stats(ctx, &stats) == HD_SUCCESS)
-        fprintf(stderr, "hdrender: %d iteration%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
-                "%.2f s, projection %.2f s) -> %s\n", iterations, iterations == 1 ? "" : "s", t_end - t0,
+        fprintf(stderr, "hdrender: %d iteration%s, %d frame%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
+                "%.2f s, projection %.2f s) -> %s\n", iterations, iterations == 1 ? "" : "s",
+                (int)stats.frames, stats.frames == 1 ? "" : "s", t_end - t0,
                 iterations / (t_end - t0), stats.seconds_direct, stats.seconds_diffusion,
                 stats.seconds_projection, out_path);
     free(rgba);
