@@ -24,16 +24,16 @@ PROJECT_FRAMES ?= 5
 
 .PHONY: bench-project
 
-$(B)/hdbench_project_%: bench/hdbench_project.c bench/hd_bench_median.h $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) $(PROJECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(PROJECT_LIB_$*)
+$(B)/hdbench_project_%: bench/hdbench_project.c bench/hd_bench_median.h bench/hd_orbit_scene.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples $(PROJECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(PROJECT_LIB_$*)
 
 $(PROJECT_OLD)/.stamp: | $(B)
 	rm -rf $(PROJECT_OLD) && mkdir -p $(PROJECT_OLD)
 	git archive $(PROJECT_BASE) | tar -x -C $(PROJECT_OLD)
 	touch $@
 
-$(B)/hdbench_project_old_%: bench/hdbench_project.c bench/hd_bench_median.h $(PROJECT_OLD)/.stamp
-	$(CC) -I$(PROJECT_OLD) -D_POSIX_C_SOURCE=200809L $(PROJECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(PROJECT_LIB_$*)
+$(B)/hdbench_project_old_%: bench/hdbench_project.c bench/hd_bench_median.h bench/hd_orbit_scene.h $(PROJECT_OLD)/.stamp
+	$(CC) -I$(PROJECT_OLD) -Iexamples -D_POSIX_C_SOURCE=200809L $(PROJECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(PROJECT_LIB_$*)
 
 $(B)/bench_project_light.f32: | $(B)/hdbench_project_cpu data
 	$(B)/hdbench_project_cpu --make-light $@ $(PROJECT_ITERS)
