@@ -355,7 +355,8 @@ typedef struct hd_params {
                                PSNR cost). Every backend (Vulkan/GL: r16f images, where the
                                device lacks them HD_ERROR_UNSUPPORTED at the next render); the
                                multigrid solver returns HD_ERROR_UNSUPPORTED. hd_read_illumination
-                               still returns floats. */
+                               still returns floats. The projection's summed copy of E + phi
+                               (one grid per channel, counted in method_bytes) stays float32. */
     float light_tolerance;  /* hd_render stops refining the light once hd_stats.light_error, the
                                estimated relative error of E + phi, is below this for two light
                                iterations in a row: 0 -> 0.1 (head CT: 10-20 iterations, the
@@ -428,7 +429,8 @@ typedef struct hd_stats {
     uint64_t iterations;      /* iterations of the current method since its state was reset */
     uint64_t frames;          /* frames accumulated into the current image */
     size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
-                                 (illumination grids and helpers; volume and image excluded) */
+                                 (illumination grids, the projection's summed light E + phi and
+                                 helpers; volume and image excluded) */
     size_t image_bytes;       /* bytes of the image accumulation */
     size_t volume_bytes;      /* bytes of the volume, the TF and the majorant grid on the device */
     int illumination_dims[3]; /* grid of the illumination volumes */

@@ -47,10 +47,11 @@ struct hd__backend {
     int light;               /* the light of the convection / sum pass being run */
     /* the projection's own inputs (hd__cpu_project_prepare): E + phi summed in the API's
        x-fastest layout, valid while lsum_ok, and the TF table for the current step, rebuilt
-       every frame. lsum_ok is cleared by the clears, the test hook's writes and the first pass
+       when its inputs change (ptab_key). lsum_ok is cleared by the clears, the test hook's writes and the first pass
        of every light iteration (direct or the lights' sum), which precedes its diffusion */
     float *lsum, *ptab;
     int lsum_ok, ptab_cap, ptab_n;
+    hd__ptab_key ptab_key;
 };
 
 static const char *hd__be_name(void) { return "cpu"; }
@@ -978,8 +979,8 @@ static void hd__cpu_lsum_row(hd__backend *be, int r)
 }
 
 /* The projection's inputs: lsum (after any pass that changed E or phi) and the TF table for the
-   current TF, step and medium (hd__project_table). Without room for either the projection reads
-   E, phi and the TF directly. */
+   current TF, step and medium (hd__project_table, rebuilt when its key changes). Without room for
+   either the projection reads E, phi and the TF directly. */
 static void hd__cpu_project_prepare(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -995,8 +996,12 @@ static void hd__cpu_project_prepare(hd__ctx *ctx)
         hd__free(ctx, be->ptab);
         be->ptab = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
         be->ptab_cap = be->ptab ? n : 0;
+        be->ptab_key.valid = 0;
     }
-    if (be->ptab) hd__project_table(ctx, be->ptab, n);
+    if (be->ptab && !hd__project_table_key_same(ctx, &be->ptab_key)) {
+        hd__project_table(ctx, be->ptab, n);
+        be->ptab_key = hd__project_table_key(ctx);
+    }
     be->ptab_n = n;
 }
 

@@ -193,11 +193,11 @@ struct hd__backend {
     hd__gl_tex lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
        lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (storage
-       buffer 5), uploaded when its host copy ptab_host (ptab_n entries) changes */
+       buffer 5, ptab_n entries), uploaded when its inputs change (ptab_key) */
     hd__gl_tex lsum;
     GLuint ptab;
     int lsum_ok, ptab_n;
-    float *ptab_host;
+    hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
@@ -759,7 +759,6 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_leave(ctx, HD_SUCCESS);
     }
     hd__free(ctx, be->mg.host_dot); /* left when GL was unreachable */
-    hd__free(ctx, be->ptab_host);
     if (be->own && be->egl) {
         if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(be->dpy, be->egl);
@@ -943,7 +942,7 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
 static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { HD__GL_STAGE(ctx, hd__gl_diffuse(ctx, jacobi)); }
 
 /* The projection's inputs: lsum rebuilt (the light-sum stage) after a pass that changed E or phi,
-   and the TF table (hd__project_table) uploaded when it differs from the one in the buffer. */
+   and the TF table (hd__project_table) built and uploaded when its inputs changed (ptab_key). */
 static hd_result hd__gl_project_prepare(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -956,22 +955,16 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
             return r;
         be->lsum_ok = 1;
     }
+    if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
     t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
     if (!t) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the projection's TF table (%d entries)", n);
     hd__project_table(ctx, t, n);
-    if (n == be->ptab_n && memcmp(t, be->ptab_host, (size_t)n * 4 * sizeof(float)) == 0) {
-        hd__free(ctx, t);
-        return HD_SUCCESS;
-    }
-    hd__free(ctx, be->ptab_host);
-    be->ptab_host = NULL;
+    be->ptab_key.valid = 0;
     be->ptab_n = 0;
     r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");
-    if (r != HD_SUCCESS) {
-        hd__free(ctx, t);
-        return r;
-    }
-    be->ptab_host = t;
+    hd__free(ctx, t);
+    if (r != HD_SUCCESS) return r;
+    be->ptab_key = hd__project_table_key(ctx);
     be->ptab_n = n;
     return HD_SUCCESS;
 }

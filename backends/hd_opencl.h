@@ -85,11 +85,11 @@ struct hd__backend {
     cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table, uploaded when
-       its host copy ptab_host (ptab_n entries) changes */
+       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (ptab_n
+       entries), uploaded when its inputs change (ptab_key) */
     cl_mem lsum, ptab;
     int lsum_ok, ptab_n;
-    float *ptab_host;
+    hd__ptab_key ptab_key;
     size_t tf_bytes, img_floats;
     int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
@@ -359,7 +359,6 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__gpu_free(ctx, &be->gg);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf); hd__cl_release(&be->maj);
     hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab);
-    hd__free(ctx, be->ptab_host);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
@@ -628,7 +627,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 }
 
 /* The projection's inputs: lsum rebuilt (hd_k_light_sum) after a pass that changed E or phi, and
-   the TF table (hd__project_table) uploaded when it differs from the one on the device. */
+   the TF table (hd__project_table) built and uploaded when its inputs changed (ptab_key). */
 static hd_result hd__cl_project_prepare(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -642,24 +641,19 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
             return r;
         be->lsum_ok = 1;
     }
+    if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
     t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
     if (!t)
         return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the projection's TF table (%d entries)", n);
     hd__project_table(ctx, t, n);
-    if (n != be->ptab_n || memcmp(t, be->ptab_host, (size_t)n * 4 * sizeof(float)) != 0) {
-        hd__cl_release(&be->ptab);
-        hd__free(ctx, be->ptab_host);
-        be->ptab_host = NULL;
-        be->ptab_n = 0;
-        if ((r = hd__cl_buffer(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, "the projection's TF table")) != HD_SUCCESS) {
-            hd__free(ctx, t);
-            return r;
-        }
-        be->ptab_host = t;
-        be->ptab_n = n;
-    } else {
-        hd__free(ctx, t);
-    }
+    hd__cl_release(&be->ptab);
+    be->ptab_key.valid = 0;
+    be->ptab_n = 0;
+    r = hd__cl_buffer(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, "the projection's TF table");
+    hd__free(ctx, t);
+    if (r != HD_SUCCESS) return r;
+    be->ptab_key = hd__project_table_key(ctx);
+    be->ptab_n = n;
     return HD_SUCCESS;
 }
 

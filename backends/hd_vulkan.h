@@ -206,12 +206,12 @@ struct hd__backend {
     hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
        lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (binding 13,
-       host-visible, ptab_cap entries, sized with the TF), written when its host copy ptab_host
-       (ptab_n entries) changes */
+       host-visible, ptab_cap entries, sized with the TF), written when its inputs change
+       (ptab_key) */
     hd__vk_image lsum;
     hd__vk_buffer ptab;
     int lsum_ok, ptab_n, ptab_cap;
-    float *ptab_host;
+    hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
     unsigned long submits, lose_at; /* queue submissions so far; HD_VK_LOSE_DEVICE (0: off) */
@@ -1296,7 +1296,6 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->messenger) be->fn.vkDestroyDebugUtilsMessengerEXT(be->instance, be->messenger, NULL);
         be->fn.vkDestroyInstance(be->instance, NULL);
     }
-    hd__free(ctx, be->ptab_host);
     hd__free(ctx, be);
     ctx->be = NULL;
 }
@@ -1456,6 +1455,7 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     if (hd__project_table_n(ctx) != be->ptab_cap) {
         hd__vk_free_buffer(ctx, &be->ptab);
         be->ptab_n = be->ptab_cap = 0;
+        be->ptab_key.valid = 0;
         if ((r = hd__vk_buffer_create(ctx, &be->ptab, (size_t)hd__project_table_n(ctx) * 4 * sizeof(float),
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the projection's TF table")) != HD_SUCCESS)
             return r;
@@ -1610,16 +1610,14 @@ static hd_result hd__be_project(hd__ctx *ctx)
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
                        n);
-    if (!(t = (float *)hd__alloc(ctx, bytes)))
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the projection's TF table (%d entries)", n);
-    hd__project_table(ctx, t, n);
-    if (n != be->ptab_n || memcmp(t, be->ptab_host, bytes) != 0) {
+    if (!hd__project_table_key_same(ctx, &be->ptab_key)) {
+        if (!(t = (float *)hd__alloc(ctx, bytes)))
+            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the projection's TF table (%d entries)", n);
+        hd__project_table(ctx, t, n);
         memcpy(be->ptab.map, t, bytes);
-        hd__free(ctx, be->ptab_host);
-        be->ptab_host = t;
-        be->ptab_n = n;
-    } else {
         hd__free(ctx, t);
+        be->ptab_key = hd__project_table_key(ctx);
+        be->ptab_n = n;
     }
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
         (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)

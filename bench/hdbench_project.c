@@ -7,7 +7,10 @@
    median and the best ms per frame. --save writes the image after the timed frames as raw
    float RGBA, --compare prints the PSNR of this run's image against such a file (peak: the
    reference's largest RGB value), --png writes it as a PNG to look at.
-   Usage: hdbench_project [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
+   --orbit takes bench-peer's scene instead (bench/hd_orbit_scene.h: the ct-skin TF, hdrender's
+   camera at azimuth 0, its key light; light file build/bench_project_light_orbit.f32), the
+   scene whose frame make bench-peer times against VTK.
+   Usage: hdbench_project [--orbit] [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
                           [--width W] [--height H] [--frames F] [--save F32] [--compare F32]
                           [--png PNG] [--tag WORD] [data/head.nrrd]
    --size N is an N x N frame; --size 1920x1080 (or --width / --height) any other.
@@ -25,6 +28,7 @@
 #include <stdlib.h>
 #include <time.h>
 #include "hd_bench_median.h"
+#include "hd_orbit_scene.h"
 
 /* A CT transfer function over HU -1024..3071 (bench/hdbench.c's): skin faint, bone dense. */
 static const float bench_tf[] = {
@@ -32,8 +36,18 @@ static const float bench_tf[] = {
     0.93f, 0.73f, 0.62f, 0.05f, 1.0f, 0.98f, 0.9f, 0.5f,    1.0f, 1.0f, 1.0f, 1.0f,
     1.0f, 1.0f, 1.0f, 1.0f,     1.0f, 1.0f, 1.0f, 1.0f,     1.0f, 1.0f, 1.0f, 1.0f};
 
+static hdo_scene g_orbit; /* --orbit: bench-peer's scene (loaded by main) */
+static int g_use_orbit;
+
 static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *light, int width, int height)
 {
+    if (g_use_orbit) {
+        *d = g_orbit.desc;
+        d->camera.width = width;
+        d->camera.height = height;
+        d->logger.func = hd_log_stderr;
+        return;
+    }
     memset(d, 0, sizeof *d);
     d->volume = vf->desc;
     d->volume.value_range[0] = -1024.0f;
@@ -97,6 +111,7 @@ int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd", *light_path = "build/bench_project_light.f32", *save = NULL;
     const char *compare = NULL, *png = NULL, *tag = "";
+    int light_given = 0;
     int width = 512, height = 512, frames = 8, make_iters = 0, i;
     hd_volume_file vf;
     hd_light light;
@@ -109,8 +124,14 @@ int main(int argc, char **argv)
     clock_t cpu0;
     int32_t n;
     for (i = 1; i < argc; ++i) {
-        if (strcmp(argv[i], "--make-light") == 0 && i + 2 < argc) { light_path = argv[++i]; make_iters = atoi(argv[++i]); }
-        else if (strcmp(argv[i], "--light") == 0 && i + 1 < argc) light_path = argv[++i];
+        if (strcmp(argv[i], "--make-light") == 0 && i + 2 < argc) {
+            light_path = argv[++i];
+            make_iters = atoi(argv[++i]);
+            light_given = 1;
+        } else if (strcmp(argv[i], "--light") == 0 && i + 1 < argc) {
+            light_path = argv[++i];
+            light_given = 1;
+        } else if (strcmp(argv[i], "--orbit") == 0) g_use_orbit = 1;
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
             const char *x = strchr(argv[++i], 'x');
             width = atoi(argv[i]);
@@ -128,6 +149,11 @@ int main(int argc, char **argv)
     if (width < 1 || height < 1 || frames < 1) {
         fprintf(stderr, "hdbench_project: --size, --width, --height and --frames must be >= 1\n");
         return 2;
+    }
+    if (g_use_orbit) {
+        hd_logger quiet = {NULL, NULL};
+        if (!hdo_scene_load(&g_orbit, path, width, &quiet)) return 2;
+        if (!light_given) light_path = "build/bench_project_light_orbit.f32";
     }
     if (hd_volume_load_nrrd(path, &vf, NULL) != HD_SUCCESS) {
         fprintf(stderr, "hdbench_project: cannot load %s (run `make data` first)\n", path);
@@ -204,5 +230,6 @@ int main(int argc, char **argv)
     free(lightbuf);
     hd_destroy(ctx);
     hd_volume_free(&vf);
+    if (g_use_orbit) hd_volume_free(&g_orbit.vol);
     return 0;
 }

@@ -18,8 +18,19 @@
 #                       ORBIT_BACKENDS picks the frame-time builds (default opencl vulkan gl).
 .PHONY: bench-peer bench-orbit
 
-$(B)/hdpeer: bench/peer/hdpeer.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_png.h $(LIB_SRC) | $(B)
+PEER_SRC := bench/peer/hdpeer.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_png.h
+$(B)/hdpeer: $(PEER_SRC) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+# The GPU backends' builds and the CPU build of PROJECT_BASE (mk/bench_project.mk), for
+# PEER_ARGS="--hd cpu=build/hdpeer --hd gl=build/hdpeer_gl ..." (bench/peer/vtk_peer.py).
+$(B)/hdpeer_opencl: $(PEER_SRC) $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples -Ibench -DHYBRIDDIFF_BACKEND_OPENCL $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -lOpenCL
+$(B)/hdpeer_gl: $(PEER_SRC) $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples -Ibench -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -lEGL
+$(B)/hdpeer_vulkan: $(PEER_SRC) $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples -Ibench -DHYBRIDDIFF_BACKEND_VULKAN $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -lvulkan
+$(B)/hdpeer_old: $(PEER_SRC) $(B)/proj-old/.stamp
+	$(CC) -I$(PROJECT_OLD) -D_POSIX_C_SOURCE=200809L -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 PEER_ARGS ?=
 bench-peer: $(B)/hdpeer

@@ -162,6 +162,31 @@ HD__MAYBE_UNUSED static int hd__project_table_n(const hd__ctx *ctx)
     int segs = ctx->tf_count - 1, m = segs < HD__PTAB_MIN ? (HD__PTAB_MIN + segs - 1) / segs : 1;
     return segs * m + 1;
 }
+/* What the table is built from: a backend keeps the key of the table it holds and rebuilds or
+   uploads it only when hd__project_table_key_same says the inputs changed (a TF, step, extinction
+   or albedo change); valid 0 (a zeroed key, or one reset with the table's buffer) never matches. */
+typedef struct hd__ptab_key {
+    int valid, n;
+    unsigned tf_serial;
+    float dt, extinction, scale;
+} hd__ptab_key;
+HD__MAYBE_UNUSED static hd__ptab_key hd__project_table_key(const hd__ctx *ctx)
+{
+    hd__ptab_key k;
+    k.valid = 1;
+    k.n = hd__project_table_n(ctx);
+    k.tf_serial = ctx->tf_serial;
+    k.dt = ctx->kp.march.x;
+    k.extinction = ctx->kp.medium.x;
+    k.scale = ctx->kp.medium.y * ctx->kp.box.w;
+    return k;
+}
+HD__MAYBE_UNUSED static int hd__project_table_key_same(const hd__ctx *ctx, const hd__ptab_key *held)
+{
+    hd__ptab_key k = hd__project_table_key(ctx);
+    return held->valid && held->n == k.n && held->tf_serial == k.tf_serial && held->dt == k.dt &&
+           held->extinction == k.extinction && held->scale == k.scale;
+}
 HD__MAYBE_UNUSED static void hd__project_table(const hd__ctx *ctx, float *dst, int n)
 {
     hd__kctx k;

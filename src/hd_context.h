@@ -197,6 +197,7 @@ static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
     hd__free(ctx, ctx->tf);
     ctx->tf = copy;
     ctx->tf_count = count;
+    ctx->tf_serial++;
     ctx->desc.transfer_function.rgba = ctx->tf;
     ctx->desc.transfer_function.count = count;
     return HD_SUCCESS;
@@ -1258,6 +1259,7 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
 #endif
     if (ctx->params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (multigrid levels) */
+    out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
     out->image_bytes = hd__image_floats(ctx->camera.width, ctx->camera.height) * sizeof(float);
     /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */

@@ -69,6 +69,7 @@ typedef struct hd__ctx {
     /* inputs */
     float *tf;               /* RGBA * tf_count */
     int tf_count;
+    unsigned tf_serial;      /* bumped by every TF change (the projection's table key, hd_backend.h) */
     hd_light lights[HD_MAX_LIGHTS];
     int light_count;
     hd_camera camera;

@@ -365,10 +365,11 @@ static void test_method_bytes_vs_lights(void)
         fprintf(stderr, "  %d light(s): CD %zu B (%.0f B/voxel), HD %zu B (%.0f B/voxel), PT %zu B\n", n, cd[n],
                 (double)cd[n] / gvox, hd[n], (double)hd[n] / gvox, pt);
     }
-    /* CD: sigma_t + E + phi + (L + 1) light volumes (the +1 is the ping-pong spare) */
-    for (n = 1; n <= 3; ++n) CHECK(cd[n] == gvox * 4 * (3 + (size_t)n + 1));
+    /* CD: sigma_t + E + phi + the projection's E + phi + (L + 1) light volumes (the +1 is the
+       ping-pong spare) */
+    for (n = 1; n <= 3; ++n) CHECK(cd[n] == gvox * 4 * (4 + (size_t)n + 1));
     CHECK(cd[2] - cd[1] == gvox * 4 && cd[3] - cd[2] == gvox * 4);
-    CHECK(hd[1] == gvox * 12 && hd[2] == hd[1] && hd[3] == hd[1]);
+    CHECK(hd[1] == gvox * 16 && hd[2] == hd[1] && hd[3] == hd[1]);
     CHECK(pt == 0);
 }
 
@@ -416,11 +417,45 @@ static void test_reset_rules(void)
     hd_destroy(ctx);
 }
 
+/* The projection's TF table (hd__project_table, kept by each backend under a key of its inputs)
+   follows a TF change that keeps the entry count, extinction and step: the blob in red, then the
+   same opacities in blue; the frame after the change has blue and no red (a stale table: red). */
+static void test_projection_table_follows_tf(void)
+{
+    static const float red[8] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f};
+    static const float blue[8] = {0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f};
+    hd_desc d;
+    hd_context ctx;
+    hd_transfer_function tf;
+    float img[TM_IMG * TM_IMG * 4];
+    double sum[3] = {0.0, 0.0, 0.0};
+    int i;
+    tm_desc(&d, 16, 16, 16, HD_METHOD_HD, 8.0f);
+    tm_blob(&d);
+    d.transfer_function.rgba = red;
+    d.lights = tm_light();
+    d.light_count = 1;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
+    tf.rgba = blue;
+    tf.count = 2;
+    CHECK(hd_set_transfer_function(ctx, &tf) == HD_SUCCESS);
+    CHECK(hd_iterate(ctx, 1) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(ctx, img, sizeof img / sizeof img[0]) == HD_SUCCESS);
+    for (i = 0; i < TM_IMG * TM_IMG * 4; ++i)
+        if (i % 4 != 3) sum[i % 4] += img[i];
+    fprintf(stderr, "  after red -> blue: image sums R %.4g G %.4g B %.4g\n", sum[0], sum[1], sum[2]);
+    CHECK(sum[2] > 0.0);
+    CHECK_MSG(sum[0] == 0.0 && sum[1] == 0.0, "the projection kept the old TF's colour (R %.4g)", sum[0]);
+    hd_destroy(ctx);
+}
+
 const hd_test_case hd_tests_methods[] = {
     {"methods_hd_no_diffusion_matches_pt_ss", test_hd_matches_pt_ss},
     {"methods_pt_ms_one_bounce_matches_pt_ss", test_pt_ms_one_bounce_matches_pt_ss},
     {"methods_cd_direct_matches_exp", test_cd_direct_matches_exp},
     {"methods_bytes_vs_lights", test_method_bytes_vs_lights},
     {"methods_reset_rules", test_reset_rules},
+    {"methods_projection_table_follows_tf", test_projection_table_follows_tf},
 };
 const int hd_tests_methods_count = (int)(sizeof hd_tests_methods / sizeof hd_tests_methods[0]);

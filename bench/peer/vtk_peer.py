@@ -3,7 +3,10 @@
 #
 # Starts build/hdpeer (which converges hybriddiff's light once, CPU backend) and drives it over a
 # pipe, so that each round times, one after the other at each size:
-#   hd       hybriddiff: one hd_render per orbit frame over the converged light (projection only)
+#   hd       hybriddiff: one hd_render per orbit frame over the converged light (projection only);
+#            --hd NAME=EXE (repeatable) drives other builds of hdpeer instead, each an engine of
+#            its own, e.g. --hd cpu=build/hdpeer --hd gl=build/hdpeer_gl (hdpeer_opencl,
+#            hdpeer_vulkan, hdpeer_old: mk/bench.mk)
 #   vtk-fp   vtkFixedPointVolumeRayCastMapper (CPU), emission-absorption, unshaded
 #   vtk-gpu  vtkGPUVolumeRayCastMapper (OpenGL, here Mesa llvmpipe), emission-absorption, unshaded
 #   vtk-gi   vtkGPUVolumeRayCastMapper's volumetric scattering (VTK's global illumination:
@@ -13,7 +16,7 @@
 # world box (largest side 1, centred at 0), the camera, and the sample distance (hybriddiff's step).
 # Every frame of a timed run moves the camera along the orbit (azimuth 360 i / N).
 #
-# Usage: pvpython vtk_peer.py [--hdpeer build/hdpeer] [--data data/head.nrrd] [--sizes 512,1024]
+# Usage: pvpython vtk_peer.py [--hdpeer build/hdpeer | --hd NAME=EXE ...] [--data data/head.nrrd] [--sizes 512,1024]
 #          [--frames 3] [--gi-frames 2] [--rounds 2] [--pictures docs/peer|none]
 # (pvpython cannot take an empty argument: --pictures none, not --pictures '')
 import argparse
@@ -85,6 +88,8 @@ class HdPeer:
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--hdpeer", default="build/hdpeer")
+    ap.add_argument("--hd", action="append", default=[], metavar="NAME=EXE",
+                    help="a hybriddiff engine (repeatable; default hd=HDPEER)")
     ap.add_argument("--data", default="data/head.nrrd")
     ap.add_argument("--sizes", default="512,1024")
     ap.add_argument("--frames", type=int, default=3, help="orbit frames per engine and round")
@@ -94,8 +99,16 @@ def main():
     a = ap.parse_args()
     sizes = [int(s) for s in a.sizes.split(",") if s]
 
-    hd = HdPeer(a.hdpeer, a.data)
+    hd_specs = [x.split("=", 1) for x in a.hd] if a.hd else [["hd", a.hdpeer]]
+    if any(len(x) != 2 or not x[0] or x[0].startswith("vtk") for x in hd_specs):
+        sys.exit("vtk_peer: --hd takes NAME=EXE, NAME not starting with vtk")
+    hds = {name: HdPeer(exe, a.data) for name, exe in hd_specs}
+    hd_names = [name for name, _ in hd_specs]
+    hd = hds[hd_names[0]]
     lo, hi, ext, step, side, dims, table = hd.tf()
+    for name in hd_names[1:]:
+        if hds[name].tf()[:6] != (lo, hi, ext, step, side, dims):
+            sys.exit("vtk_peer: %s's scene differs from %s's" % (name, hd_names[0]))
 
     # the volume, in hybriddiff's world box: voxel centres at ((i + 0.5) / n - 0.5) * side
     reader = vtk.vtkNrrdReader()
@@ -171,7 +184,8 @@ def main():
         light.SetLightTypeToSceneLight()
         light.SetPositional(0)
         engines[name] = (ren, light)
-    names = ["hd", "vtk-fp", "vtk-gpu", "vtk-gi"]
+    vtk_names = ["vtk-fp", "vtk-gpu", "vtk-gi"]
+    names = hd_names + vtk_names
 
     def use(name, size, deg):
         ren, light = engines[name]
@@ -208,20 +222,20 @@ def main():
     use("vtk-gpu", sizes[0], 0.0)
     win.Render()
     gl = [l for l in win.ReportCapabilities().splitlines() if "renderer string" in l]
-    print("bench-peer: VTK %s (%s), hybriddiff CPU backend via %s; %d rounds, %d frames "
+    print("bench-peer: VTK %s (%s), hybriddiff via %s; %d rounds, %d frames "
           "per engine (vtk-gi %d), interleaved" % (vtk.vtkVersion.GetVTKVersion(),
-          gl[0].split(":", 1)[1].strip() if gl else "OpenGL renderer unknown", a.hdpeer,
-          a.rounds, a.frames, a.gi_frames), flush=True)
+          gl[0].split(":", 1)[1].strip() if gl else "OpenGL renderer unknown",
+          ", ".join("%s=%s" % (n, e) for n, e in hd_specs), a.rounds, a.frames, a.gi_frames), flush=True)
     ms = {(s, e): [] for s in sizes for e in names}
     cms = {(s, e): [] for s in sizes for e in names}
     for r in range(a.rounds):
         for s in sizes:
             for e in names:
-                if e == "hd":
-                    ans = hd.ask("frames %d %d" % (s, a.frames))
+                if e in hds:
+                    ans = hds[e].ask("frames %d %d" % (s, a.frames))
                     t, c = float(ans[1]), float(ans[3]) / CORES
                     if float(ans[2]) != 0.0:
-                        print("bench-peer: hd spent %s s on light during timed frames" % ans[2])
+                        print("bench-peer: %s spent %s s on light during timed frames" % (e, ans[2]))
                 else:
                     t, c = time_vtk(e, s, a.gi_frames if e == "vtk-gi" else a.frames)
                 ms[(s, e)].append(t)
@@ -230,12 +244,13 @@ def main():
                     r + 1, s, e, t, c, CORES), flush=True)
     for title, tab in (("wall clock", ms), ("process CPU time / %d cores" % CORES, cms)):
         print("\nms per orbit frame, %s (median of %d rounds; same run, interleaved):" % (title, a.rounds))
-        print("%6s %10s %10s %10s %10s   hd/vtk-fp  hd/vtk-gpu" % ("size", *names))
+        print("%6s" % "size" + "".join(" %10s" % e for e in names) +
+              "".join("  %s/vtk-fp  %s/vtk-gpu" % (h, h) for h in hd_names))
         for s in sizes:
             med = {e: statistics.median(tab[(s, e)]) for e in names}
-            print("%4d^2 %10.1f %10.1f %10.1f %10.1f   %9.2f  %10.2f" % (
-                s, med["hd"], med["vtk-fp"], med["vtk-gpu"], med["vtk-gi"],
-                med["hd"] / med["vtk-fp"], med["hd"] / med["vtk-gpu"]))
+            print("%4d^2" % s + "".join(" %10.1f" % med[e] for e in names) +
+                  "".join("  %*.2f  %*.2f" % (len(h) + 7, med[h] / med["vtk-fp"], len(h) + 8,
+                                               med[h] / med["vtk-gpu"]) for h in hd_names))
 
     if a.pictures and a.pictures != "none":
         os.makedirs(a.pictures, exist_ok=True)
@@ -244,7 +259,7 @@ def main():
             p = os.path.abspath(os.path.join(a.pictures, "hd-%d.png" % s))
             hd.ask("picture %d %s" % (s, p))
             files.append(p)
-            for e in names[1:]:
+            for e in vtk_names:
                 use(e, s, 0.0)
                 win.Render()
                 grab = vtk.vtkWindowToImageFilter()
@@ -273,8 +288,9 @@ def main():
             w.Write()
             for p in files:
                 os.remove(p)
-            print("picture: %s (left to right: %s)" % (out, ", ".join(names)))
-    hd.quit()
+            print("picture: %s (left to right: %s)" % (out, ", ".join([hd_names[0]] + vtk_names)))
+    for h in hds.values():
+        h.quit()
 
 
 main()
