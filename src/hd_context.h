@@ -691,14 +691,16 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
                     int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
                     size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
                     size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
-                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B - lo[0];
-                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B - lo[0];
-                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B - lo[0];
-                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B - lo[0];
-                    int32_t a = b0[x];
+                    /* the block's rows of the 4 voxel rows, at x and x1 */
+                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
+                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
+                    int xa = x - lo[0], xb = x1 - lo[0];
+                    int32_t a = b0[xa];
                     float v = vol[r00 + x];
-                    uint8_t full = !(a != 0 && b0[x1] == a && b1[x] == a && b1[x1] == a && b2[x] == a && b2[x1] == a &&
-                                     b3[x] == a && b3[x1] == a);
+                    uint8_t full = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
+                                     b3[xa] == a && b3[xb] == a);
                     /* 8 equal values interpolate to that value exactly, whatever the weights */
                     if (full && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
                         vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
