@@ -571,9 +571,10 @@ static size_t hd__illum_floats(const hd__ctx *ctx)
 #define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
 #define HD__DL_BRICK 8 /* voxels per edge of the list's bricks (a multiple of the light's runs of 8) */
 
-/* The run of zero-alpha TF entries (numbered from 1) that every value within HD__DL_VALUE_EPS of [t0, t1] lies in,
-   0 when some of them may have sigma_t > 0. A value's entries lie within those of the range
-   (both ends are monotone in the value), so a range in one run puts each of its values there. */
+/* The run of zero-alpha TF entries (numbered from 1) that every value within HD__DL_VALUE_EPS of
+   [t0, t1] lies in, 0 when some of them may have sigma_t > 0. A value's entries lie within those
+   of the range (both ends are monotone in the value), so a range in one run puts each of its
+   values there. */
 static int32_t hd__dl_run_range(const int32_t *entry_run, int n, float t0, float t1)
 {
     float lo = t0 - HD__DL_VALUE_EPS, hi = t1 + HD__DL_VALUE_EPS, n1 = (float)(n - 1);
