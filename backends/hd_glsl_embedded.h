@@ -383,8 +383,9 @@ static const char *const hd__gl_source[] = {
 "/* ---- transmittance tracking --------------------------------------------------------------- */\n",
 "/* One unbiased estimate of the transmittance along p + t d, t in [0, tmax] (p inside the box,\n",
 "   d unit). Null-collision tracking with a local majorant per cell of the majorant grid, walked\n",
-"   cell by cell (a 3D DDA), so empty cells cost no collision at all; the exponential free path is\n",
-"   memoryless, so restarting it at each cell boundary is exact. mode: HD_TRACK_RATIO (ratio\n",
+"   cell by cell (a 3D DDA), so empty cells cost no collision at all. The free path is drawn as an\n",
+"   optical depth tau ~ Exp(1) and spent cell by cell (mu * length): a collision where it runs out,\n",
+"   the same distribution as a fresh exponential per cell, with one draw per collision. mode: HD_TRACK_RATIO (ratio\n",
 "   tracking, Russian roulette below HD_RR_THRESHOLD) or HD_TRACK_DELTA (0 or 1).\n",
 "   Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim.\n",
 "   hd_track is the shared walker: with HD_TRACK_DELTA it also reports in *t_hit the distance of\n",
@@ -398,6 +399,7 @@ static const char *const hd__gl_source[] = {
 "    float hit = tmax;\n",
 "    hd_u32 dim = dim0;\n",
 "    float t = 0.0f;\n",
+"    float tau = -1.0f; /* optical depth to the next collision, drawn when first needed (< 0: none) */\n",
 "    int done = 0;\n",
 "    /* The ray in majorant-cell coordinates (cells of mdims.w voxels): g(t) = g0 + t * gd. */\n",
 "    hd_v3 u0 = hd_world_to_tex(HD_KPASS p);\n",
@@ -426,11 +428,19 @@ static const char *const hd__gl_source[] = {
 "        if (mu > 0.0f) {\n",
 "            float inv_mu = 1.0f / mu;\n",
 "            for (;;) {\n",
-"                float xi = hd_rand(key, dim);\n",
-"                float sig, ratio;\n",
-"                dim += 1u;\n",
-"                t -= hd_log(1.0f - xi) * inv_mu;\n",
-"                if (t >= t_end) break;\n",
+"                float sig, ratio, tc;\n",
+"                if (tau < 0.0f) {\n",
+"                    tau = -hd_log(1.0f - hd_rand(key, dim));\n",
+"                    dim += 1u;\n",
+"                }\n",
+"                tc = t + tau * inv_mu;\n",
+"                if (tc >= t_end) {\n",
+"                    /* no collision in this cell: the optical depth left carries into the next */\n",
+"                    tau = hd_maxf(tau - (t_end - t) * mu, 0.0f);\n",
+"                    break;\n",
+"                }\n",
+"                t = tc;\n",
+"                tau = -1.0f;\n",
 "                steps += 1;\n",
 "                if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; done = 1; hit = t; break; }\n",
 "                sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));\n",
@@ -2116,7 +2126,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 1798 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 1808 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

@@ -1,12 +1,12 @@
 /* hdbench_direct - HD's direct-light stage per iteration on one backend: tracked only at the
    voxels whose E is read (the library's way, hd__direct_mask) against every voxel of the
    illumination grid (the test hook hd__test_direct_all), in one process, interleaved. Head CT,
-   full grid (illumination_downsample 1), one directional light, the ct-skin and ct-bone TFs of
+   full grid (illumination_downsample 1, or N with --grid N), one directional light, the ct-skin and ct-bone TFs of
    examples/hd_tf.h. Per TF: the tracked voxels and the list's bytes, the time to build the mask,
    then reps x (masked, every voxel) blocks of `iters` direct passes, each timed with the device
    drained; prints the median ms per pass of each and their ratio, and checks that E agrees at
    every tracked voxel. Figures, not a test: it fails only on an error or an E mismatch.
-   Usage: hdbench_direct [--iters N] [--reps R] [data/head.nrrd] */
+   Usage: hdbench_direct [--iters N] [--reps R] [--grid N] [data/head.nrrd] */
 #define HYBRIDDIFF_IMPLEMENTATION
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_GL) && \
     !defined(HYBRIDDIFF_BACKEND_VULKAN)
@@ -32,7 +32,7 @@ static double time_passes(hd_context h, int iters, int *ok)
     return (hd__now() - t0) * 1e3 / iters;
 }
 
-static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int reps)
+static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int reps, int grid)
 {
     hdx_tf tf;
     hd_desc d;
@@ -59,7 +59,7 @@ static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int
     d.lights = &light;
     d.light_count = 1;
     d.camera.eye[1] = 2.3f; d.camera.up[2] = 1.0f; d.camera.width = d.camera.height = 64;
-    d.params.illumination_downsample = 1;
+    d.params.illumination_downsample = grid;
     d.params.diffusion_boundary = HD_BOUNDARY_BOX;
     d.logger.func = hd_log_stderr;
     for (m = 0; m < 2 && ok; ++m) {
@@ -120,17 +120,21 @@ done:
 int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd";
-    int iters = 4, reps = 3, i, ok = 1;
+    int iters = 4, reps = 3, grid = 1, i, ok = 1;
     hd_volume_file vf;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--iters") == 0 && i + 1 < argc) iters = atoi(argv[++i]);
         else if (strcmp(argv[i], "--reps") == 0 && i + 1 < argc) reps = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--grid") == 0 && i + 1 < argc) grid = atoi(argv[++i]);
         else if (argv[i][0] != '-') path = argv[i];
-        else { fprintf(stderr, "usage: hdbench_direct [--iters N] [--reps R] [data/head.nrrd]\n"); return 2; }
+        else { fprintf(stderr, "usage: hdbench_direct [--iters N] [--reps R] [--grid N] [data/head.nrrd]\n"); return 2; }
     }
-    if (iters < 1 || reps < 1 || reps > MAX_REPS) { fprintf(stderr, "hdbench_direct: iters >= 1, reps in 1..%d\n", MAX_REPS); return 2; }
+    if (iters < 1 || reps < 1 || reps > MAX_REPS || grid < 1 || grid > 8) {
+        fprintf(stderr, "hdbench_direct: iters >= 1, reps in 1..%d, grid in 1..8\n", MAX_REPS);
+        return 2;
+    }
     if (hd_volume_load_nrrd(path, &vf, NULL) != HD_SUCCESS) { fprintf(stderr, "hdbench_direct: cannot load %s\n", path); return 1; }
-    ok = bench_tf(&vf, "ct-skin", iters, reps) && bench_tf(&vf, "ct-bone", iters, reps);
+    ok = bench_tf(&vf, "ct-skin", iters, reps, grid) && bench_tf(&vf, "ct-bone", iters, reps, grid);
     hd_volume_free(&vf);
     return ok ? 0 : 1;
 }

@@ -61,7 +61,7 @@ static hd_result hd__be_classify(hd__ctx *ctx);
 /* HD: one Monte Carlo sample of the direct light into E's running mean (hd_k_direct.h) at each of
    the ctx->dl_count grid voxels listed in ctx->dl_idx; E elsewhere is left as it is (0). */
 static hd_result hd__be_direct(hd__ctx *ctx);
-/* HD: ctx->dl_idx (ctx->dl_count grid indices, ascending) changed with sigma_t: make it the list
+/* HD: ctx->dl_idx (ctx->dl_count grid indices, in bricks) changed with sigma_t: make it the list
    hd__be_direct reads (a GPU backend uploads it). */
 static hd_result hd__be_direct_list(hd__ctx *ctx);
 /* One sweep of the single-level solver (jacobi: Jacobi into phi2, then swapped; else one

@@ -570,12 +570,15 @@ static size_t hd__illum_floats(const hd__ctx *ctx)
    an interpolation that reads it (weight 0 included) can sample a non-empty cell. */
 #define HD__DL_VALUE_EPS 1e-5f
 #define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
+#define HD__DL_BRICK 8 /* voxels per edge of the list's bricks (a multiple of the light's runs of 8) */
 
-/* The run of zero-alpha TF entries (numbered from 1) every value within HD__DL_VALUE_EPS of t
-   lies in, 0 when some of them may have sigma_t > 0. */
-static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
+/* The run of zero-alpha TF entries (numbered from 1) that every value within HD__DL_VALUE_EPS of
+   [t0, t1] lies in, 0 when some of them may have sigma_t > 0. A value's entries lie within those
+   of the range (both ends are monotone in the value), so a range in one run puts each of its
+   values there. */
+static int32_t hd__dl_run_range(const int32_t *entry_run, int n, float t0, float t1)
 {
-    float lo = t - HD__DL_VALUE_EPS, hi = t + HD__DL_VALUE_EPS, n1 = (float)(n - 1);
+    float lo = t0 - HD__DL_VALUE_EPS, hi = t1 + HD__DL_VALUE_EPS, n1 = (float)(n - 1);
     int i, i0, i1;
     lo = lo < 0.0f ? 0.0f : lo;
     hi = hi > 1.0f ? 1.0f : hi;
@@ -586,6 +589,12 @@ static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
     for (i = i0; i <= i1; ++i)
         if (entry_run[i] == 0) return 0;
     return entry_run[i0]; /* consecutive zero entries share their run */
+}
+
+/* The same for one value. */
+static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
+{
+    return hd__dl_run_range(entry_run, n, t, t);
 }
 
 /* Dual cells [lo, hi] along one axis (volume size n) that an interpolation reading grid voxel x
@@ -619,8 +628,8 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
 {
     const int *n = ctx->dims, *g = ctx->gdims;
     int dn[3], d, x, y, z, j;
-    size_t gvox = (size_t)g[0] * g[1] * g[2], ndual, i, k;
-    int32_t *entry_run = NULL, *run = NULL;
+    size_t gvox = (size_t)g[0] * g[1] * g[2], ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2], ndual, i, k;
+    int32_t *entry_run = NULL;
     uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL;
     int (*span)[2] = NULL;
     hd_result r = HD_SUCCESS;
@@ -629,13 +638,12 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
     ndual = (size_t)dn[0] * dn[1] * dn[2];
     ctx->dl_bits = (uint8_t *)hd__calloc(ctx, (gvox + 7) / 8, 1);
     entry_run = (int32_t *)hd__alloc(ctx, (size_t)ctx->tf_count * sizeof(int32_t));
-    run = (int32_t *)hd__alloc(ctx, ctx->nvox * sizeof(int32_t));
     cell = (uint8_t *)hd__alloc(ctx, ndual);
     ax = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * dn[1] * dn[2]);
     ay = (uint8_t *)hd__alloc(ctx, (size_t)g[0] * g[1] * dn[2]);
     span = (int (*)[2])hd__alloc(ctx, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
     crop = (uint8_t *)hd__alloc(ctx, (size_t)(dn[0] + dn[1] + dn[2]));
-    if (!ctx->dl_bits || !entry_run || !run || !cell || !ax || !ay || !span || !crop) {
+    if (!ctx->dl_bits || !entry_run || !cell || !ax || !ay || !span || !crop) {
         r = HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
         goto done;
     }
@@ -645,32 +653,65 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
         if (zero && (j == 0 || entry_run[j - 1] == 0)) ++k;
         entry_run[j] = zero ? (int32_t)k : 0;
     }
-    for (i = 0; i < ctx->nvox; ++i) run[i] = hd__dl_run(entry_run, ctx->tf_count, ctx->vol[i]);
     /* dual cells per axis that meet the crop box: cell j holds the samples at u n - 0.5 in
        [j, j + 1], the first and last also those the clamp folds onto them */
     for (d = 0, k = 0; d < 3; ++d)
         for (j = 0; j < dn[d]; ++j, ++k)
             crop[k] = (uint8_t)hd__crop_meets(ctx, d, j == 0 ? -1.0 : ((double)j + 0.5) / n[d],
                                               j == dn[d] - 1 ? 2.0 : ((double)j + 1.5) / n[d], HD__DL_COORD_EPS);
-    /* a dual cell is empty when its 8 voxels share one zero run */
-    for (z = 0, k = 0; z < dn[2]; ++z)
-        for (y = 0; y < dn[1]; ++y)
-            for (x = 0; x < dn[0]; ++x, ++k) {
-                int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
-                size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
-                size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
-                int32_t a = run[r00 + x];
-                const float *vol = ctx->vol;
-                float v = vol[r00 + x];
-                cell[k] = !(a != 0 && run[r00 + x1] == a && run[r10 + x] == a && run[r10 + x1] == a &&
-                            run[r01 + x] == a && run[r01 + x1] == a && run[r11 + x] == a && run[r11 + x1] == a);
-                /* 8 equal values interpolate to that value exactly, whatever the weights */
-                if (cell[k] && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
-                    vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
-                    !(hd__tf_alpha(ctx, v) * ctx->params.extinction > 0.0f))
-                    cell[k] = 0;
-                if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) cell[k] = 0;
-            }
+    /* a dual cell is empty when its 8 voxels share one zero run. Dual cells are taken per
+       majorant cell (those whose lower corner it holds): the cell's value range, filter halo
+       included, covers their 8 voxels, so when it lies in one zero run they are all empty and no
+       voxel's run is needed; elsewhere the runs of the cell's block of voxels are computed once */
+    memset(cell, 0, ndual);
+    for (i = 0; i < ncell; ++i) {
+        enum { M = HD__MAJORANT_CELL, B = HD__MAJORANT_CELL + 1 };
+        int32_t blk[B * B * B];
+        int c[3], lo[3], hi[3], bx, by, bz;
+        const float *vol = ctx->vol;
+        if (hd__dl_run_range(entry_run, ctx->tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
+        c[0] = (int)(i % (size_t)ctx->mdims[0]);
+        c[1] = (int)(i / (size_t)ctx->mdims[0] % (size_t)ctx->mdims[1]);
+        c[2] = (int)(i / ((size_t)ctx->mdims[0] * ctx->mdims[1]));
+        for (d = 0; d < 3; ++d) {
+            lo[d] = c[d] * M;                                       /* first dual cell and voxel */
+            hi[d] = lo[d] + M < dn[d] ? lo[d] + M : dn[d];          /* dual cells end (exclusive) */
+        }
+        if (lo[0] >= hi[0] || lo[1] >= hi[1] || lo[2] >= hi[2]) continue;
+        /* runs of voxels lo .. min(hi, n - 1) */
+        bx = (hi[0] < n[0] - 1 ? hi[0] : n[0] - 1) - lo[0] + 1;
+        by = (hi[1] < n[1] - 1 ? hi[1] : n[1] - 1) - lo[1] + 1;
+        bz = (hi[2] < n[2] - 1 ? hi[2] : n[2] - 1) - lo[2] + 1;
+        for (z = 0; z < bz; ++z)
+            for (y = 0; y < by; ++y)
+                for (x = 0; x < bx; ++x)
+                    blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->tf_count,
+                                                          vol[((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x]);
+        for (z = lo[2]; z < hi[2]; ++z)
+            for (y = lo[1]; y < hi[1]; ++y)
+                for (x = lo[0]; x < hi[0]; ++x) {
+                    int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
+                    size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
+                    size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
+                    /* the block's rows of the 4 voxel rows, at x and x1 */
+                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
+                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
+                    int xa = x - lo[0], xb = x1 - lo[0];
+                    int32_t a = b0[xa];
+                    float v = vol[r00 + x];
+                    uint8_t full = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
+                                     b3[xa] == a && b3[xb] == a);
+                    /* 8 equal values interpolate to that value exactly, whatever the weights */
+                    if (full && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
+                        vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
+                        !(hd__tf_alpha(ctx, v) * ctx->params.extinction > 0.0f))
+                        full = 0;
+                    if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full = 0;
+                    cell[((size_t)z * dn[1] + y) * dn[0] + x] = full;
+                }
+    }
     /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
     for (d = 0, k = 0; d < 3; ++d)
         for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
@@ -707,11 +748,22 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
         r = HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's list (%zu voxels)", ctx->dl_count);
         goto done;
     }
-    for (k = 0, i = 0; k < gvox; ++k)
-        if (ctx->dl_all || (ctx->dl_bits[k >> 3] >> (k & 7) & 1u)) ctx->dl_idx[i++] = (uint32_t)k;
+    if (ctx->dl_all) {
+        for (k = 0; k < gvox; ++k) ctx->dl_idx[k] = (uint32_t)k;
+    } else {
+        /* brick by brick (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries,
+           one work item's, start side by side, so their rays read the same part of the volume */
+        int bx, by, bz, b = HD__DL_BRICK;
+        for (bz = 0, i = 0; bz < g[2]; bz += b)
+            for (by = 0; by < g[1]; by += b)
+                for (bx = 0; bx < g[0]; bx += b)
+                    for (z = bz; z < bz + b && z < g[2]; ++z)
+                        for (y = by; y < by + b && y < g[1]; ++y)
+                            for (x = bx, k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx; x < bx + b && x < g[0]; ++x, ++k)
+                                if (ctx->dl_bits[k >> 3] >> (k & 7) & 1u) ctx->dl_idx[i++] = (uint32_t)k;
+    }
 done:
     hd__free(ctx, entry_run);
-    hd__free(ctx, run);
     hd__free(ctx, cell);
     hd__free(ctx, ax);
     hd__free(ctx, ay);

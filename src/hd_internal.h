@@ -111,7 +111,7 @@ typedef struct hd__ctx {
     /* HD's direct light is tracked only at the illumination-grid voxels whose E is read (the
        projection's and the diffusion's footprint of the medium, hd__direct_mask); rebuilt with
        sigma_t, E elsewhere stays 0 */
-    uint32_t *dl_idx;        /* their grid indices, ascending (every voxel with dl_all) */
+    uint32_t *dl_idx;        /* their grid indices in bricks (hd__direct_mask; every voxel, ascending, with dl_all) */
     size_t dl_count;
     uint8_t *dl_bits;        /* the same voxels, one bit each (read by the convergence estimate) */
     int dl_all;              /* track every voxel (a test hook: the reference for the mask) */

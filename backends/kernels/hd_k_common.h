@@ -159,8 +159,9 @@ HD_FN float hd_box_entry(HD_KARGS hd_v3 o, hd_v3 d, HD_INOUT(float) t_exit)
 /* ---- transmittance tracking --------------------------------------------------------------- */
 /* One unbiased estimate of the transmittance along p + t d, t in [0, tmax] (p inside the box,
    d unit). Null-collision tracking with a local majorant per cell of the majorant grid, walked
-   cell by cell (a 3D DDA), so empty cells cost no collision at all; the exponential free path is
-   memoryless, so restarting it at each cell boundary is exact. mode: HD_TRACK_RATIO (ratio
+   cell by cell (a 3D DDA), so empty cells cost no collision at all. The free path is drawn as an
+   optical depth tau ~ Exp(1) and spent cell by cell (mu * length): a collision where it runs out,
+   the same distribution as a fresh exponential per cell, with one draw per collision. mode: HD_TRACK_RATIO (ratio
    tracking, Russian roulette below HD_RR_THRESHOLD) or HD_TRACK_DELTA (0 or 1).
    Random numbers: dims dim0, dim0 + 1, ... of key; returns the next unused dim in *next_dim.
    hd_track is the shared walker: with HD_TRACK_DELTA it also reports in *t_hit the distance of
@@ -174,6 +175,7 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
     float hit = tmax;
     hd_u32 dim = dim0;
     float t = 0.0f;
+    float tau = -1.0f; /* optical depth to the next collision, drawn when first needed (< 0: none) */
     int done = 0;
     /* The ray in majorant-cell coordinates (cells of mdims.w voxels): g(t) = g0 + t * gd. */
     hd_v3 u0 = hd_world_to_tex(HD_KPASS p);
@@ -202,11 +204,19 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
         if (mu > 0.0f) {
             float inv_mu = 1.0f / mu;
             for (;;) {
-                float xi = hd_rand(key, dim);
-                float sig, ratio;
-                dim += 1u;
-                t -= hd_log(1.0f - xi) * inv_mu;
-                if (t >= t_end) break;
+                float sig, ratio, tc;
+                if (tau < 0.0f) {
+                    tau = -hd_log(1.0f - hd_rand(key, dim));
+                    dim += 1u;
+                }
+                tc = t + tau * inv_mu;
+                if (tc >= t_end) {
+                    /* no collision in this cell: the optical depth left carries into the next */
+                    tau = hd_maxf(tau - (t_end - t) * mu, 0.0f);
+                    break;
+                }
+                t = tc;
+                tau = -1.0f;
                 steps += 1;
                 if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; done = 1; hit = t; break; }
                 sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
