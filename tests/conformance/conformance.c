@@ -597,62 +597,30 @@ static void case_method(hd_method method, hd_voxel_type type, const int *d, int 
 
 /* The per-frame API: light refined without frames (hd_refine) until it converges, then frames
    from the converged light (hd_render) before and after a camera move; both sides must agree on
-   the light, the image, and the iteration and frame counts. */
-static void case_render(hd_method method, hd_voxel_type type, const int *d, int lights, int n)
+   the light, the image, and the iteration and frame counts. With scale != 0 (params.render_scale)
+   the frames are marched at the reduced size and upsampled on the device (the projection's entry
+   point with HD_FLAG_UPSAMPLE, hd_k_upsample.h): a fixed divisor (3: 48x40 -> 16x14, not a
+   divisor of the height) or HD_RENDER_SCALE_AUTO (1/4, 1/2, then full frames); both sides must
+   also agree on the scale and the image size. */
+static void case_render_at(hd_method method, hd_voxel_type type, const int *d, int lights, int scale, int n)
 {
     scene s;
     guard g;
     pair p;
     char name[128];
     double l2 = 0.0, linf = 0.0;
-    int k;
-    scene_init(&s, type, d[0], d[1], d[2], lights, 0, 0);
-    s.params.method = method;
-    s.params.light_tolerance = 1000.0f; /* converged after the first two estimates */
-    guard_take(&g, &s);
-    snprintf(name, sizeof name, "%s refine x%d + render, camera move %s %dx%dx%d %dL", hd_api_cpu.method_name(method), n,
-             type_name(type), d[0], d[1], d[2], lights);
-    if (pair_create(&p, &s)) {
-        hd_stats a, b;
-        hd_camera cam = s.camera;
-        BOTH(&p, refine, (p.ref, n), (p.dut, n));
-        for (k = 0; k < 2; ++k) BOTH(&p, render, (p.ref), (p.dut));
-        cam.eye[0] = -1.5f; cam.eye[1] = 0.3f; cam.eye[2] = 1.4f;
-        BOTH(&p, set_camera, (p.ref, &cam), (p.dut, &cam));
-        for (k = 0; k < 3; ++k) BOTH(&p, render, (p.ref), (p.dut));
-        hd_api_cpu.get_stats(p.ref, &a);
-        hd_api_backend.get_stats(p.dut, &b);
-        if (p.ok && (a.iterations != (uint64_t)n || b.iterations != a.iterations || a.frames != 3 || b.frames != 3 ||
-                     !a.light_converged || !b.light_converged))
-            pair_fail(&p, "iteration / frame counts or convergence differ", HD_SUCCESS);
-        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
-    }
-    report(name, &p, &g, l2, linf, method == HD_METHOD_CD);
-    pair_destroy(&p);
-    guard_free(&g);
-    scene_free(&s);
-}
-
-/* params.render_scale: frames marched at the reduced size and upsampled on the device (the
-   projection's entry point with HD_FLAG_UPSAMPLE, hd_k_upsample.h), a fixed divisor (3: 48x40 ->
-   16x14, not a divisor of the height) or HD_RENDER_SCALE_AUTO (1/4, 1/2, then full frames), before
-   and after a camera move; both sides must agree on the full-size image, the frame counts and
-   the scale. */
-static void case_render_scale(hd_method method, hd_voxel_type type, const int *d, int lights, int scale, int n)
-{
-    scene s;
-    guard g;
-    pair p;
-    char name[128];
-    double l2 = 0.0, linf = 0.0;
-    int k;
+    int k, after = scale ? 2 : 3;
     scene_init(&s, type, d[0], d[1], d[2], lights, 0, 0);
     s.params.method = method;
     s.params.light_tolerance = 1000.0f; /* converged after the first two estimates */
     s.params.render_scale = scale;
     guard_take(&g, &s);
-    snprintf(name, sizeof name, "%s render_scale %d, camera move %s %dx%dx%d %dL", hd_api_cpu.method_name(method), scale,
-             type_name(type), d[0], d[1], d[2], lights);
+    if (scale)
+        snprintf(name, sizeof name, "%s render_scale %d, camera move %s %dx%dx%d %dL", hd_api_cpu.method_name(method),
+                 scale, type_name(type), d[0], d[1], d[2], lights);
+    else
+        snprintf(name, sizeof name, "%s refine x%d + render, camera move %s %dx%dx%d %dL", hd_api_cpu.method_name(method),
+                 n, type_name(type), d[0], d[1], d[2], lights);
     if (pair_create(&p, &s)) {
         hd_stats a, b;
         hd_camera cam = s.camera;
@@ -660,13 +628,16 @@ static void case_render_scale(hd_method method, hd_voxel_type type, const int *d
         for (k = 0; k < 2; ++k) BOTH(&p, render, (p.ref), (p.dut));
         cam.eye[0] = -1.5f; cam.eye[1] = 0.3f; cam.eye[2] = 1.4f;
         BOTH(&p, set_camera, (p.ref, &cam), (p.dut, &cam));
-        for (k = 0; k < 2; ++k) BOTH(&p, render, (p.ref), (p.dut));
+        for (k = 0; k < after; ++k) BOTH(&p, render, (p.ref), (p.dut));
         hd_api_cpu.get_stats(p.ref, &a);
         hd_api_backend.get_stats(p.dut, &b);
-        if (p.ok && (b.frames != a.frames || b.render_scale != a.render_scale || b.image_bytes != a.image_bytes ||
-                     a.render_scale != (scale > 0 ? scale : 2)))
+        if (p.ok && !scale && (a.iterations != (uint64_t)n || b.iterations != a.iterations || a.frames != 3 ||
+                               b.frames != 3 || !a.light_converged || !b.light_converged))
+            pair_fail(&p, "iteration / frame counts or convergence differ", HD_SUCCESS);
+        if (p.ok && scale && (b.frames != a.frames || b.render_scale != a.render_scale || b.image_bytes != a.image_bytes ||
+                              a.render_scale != (scale > 0 ? scale : 2)))
             pair_fail(&p, "frame counts, render scale or image size differ", HD_SUCCESS);
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, scale ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
     }
     report(name, &p, &g, l2, linf, method == HD_METHOD_CD);
     pair_destroy(&p);
@@ -823,12 +794,12 @@ static void case_shell(hd_voxel_type type, const int *d, int factor, int surface
 /* the per-frame API */
 static void render_cases(const int *odd, const int *other)
 {
-    case_render(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 6);
-    case_render(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 6);
-    case_render_scale(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 3, 4);
-    case_render_scale(HD_METHOD_CD, HD_VOXEL_F32, other, 3, 2, 4);
-    case_render_scale(HD_METHOD_HD, HD_VOXEL_U16, odd, 1, HD_RENDER_SCALE_AUTO, 6);
-    case_render_scale(HD_METHOD_HD, HD_VOXEL_U8, other, 3, 8, 6);
+    case_render_at(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 6);
+    case_render_at(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 0, 6);
+    case_render_at(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 3, 4);
+    case_render_at(HD_METHOD_CD, HD_VOXEL_F32, other, 3, 2, 4);
+    case_render_at(HD_METHOD_HD, HD_VOXEL_U16, odd, 1, HD_RENDER_SCALE_AUTO, 6);
+    case_render_at(HD_METHOD_HD, HD_VOXEL_U8, other, 3, 8, 6);
 }
 
 static int backend_available(void)
