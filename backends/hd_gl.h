@@ -956,9 +956,7 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
         be->lsum_ok = 1;
     }
     if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
-    t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
-    if (!t) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the projection's TF table (%d entries)", n);
-    hd__project_table(ctx, t, n);
+    if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
     be->ptab_key.valid = 0;
     be->ptab_n = 0;
     r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");

@@ -1603,19 +1603,13 @@ static hd_result hd__be_project(hd__ctx *ctx)
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline sum, proj;
     int n = hd__project_table_n(ctx);
-    size_t bytes = (size_t)n * 4 * sizeof(float);
-    float *t;
     hd_result r;
     HD__VK_LOST_CHECK(ctx);
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
                        n);
     if (!hd__project_table_key_same(ctx, &be->ptab_key)) {
-        if (!(t = (float *)hd__alloc(ctx, bytes)))
-            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the projection's TF table (%d entries)", n);
-        hd__project_table(ctx, t, n);
-        memcpy(be->ptab.map, t, bytes);
-        hd__free(ctx, t);
+        hd__project_table(ctx, (float *)be->ptab.map, n); /* written in place: the table is only written */
         be->ptab_key = hd__project_table_key(ctx);
         be->ptab_n = n;
     }

@@ -205,5 +205,17 @@ HD__MAYBE_UNUSED static void hd__project_table(const hd__ctx *ctx, float *dst, i
         dst[j * 4 + 3] = a;
     }
 }
+/* The table in a new host buffer (free with hd__free), for a backend to upload; NULL, logged,
+   without memory. */
+HD__MAYBE_UNUSED static float *hd__project_table_new(hd__ctx *ctx, int n)
+{
+    float *t = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
+    if (t)
+        hd__project_table(ctx, t, n);
+    else
+        (void)HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate the projection's TF table (%d entries)",
+                      hd__be_name(), n);
+    return t;
+}
 
 #endif
