@@ -549,15 +549,19 @@ static void image_brightness(const uint8_t *rgba, size_t npix, double *mean, dou
 /* The single view's frames over converged light: hd_render until the frame window is full or,
    unless --frame-window was given, until the jitter noise left in the image is below one 8-bit
    level (examples/hd_frames.h). */
-static void render_frames(hd_context ctx, log_state *ls, const hd_desc *desc, int window_given, hd_stats *stats)
+static void render_frames(hd_context ctx, log_state *ls, int window_given, hd_stats *stats)
 {
-    size_t npix = (size_t)desc->camera.width * desc->camera.height;
-    uint8_t *prev = window_given ? NULL : (uint8_t *)malloc(npix * 4);
-    uint8_t *cur = window_given ? NULL : (uint8_t *)malloc(npix * 4);
-    uint64_t window = (uint64_t)desc->params.frame_window + (desc->params.frame_window ? 0 : 8);
+    hd_desc desc; /* with the library's defaults filled in (frame_window) */
+    size_t npix;
+    uint8_t *prev, *cur;
+    uint64_t window;
     hd_result r;
-    if (!window_given && (!prev || !cur)) fail(1, "out of memory for a %dx%d image", desc->camera.width,
-                                               desc->camera.height);
+    if ((r = hd_query_desc(ctx, &desc)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_query_desc", NULL);
+    npix = (size_t)desc.camera.width * desc.camera.height;
+    prev = window_given ? NULL : (uint8_t *)malloc(npix * 4);
+    cur = window_given ? NULL : (uint8_t *)malloc(npix * 4);
+    window = (uint64_t)desc.params.frame_window;
+    if (!window_given && (!prev || !cur)) fail(1, "out of memory for a %dx%d image", desc.camera.width, desc.camera.height);
     do {
         uint8_t *t;
         ls->last[0] = 0;
@@ -1020,7 +1024,7 @@ int main(int argc, char **argv)
         if (!stats.light_converged && !g_quiet)
             fprintf(stderr, "hdrender: the light did not converge in %d iterations (estimated error %.4f)\n", done,
                     stats.light_error);
-        render_frames(ctx, &ls, &desc, window_given, &stats);
+        render_frames(ctx, &ls, window_given, &stats);
         done = iterations = (int)stats.iterations;
     }
     /* ---- fixed iterations, in chunks of about 0.2 s ---- */
