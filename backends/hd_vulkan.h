@@ -1488,21 +1488,29 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     return hd__vk_flush(ctx);
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
-    VkDeviceSize bytes = (VkDeviceSize)hd__image_floats(width, height) * sizeof(float);
+    size_t floats = hd__image_floats(width, height, reduced);
+    VkDeviceSize bytes = (VkDeviceSize)floats * sizeof(float);
+    hd__vk_buffer img;
     hd_result r;
     HD__VK_IDLE(ctx);
-    hd__vk_free_buffer(ctx, &be->img);
-    be->img_floats = 0;
+    if (be->rec) /* a recorded command names the buffer: hd_vulkan_record makes it before recording */
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the image buffer changed while recording (internal error)");
     if (bytes > be->limits.maxStorageBufferRange)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image needs %llu bytes, above maxStorageBufferRange = %u",
-                       width, height, (unsigned long long)bytes, be->limits.maxStorageBufferRange);
-    if ((r = hd__vk_buffer_create(ctx, &be->img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, "the image")) != HD_SUCCESS)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image%s needs %llu bytes, above maxStorageBufferRange = %u",
+                       width, height, reduced ? " with room for reduced frames" : "", (unsigned long long)bytes,
+                       be->limits.maxStorageBufferRange);
+    if ((r = hd__vk_buffer_create(ctx, &img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, reduced ? "the image with room for reduced frames" : "the image")) !=
+        HD_SUCCESS) {
+        hd__vk_free_buffer(ctx, &img);
         return r;
-    be->img_floats = hd__image_floats(width, height);
+    }
+    hd__vk_free_buffer(ctx, &be->img);
+    be->img = img;
+    be->img_floats = floats;
     return HD_SUCCESS;
 }
 
@@ -2064,6 +2072,8 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { r
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
 static hd_result hd__prepare(hd__ctx *ctx);
 static hd_result hd__iterate_method(hd__ctx *ctx);
+static hd_result hd__image_room(hd__ctx *ctx);
+static int hd__method_is_pt(hd_method m);
 
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
@@ -2085,6 +2095,8 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
     /* uploads, allocations and clears are submitted and waited for here; only iterations are
        recorded, each with its own parameter slot */
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    /* reduced frames need the image buffer's second region, which cannot be made mid-recording */
+    if (!hd__method_is_pt(ctx->params.method) && ctx->params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
     /* light, frame and a reduced frame's upsample pass (params.render_scale) */
     if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;

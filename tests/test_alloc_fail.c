@@ -1,9 +1,10 @@
 /* test_alloc_fail.c - allocation failure, on the CPU backend in build/hdtest and on OpenCL in
    build/afgpu/alloc-fail-opencl (mk/alloc_fail_gpu.mk). A counting allocator hook fails the
-   k-th allocation, for every k in a full cycle: create, iterate HD, switch to CD and iterate,
-   switch to PT_SS and iterate, read the image and illumination, destroy. Each run must return
-   HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never crash, and free every byte it took
-   (live allocations are counted here; under `make asan` LSan checks the rest). */
+   k-th allocation, for every k in a full cycle: create, iterate HD (at render scale 1, then 2),
+   switch to CD and iterate, switch to PT_SS and iterate, read the image and illumination,
+   destroy. Each run must return HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never
+   crash, and free every byte it took (live allocations are counted here; under `make asan` LSan
+   checks the rest). */
 #include "hybriddiff.h"
 #include "hd_test.h"
 #include <stdlib.h>
@@ -73,6 +74,10 @@ static hd_result af_cycle(af_state *st, af_log *log)
     if (r == HD_SUCCESS) r = hd_query_desc(ctx, &d);
     if (r == HD_SUCCESS) {
         p = d.params;
+        p.render_scale = 2; /* the image buffer's reduced frames' region comes with this frame */
+        r = hd_set_params(ctx, &p);
+        if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        p.render_scale = 1;
         p.method = HD_METHOD_CD;
         r = hd_set_params(ctx, &p);
         if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);

@@ -558,6 +558,86 @@ static void test_kept_instance(void)
            ok ? "PASS" : "FAIL", CYCLES + 2, rendered + 1, instances_made, instances_made == 1 ? "" : "s");
 }
 
+/* Records n iterations of h into a command buffer of the backend's own device, submits it and
+   waits, as an application using hd_vulkan_record would. */
+static hd_result record_run(hd_context h, int n)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__backend *be = ctx->be;
+    VkCommandPoolCreateInfo cpci;
+    VkCommandBufferAllocateInfo cbai;
+    VkCommandBufferBeginInfo bi;
+    VkSubmitInfo si;
+    VkCommandPool pool;
+    VkCommandBuffer cb;
+    hd_result r;
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    cpci.queueFamilyIndex = be->queue_family;
+    if (be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &pool) != VK_SUCCESS) return HD_ERROR_BACKEND;
+    memset(&cbai, 0, sizeof cbai);
+    cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    cbai.commandPool = pool;
+    cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbai.commandBufferCount = 1;
+    be->fn.vkAllocateCommandBuffers(be->device, &cbai, &cb);
+    memset(&bi, 0, sizeof bi);
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    be->fn.vkBeginCommandBuffer(cb, &bi);
+    r = hd_vulkan_record(h, cb, n);
+    be->fn.vkEndCommandBuffer(cb);
+    if (r == HD_SUCCESS) {
+        memset(&si, 0, sizeof si);
+        si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        si.commandBufferCount = 1;
+        si.pCommandBuffers = &cb;
+        if (be->fn.vkQueueSubmit(be->queue, 1, &si, VK_NULL_HANDLE) != VK_SUCCESS) r = HD_ERROR_BACKEND;
+        be->fn.vkDeviceWaitIdle(be->device);
+    }
+    be->fn.vkDestroyCommandPool(be->device, pool, NULL);
+    return r;
+}
+
+/* 7: the image buffer's reduced-frame region: absent at render scale 1, made with the first
+   reduced frame (submitted or recorded); when device memory is short for it, the frame fails
+   with HD_ERROR_OUT_OF_DEVICE_MEMORY and the context renders full frames on (validation on, no
+   message). */
+static void test_image_room(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats s;
+    hd_params p;
+    hd__ctx *ctx;
+    size_t full = (size_t)32 * 24 * 16, room = (size_t)16 * 12 * 16;
+    int ok = 1;
+    d.vulkan.enable_validation = 1;
+    messages = 0;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    ctx = hd__lookup(h, NULL);
+    ok &= hd_iterate(h, 1) == HD_SUCCESS && hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
+    p = d.params;
+    p.render_scale = 2;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS;
+    ctx->be->mem_limit = ctx->be->mem_used + 4096; /* no room for a second image buffer */
+    ok &= hd_iterate(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    ok &= record_run(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
+    p.render_scale = 1;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS;
+    ctx->be->mem_limit = 0;
+    p.render_scale = 2;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS && record_run(h, 2) == HD_SUCCESS;
+    ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full + room && s.render_scale == 2 && s.frames == 2;
+    ok &= hd_iterate(h, 1) == HD_SUCCESS;
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    ok &= messages == 0;
+    CHECK(ok);
+    printf("%s image buffer: %zu bytes at scale 1, %zu with the reduced region made by the first reduced frame; short device "
+           "memory fails it (hd_iterate and hd_vulkan_record) and full frames go on (%lu validation messages)\n",
+           ok ? "PASS" : "FAIL", full, full + room, messages);
+}
+
 int main(void)
 {
     if (test_messenger()) {
@@ -567,6 +647,7 @@ int main(void)
         test_half();
         test_multigrid();
         test_kept_instance();
+        test_image_room();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
