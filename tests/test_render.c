@@ -420,27 +420,6 @@ static void test_render_scale_auto(void)
     hd_destroy(ctx);
 }
 
-/* An allocator that fails the allocations it is told to (fail_next), counting the live ones. */
-typedef struct room_alloc {
-    int fail_next;
-    long live;
-} room_alloc;
-static void *room_alloc_fn(size_t size, void *user)
-{
-    room_alloc *a = (room_alloc *)user;
-    void *p;
-    if (a->fail_next) return NULL;
-    p = malloc(size ? size : 1);
-    if (p) ++a->live;
-    return p;
-}
-static void room_free_fn(void *ptr, void *user)
-{
-    room_alloc *a = (room_alloc *)user;
-    if (ptr) --a->live;
-    free(ptr);
-}
-
 /* The image buffer holds the reduced frames' region only once a scale > 1 is used: full frames
    cost the w x h image alone (hd_stats.image_bytes says what is held). A new camera size keeps
    the region while the parameters may still ask for reduced frames. When the region cannot be
@@ -451,19 +430,16 @@ static void test_render_scale_image_room(void)
     enum { H = W / 2, W2 = 2 * W };
     const size_t full = (size_t)W * W * 16, room = (size_t)H * H * 16;
     float *img = (float *)malloc(full), *before = (float *)malloc(full);
-    room_alloc al;
+    hd_test_alloc al;
     hd_test_log log;
     hd_desc d;
     hd_context ctx;
     hd_stats s;
     hd_params p;
     hd_camera cam;
-    memset(&al, 0, sizeof al);
     make_desc(&d, &log);
     d.params.light_tolerance = 1e6f; /* converged within 3 iterations: hd_render only projects */
-    d.allocator.alloc = room_alloc_fn;
-    d.allocator.free = room_free_fn;
-    d.allocator.user_data = &al;
+    hd_test_allocator(&d, &al);
     CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
     CHECK(hd_refine(ctx, 3) == HD_SUCCESS && hd_render(ctx) == HD_SUCCESS);
     CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full, "scale 1: %zu image bytes, want %zu", s.image_bytes, full);
@@ -473,9 +449,8 @@ static void test_render_scale_image_room(void)
     p = d.params;
     p.render_scale = 2;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
-    al.fail_next = 1;
-    CHECK(hd_render(ctx) == HD_ERROR_OUT_OF_MEMORY && log.errors == 1 && log.last_code == HD_ERROR_OUT_OF_MEMORY);
-    al.fail_next = 0;
+    al.fail_at = al.calls + 1;
+    CHECK(hd_render(ctx) == HD_ERROR_OUT_OF_MEMORY && log.errors == 1 && log.last_code == HD_ERROR_OUT_OF_MEMORY && al.failed == 1);
     CHECK_MSG(strstr(log.last, "reduced") != NULL, "log: %s", log.last);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full && s.frames == 0);
     p.render_scale = 1;
