@@ -1108,7 +1108,8 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     }
     dt = hd__now() - t0;
     ctx->seconds[2] += dt;
-    if (r == HD_SUCCESS) ctx->frame_cost = dt * (double)(s * s);
+    /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
+    if (r == HD_SUCCESS && !ctx->no_measure) ctx->frame_cost = dt * (double)(s * s);
     return r;
 }
 

@@ -638,6 +638,47 @@ static void test_image_room(void)
            ok ? "PASS" : "FAIL", full, full + room, messages);
 }
 
+/* 8: HD_RENDER_SCALE_AUTO while recording picks its first scale from the device time of the last
+   recorded frame, as it does from the measured time of a submitted one: full frames when the
+   budget holds many full frames (the prediction from a scale-4 frame, its time times 16, is
+   above a full frame's: fixed costs per frame), reduced ones when it holds an eighth of one.
+   Without a measurement the first scale would be 4; timed by recording, 1 for both budgets. */
+static void test_record_auto_scale(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats s0, s1;
+    hd_params p;
+    double t = 1e30;
+    int k, first_fit, first_small;
+    d.camera.width = d.camera.height = 512;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    for (k = 0; k < 3; ++k) { /* a full frame's time: the fastest of three projections */
+        CHECK(hd_get_stats(h, &s0) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && hd_get_stats(h, &s1) == HD_SUCCESS);
+        if (s1.seconds_projection - s0.seconds_projection < t) t = s1.seconds_projection - s0.seconds_projection;
+    }
+    hd_destroy(h);
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = (float)(100.0 * t);
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    CHECK(record_run(h, 1) == HD_SUCCESS); /* nothing measured yet: scale 4 */
+    CHECK(hd_get_stats(h, &s0) == HD_SUCCESS && s0.render_scale == 4);
+    CHECK(hd_set_camera(h, &d.camera) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(h, &s0) == HD_SUCCESS);
+    first_fit = s0.render_scale;
+    CHECK(hd_query_desc(h, &d) == HD_SUCCESS);
+    p = d.params;
+    p.render_budget = (float)(t / 8.0);
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS && hd_set_camera(h, &d.camera) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(h, &s1) == HD_SUCCESS);
+    first_small = s1.render_scale;
+    hd_destroy(h);
+    CHECK(first_fit == 1 && first_small >= 2);
+    printf("%s HD_RENDER_SCALE_AUTO while recording: a new view's first frame at scale %d with a budget of 100 full frames "
+           "(%.1f ms each), %d with an eighth of one\n",
+           first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
+}
+
 int main(void)
 {
     if (test_messenger()) {
@@ -648,6 +689,7 @@ int main(void)
         test_multigrid();
         test_kept_instance();
         test_image_room();
+        test_record_auto_scale();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
