@@ -83,7 +83,7 @@ $(B)/hdtest: $(TEST_OBJ)
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS)
 
 # build/hdrender and its per-backend siblings: mk/hdrender.mk
-$(B)/hdbench: bench/hdbench.c bench/hdbench_triad.h bench/hd_bench_median.h $(LIB_SRC) | $(B)
+$(B)/hdbench: bench/hdbench.c bench/hdbench_triad.h bench/hd_bench_median.h examples/hd_tf.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 # the CPU red-black schedule against the one before it, in one process (bench/hdbench_rb_schedule.c)

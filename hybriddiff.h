@@ -381,8 +381,11 @@ typedef struct hd_params {
                                converges to the full image). The first scale is the smallest power
                                of two whose predicted frame time (from the last frame measured) fits
                                render_budget, or 4 while render_budget is 0 or nothing is measured.
-                               A change of scale restarts the running mean. The path tracers ignore
-                               it. Else HD_ERROR_INVALID_PARAMETER */
+                               A change of scale restarts the running mean. The first frame at a
+                               scale > 1 adds a quarter of the image's memory for the reduced
+                               frames (hd_stats.image_bytes); where that fails, the call returns
+                               HD_ERROR_OUT_OF_MEMORY / _OUT_OF_DEVICE_MEMORY and full frames still
+                               work. The path tracers ignore it. Else HD_ERROR_INVALID_PARAMETER */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -533,6 +536,7 @@ HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
    from a pool of desc.vulkan.queue_family) instead of submitting them; hd_iterate submits and
    waits itself. Changed inputs are uploaded first (submitted and waited for). The caller
    submits the command buffer and waits for it before the next call on this context.
+   HD_RENDER_SCALE_AUTO times recorded frames on the device (timestamps read by the next call).
    HD_SOLVER_MULTIGRID (with HD or CD diffusing) cannot be recorded: each step reads its dot
    products back on the host; HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_vulkan_record(hd_context ctx, void *command_buffer, int n);

@@ -313,12 +313,15 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
+    float *img = (float *)hd__calloc(ctx, hd__image_floats(width, height, reduced), sizeof(float));
+    if (!img)
+        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image%s", width, height,
+                       reduced ? " with room for reduced frames" : "");
     hd__free(ctx, be->img);
-    be->img = be->k.img = (float *)hd__calloc(ctx, hd__image_floats(width, height), sizeof(float));
-    if (!be->img) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image", width, height);
+    be->img = be->k.img = img;
     return HD_SUCCESS;
 }
 

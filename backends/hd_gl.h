@@ -861,23 +861,28 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 }
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)); }
 
-static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
-    size_t bytes = hd__image_floats(width, height) * sizeof(float);
+    size_t floats = hd__image_floats(width, height, reduced), bytes = floats * sizeof(float);
+    GLuint img = 0;
     hd_result r;
-    hd__gl_free_buffer(be, &be->img);
-    be->img_floats = 0;
     if (bytes > (size_t)be->max_ssbo_block)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
-                       width, height, bytes, (int)be->max_ssbo_block);
-    if ((r = hd__gl_buffer_data(ctx, &be->img, bytes, NULL, GL_DYNAMIC_COPY, "the image")) != HD_SUCCESS) return r;
-    be->img_floats = hd__image_floats(width, height);
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image%s needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
+                       width, height, reduced ? " with room for reduced frames" : "", bytes, (int)be->max_ssbo_block);
+    if ((r = hd__gl_buffer_data(ctx, &img, bytes, NULL, GL_DYNAMIC_COPY, reduced ? "the image with room for reduced frames" : "the image")) !=
+        HD_SUCCESS) {
+        hd__gl_free_buffer(be, &img);
+        return r;
+    }
+    hd__gl_free_buffer(be, &be->img);
+    be->img = img;
+    be->img_floats = floats;
     return HD_SUCCESS;
 }
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
-    HD__GL_STAGE(ctx, hd__gl_alloc_image(ctx, width, height));
+    HD__GL_STAGE(ctx, hd__gl_alloc_image(ctx, width, height, reduced));
 }
 
 static hd_result hd__gl_clear(hd__ctx *ctx, unsigned what)

@@ -459,15 +459,21 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
+    size_t floats = hd__image_floats(width, height, reduced);
+    cl_mem img;
     hd_result r;
     HD__CL_LOST_CHECK(ctx);
+    if ((r = hd__cl_buffer(ctx, &img, floats * sizeof(float), NULL, reduced ? "the image with room for reduced frames" : "the image")) !=
+        HD_SUCCESS) {
+        hd__cl_release(&img);
+        return r;
+    }
     hd__cl_release(&be->img);
-    be->img_floats = 0;
-    if ((r = hd__cl_buffer(ctx, &be->img, hd__image_floats(width, height) * sizeof(float), NULL, "the image")) != HD_SUCCESS) return r;
-    be->img_floats = hd__image_floats(width, height);
+    be->img = img;
+    be->img_floats = floats;
     return HD_SUCCESS;
 }
 

@@ -88,7 +88,8 @@ VKAPI_ATTR PFN_vkVoidFunction VKAPI_CALL vkGetInstanceProcAddr(VkInstance instan
     X(vkAllocateDescriptorSets) X(vkUpdateDescriptorSets) X(vkCmdBindPipeline) \
     X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch) X(vkCmdPipelineBarrier) \
     X(vkCmdCopyBuffer) X(vkCmdCopyBufferToImage) X(vkCmdCopyImageToBuffer) X(vkCmdFillBuffer) \
-    X(vkCmdClearColorImage) X(vkCmdCopyImage)
+    X(vkCmdClearColorImage) X(vkCmdCopyImage) X(vkCreateQueryPool) X(vkDestroyQueryPool) \
+    X(vkCmdResetQueryPool) X(vkCmdWriteTimestamp) X(vkGetQueryPoolResults)
 
 typedef struct hd__vk_fns {
 #define HD__VK_FN(name) PFN_##name name;
@@ -172,6 +173,13 @@ struct hd__backend {
     VkFence fence;
     int open;                     /* cmd is recording */
     VkCommandBuffer rec;          /* the caller's command buffer (hd_vulkan_record), or NULL */
+    /* the device time of the last recorded frame (HD_RENDER_SCALE_AUTO's frame cost): timestamps
+       0 and 1 of ts_pool around it, read by the next hd_vulkan_record */
+    VkQueryPool ts_pool;
+    int ts_state;                 /* 0: not looked at yet; 1: pool made; -1: the queue has no timestamps */
+    uint64_t ts_mask;             /* the queue family's timestampValidBits as a mask */
+    int ts_pending, ts_scale;     /* a recorded frame's timestamps to read, and its render scale */
+    double ts_cost_after;         /* ctx->frame_cost when it was recorded (a frame run since wins) */
     /* pipelines and bindings */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -1289,6 +1297,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
         if (be->set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, be->set_layout, NULL);
         if (be->fence) be->fn.vkDestroyFence(be->device, be->fence, NULL);
+        if (be->ts_pool) be->fn.vkDestroyQueryPool(be->device, be->ts_pool, NULL);
         if (be->pool) be->fn.vkDestroyCommandPool(be->device, be->pool, NULL);
         if (be->own_device) be->fn.vkDestroyDevice(be->device, NULL);
     }
@@ -1488,21 +1497,29 @@ static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
     return hd__vk_flush(ctx);
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
-    VkDeviceSize bytes = (VkDeviceSize)hd__image_floats(width, height) * sizeof(float);
+    size_t floats = hd__image_floats(width, height, reduced);
+    VkDeviceSize bytes = (VkDeviceSize)floats * sizeof(float);
+    hd__vk_buffer img;
     hd_result r;
     HD__VK_IDLE(ctx);
-    hd__vk_free_buffer(ctx, &be->img);
-    be->img_floats = 0;
+    if (be->rec) /* a recorded command names the buffer: hd_vulkan_record makes it before recording */
+        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the image buffer changed while recording (internal error)");
     if (bytes > be->limits.maxStorageBufferRange)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image needs %llu bytes, above maxStorageBufferRange = %u",
-                       width, height, (unsigned long long)bytes, be->limits.maxStorageBufferRange);
-    if ((r = hd__vk_buffer_create(ctx, &be->img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, "the image")) != HD_SUCCESS)
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image%s needs %llu bytes, above maxStorageBufferRange = %u",
+                       width, height, reduced ? " with room for reduced frames" : "", (unsigned long long)bytes,
+                       be->limits.maxStorageBufferRange);
+    if ((r = hd__vk_buffer_create(ctx, &img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, reduced ? "the image with room for reduced frames" : "the image")) !=
+        HD_SUCCESS) {
+        hd__vk_free_buffer(ctx, &img);
         return r;
-    be->img_floats = hd__image_floats(width, height);
+    }
+    hd__vk_free_buffer(ctx, &be->img);
+    be->img = img;
+    be->img_floats = floats;
     return HD_SUCCESS;
 }
 
@@ -2064,6 +2081,75 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { r
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
 static hd_result hd__prepare(hd__ctx *ctx);
 static hd_result hd__iterate_method(hd__ctx *ctx);
+static hd_result hd__light_iteration(hd__ctx *ctx);
+static hd_result hd__project_frame(hd__ctx *ctx);
+static hd_result hd__image_room(hd__ctx *ctx);
+static int hd__method_is_pt(hd_method m);
+
+/* The timestamp pool for recorded frames, made on the first recording; none (ts_state -1) where
+   the queue family has no timestamps, and then HD_RENDER_SCALE_AUTO has no frame time to go on
+   while recording (its first scale stays 4, or what an unrecorded frame measured). */
+static hd_result hd__vk_timestamps(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    VkQueueFamilyProperties q[32];
+    VkQueryPoolCreateInfo qpci;
+    uint32_t n = 32, bits;
+    if (be->ts_state != 0) return HD_SUCCESS;
+    be->fn.vkGetPhysicalDeviceQueueFamilyProperties(be->phys, &n, q);
+    bits = be->queue_family < n && be->queue_family < 32 ? q[be->queue_family].timestampValidBits : 0;
+    if (bits == 0) {
+        be->ts_state = -1;
+        HD__INFO(&ctx->log, "vulkan: queue family %u has no timestamps: recorded frames are not timed for HD_RENDER_SCALE_AUTO",
+                 be->queue_family);
+        return HD_SUCCESS;
+    }
+    be->ts_mask = bits >= 64 ? ~(uint64_t)0 : (((uint64_t)1 << bits) - 1);
+    memset(&qpci, 0, sizeof qpci);
+    qpci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    qpci.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qpci.queryCount = 2;
+    HD__VK_TRY(ctx, be->fn.vkCreateQueryPool(be->device, &qpci, NULL, &be->ts_pool), "vkCreateQueryPool");
+    be->ts_state = 1;
+    return HD_SUCCESS;
+}
+
+/* The last recorded frame's device time, scaled to full resolution, becomes the frame cost
+   HD_RENDER_SCALE_AUTO predicts from (the caller has run the command buffer by now; a frame
+   measured since by hd_iterate or hd_render is newer and is kept). */
+static void hd__vk_read_frame_time(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    uint64_t t[2];
+    VkResult e;
+    if (!be->ts_pending) return;
+    be->ts_pending = 0;
+    e = be->fn.vkGetQueryPoolResults(be->device, be->ts_pool, 0, 2, sizeof t, t, sizeof t[0], VK_QUERY_RESULT_64_BIT);
+    if (e == VK_SUCCESS && ctx->frame_cost == be->ts_cost_after) {
+        double dt = (double)((t[1] - t[0]) & be->ts_mask) * (double)be->limits.timestampPeriod * 1e-9;
+        if (dt > 0.0) ctx->frame_cost = dt * (double)be->ts_scale * (double)be->ts_scale;
+    }
+}
+
+/* One recorded HD or CD iteration: the light, then the frame between two timestamps. */
+static hd_result hd__vk_record_iteration(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    if ((r = hd__light_iteration(ctx)) != HD_SUCCESS) return r;
+    if (be->ts_pool) {
+        be->fn.vkCmdResetQueryPool(be->rec, be->ts_pool, 0, 2);
+        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 0);
+    }
+    if ((r = hd__project_frame(ctx)) != HD_SUCCESS) return r;
+    if (be->ts_pool) {
+        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 1);
+        be->ts_pending = 1;
+        be->ts_scale = ctx->frame_scale;
+        be->ts_cost_after = ctx->frame_cost;
+    }
+    return HD_SUCCESS;
+}
 
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
@@ -2084,8 +2170,12 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
                        "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
     /* uploads, allocations and clears are submitted and waited for here; only iterations are
        recorded, each with its own parameter slot */
+    hd__vk_read_frame_time(ctx);
     if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
+    /* reduced frames need the image buffer's second region, which cannot be made mid-recording */
+    if (!hd__method_is_pt(ctx->params.method) && ctx->params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_timestamps(ctx)) != HD_SUCCESS) return r;
     /* light, frame and a reduced frame's upsample pass (params.render_scale) */
     if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
     if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
@@ -2093,9 +2183,12 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
     be->have_slot = 0;
     be->rec = (VkCommandBuffer)command_buffer;
     ctx->no_measure = 1;
-    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__iterate_method(ctx);
+    for (i = 0; i < n && r == HD_SUCCESS; ++i)
+        r = ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD ? hd__vk_record_iteration(ctx)
+                                                                                     : hd__iterate_method(ctx);
     ctx->no_measure = 0;
     if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
+    else be->ts_pending = 0;                           /* a failed recording is not submitted */
     be->rec = VK_NULL_HANDLE;
     return r;
 }

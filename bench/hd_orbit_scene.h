@@ -1,8 +1,8 @@
 /* hd_orbit_scene.h - the scene of the orbit benchmarks (bench/hdbench_orbit.c, bench/peer/):
    the head CT with hdrender's defaults (ct-skin TF, the three-quarter camera in front of the face,
    one key light placed from that camera, exposure 8), a camera orbit around the vertical axis
-   through the target, the tone map and PSNR of hdeval (t(L) = srgb(clamp(exposure L, 0, 1)),
-   peak 1), and a wall clock. Bench helpers, every function static, hdo_. */
+   through the target, and a wall clock; the tone map and PSNR are hdeval's (examples/hd_tonemap.h).
+   Bench helpers, every function static, hdo_. */
 #ifndef HD_ORBIT_SCENE_H
 #define HD_ORBIT_SCENE_H
 
@@ -13,6 +13,7 @@
 #include <time.h>
 #include "hybriddiff.h"
 #include "hd_tf.h"
+#include "hd_tonemap.h"
 
 #if defined(__GNUC__) || defined(__clang__)
 #define HDO_FN static __attribute__((unused))
@@ -94,10 +95,7 @@ HDO_FN int hdo_scene_load(hdo_scene *s, const char *path, int size, const hd_log
         return 0;
     }
     hdx_tf_preset("ct-skin", &s->tf);
-    s->desc.volume = s->vol.desc;
-    s->desc.volume.value_range[0] = s->tf.domain[0];
-    s->desc.volume.value_range[1] = s->tf.domain[1];
-    s->desc.transfer_function = hdx_tf_desc(&s->tf);
+    hdx_tf_use(&s->desc, &s->vol.desc, &s->tf);
     s->desc.camera = hdo_orbit_camera(0.0, size);
     s->light = hdo_key_light(&s->desc.camera);
     s->desc.lights = &s->light;
@@ -151,36 +149,6 @@ HDO_FN int hdo_converge(hd_context ctx, int max_iters, const char *tag, double *
             "more iterations, light_error %.4g\n", tag, (double)d.params.light_tolerance,
             st.light_converged, extra + 1, st.light_error);
     return st.light_converged ? 0 : -1;
-}
-
-HDO_FN double hdo_srgb(double x)
-{
-    x = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
-    return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
-}
-
-/* Tone-maps a linear RGBA float image in place (rgb; alpha kept). */
-HDO_FN void hdo_tonemap(float *img, size_t npix, float exposure)
-{
-    size_t i;
-    int c;
-    for (i = 0; i < npix; ++i)
-        for (c = 0; c < 3; ++c) img[4 * i + c] = (float)hdo_srgb((double)exposure * img[4 * i + c]);
-}
-
-/* PSNR (dB, peak 1) over the RGB channels of two tone-mapped RGBA float images. */
-HDO_FN double hdo_psnr(const float *a, const float *b, size_t npix)
-{
-    double s = 0.0;
-    size_t i;
-    int c;
-    for (i = 0; i < npix; ++i)
-        for (c = 0; c < 3; ++c) {
-            double d = (double)a[4 * i + c] - (double)b[4 * i + c];
-            s += d * d;
-        }
-    s /= 3.0 * (double)npix;
-    return s > 0.0 ? 10.0 * log10(1.0 / s) : 200.0;
 }
 
 #endif

@@ -12,6 +12,7 @@
 #define HYBRIDDIFF_BACKEND_CPU
 #endif
 #include "hybriddiff.h"
+#include "examples/hd_tf.h"
 
 #include "hdbench_triad.h"
 #include "hd_bench_median.h"
@@ -88,11 +89,7 @@ static const float bench_tf[] = {
 static void fill_desc(hd_desc *d, const hd_volume_file *vf, int size, int lights)
 {
     memset(d, 0, sizeof *d);
-    d->volume = vf->desc;
-    d->volume.value_range[0] = -1024.0f;
-    d->volume.value_range[1] = 3071.0f;
-    d->transfer_function.rgba = bench_tf;
-    d->transfer_function.count = (int)(sizeof bench_tf / sizeof bench_tf[0] / 4);
+    hdx_desc_volume_tf(d, &vf->desc, -1024.0f, 3071.0f, bench_tf, (int)(sizeof bench_tf / sizeof bench_tf[0] / 4));
     d->lights = bench_lights;
     d->light_count = lights;
     d->camera.eye[1] = 2.3f; d->camera.eye[2] = 0.3f; d->camera.up[2] = 1.0f;

@@ -38,11 +38,7 @@ int main(int argc, char **argv)
             light.type = HD_LIGHT_DIRECTIONAL;
             light.direction[1] = -1.0f;
             memset(&d, 0, sizeof d);
-            d.volume = vf.desc;
-            d.volume.value_range[0] = tf.domain[0];
-            d.volume.value_range[1] = tf.domain[1];
-            d.transfer_function.rgba = tf.rgba;
-            d.transfer_function.count = tf.count;
+            hdx_tf_use(&d, &vf.desc, &tf);
             d.lights = &light;
             d.light_count = 1;
             d.camera.eye[1] = 2.3f; d.camera.up[2] = 1.0f; d.camera.width = d.camera.height = 64;

@@ -10,6 +10,7 @@
    Usage: hdbench_mg_vulkan [data/head.nrrd] [--rounds N] [--steps N] [--downsample N]
    Figures, not a test: nothing here passes or fails. Run it under flock /tmp/hd-bench.lock. */
 #include "tests/conformance/hd_api.h"
+#include "examples/hd_tf.h"
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -67,11 +68,7 @@ static int run_case(const hd_volume_file *vf, int boundary, int downsample, int 
     double t[2][MAX_ROUNDS], sum[2] = {0.0, 0.0};
     int k, b;
     memset(&d, 0, sizeof d);
-    d.volume = vf->desc;
-    d.volume.value_range[0] = -1024.0f;
-    d.volume.value_range[1] = 3071.0f;
-    d.transfer_function.rgba = mg_tf;
-    d.transfer_function.count = (int)(sizeof mg_tf / sizeof mg_tf[0] / 4);
+    hdx_desc_volume_tf(&d, &vf->desc, -1024.0f, 3071.0f, mg_tf, (int)(sizeof mg_tf / sizeof mg_tf[0] / 4));
     d.camera.width = d.camera.height = 16;
     d.params.solver = HD_SOLVER_MULTIGRID;
     d.params.diffusion_boundary = (hd_boundary)boundary;

@@ -19,6 +19,7 @@
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"
+#include "examples/hd_tf.h"
 #include "hd_residual_f64.h"
 #include <time.h>
 
@@ -223,11 +224,7 @@ int main(int argc, char **argv)
         hd_stats s_rb, s_mg;
         mg_run a, b;
         memset(&d, 0, sizeof d);
-        d.volume = vf.desc;
-        d.volume.value_range[0] = -1024.0f;
-        d.volume.value_range[1] = 3071.0f;
-        d.transfer_function.rgba = mg_tf;
-        d.transfer_function.count = (int)(sizeof mg_tf / sizeof mg_tf[0] / 4);
+        hdx_desc_volume_tf(&d, &vf.desc, -1024.0f, 3071.0f, mg_tf, (int)(sizeof mg_tf / sizeof mg_tf[0] / 4));
         d.camera.width = d.camera.height = 16;
         d.params.diffusion_boundary = (hd_boundary)boundary;
         d.params.illumination_downsample = downsample;

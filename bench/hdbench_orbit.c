@@ -249,7 +249,7 @@ static void set_view(hd_context c, int k, int size)
 static void read_tonemapped(hd_context c, float *img, size_t npix)
 {
     check(hd_read_image_f32(c, img, npix * 4), "hd_read_image_f32");
-    hdo_tonemap(img, npix, HDO_EXPOSURE);
+    hdx_tonemap_image(img, npix, HDO_EXPOSURE);
 }
 
 /* The PT_MS reference of view k, tone-mapped, from the cache or rendered (and cached). */
@@ -306,7 +306,7 @@ static void budget_run(hd_context c, int hd_mode, const float *ref, float *img, 
         while (j < O.nb && O.budgets[j] < t) { psnr[j] = last; count[j] = n; ++j; }
         ++n;
         read_tonemapped(c, img, npix);
-        last = hdo_psnr(img, ref, npix);
+        last = hdx_psnr_rgb(img, ref, npix);
         check(hd_get_stats(c, &st), "hd_get_stats");
         if (hd_mode && st.light_converged && st.frames >= (uint64_t)d.params.frame_window &&
             (d.params.render_scale != HD_RENDER_SCALE_AUTO || st.render_scale == 1))
@@ -358,7 +358,7 @@ static int single_view(const hdo_scene *s)
         read_tonemapped(c, img, npix);
         if (nfr < MAX_FRAMES) {
             fr_t[nfr] = t;
-            fr_psnr[nfr] = hdo_psnr(img, ref, npix);
+            fr_psnr[nfr] = hdx_psnr_rgb(img, ref, npix);
             fr_pt[nfr] = -1.0;
             fr_paths[nfr++] = 0;
         }
@@ -388,7 +388,7 @@ static int single_view(const hdo_scene *s)
         t += bench_clock() - ts;
         ++paths;
         read_tonemapped(c, img, npix);
-        pt_psnr = hdo_psnr(img, ref, npix);
+        pt_psnr = hdx_psnr_rgb(img, ref, npix);
         for (k = 0; k < nfr; ++k)
             if (fr_pt[k] < 0.0 && pt_psnr >= fr_psnr[k]) { fr_pt[k] = t; fr_paths[k] = paths; }
         if (pt_psnr >= hd_psnr) { t_pt = t; break; }
@@ -527,9 +527,7 @@ int main(int argc, char **argv)
         d.params.method = HD_METHOD_PT_MS;
         d.lights = &s.light;
         d.light_count = 1;
-        d.transfer_function = hdx_tf_desc(&s.tf);
-        d.volume = s.desc.volume;
-        d.volume.data = s.vol.data;
+        hdx_tf_use(&d, &s.vol.desc, &s.tf);
         check(hd_create(&d, &pt), "hd_create (PT_MS)");
         for (k = 0; k < O.views; ++k) {
             reference(&s, k, ref);

@@ -387,4 +387,22 @@ HDX_TF_FN hd_transfer_function hdx_tf_desc(const hdx_tf *tf)
     return d;
 }
 
+/* Puts volume vol and a transfer function of count RGBA entries over the data values lo..hi
+   into d: the volume's value_range is [lo, hi], so the library maps lo to the first entry and
+   hi to the last. d points at vol's voxels and at rgba until hd_create copies them. */
+HDX_TF_FN void hdx_desc_volume_tf(hd_desc *d, const hd_volume_desc *vol, float lo, float hi, const float *rgba, int count)
+{
+    d->volume = *vol;
+    d->volume.value_range[0] = lo;
+    d->volume.value_range[1] = hi;
+    d->transfer_function.rgba = rgba;
+    d->transfer_function.count = count;
+}
+
+/* The same with tf over its domain. */
+HDX_TF_FN void hdx_tf_use(hd_desc *d, const hd_volume_desc *vol, const hdx_tf *tf)
+{
+    hdx_desc_volume_tf(d, vol, tf->domain[0], tf->domain[1], tf->rgba, tf->count);
+}
+
 #endif /* HD_TF_H */

@@ -32,6 +32,7 @@
 #define HYBRIDDIFF_IMPLEMENTATION
 #include "hybriddiff.h"
 #include "hd_tf.h"
+#include "hd_tonemap.h"
 #include "hd_eval_scene.h"
 
 #include <errno.h>
@@ -183,10 +184,7 @@ static hd_context make_ctx(int m, int lights, int size, uint32_t seed)
         L[i].color[0] = L[i].color[1] = L[i].color[2] = 1.0f;
         L[i].intensity = S.light_intensity[i];
     }
-    d.volume = g_vol.desc;
-    d.volume.value_range[0] = g_tf.domain[0];
-    d.volume.value_range[1] = g_tf.domain[1];
-    d.transfer_function = hdx_tf_desc(&g_tf);
+    hdx_tf_use(&d, &g_vol.desc, &g_tf);
     d.lights = L;
     d.light_count = lights;
     memcpy(d.camera.eye, S.eye, sizeof S.eye);
@@ -230,13 +228,6 @@ static void read_image(hd_context ctx, float *img, int size)
 }
 
 /* ---- tone map and metrics ------------------------------------------------------------------------ */
-static float tonemap(float v)
-{
-    v *= S.exposure;
-    if (!(v > 0.0f)) return 0.0f;
-    if (v >= 1.0f) return 1.0f;
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
-}
 
 typedef struct ref_img {
     int method, lights, paths;
@@ -260,7 +251,7 @@ static err2 compare(const float *img, const ref_img *ref, size_t npix)
     for (i = 0; i < npix; ++i) {
         double d2 = 0.0;
         for (c = 0; c < 3; ++c) {
-            double d = (double)tonemap(img[4 * i + c]) - (double)ref->tm[3 * i + c];
+            double d = (double)hdx_tonemap(img[4 * i + c], S.exposure) - (double)ref->tm[3 * i + c];
             d2 += d * d;
         }
         s += d2;
@@ -271,7 +262,6 @@ static err2 compare(const float *img, const ref_img *ref, size_t npix)
     return e;
 }
 
-static double psnr(double mse) { return mse > 0.0 ? 10.0 * log10(1.0 / mse) : 200.0; }
 
 /* ---- reference images, cached -------------------------------------------------------------------- */
 static uint64_t fnv(uint64_t h, const void *p, size_t n)
@@ -318,7 +308,7 @@ static void ref_finish(ref_img *ref, size_t npix)
     ref->lit = (unsigned char *)xmalloc(npix);
     ref->nlit = 0;
     for (i = 0; i < npix; ++i) {
-        for (c = 0; c < 3; ++c) ref->tm[3 * i + c] = tonemap(ref->lin[4 * i + c]);
+        for (c = 0; c < 3; ++c) ref->tm[3 * i + c] = hdx_tonemap(ref->lin[4 * i + c], S.exposure);
         ref->lit[i] = ref->lin[4 * i + 3] > S.lit_opacity;
         ref->nlit += ref->lit[i];
     }
@@ -422,7 +412,7 @@ static void ref_get(ref_img *ref, int m, int lights, const char *cache_dir)
     }
     say("reference %s %d light%s: %d paths/pixel, %s %.1f s; its own noise: PSNR %.1f dB (lit %.1f dB); %s",
         k_name[m], lights, lights == 1 ? "" : "s", ref->paths, ref->cached ? "cached, rendered in" : "rendered in",
-        ref->seconds, psnr(ref->noise_mse), psnr(ref->noise_mse_lit), path);
+        ref->seconds, hdx_psnr(ref->noise_mse), hdx_psnr(ref->noise_mse_lit), path);
 }
 
 /* ---- Table 1 ---------------------------------------------------------------------------------------- */
@@ -602,7 +592,7 @@ static void run_curve(curve *c, int m, int lights, ref_img *ref_ss, ref_img *ref
     hd_destroy(ctx);
     free(img);
     say("curve %-5s %d light%s: %d iterations in %.1f s (wall %.1f s), PSNR %.2f dB vs PT_SS, %.2f dB vs PT_MS", k_name[m],
-        lights, lights == 1 ? " " : "s", total, sec, wall, psnr(c->p[c->n - 1].e[0].mse), psnr(c->p[c->n - 1].e[1].mse));
+        lights, lights == 1 ? " " : "s", total, sec, wall, hdx_psnr(c->p[c->n - 1].e[0].mse), hdx_psnr(c->p[c->n - 1].e[1].mse));
 }
 
 /* First time (and iteration) at which PSNR against PT_MS reaches level; -1 if never. */
@@ -610,7 +600,7 @@ static double time_to(const curve *c, double level, int *it)
 {
     int i;
     for (i = 0; i < c->n; ++i)
-        if (psnr(c->p[i].e[1].mse) >= level) {
+        if (hdx_psnr(c->p[i].e[1].mse) >= level) {
             if (it) *it = c->p[i].it;
             return c->p[i].sec;
         }
@@ -621,7 +611,7 @@ static double psnr_at(const curve *c, int it, int ref, int lit)
 {
     int i;
     for (i = 0; i < c->n; ++i)
-        if (c->p[i].it == it) return psnr(lit ? c->p[i].e[ref].mse_lit : c->p[i].e[ref].mse);
+        if (c->p[i].it == it) return hdx_psnr(lit ? c->p[i].e[ref].mse_lit : c->p[i].e[ref].mse);
     return -1.0;
 }
 
@@ -633,7 +623,7 @@ static void blit(uint8_t *dst, int dst_w, int x0, int y0, const float *img, int 
         for (x = 0; x < size; ++x)
             for (c = 0; c < 3; ++c)
                 dst[3 * ((size_t)(y0 + y) * dst_w + x0 + x) + c] =
-                    (uint8_t)(tonemap(img[4 * ((size_t)y * size + x) + c]) * 255.0f + 0.5f);
+                    (uint8_t)(hdx_tonemap(img[4 * ((size_t)y * size + x) + c], S.exposure) * 255.0f + 0.5f);
 }
 
 static void write_grid(const char *dir, const char *name, const float *const *tiles, int cols, int rows)
@@ -660,9 +650,9 @@ static void write_dat(const char *work, const curve *c, int m, int lights)
     f = open_w(work, name, NULL);
     fprintf(f, "# it sec psnr_ss rmse_ss psnr_ms rmse_ms psnr_lit_ss psnr_lit_ms\n");
     for (i = 0; i < c->n; ++i)
-        fprintf(f, "%d %.5f %.4f %.6f %.4f %.6f %.4f %.4f\n", c->p[i].it, c->p[i].sec, psnr(c->p[i].e[0].mse),
-                sqrt(c->p[i].e[0].mse), psnr(c->p[i].e[1].mse), sqrt(c->p[i].e[1].mse),
-                psnr(c->p[i].e[0].mse_lit), psnr(c->p[i].e[1].mse_lit));
+        fprintf(f, "%d %.5f %.4f %.6f %.4f %.6f %.4f %.4f\n", c->p[i].it, c->p[i].sec, hdx_psnr(c->p[i].e[0].mse),
+                sqrt(c->p[i].e[0].mse), hdx_psnr(c->p[i].e[1].mse), sqrt(c->p[i].e[1].mse),
+                hdx_psnr(c->p[i].e[0].mse_lit), hdx_psnr(c->p[i].e[1].mse_lit));
     fclose(f);
 }
 
@@ -781,7 +771,7 @@ static void run_downsample_study(const ref_img *ref, const char *out)
             if (budget > 0 && eq == 0 && cpu_now() - t0 >= budget) {
                 read_image(ctx, img, S.size);
                 e = compare(img, ref, npix);
-                eq = psnr(e.mse); eq_lit = psnr(e.mse_lit);
+                eq = hdx_psnr(e.mse); eq_lit = hdx_psnr(e.mse_lit);
             }
             if (done == n) {
                 t = cpu_now() - t0;
@@ -795,10 +785,10 @@ static void run_downsample_study(const ref_img *ref, const char *out)
         if (k == 0) rate1 = rate;
         fprintf(md, "| %d | %dx%dx%d | %.2f | %.3f | %.2fx | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", factors[k],
                 st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2],
-                (double)st.method_bytes / nvox, rate, rate / rate1, psnr(e.mse), psnr(e.mse_lit), eq, eq_lit);
+                (double)st.method_bytes / nvox, rate, rate / rate1, hdx_psnr(e.mse), hdx_psnr(e.mse_lit), eq, eq_lit);
         check_line("downsample %d: grid %dx%dx%d, %.2f B/voxel, %.3f it/s (%.2fx), PSNR vs PT_MS %.2f dB (lit %.2f) after %d it",
                    factors[k], st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2],
-                   (double)st.method_bytes / nvox, rate, rate / rate1, psnr(e.mse), psnr(e.mse_lit), n);
+                   (double)st.method_bytes / nvox, rate, rate / rate1, hdx_psnr(e.mse), hdx_psnr(e.mse_lit), n);
         hd_destroy(ctx);
     }
     g_downsample = saved;
@@ -901,13 +891,13 @@ static void run_rgb_study(const ref_img *ref, const char *out)
         fprintf(md, "| %s | %s | %.1f | %.3f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", g_rgb ? "RGB" : "grey",
                 k >= 2 ? "surface" : "box",
                 (double)st.method_bytes / ((double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2]),
-                mean, psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
+                mean, hdx_psnr(e1.mse), hdx_psnr(e1.mse_lit), hdx_psnr(e4.mse), hdx_psnr(e4.mse_lit));
         check_line("rgb_scattering %d, boundary %s: mean radiance %.3f x PT_MS, PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, "
                    "%.2f dB (lit %.2f) after %d it; R G B means %.3f %.3f %.3f x PT_MS, G/R %.3f and B/R %.3f x PT_MS's; "
                    "luminance-matched (x%.3f) PSNR %.2f dB (lit %.2f) after %d it, %.2f dB (lit %.2f) after %d it",
-                   g_rgb, k >= 2 ? "surface" : "box", mean, psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse),
-                   psnr(e4.mse_lit), 4 * n, r->ch[0], r->ch[1], r->ch[2], r->gr, r->br, r->scale, psnr(r->lm1.mse),
-                   psnr(r->lm1.mse_lit), n, psnr(r->lm4.mse), psnr(r->lm4.mse_lit), 4 * n);
+                   g_rgb, k >= 2 ? "surface" : "box", mean, hdx_psnr(e1.mse), hdx_psnr(e1.mse_lit), n, hdx_psnr(e4.mse),
+                   hdx_psnr(e4.mse_lit), 4 * n, r->ch[0], r->ch[1], r->ch[2], r->gr, r->br, r->scale, hdx_psnr(r->lm1.mse),
+                   hdx_psnr(r->lm1.mse_lit), n, hdx_psnr(r->lm4.mse), hdx_psnr(r->lm4.mse_lit), 4 * n);
         hd_destroy(ctx);
     }
     fprintf(md, "\nColour apart from brightness, after %d it (PT_MS's R G B means %.4g %.4g %.4g, G/R %.3f, B/R %.3f). "
@@ -921,7 +911,7 @@ static void run_rgb_study(const ref_img *ref, const char *out)
         const rgb_row *r = &rows[k];
         fprintf(md, "| %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n",
                 k & 1 ? "RGB" : "grey", k >= 2 ? "surface" : "box", r->ch[0], r->ch[1], r->ch[2], r->gr, r->br,
-                r->scale, psnr(r->lm1.mse), psnr(r->lm1.mse_lit), psnr(r->lm4.mse), psnr(r->lm4.mse_lit));
+                r->scale, hdx_psnr(r->lm1.mse), hdx_psnr(r->lm1.mse_lit), hdx_psnr(r->lm4.mse), hdx_psnr(r->lm4.mse_lit));
     }
     g_rgb = 0;
     g_boundary = HD_BOUNDARY_BOX;
@@ -963,10 +953,10 @@ static void run_half_study(const ref_img *ref, const char *out)
         gvox = (double)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2];
         illum = 2.0 * st.illumination_channels * (k ? 2.0 : 4.0); /* E and phi, per channel */
         fprintf(md, "| %s | %.0f | %.1f | %.2f dB | %.2f dB | %.2f dB | %.2f dB |\n", k ? "float16" : "float32", illum,
-                (double)st.method_bytes / gvox, psnr(e1.mse), psnr(e1.mse_lit), psnr(e4.mse), psnr(e4.mse_lit));
+                (double)st.method_bytes / gvox, hdx_psnr(e1.mse), hdx_psnr(e1.mse_lit), hdx_psnr(e4.mse), hdx_psnr(e4.mse_lit));
         check_line("precision %s: E+phi %.0f B/voxel, state %.1f B/voxel, PSNR vs PT_MS %.2f dB (lit %.2f) after %d it, "
                    "%.2f dB (lit %.2f) after %d it", k ? "float16" : "float32", illum, (double)st.method_bytes / gvox,
-                   psnr(e1.mse), psnr(e1.mse_lit), n, psnr(e4.mse), psnr(e4.mse_lit), 4 * n);
+                   hdx_psnr(e1.mse), hdx_psnr(e1.mse_lit), n, hdx_psnr(e4.mse), hdx_psnr(e4.mse_lit), 4 * n);
         hd_destroy(ctx);
     }
     g_precision = HD_PRECISION_FLOAT32;
@@ -977,12 +967,12 @@ static void run_half_study(const ref_img *ref, const char *out)
         int c;
         for (i = 0; i < npix; ++i)
             for (c = 0; c < 3; ++c) {
-                d = (double)tonemap(img[1][j][4 * i + c]) - tonemap(img[0][j][4 * i + c]);
+                d = (double)hdx_tonemap(img[1][j][4 * i + c], S.exposure) - hdx_tonemap(img[0][j][4 * i + c], S.exposure);
                 mse += d * d;
             }
         mse /= 3.0 * (double)npix;
-        fprintf(md, "%sfloat16 against float32 after %d it: %.2f dB%s", j ? "; " : "\n", j ? 4 * n : n, psnr(mse), j ? "\n" : "");
-        check_line("float16 vs float32 image after %d it: PSNR %.2f dB", j ? 4 * n : n, psnr(mse));
+        fprintf(md, "%sfloat16 against float32 after %d it: %.2f dB%s", j ? "; " : "\n", j ? 4 * n : n, hdx_psnr(mse), j ? "\n" : "");
+        check_line("float16 vs float32 image after %d it: PSNR %.2f dB", j ? 4 * n : n, hdx_psnr(mse));
     }
     fclose(md);
     for (k = 0; k < 2; ++k)
@@ -1079,7 +1069,7 @@ static double mg_psnr_at(const curve *c, double t, int wall, int lit, int *it)
         if ((wall ? c->p[i].wall : c->p[i].sec) <= t) last = i;
     if (it) *it = last < 0 ? 0 : c->p[last].it;
     if (last < 0) return -1.0;
-    return psnr(lit ? c->p[last].e[1].mse_lit : c->p[last].e[1].mse);
+    return hdx_psnr(lit ? c->p[last].e[1].mse_lit : c->p[last].e[1].mse);
 }
 
 static void mg_write_md_table(FILE *md, mg_run runs[MG_BOUNDARIES][MG_CONFIGS], int wall, int ntimes)
@@ -1121,7 +1111,7 @@ static void mg_plot(const char *work, const char *out, mg_run runs[MG_BOUNDARIES
             fprintf(f, "# it wall_s cpu_s psnr_ms psnr_lit_ms\n");
             for (i = 0; i < runs[b][k].c.n; ++i) {
                 const point *p = &runs[b][k].c.p[i];
-                fprintf(f, "%d %.5f %.5f %.4f %.4f\n", p->it, p->wall, p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+                fprintf(f, "%d %.5f %.5f %.4f %.4f\n", p->it, p->wall, p->sec, hdx_psnr(p->e[1].mse), hdx_psnr(p->e[1].mse_lit));
             }
             fclose(f);
         }
@@ -1183,7 +1173,7 @@ static void run_multigrid_study(const ref_img *ref, const char *out, const char 
                            b ? "box" : "surface", mg_label(r, lab, sizeof lab), r->c.n, last->wall, r->c.n / last->wall,
                            last->sec, g_cores, r->c.n / last->sec, r->st.seconds_direct / r->c.n,
                            r->st.seconds_diffusion / r->c.n, r->st.seconds_projection / r->c.n,
-                           mg_psnr_at(&r->c, 1.0, 1, 0, NULL), psnr(last->e[1].mse), psnr(last->e[1].mse_lit), r->mean);
+                           mg_psnr_at(&r->c, 1.0, 1, 0, NULL), hdx_psnr(last->e[1].mse), hdx_psnr(last->e[1].mse_lit), r->mean);
             }
         }
     load_average(load1, sizeof load1);
@@ -1222,7 +1212,7 @@ static void run_multigrid_study(const ref_img *ref, const char *out, const char 
                 const point *p = &runs[b][k].c.p[j];
                 fprintf(f, "%s,%s,%d,%d,%.4f,%.4f,%.3f,%.3f\n", b ? "box" : "surface",
                         runs[b][k].solver == HD_SOLVER_MULTIGRID ? "multigrid" : "red_black", runs[b][k].steps, p->it,
-                        p->wall, p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+                        p->wall, p->sec, hdx_psnr(p->e[1].mse), hdx_psnr(p->e[1].mse_lit));
             }
     fclose(f);
 
@@ -1234,7 +1224,7 @@ static void run_multigrid_study(const ref_img *ref, const char *out, const char 
                 "the end.\n\n",
             S.size, S.size, runs[0][0].st.illumination_dims[0], runs[0][0].st.illumination_dims[1],
             runs[0][0].st.illumination_dims[2], g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2], g_cores,
-            ref->paths, psnr(ref->noise_mse), load0, load1);
+            ref->paths, hdx_psnr(ref->noise_mse), load0, load1);
     fprintf(md, "Wall clock of hd_iterate (it/s by the wall clock; diffusion s/it from the library's stage timer):\n\n");
     mg_write_md_table(md, runs, 1, ntimes);
     fprintf(md, "\nCPU time of hd_iterate / %d threads (what the same work takes on %d otherwise idle cores; "
@@ -1337,7 +1327,7 @@ static void run_defaults_study(const ref_img *ref, const char *out)
                 "'equal time': the PSNR of the last image finished within the time the first row takes for %d "
                 "iterations (CPU clock; wall clock in brackets). Load average %s at the start, %s at the end.\n\n",
             S.size, S.size, g_vol.desc.dims[0], g_vol.desc.dims[1], g_vol.desc.dims[2], g_cores, ref->paths,
-            psnr(ref->noise_mse), g_cores, (n + 3) / 4, load0, load1);
+            hdx_psnr(ref->noise_mse), g_cores, (n + 3) / 4, load0, load1);
     fprintf(md, "| grid | boundary | solver | state B/voxel | it/s wall | it/s CPU | speed-up (CPU) |");
     for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, " %d it |", marks[j]);
     fprintf(md, " lit part, %d it | equal time |\n|---|---|---|---|---|---|---|", n);
@@ -1351,11 +1341,11 @@ static void run_defaults_study(const ref_img *ref, const char *out)
         const char *sol = cfg[k].solver == HD_SOLVER_MULTIGRID ? "multigrid" : "red_black";
         for (it = 0; it < n; ++it) {
             const point *p = &c[k].p[it];
-            if (p->sec <= budget_cpu) eqc = psnr(p->e[1].mse);
-            if (p->wall <= budget_wall) eqw = psnr(p->e[1].mse);
+            if (p->sec <= budget_cpu) eqc = hdx_psnr(p->e[1].mse);
+            if (p->wall <= budget_wall) eqw = hdx_psnr(p->e[1].mse);
             fprintf(f, "%d,%s,%s,%d,%d,%.4f,%.4f,%.3f,%.3f\n", cfg[k].downsample,
                     cfg[k].boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", sol, cfg[k].steps, p->it, p->wall,
-                    p->sec, psnr(p->e[1].mse), psnr(p->e[1].mse_lit));
+                    p->sec, hdx_psnr(p->e[1].mse), hdx_psnr(p->e[1].mse_lit));
         }
         fprintf(md, "| %dx%dx%d | %s | %s, %d %s | %.2f | %.3f | %.3f | %.2fx |", st[k].illumination_dims[0],
                 st[k].illumination_dims[1], st[k].illumination_dims[2],
@@ -1363,8 +1353,8 @@ static void run_defaults_study(const ref_img *ref, const char *out)
                 cfg[k].solver == HD_SOLVER_MULTIGRID ? "multigrid CG" : "red-black", cfg[k].steps,
                 cfg[k].solver == HD_SOLVER_MULTIGRID ? "step" : "sweeps", (double)st[k].method_bytes / nvox,
                 n / last->wall, n / last->sec, c[0].p[n - 1].sec / last->sec);
-        for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, " %.2f |", psnr(c[k].p[marks[j] - 1].e[1].mse));
-        fprintf(md, " %.2f |", psnr(last->e[1].mse_lit));
+        for (j = 0; j < DF_MARKS && marks[j] <= n; ++j) fprintf(md, " %.2f |", hdx_psnr(c[k].p[marks[j] - 1].e[1].mse));
+        fprintf(md, " %.2f |", hdx_psnr(last->e[1].mse_lit));
         if (eqc < 0) fprintf(md, " no image |");
         else fprintf(md, " %.2f (%.2f) |", eqc, eqw);
         fputc('\n', md);
@@ -1372,8 +1362,8 @@ static void run_defaults_study(const ref_img *ref, const char *out)
                    "PSNR vs PT_MS after 1 it %.2f dB, after %d it %.2f dB (lit %.2f); per it: direct %.3f s, "
                    "diffusion %.3f s, projection %.3f s (wall)",
                    cfg[k].downsample, cfg[k].boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", sol, cfg[k].steps,
-                   n / last->wall, n / last->sec, g_cores, c[0].p[n - 1].sec / last->sec, psnr(c[k].p[0].e[1].mse), n,
-                   psnr(last->e[1].mse), psnr(last->e[1].mse_lit), st[k].seconds_direct / n,
+                   n / last->wall, n / last->sec, g_cores, c[0].p[n - 1].sec / last->sec, hdx_psnr(c[k].p[0].e[1].mse), n,
+                   hdx_psnr(last->e[1].mse), hdx_psnr(last->e[1].mse_lit), st[k].seconds_direct / n,
                    st[k].seconds_diffusion / n, st[k].seconds_projection / n);
         free(c[k].p);
     }
@@ -1548,8 +1538,8 @@ int main(int argc, char **argv)
             for (i = 0; i < cur[m][li].n; ++i) {
                 const point *p = &cur[m][li].p[i];
                 fprintf(f, "%s,%d,%d,%.4f,%.4f,%.3f,%.5f,%.3f,%.5f,%.3f,%.3f\n", k_name[m], k_lights[li], p->it, p->sec, p->wall,
-                        psnr(p->e[0].mse), sqrt(p->e[0].mse), psnr(p->e[1].mse), sqrt(p->e[1].mse),
-                        psnr(p->e[0].mse_lit), psnr(p->e[1].mse_lit));
+                        hdx_psnr(p->e[0].mse), sqrt(p->e[0].mse), hdx_psnr(p->e[1].mse), sqrt(p->e[1].mse),
+                        hdx_psnr(p->e[0].mse_lit), hdx_psnr(p->e[1].mse_lit));
             }
     fclose(f);
 
@@ -1576,8 +1566,8 @@ int main(int argc, char **argv)
     for (li = 0; li < 2; ++li)
         for (m = HDE_SS; m <= HDE_MS; ++m)
             check_line("  %s %d light%s: %d paths/pixel, noise floor %.1f dB (lit part %.1f dB, %zu pixels)",
-                       k_name[m], k_lights[li], li ? "s" : "", refs[m][li].paths, psnr(refs[m][li].noise_mse),
-                       psnr(refs[m][li].noise_mse_lit), refs[m][li].nlit);
+                       k_name[m], k_lights[li], li ? "s" : "", refs[m][li].paths, hdx_psnr(refs[m][li].noise_mse),
+                       hdx_psnr(refs[m][li].noise_mse_lit), refs[m][li].nlit);
     if (!skip_table) {
         double hd_ratio = rows[HDE_HD].rate[1] / rows[HDE_HD].rate[0];
         double cd_ratio = rows[HDE_CD].rate[1] / rows[HDE_CD].rate[0];
@@ -1611,7 +1601,7 @@ int main(int argc, char **argv)
                     t[m] = time_to(&cur[m][li], S.levels[k], &its[m]);
                     fprintf(f, "%s,%d,%g,%.4f,%d\n", k_name[m], k_lights[li], (double)S.levels[k], t[m], its[m]);
                     if (t[m] >= 0) fprintf(md, " %.2f s (%d it) |", t[m], its[m]);
-                    else fprintf(md, " never (best %.1f dB) |", psnr(cur[m][li].p[cur[m][li].n - 1].e[1].mse));
+                    else fprintf(md, " never (best %.1f dB) |", hdx_psnr(cur[m][li].p[cur[m][li].n - 1].e[1].mse));
                 }
                 fputc('\n', md);
                 {

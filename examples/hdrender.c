@@ -954,8 +954,6 @@ int main(int argc, char **argv)
                      r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0
                          ? "; run scripts/fetch-data (make data) to fetch the head CT" : NULL);
     }
-    desc.volume = vol.desc;
-    if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
 
     if (!tf_arg) {
         if (vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f) hdx_tf_preset("ct-skin", &tf);
@@ -968,9 +966,8 @@ int main(int argc, char **argv)
         if (!(hi > lo)) hi = lo + 1.0f;
         hdx_tf_set_domain(&tf, lo, hi);
     }
-    desc.volume.value_range[0] = tf.domain[0];
-    desc.volume.value_range[1] = tf.domain[1];
-    desc.transfer_function = hdx_tf_desc(&tf);
+    hdx_tf_use(&desc, &vol.desc, &tf);
+    if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
 
     /* ---- lights, the rest ---- */
     if (!light_count) light_count = preset_lights(lights_n ? lights_n : 1, &desc.camera, lights);

@@ -567,7 +567,6 @@ int main(int argc, char **argv)
     hd_volume_file vol;
     hd_desc desc;
     hd_logger logger = {hd_log_stderr, NULL};
-    hd_transfer_function t;
     hd_result r;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = atoi(argv[++i]);
@@ -616,11 +615,7 @@ int main(int argc, char **argv)
     set_tf(&v, v.is_ct ? 0 : HDX_TF_PRESET_COUNT - 1);
     set_lights(&v, 1);
     memset(&desc, 0, sizeof desc);
-    desc.volume = vol.desc;
-    desc.volume.value_range[0] = v.tf.domain[0];
-    desc.volume.value_range[1] = v.tf.domain[1];
-    t = hdx_tf_desc(&v.tf);
-    desc.transfer_function = t;
+    hdx_tf_use(&desc, &vol.desc, &v.tf);
     desc.lights = v.lights;
     desc.light_count = v.light_count;
     desc.camera = v.cam;

@@ -18,7 +18,7 @@
 #                       ORBIT_BACKENDS picks the frame-time builds (default opencl vulkan gl).
 .PHONY: bench-peer bench-orbit
 
-PEER_SRC := bench/peer/hdpeer.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_png.h
+PEER_SRC := bench/peer/hdpeer.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_tonemap.h examples/hd_png.h
 $(B)/hdpeer: $(PEER_SRC) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 # The GPU backends' builds and the CPU build of PROJECT_BASE (mk/bench_project.mk), for
@@ -40,7 +40,7 @@ bench-peer: $(B)/hdpeer
 	      DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends python3-paraview xvfb xauth; }
 	xvfb-run -a -s "-screen 0 1280x1280x24" pvpython bench/peer/vtk_peer.py --hdpeer $(B)/hdpeer $(PEER_ARGS)
 
-ORBIT_SRC := bench/hdbench_orbit.c bench/hd_orbit_scene.h examples/hd_tf.h $(LIB_SRC)
+ORBIT_SRC := bench/hdbench_orbit.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_tonemap.h $(LIB_SRC)
 ORBIT_CC = $(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 $(B)/hdbench_orbit: $(ORBIT_SRC) | $(B)
 	$(ORBIT_CC) -DHYBRIDDIFF_BACKEND_CPU

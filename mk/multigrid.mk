@@ -5,7 +5,7 @@
 #                          (BENCH_ARGS="--f64 --surface-only" evaluates the residual in double,
 #                          --downsample 2 at half resolution)
 .PHONY: bench-multigrid
-$(B)/hdbench_multigrid: bench/hdbench_multigrid.c bench/hd_residual_f64.c bench/hd_residual_f64.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
+$(B)/hdbench_multigrid: bench/hdbench_multigrid.c bench/hd_residual_f64.c bench/hd_residual_f64.h examples/hd_tf.h $(LIB_SRC) src/hd_test_hooks.h | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -Ibench bench/hdbench_multigrid.c bench/hd_residual_f64.c -o $@ $(LDLIBS)
 
 bench-multigrid: $(B)/hdbench_multigrid data

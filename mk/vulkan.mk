@@ -55,7 +55,7 @@ $(B)/hdbench_vulkan: bench/hdbench_vulkan.c $(B)/hdbench_vulkan_spirv.h $(LIB_SR
 bench-vulkan: $(B)/hdbench_vulkan data
 	$(B)/hdbench_vulkan data/head.nrrd 2 $(BENCH_ARGS)
 
-$(B)/hdbench_mg_vulkan.o: bench/hdbench_mg_vulkan.c bench/hd_bench_median.h $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
+$(B)/hdbench_mg_vulkan.o: bench/hdbench_mg_vulkan.c bench/hd_bench_median.h examples/hd_tf.h $(VK_CONF)/hd_api.h hybriddiff.h | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
 $(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu.o $(B)/conf_impl_vk.o
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)

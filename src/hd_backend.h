@@ -39,14 +39,15 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx);
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats);
 /* The Jacobi solver's second phi buffer: allocated when enable, freed otherwise. */
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable);
-/* The RGBA float image of width x height and after it the reduced frames' region
-   (hd__image_floats), contents undefined until hd__be_clear. */
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height);
-/* The image buffer's floats: width x height RGBA, then room for a frame at render scale 2 (the
-   largest reduced frame; hd_k_upsample.h). */
-HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height)
+/* The RGBA float image of width x height and, with reduced, after it the reduced frames' region
+   (hd__image_floats), contents undefined until hd__be_clear. The new buffer is made before the
+   old one is released, so on failure the image held before is kept as it was. */
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced);
+/* The image buffer's floats: width x height RGBA, then with reduced the room for a frame at render
+   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use. */
+HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
 {
-    return ((size_t)width * height + (size_t)((width + 1) / 2) * ((height + 1) / 2)) * 4;
+    return ((size_t)width * height + (reduced ? (size_t)((width + 1) / 2) * ((height + 1) / 2) : 0)) * 4;
 }
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count);

@@ -922,6 +922,13 @@ static hd_result hd__light_measure(hd__ctx *ctx)
 
 static int hd__light_converged(const hd__ctx *ctx) { return ctx->conv_below >= 2; }
 
+/* Whether a new image buffer (a new camera size) keeps the reduced frames' region: the old one
+   had it and the parameters may still ask for reduced frames. */
+static int hd__image_room_kept(const hd__ctx *ctx)
+{
+    return ctx->image_room && ctx->params.render_scale != 1 && !hd__method_is_pt(ctx->params.method);
+}
+
 /* Brings the device state up to date with what the setters changed, in dependency order. */
 static hd_result hd__prepare(hd__ctx *ctx)
 {
@@ -944,7 +951,9 @@ static hd_result hd__prepare(hd__ctx *ctx)
     /* the path tracers' state is their image: whatever resets it restarts them */
     if (pt && (dirty & HD__DIRTY_IMAGE)) dirty |= HD__DIRTY_DIRECT;
     if (dirty & HD__DIRTY_IMAGE_ALLOC) {
-        if ((r = hd__be_alloc_image(ctx, ctx->camera.width, ctx->camera.height)) != HD_SUCCESS) return r;
+        int room = hd__image_room_kept(ctx);
+        if ((r = hd__be_alloc_image(ctx, ctx->camera.width, ctx->camera.height, room)) != HD_SUCCESS) return r;
+        ctx->image_room = room;
         dirty |= HD__DIRTY_IMAGE;
     }
     ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
@@ -1042,12 +1051,29 @@ static int hd__next_scale(const hd__ctx *ctx)
     return s;
 }
 
-/* Makes s the scale of the image's frames; frames at another scale are dropped (the running
-   mean restarts). */
-static void hd__use_scale(hd__ctx *ctx, int s)
+/* Gives the image buffer the reduced frames' region if it lacks it (the first frame at a scale
+   > 1), then clears it (the new buffer's contents are undefined; the frame about to be made
+   restarts the running mean anyway). On failure the full-size image is kept as it was and
+   frames at scale 1 go on working. */
+static hd_result hd__image_room(hd__ctx *ctx)
 {
+    hd_result r;
+    if (ctx->image_room) return HD_SUCCESS;
+    if ((r = hd__be_alloc_image(ctx, ctx->camera.width, ctx->camera.height, 1)) != HD_SUCCESS) return r;
+    ctx->image_room = 1;
+    ctx->frames = ctx->converged_frames = 0;
+    return hd__be_clear(ctx, HD__DIRTY_IMAGE);
+}
+
+/* Makes s the scale of the image's frames; frames at another scale are dropped (the running
+   mean restarts). A scale > 1 first needs the reduced frames' region (hd__image_room). */
+static hd_result hd__use_scale(hd__ctx *ctx, int s)
+{
+    hd_result r;
+    if (s > 1 && (r = hd__image_room(ctx)) != HD_SUCCESS) return r;
     if (ctx->frames > 0 && s != ctx->frame_scale) ctx->frames = ctx->converged_frames = 0;
     ctx->frame_scale = s;
+    return HD_SUCCESS;
 }
 
 /* One projection frame from the current E and phi into the image's running mean. At render
@@ -1059,7 +1085,7 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     hd_result r;
     double t0 = hd__now(), dt;
     int s;
-    hd__use_scale(ctx, hd__next_scale(ctx));
+    if ((r = hd__use_scale(ctx, hd__next_scale(ctx))) != HD_SUCCESS) return r;
     s = ctx->frame_scale;
     ctx->frames++;
     hd__fill_kparams(ctx);
@@ -1082,7 +1108,8 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     }
     dt = hd__now() - t0;
     ctx->seconds[2] += dt;
-    if (r == HD_SUCCESS) ctx->frame_cost = dt * (double)(s * s);
+    /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
+    if (r == HD_SUCCESS && !ctx->no_measure) ctx->frame_cost = dt * (double)(s * s);
     return r;
 }
 
@@ -1198,7 +1225,7 @@ HDDEF hd_result hd_render(hd_context h)
         /* the image is done once frame_window frames at its final scale are in */
         int s = hd__next_scale(ctx);
         if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->params.frame_window) return HD_SUCCESS;
-        hd__use_scale(ctx, s);
+        if ((r = hd__use_scale(ctx, s)) != HD_SUCCESS) return r;
         ctx->converged_frames++;
     }
     return hd__project_frame(ctx);
@@ -1313,7 +1340,10 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->method_bytes += hd__be_solver_bytes(ctx); /* the solver's own state (multigrid levels) */
     out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
     if (hd__method_is_pt(ctx->params.method)) out->method_bytes = 0;
-    out->image_bytes = hd__image_floats(ctx->camera.width, ctx->camera.height) * sizeof(float);
+    /* the buffer held, or the one the next call makes for a new camera size */
+    out->image_bytes = hd__image_floats(ctx->camera.width, ctx->camera.height,
+                                        (ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) *
+                       sizeof(float);
     /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */
     out->volume_bytes = ctx->nvox * sizeof(float) + (size_t)ctx->tf_count * 16 +
                         (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float);

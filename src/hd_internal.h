@@ -104,6 +104,8 @@ typedef struct hd__ctx {
                                 was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
     double frame_cost;       /* seconds of the last projection frame scaled to full resolution
                                 (its time times its scale squared); 0 before the first */
+    int image_room;          /* the image buffer holds the reduced frames' region (made when a
+                                scale > 1 is first used, hd__image_room) */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */

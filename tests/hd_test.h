@@ -4,6 +4,7 @@
 #ifndef HD_TEST_H
 #define HD_TEST_H
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <math.h>
 
@@ -64,6 +65,42 @@ static inline hd_logger hd_test_logger(hd_test_log *l)
     lg.func = hd_test_log_fn;
     lg.user_data = l;
     return lg;
+}
+
+/* An allocator (hd_desc.allocator, user_data an hd_test_alloc) that fails the fail_at-th call
+   (1-based; 0: none) and counts the calls, the blocks still live and the failures. */
+typedef struct hd_test_alloc {
+    long calls, fail_at;
+    long live, failed;
+} hd_test_alloc;
+
+static inline void *hd_test_alloc_fn(size_t size, void *user)
+{
+    hd_test_alloc *s = (hd_test_alloc *)user;
+    void *p;
+    if (++s->calls == s->fail_at) {
+        ++s->failed;
+        return NULL;
+    }
+    p = malloc(size ? size : 1);
+    if (p) ++s->live;
+    return p;
+}
+
+static inline void hd_test_free_fn(void *ptr, void *user)
+{
+    hd_test_alloc *s = (hd_test_alloc *)user;
+    if (ptr) --s->live;
+    free(ptr);
+}
+
+/* The allocator of desc d made the one above, counting into s (cleared). */
+static inline void hd_test_allocator(hd_desc *d, hd_test_alloc *s)
+{
+    memset(s, 0, sizeof *s);
+    d->allocator.alloc = hd_test_alloc_fn;
+    d->allocator.free = hd_test_free_fn;
+    d->allocator.user_data = s;
 }
 #endif
 

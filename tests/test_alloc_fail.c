@@ -1,37 +1,13 @@
 /* test_alloc_fail.c - allocation failure, on the CPU backend in build/hdtest and on OpenCL in
    build/afgpu/alloc-fail-opencl (mk/alloc_fail_gpu.mk). A counting allocator hook fails the
-   k-th allocation, for every k in a full cycle: create, iterate HD, switch to CD and iterate,
-   switch to PT_SS and iterate, read the image and illumination, destroy. Each run must return
-   HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never crash, and free every byte it took
-   (live allocations are counted here; under `make asan` LSan checks the rest). */
+   k-th allocation, for every k in a full cycle: create, iterate HD (at render scale 1, then 2),
+   switch to CD and iterate, switch to PT_SS and iterate, read the image and illumination,
+   destroy. Each run must return HD_ERROR_OUT_OF_MEMORY (with a log line) or succeed, never
+   crash, and free every byte it took (live allocations are counted here; under `make asan` LSan
+   checks the rest). */
 #include "hybriddiff.h"
 #include "hd_test.h"
 #include <stdlib.h>
-
-typedef struct af_state {
-    long calls, fail_at; /* fail_at: 1-based index of the allocation to fail, 0: never */
-    long live, failed;
-} af_state;
-
-static void *af_alloc(size_t size, void *user)
-{
-    af_state *s = (af_state *)user;
-    void *p;
-    if (++s->calls == s->fail_at) {
-        ++s->failed;
-        return NULL;
-    }
-    p = malloc(size ? size : 1);
-    if (p) ++s->live;
-    return p;
-}
-
-static void af_free(void *ptr, void *user)
-{
-    af_state *s = (af_state *)user;
-    if (ptr) --s->live;
-    free(ptr);
-}
 
 typedef struct af_log { int errors; hd_result last; } af_log;
 static void af_log_fn(void *user, hd_log_level level, hd_result code, const char *msg,
@@ -47,7 +23,7 @@ static uint8_t af_vol[AF_N * AF_N * AF_N];
 
 /* One cycle; returns the first error (HD_SUCCESS if all went through). The context is always
    destroyed if it was created. */
-static hd_result af_cycle(af_state *st, af_log *log)
+static hd_result af_cycle(hd_test_alloc *st, af_log *log)
 {
     hd_desc d;
     hd_context ctx;
@@ -62,8 +38,8 @@ static hd_result af_cycle(af_state *st, af_log *log)
     d.volume.data = af_vol;
     d.camera.width = d.camera.height = 16;
     d.threads = 2;
-    d.allocator.alloc = af_alloc;
-    d.allocator.free = af_free;
+    d.allocator.alloc = hd_test_alloc_fn;
+    d.allocator.free = hd_test_free_fn;
     d.allocator.user_data = st;
     d.logger.func = af_log_fn;
     d.logger.user_data = log;
@@ -73,6 +49,10 @@ static hd_result af_cycle(af_state *st, af_log *log)
     if (r == HD_SUCCESS) r = hd_query_desc(ctx, &d);
     if (r == HD_SUCCESS) {
         p = d.params;
+        p.render_scale = 2; /* the image buffer's reduced frames' region comes with this frame */
+        r = hd_set_params(ctx, &p);
+        if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
+        p.render_scale = 1;
         p.method = HD_METHOD_CD;
         r = hd_set_params(ctx, &p);
         if (r == HD_SUCCESS) r = hd_iterate(ctx, 1);
@@ -100,7 +80,7 @@ static hd_result af_cycle(af_state *st, af_log *log)
 
 static void test_alloc_fail_every_k(void)
 {
-    af_state st;
+    hd_test_alloc st;
     af_log log;
     long total, k, failures = 0;
     memset(&st, 0, sizeof st);

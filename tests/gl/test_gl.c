@@ -19,6 +19,8 @@
    5. the caller's context (use_current_context) not current, or another one current: hd_iterate
       and hd_read_image_f32 return HD_ERROR_GL_CONTEXT_NOT_CURRENT with one logged error and count
       no iteration; with it current again the context goes on from the iterations that ran.
+   6. a device limit that holds the image but not its reduced frames' region: the first frame at
+      render scale 2 fails with HD_ERROR_UNSUPPORTED and one logged error, full frames go on.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -389,6 +391,51 @@ static void check_not_current(EGLDisplay dpy, EGLConfig cfg, const EGLint *attrs
     if (other != EGL_NO_CONTEXT) eglDestroyContext(dpy, other);
 }
 
+/* Check 6: the image buffer's reduced frames' region comes with the first frame at a render
+   scale > 1; a device whose largest storage block holds the image but not the region (the
+   limit lowered to the image's size) fails that frame with HD_ERROR_UNSUPPORTED and one logged
+   error, keeps its image buffer and renders full frames on; with the limit back, scale 2 works
+   and hd_stats.image_bytes counts the region. */
+static void check_image_room(void)
+{
+    static uint8_t vox[16 * 16 * 16];
+    hd_desc d;
+    hd_context c;
+    hd_stats st;
+    hd_params p;
+    hd_result r;
+    hd__ctx *ctx;
+    GLint limit;
+    size_t full = (size_t)48 * 40 * 16, room = (size_t)24 * 20 * 16;
+    make_desc(&d, vox, 16);
+    d.gl.use_current_context = 1;
+    d.logger.func = nc_log;
+    nc_errors = 0;
+    r = hd_create(&d, &c);
+    CHECK(r == HD_SUCCESS, "image room: hd_create: %s", hd_result_string(r));
+    if (r != HD_SUCCESS) return;
+    ctx = hd__lookup(c, NULL);
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_get_stats(c, &st) == HD_SUCCESS && st.image_bytes == full,
+          "image room: %zu image bytes at scale 1, want %zu", st.image_bytes, full);
+    limit = ctx->be->max_ssbo_block;
+    ctx->be->max_ssbo_block = (GLint)full;
+    p = d.params;
+    p.render_scale = 2;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS, "image room: render_scale 2");
+    r = hd_iterate(c, 1);
+    CHECK(r == HD_ERROR_UNSUPPORTED && nc_errors == 1 && nc_last == r, "image room: scale 2 above the limit: %s, %d errors",
+          hd_result_string(r), nc_errors);
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS && st.image_bytes == full, "image room: %zu bytes after the failure", st.image_bytes);
+    p.render_scale = 1;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_iterate(c, 1) == HD_SUCCESS && nc_errors == 1, "image room: scale 1 after it");
+    ctx->be->max_ssbo_block = limit;
+    p.render_scale = 2;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_iterate(c, 2) == HD_SUCCESS && hd_get_stats(c, &st) == HD_SUCCESS &&
+              st.image_bytes == full + room && st.render_scale == 2 && nc_errors == 1,
+          "image room: scale 2 with the limit back: %zu bytes, scale %d", st.image_bytes, st.render_scale);
+    hd_destroy(c);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -410,6 +457,7 @@ int main(void)
     check_f16_round();
     run_calls(1, "caller's context");
     check_not_current(dpy, cfg, ctx_attrs, host);
+    check_image_room();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
     {

@@ -558,6 +558,127 @@ static void test_kept_instance(void)
            ok ? "PASS" : "FAIL", CYCLES + 2, rendered + 1, instances_made, instances_made == 1 ? "" : "s");
 }
 
+/* Records n iterations of h into a command buffer of the backend's own device, submits it and
+   waits, as an application using hd_vulkan_record would. */
+static hd_result record_run(hd_context h, int n)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__backend *be = ctx->be;
+    VkCommandPoolCreateInfo cpci;
+    VkCommandBufferAllocateInfo cbai;
+    VkCommandBufferBeginInfo bi;
+    VkSubmitInfo si;
+    VkCommandPool pool;
+    VkCommandBuffer cb;
+    hd_result r;
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    cpci.queueFamilyIndex = be->queue_family;
+    if (be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &pool) != VK_SUCCESS) return HD_ERROR_BACKEND;
+    memset(&cbai, 0, sizeof cbai);
+    cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    cbai.commandPool = pool;
+    cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbai.commandBufferCount = 1;
+    be->fn.vkAllocateCommandBuffers(be->device, &cbai, &cb);
+    memset(&bi, 0, sizeof bi);
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    be->fn.vkBeginCommandBuffer(cb, &bi);
+    r = hd_vulkan_record(h, cb, n);
+    be->fn.vkEndCommandBuffer(cb);
+    if (r == HD_SUCCESS) {
+        memset(&si, 0, sizeof si);
+        si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        si.commandBufferCount = 1;
+        si.pCommandBuffers = &cb;
+        if (be->fn.vkQueueSubmit(be->queue, 1, &si, VK_NULL_HANDLE) != VK_SUCCESS) r = HD_ERROR_BACKEND;
+        be->fn.vkDeviceWaitIdle(be->device);
+    }
+    be->fn.vkDestroyCommandPool(be->device, pool, NULL);
+    return r;
+}
+
+/* 7: the image buffer's reduced-frame region: absent at render scale 1, made with the first
+   reduced frame (submitted or recorded); when device memory is short for it, the frame fails
+   with HD_ERROR_OUT_OF_DEVICE_MEMORY and the context renders full frames on (validation on, no
+   message). */
+static void test_image_room(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats s;
+    hd_params p;
+    hd__ctx *ctx;
+    size_t full = (size_t)32 * 24 * 16, room = (size_t)16 * 12 * 16;
+    int ok = 1;
+    d.vulkan.enable_validation = 1;
+    messages = 0;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    ctx = hd__lookup(h, NULL);
+    ok &= hd_iterate(h, 1) == HD_SUCCESS && hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
+    p = d.params;
+    p.render_scale = 2;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS;
+    ctx->be->mem_limit = ctx->be->mem_used + 4096; /* no room for a second image buffer */
+    ok &= hd_iterate(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    ok &= record_run(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
+    ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
+    p.render_scale = 1;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS;
+    ctx->be->mem_limit = 0;
+    p.render_scale = 2;
+    ok &= hd_set_params(h, &p) == HD_SUCCESS && record_run(h, 2) == HD_SUCCESS;
+    ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full + room && s.render_scale == 2 && s.frames == 2;
+    ok &= hd_iterate(h, 1) == HD_SUCCESS;
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    ok &= messages == 0;
+    CHECK(ok);
+    printf("%s image buffer: %zu bytes at scale 1, %zu with the reduced region made by the first reduced frame; short device "
+           "memory fails it (hd_iterate and hd_vulkan_record) and full frames go on (%lu validation messages)\n",
+           ok ? "PASS" : "FAIL", full, full + room, messages);
+}
+
+/* 8: HD_RENDER_SCALE_AUTO while recording picks its first scale from the device time of the last
+   recorded frame, as it does from the measured time of a submitted one: full frames when the
+   budget holds many full frames (the prediction from a scale-4 frame, its time times 16, is
+   above a full frame's: fixed costs per frame), reduced ones when it holds an eighth of one.
+   Without a measurement the first scale would be 4; timed by recording, 1 for both budgets. */
+static void test_record_auto_scale(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats s0, s1;
+    hd_params p;
+    double t = 1e30;
+    int k, first_fit, first_small;
+    d.camera.width = d.camera.height = 512;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    for (k = 0; k < 3; ++k) { /* a full frame's time: the fastest of three projections */
+        CHECK(hd_get_stats(h, &s0) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && hd_get_stats(h, &s1) == HD_SUCCESS);
+        if (s1.seconds_projection - s0.seconds_projection < t) t = s1.seconds_projection - s0.seconds_projection;
+    }
+    hd_destroy(h);
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = (float)(100.0 * t);
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    CHECK(record_run(h, 1) == HD_SUCCESS); /* nothing measured yet: scale 4 */
+    CHECK(hd_get_stats(h, &s0) == HD_SUCCESS && s0.render_scale == 4);
+    CHECK(hd_set_camera(h, &d.camera) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(h, &s0) == HD_SUCCESS);
+    first_fit = s0.render_scale;
+    CHECK(hd_query_desc(h, &d) == HD_SUCCESS);
+    p = d.params;
+    p.render_budget = (float)(t / 8.0);
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS && hd_set_camera(h, &d.camera) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(h, &s1) == HD_SUCCESS);
+    first_small = s1.render_scale;
+    hd_destroy(h);
+    CHECK(first_fit == 1 && first_small >= 2);
+    printf("%s HD_RENDER_SCALE_AUTO while recording: a new view's first frame at scale %d with a budget of 100 full frames "
+           "(%.1f ms each), %d with an eighth of one\n",
+           first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
+}
+
 int main(void)
 {
     if (test_messenger()) {
@@ -567,6 +688,8 @@ int main(void)
         test_half();
         test_multigrid();
         test_kept_instance();
+        test_image_room();
+        test_record_auto_scale();
     }
     printf("%s\n", failures ? "FAILED" : "all passed");
     return failures ? 1 : 0;
