@@ -28,6 +28,7 @@
 #include "hybriddiff.h"
 #include "examples/hd_tf.h"
 #include "examples/hd_png.h"
+#include "examples/hd_tonemap.h"
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -149,10 +150,7 @@ static hd_context make_ctx(const scene *s, hd_method m, const econfig *cfg, hd_s
     memcpy(L.direction, k_light, sizeof L.direction);
     L.color[0] = L.color[1] = L.color[2] = 1.0f;
     L.intensity = 1.0f;
-    d.volume = s->vol.desc;
-    d.volume.value_range[0] = s->tf.domain[0];
-    d.volume.value_range[1] = s->tf.domain[1];
-    d.transfer_function = hdx_tf_desc(&s->tf);
+    hdx_tf_use(&d, &s->vol.desc, &s->tf);
     d.lights = &L;
     d.light_count = 1;
     memcpy(d.camera.eye, s->c->eye, sizeof d.camera.eye);
@@ -192,13 +190,7 @@ static void run(hd_context ctx, int n, float *img)
 }
 
 /* ---- metrics ---------------------------------------------------------------------------------- */
-static double tonemap(double v)
-{
-    v *= EXPOSURE;
-    if (!(v > 0.0)) return 0.0;
-    if (v >= 1.0) return 1.0;
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-}
+static double tonemap(double v) { return hdx_srgb(EXPOSURE * v); }
 
 static double mse_of(const float *a, const float *b, size_t npix)
 {
@@ -212,8 +204,6 @@ static double mse_of(const float *a, const float *b, size_t npix)
         }
     return s / (3.0 * (double)npix);
 }
-
-static double psnr(double mse) { return mse > 0.0 ? 10.0 * log10(1.0 / mse) : 200.0; }
 
 static double mean_of(const float *img, size_t npix)
 {
@@ -344,7 +334,7 @@ static void region_report(const float *hd, const float *ms, const float *ss, con
             }
         printf("\n    channels / PT_MS: R %.3f G %.3f B %.3f; PSNR each channel scaled %.2f dB",
                cm[0] > 0.0 ? ch[0] / cm[0] : 0.0, cm[1] > 0.0 ? ch[1] / cm[1] : 0.0, cm[2] > 0.0 ? ch[2] / cm[2] : 0.0,
-               psnr(e / (3.0 * (double)npix)));
+               hdx_psnr(e / (3.0 * (double)npix)));
     }
     printf("\n");
     free(r);
@@ -452,7 +442,7 @@ static void ref_get(const scene *s, hd_method m, ref_img *ref)
     } else {
         fclose(f);
     }
-    ref->noise_db = psnr(mse_of(h[0], h[1], npix) / 4.0);
+    ref->noise_db = hdx_psnr(mse_of(h[0], h[1], npix) / 4.0);
     for (i = 0; i < n4; ++i) h[0][i] = 0.5f * (h[0][i] + h[1][i]);
     free(h[1]);
     ref->lin = h[0];
@@ -530,9 +520,9 @@ static void run_case(const ecase *c, const char *configs)
         hd_destroy(ctx);
         /* "MS scaled": PSNR against PT_MS with HD scaled to PT_MS's mean */
         printf("  %-9s %9.5f %8.3f %8.3f %8.2f dB %8.2f dB %8.2f dB %9.4f %12.4f\n", cfg->name, m,
-               m / mean_of(ms.lin, npix), m / mean_of(ss.lin, npix), psnr(mse_of(img, ms.lin, npix)),
-               psnr(mse_of(img, ss.lin, npix)),
-               psnr(mse_scaled(img, ms.lin, npix, m > 0.0 ? mean_of(ms.lin, npix) / m : 1.0)), st.light_error, spi);
+               m / mean_of(ms.lin, npix), m / mean_of(ss.lin, npix), hdx_psnr(mse_of(img, ms.lin, npix)),
+               hdx_psnr(mse_of(img, ss.lin, npix)),
+               hdx_psnr(mse_scaled(img, ms.lin, npix, m > 0.0 ? mean_of(ms.lin, npix) / m : 1.0)), st.light_error, spi);
         if (g_images != NULL) {
             region_report(img, ms.lin, ss.lin, reg, npix);
             write_images(c->name, cfg->name, img, ms.lin, g_size);

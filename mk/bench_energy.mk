@@ -7,7 +7,7 @@ ENERGY_ARGS ?=
 
 .PHONY: bench-energy
 
-$(B)/hdbench_energy: bench/hdbench_energy.c examples/hd_tf.h examples/hd_png.h $(LIB_SRC) | $(B)
+$(B)/hdbench_energy: bench/hdbench_energy.c examples/hd_tf.h examples/hd_png.h examples/hd_tonemap.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 
 bench-energy: $(B)/hdbench_energy
