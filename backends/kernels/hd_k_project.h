@@ -87,15 +87,10 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
    interpolated opacity differs from the exact one only by the exponential's curvature. */
 HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
 {
-    int n = HD_PTAB_N;
-    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
-    int i = hd_mini(HD_I(t), n - 2);
-    float f = t - HD_F(i);
-    int a = i * 4, b = a + 4;
-    return HD_V4(HD_GET1(ptab, a) + f * (HD_GET1(ptab, b) - HD_GET1(ptab, a)),
-                 HD_GET1(ptab, a + 1) + f * (HD_GET1(ptab, b + 1) - HD_GET1(ptab, a + 1)),
-                 HD_GET1(ptab, a + 2) + f * (HD_GET1(ptab, b + 2) - HD_GET1(ptab, a + 2)),
-                 HD_GET1(ptab, a + 3) + f * (HD_GET1(ptab, b + 3) - HD_GET1(ptab, a + 3)));
+    float f;
+    int a = hd_table_segment(v, HD_PTAB_N, HD_REF(f));
+    return HD_V4(HD_TABLE_LERP(ptab, a, f, 0), HD_TABLE_LERP(ptab, a, f, 1), HD_TABLE_LERP(ptab, a, f, 2),
+                 HD_TABLE_LERP(ptab, a, f, 3));
 }
 #endif
 
