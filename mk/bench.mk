@@ -31,6 +31,9 @@ $(B)/hdpeer_vulkan: $(PEER_SRC) $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples -Ibench -DHYBRIDDIFF_BACKEND_VULKAN $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -lvulkan
 $(B)/hdpeer_old: $(PEER_SRC) $(B)/proj-old/.stamp
 	$(CC) -I$(PROJECT_OLD) -D_POSIX_C_SOURCE=200809L -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+# the same for a GPU backend of PROJECT_BASE: build/hdpeer_old_{opencl,gl,vulkan}
+$(B)/hdpeer_old_%: $(PEER_SRC) $(B)/proj-old/.stamp
+	$(CC) -I$(PROJECT_OLD) -D_POSIX_C_SOURCE=200809L -Iexamples -Ibench $(PROJECT_DEF_$*) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(PROJECT_LIB_$*)
 
 PEER_ARGS ?=
 bench-peer: $(B)/hdpeer

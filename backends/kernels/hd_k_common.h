@@ -96,18 +96,24 @@ HD_FN float hd_sample_value(HD_KARGS hd_v3 u)
 }
 #endif
 
+/* A table of n rgba entries, entry i at value i / (n - 1) (the TF, the projection's step table):
+   the first float of the segment value v falls in (v clamped to 0..1), and v's place f in it.
+   HD_TABLE_LERP(buf, a, f, k) is channel k of that segment's entries interpolated by f. */
+HD_FN int hd_table_segment(float v, int n, HD_INOUT(float) f)
+{
+    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
+    int i = hd_mini(HD_I(t), n - 2);
+    HD_DEREF(f) = t - HD_F(i);
+    return i * 4;
+}
+#define HD_TABLE_LERP(buf, a, f, k) (HD_GET1(buf, (a) + (k)) + (f) * (HD_GET1(buf, (a) + (k) + 4) - HD_GET1(buf, (a) + (k))))
+
 /* The transfer function: entries at i/(count-1), linearly interpolated; rgba. */
 HD_FN hd_v4 hd_tf(HD_KARGS float v)
 {
-    int n = HD_PRM(dims).w;
-    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
-    int i = hd_mini(HD_I(t), n - 2);
-    float f = t - HD_F(i);
-    int a = i * 4, b = a + 4;
-    return HD_V4(HD_GET1(tf, a) + f * (HD_GET1(tf, b) - HD_GET1(tf, a)),
-                 HD_GET1(tf, a + 1) + f * (HD_GET1(tf, b + 1) - HD_GET1(tf, a + 1)),
-                 HD_GET1(tf, a + 2) + f * (HD_GET1(tf, b + 2) - HD_GET1(tf, a + 2)),
-                 HD_GET1(tf, a + 3) + f * (HD_GET1(tf, b + 3) - HD_GET1(tf, a + 3)));
+    float f;
+    int a = hd_table_segment(v, HD_PRM(dims).w, HD_REF(f));
+    return HD_V4(HD_TABLE_LERP(tf, a, f, 0), HD_TABLE_LERP(tf, a, f, 1), HD_TABLE_LERP(tf, a, f, 2), HD_TABLE_LERP(tf, a, f, 3));
 }
 
 /* 1 inside the crop box (params.crop_min/max), 0 outside, where matter is absent; crop_lo.w = 0

@@ -87,15 +87,10 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
    interpolated opacity differs from the exact one only by the exponential's curvature. */
 HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
 {
-    int n = HD_PTAB_N;
-    float t = hd_clampf(v, 0.0f, 1.0f) * HD_F(n - 1);
-    int i = hd_mini(HD_I(t), n - 2);
-    float f = t - HD_F(i);
-    int a = i * 4, b = a + 4;
-    return HD_V4(HD_GET1(ptab, a) + f * (HD_GET1(ptab, b) - HD_GET1(ptab, a)),
-                 HD_GET1(ptab, a + 1) + f * (HD_GET1(ptab, b + 1) - HD_GET1(ptab, a + 1)),
-                 HD_GET1(ptab, a + 2) + f * (HD_GET1(ptab, b + 2) - HD_GET1(ptab, a + 2)),
-                 HD_GET1(ptab, a + 3) + f * (HD_GET1(ptab, b + 3) - HD_GET1(ptab, a + 3)));
+    float f;
+    int a = hd_table_segment(v, HD_PTAB_N, HD_REF(f));
+    return HD_V4(HD_TABLE_LERP(ptab, a, f, 0), HD_TABLE_LERP(ptab, a, f, 1), HD_TABLE_LERP(ptab, a, f, 2),
+                 HD_TABLE_LERP(ptab, a, f, 3));
 }
 #endif
 
@@ -137,6 +132,17 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
     }
     HD_DEREF(T) *= keep;
 }
+
+/* HD_MARCH_SAMPLES: how the march below takes a non-empty cell's samples. `while` (the default)
+   runs them in a loop inside the walk over cells: the tight loop a processor running one ray at
+   a time wants. `if` takes one sample per iteration of the walk, a cell step in the iterations
+   without one, so rays that run in the lanes of one SIMD instruction stream (llvmpipe, lavapipe,
+   GPUs: the GLSL prelude picks it) stay in one loop whatever cell each is in; with `while` the
+   inner loop runs for as long as its slowest lane, once for every cell any lane steps through.
+   The samples, and their order, are the same either way. */
+#ifndef HD_MARCH_SAMPLES
+#define HD_MARCH_SAMPLES while
+#endif
 
 /* The samples sit at s0 + n dt from the ray's entry into the box, n counted (s0: the jitter), so
    the step advances however far the eye is; the chord is at most the box diagonal and n stays
@@ -186,39 +192,54 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     int skipped = 1;  /* the cells since the last sample were empty: n must catch up with se */
     int n = 0;
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
-    while (cells > 0) {
-        /* the axis whose face comes first, and whether stepping across it leaves the grid */
-        int ax = nx <= ny && nx <= nz ? 0 : (ny <= nz ? 1 : 2);
-        float sn = ax == 0 ? nx : (ax == 1 ? ny : nz);
-        int next = ax == 0 ? cx + sx : (ax == 1 ? cy + sy : cz + sz);
-        int last = next < 0 || next >= (ax == 0 ? md.x : (ax == 1 ? md.y : md.z)) ? 1 : 0;
-        float sc = last != 0 || !(sn < len) ? len : sn;
-        if (HD_GET1(maj, (cz * md.y + cy) * md.x + cx) > 0.0f) {
-            float s;
-            if (skipped != 0) {
-                float m = hd_floor((se - s0) * idt) + 1.0f;
-                if (se > s0) n = m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
-                skipped = 0;
+    int fresh = 1;    /* the current cell's exit and majorant are still to be read */
+    int occupied = 0, ax = 0, next = 0;
+    float sc = 0.0f, s = 0.0f;
+    for (;;) {
+        if (fresh != 0) {
+            /* the axis whose face comes first, and whether stepping across it leaves the grid */
+            float sn;
+            int last;
+            ax = nx <= ny && nx <= nz ? 0 : (ny <= nz ? 1 : 2);
+            sn = ax == 0 ? nx : (ax == 1 ? ny : nz);
+            next = ax == 0 ? cx + sx : (ax == 1 ? cy + sy : cz + sz);
+            last = next < 0 || next >= (ax == 0 ? md.x : (ax == 1 ? md.y : md.z)) ? 1 : 0;
+            sc = last != 0 || !(sn < len) ? len : sn;
+            occupied = HD_GET1(maj, (cz * md.y + cy) * md.x + cx) > 0.0f ? 1 : 0;
+            if (occupied != 0) {
+                if (skipped != 0) {
+                    float m = hd_floor((se - s0) * idt) + 1.0f;
+                    if (se > s0) n = m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
+                    skipped = 0;
+                }
+                s = s0 + HD_F(n) * dt;
+            } else {
+                skipped = 1;
             }
-            s = s0 + HD_F(n) * dt;
-            while (s < sc && n < HD_MAX_MARCH_STEPS) {
-                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T),
-                                  HD_REF(r), HD_REF(g), HD_REF(b));
+            fresh = 0;
+        }
+        /* the cell's samples: all of them in a loop (while), or one per iteration of the walk
+           (if: HD_MARCH_SAMPLES above) */
+        if (occupied != 0) {
+            HD_MARCH_SAMPLES (s < sc && n < HD_MAX_MARCH_STEPS) {
+                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r),
+                                  HD_REF(g), HD_REF(b));
                 if (T < HD_PRM(march).z) break;
                 ++n;
                 s = s0 + HD_F(n) * dt;
+                continue;
             }
-            if (T < HD_PRM(march).z) { T = 0.0f; break; }
-        } else {
-            skipped = 1;
+            if (T < HD_PRM(march).z) break; /* (while) the ray ended inside the cell */
         }
-        if (!(sc < len) || n >= HD_MAX_MARCH_STEPS) break;
+        if (!(sc < len) || n >= HD_MAX_MARCH_STEPS || cells <= 1) break;
         se = sc;
         if (ax == 0) { cx = next; nx += dx; }
         else if (ax == 1) { cy = next; ny += dy; }
         else { cz = next; nz += dz; }
         --cells;
+        fresh = 1;
     }
+    if (T < HD_PRM(march).z) T = 0.0f; /* the march stopped on it */
     hd_accumulate_pixel(HD_KPASS i, HD_V4(r + T * HD_PRM(background).x, g + T * HD_PRM(background).y,
                                           b + T * HD_PRM(background).z, 1.0f - T));
 }
