@@ -57,10 +57,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__cl_level {
-    int dims[3];
-    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    int kp_sent;             /* params holds kp */
-    cl_mem params;
+    cl_mem params;           /* the level's parameter block (src/hd_gpu.h's hd__gpu_level) */
     cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
     cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
 } hd__cl_level;
@@ -85,13 +82,12 @@ struct hd__backend {
     cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (ptab_n
+       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (ptab_n
        entries), uploaded when its inputs change (ptab_key) */
     cl_mem lsum, ptab;
-    int lsum_ok, ptab_n;
+    int ptab_n;
     hd__ptab_key ptab_key;
     size_t tf_bytes, img_floats;
-    int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
     int params_valid;
@@ -334,7 +330,7 @@ static cl_mem *hd__cl_grid(hd__backend *be, int id)
 static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
 {
     size_t n = id == HD__G_LSUM || id >= HD__G_LIGHT ? (size_t)w * h * d : hd__split_slots(w, h, (size_t)d);
-    int half = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2;
+    int half = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2;
     hd__cl_release(hd__cl_grid(ctx->be, id));
     return hd__cl_buffer(ctx, hd__cl_grid(ctx->be, id), half ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float), NULL, what);
 }
@@ -350,6 +346,19 @@ static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
 }
 
 /* ---- life cycle -------------------------------------------------------------------------- */
+/* The bracket of a public call (src/hd_backend.h): a lost device refused; each stage has waited
+   for its own work already (hd__cl_finish). */
+static hd_result hd__be_begin(hd__ctx *ctx)
+{
+    HD__CL_LOST_CHECK(ctx);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+{
+    (void)ctx;
+    return r;
+}
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -405,7 +414,6 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
     size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     if (tf_bytes != be->tf_bytes) {
         hd__cl_release(&be->tf);
         be->tf_bytes = 0;
@@ -436,7 +444,7 @@ static size_t hd__cl_slot(const hd__ctx *ctx, int x, int y, int zz)
 /* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
 static int hd__cl_k(const hd__ctx *ctx, int k)
 {
-    if (!ctx->be->f16) return k;
+    if (!ctx->be->gg.f16) return k;
     if (k == HD__CL_DIRECT) return HD__CL_DIRECT_HALF;
     if (k == HD__CL_PROJECT) return HD__CL_PROJECT_HALF;
     if (k == HD__CL_SUM_LIGHT) return HD__CL_SUM_LIGHT_HALF;
@@ -447,23 +455,15 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
 
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
-    HD__CL_LOST_CHECK(ctx);
-    ctx->be->lsum_ok = 0;
-    ctx->be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
 }
 
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
-{
-    HD__CL_LOST_CHECK(ctx);
-    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
-}
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable); }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     hd__cl_release(&be->img);
     be->img_floats = 0;
     if ((r = hd__cl_buffer(ctx, &be->img, hd__image_floats(width, height) * sizeof(float), NULL, "the image")) != HD_SUCCESS) return r;
@@ -475,9 +475,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
-    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
     return (what & HD__DIRTY_IMAGE) ? hd__cl_zero(ctx, be->img, be->img_floats) : HD_SUCCESS;
 }
 
@@ -487,7 +485,6 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 static hd_result hd__cl_send_params(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    HD__CL_LOST_CHECK(ctx);
     if (!be->params_valid || memcmp(&be->params_sent, &ctx->kp, sizeof ctx->kp) != 0) {
         HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof ctx->kp, &ctx->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
         be->params_sent = ctx->kp;
@@ -606,7 +603,7 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd_result r;
     int k = hd__cl_k(ctx, HD__CL_DIRECT);
     cl_int count = (cl_int)ctx->dl_count;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     HD__CL_ARG(ctx, k, 10, count);
     if ((r = hd__cl_mems(ctx, k, 9, 1, ctx->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS)
         return r;
@@ -619,7 +616,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
     hd_result r;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(ctx, k, ctx->gdims, ctx->channels, 9, 0, 2)) != HD_SUCCESS)
         return r;
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
@@ -634,12 +631,12 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
     int n = hd__project_table_n(ctx), k = hd__cl_k(ctx, HD__CL_LIGHT_SUM);
     float *t;
     hd_result r;
-    if (!be->lsum_ok) {
+    if (!be->gg.lsum_ok) {
         if ((r = hd__cl_mems(ctx, k, 9, 1, be->lsum)) != HD_SUCCESS ||
             (r = hd__cl_bind_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1],
                                  (size_t)ctx->gdims[2] * (size_t)ctx->channels)) != HD_SUCCESS)
             return r;
-        be->lsum_ok = 1;
+        be->gg.lsum_ok = 1;
     }
     if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
     if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
@@ -673,7 +670,6 @@ static hd_result hd__be_project(hd__ctx *ctx)
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 {
     hd__backend *be = ctx->be;
-    HD__CL_LOST_CHECK(ctx);
     HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(image)");
     return HD_SUCCESS;
@@ -685,7 +681,7 @@ static hd_result hd__cl_map_illumination(hd__ctx *ctx, hd_illumination which, cl
     hd__backend *be = ctx->be;
     cl_int e;
     *out = clEnqueueMapBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, flags, 0,
-                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
+                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->gg.f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
     if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
     return HD_SUCCESS;
 }
@@ -709,14 +705,13 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
     unsigned char *m;
     void *mv;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     if ((r = hd__cl_map_illumination(ctx, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
     m = (unsigned char *)mv;
     for (k = 0; k < nz; ++k)
         for (zz = list ? list[k] : k, y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__cl_slot(ctx, x, y, zz);
-                if (be->f16) {
+                if (be->gg.f16) {
                     uint16_t v;
                     if (src != NULL) { v = hd_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
                     else { memcpy(&v, m + 2 * s, 2); *dst++ = hd_h2f(v); }
@@ -728,12 +723,7 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
     return hd__cl_unmap_illumination(ctx, which, mv);
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
-{
-    return hd__cl_copy_illumination(ctx, which, NULL, dst, NULL, 0);
-}
-
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
     return hd__cl_copy_illumination(ctx, which, NULL, dst, zz, count);
 }
@@ -741,16 +731,12 @@ static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination w
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__cl_copy_illumination(ctx, which, src, NULL, NULL, 0);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
-{
-    HD__CL_LOST_CHECK(ctx);
-    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
-}
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count); }
 
 /* One convection step of light `light`: reads its volume, writes the spare, the two swap. */
 static hd_result hd__be_convect(hd__ctx *ctx, int light)
@@ -774,7 +760,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     int k = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
     hd_result r;
     int l;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
     for (l = 0; l < be->gg.nlv; ++l) {
         cl_int li = l, first = l == 0;
@@ -837,7 +823,7 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     return b;
 }
 
-/* The levels' dims and parameter blocks, the row sums (device and host) and the row buffer. */
+/* The levels' parameter blocks, the row sums (device and host) and the row buffer. */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
@@ -848,8 +834,6 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     for (l = 0; l < be->gg.levels; ++l) {
         hd__cl_level *L = &mg->lv[l];
         hd__cl_release(&L->params);
-        L->kp_sent = 0;
-        hd__mg_level_dims(be->gg.fine, l, L->dims);
         if (make && r == HD_SUCCESS) r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters");
     }
     hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b); hd__cl_release(&mg->line);
@@ -864,15 +848,10 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     return hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(&be->gg) * sizeof(float), NULL, "multigrid's row buffer");
 }
 
-/* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
-static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 {
-    hd__cl_level *L = &ctx->be->mg.lv[l];
-    hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-    if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, L->params, CL_TRUE, 0, sizeof kp, &kp, 0, NULL, NULL), "clEnqueueWriteBuffer(multigrid level parameters)");
-    L->kp = kp;
-    L->kp_sent = 1;
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, ctx->be->mg.lv[l].params, CL_TRUE, 0, sizeof *kp, kp, 0, NULL, NULL),
+               "clEnqueueWriteBuffer(multigrid level parameters)");
     return HD_SUCCESS;
 }
 
@@ -883,7 +862,7 @@ static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->
    buffers following n. */
 static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n, ...)
 {
-    const int *d = ctx->be->mg.lv[l].dims;
+    const int *d = ctx->be->gg.lv[l].dims;
     va_list ap;
     hd_result r;
     va_start(ap, n);
@@ -895,7 +874,7 @@ static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n,
 /* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
 static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
 {
-    return hd__cl_colour_passes(ctx, k, ctx->be->mg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
+    return hd__cl_colour_passes(ctx, k, ctx->be->gg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
 }
 
 /* n colour passes of kernel k with level l bound to its nine HD__CL_BUFFERS arguments: sigma_t,
@@ -935,8 +914,8 @@ static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
         return r;
     for (parity = 0; parity < 2; ++parity) {
         HD__CL_ARG(ctx, HD__CL_MG_RESTRICT_LINE, 4, parity);
-        if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
-                            (size_t)C->dims[2] * (size_t)g->channels)) != HD_SUCCESS)
+        if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)g->lv[l].dims[0] + 1) / 2,
+                            (size_t)g->lv[l + 1].dims[1], (size_t)g->lv[l + 1].dims[2] * (size_t)g->channels)) != HD_SUCCESS)
             return r;
     }
     return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, g->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
@@ -976,15 +955,10 @@ static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
-    hd__backend *be = ctx->be;
     hd_result r;
-    int l;
-    HD__CL_LOST_CHECK(ctx);
-    if (!be->fp64)
+    if (!ctx->be->fp64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
-    for (l = 0; l < be->gg.levels; ++l)
-        if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_mg_begin(ctx, &ctx->be->gg, fresh)) != HD_SUCCESS) return r;
     return hd__cl_send_params(ctx);
 }
 
@@ -1056,7 +1030,7 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 {
     hd__backend *be = ctx->be;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
     return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->gg.channels, 4, be->mg.lv[0].params, be->phi, be->mg.lo, be->mg.p);
 }
@@ -1065,7 +1039,7 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     hd__backend *be = ctx->be;
     cl_int c = colour;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
     return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->gg.channels, 5, be->params, be->sig, be->E, be->phi, be->mg.lo);
 }

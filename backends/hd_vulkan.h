@@ -130,8 +130,6 @@ enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG
 #define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
 
 typedef struct hd__vk_level {
-    int dims[3];
-    hd__kparams kp;           /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
     hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
     hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
     /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
@@ -196,7 +194,6 @@ struct hd__backend {
     hd__vk_buffer tf, maj, img, staging, dummy_buffer;
     hd__vk_buffer dl;             /* the direct light's list of voxels (ctx->dl_idx), binding 12 */
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
-    int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
     hd__gpu_grids gg;             /* what the grids are made for (src/hd_gpu.h) */
@@ -205,12 +202,12 @@ struct hd__backend {
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (binding 13,
+       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (binding 13,
        host-visible, ptab_cap entries, sized with the TF), written when its inputs change
        (ptab_key) */
     hd__vk_image lsum;
     hd__vk_buffer ptab;
-    int lsum_ok, ptab_n, ptab_cap;
+    int ptab_n, ptab_cap;
     hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
@@ -262,10 +259,10 @@ static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int lin
          if (hd__e < 0) return hd__vk_fail((ctx), hd__e, (name), __LINE__); } while (0)
 #define HD__VK_LOST_CHECK(ctx) \
     do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
-/* HD__VK_LOST_CHECK, then what the backend recorded submitted and waited for (hd__vk_flush), so
-   nothing is in flight; returns from the calling function on failure. */
+/* What the backend recorded submitted and waited for (hd__vk_flush), so nothing is in flight;
+   returns from the calling function on failure. */
 #define HD__VK_IDLE(ctx) \
-    do { hd_result hd__r; HD__VK_LOST_CHECK(ctx); if ((hd__r = hd__vk_flush(ctx)) != HD_SUCCESS) return hd__r; } while (0)
+    do { hd_result hd__r = hd__vk_flush(ctx); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
 
 /* The validation layer's messages: logged as errors and counted (the tests fail on any). */
 static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -772,7 +769,7 @@ static void hd__gpu_grid_free(hd__ctx *ctx, int id)
 }
 static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
 {
-    VkFormat fmt = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
+    VkFormat fmt = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
     hd__gpu_grid_free(ctx, id);
     return hd__vk_image_new_as(ctx, hd__vk_grid(ctx->be, id), w, h, d, fmt, what);
 }
@@ -963,7 +960,7 @@ static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    if (!be->f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
+    if (!be->gg.f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
         *out = be->pipelines[p];
         return HD_SUCCESS;
     }
@@ -980,17 +977,17 @@ static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
-        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi && be->diffuse_half[i] == be->f16) {
+        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi && be->diffuse_half[i] == be->gg.f16) {
             *out = be->diffuse[i];
             return HD_SUCCESS;
         }
     if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag, solver and precision combinations for the diffusion stage",
                        HD__VK_DIFFUSE_VARIANTS);
-    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->gg.f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
     be->diffuse_flags[be->ndiffuse] = flags;
     be->diffuse_jacobi[be->ndiffuse] = jacobi;
-    be->diffuse_half[be->ndiffuse] = be->f16;
+    be->diffuse_half[be->ndiffuse] = be->gg.f16;
     *out = be->diffuse[be->ndiffuse++];
     return HD_SUCCESS;
 }
@@ -1136,7 +1133,7 @@ static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buf
             w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
             w[i].pBufferInfo = &bi[i];
         } else {
-            const hd__vk_image *x = im[i] && im[i]->image ? im[i] : be->f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
+            const hd__vk_image *x = im[i] && im[i]->image ? im[i] : be->gg.f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
             ii[i].sampler = VK_NULL_HANDLE;
             ii[i].imageView = x->view;
             ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
@@ -1254,7 +1251,6 @@ static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pi
 static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
 {
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (!ctx->be->sets_valid) {
         if (ctx->be->rec)
             return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: resources changed while recording (internal error)");
@@ -1265,6 +1261,15 @@ static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
 }
 
 /* ---- life cycle -------------------------------------------------------------------------------- */
+/* The bracket of a public call (src/hd_backend.h): a lost device refused; at the end, what is
+   still recorded (a clear, a new grid's zeroing) submitted and waited for. */
+static hd_result hd__be_begin(hd__ctx *ctx)
+{
+    HD__VK_LOST_CHECK(ctx);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r) { return r != HD_SUCCESS ? r : hd__vk_flush(ctx); }
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1469,23 +1474,18 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__backend *be = ctx->be;
     hd_result r;
     HD__VK_IDLE(ctx);
-    be->lsum_ok = 0;
     be->sets_valid = 0; /* the placeholders bound for absent E / phi / phi2 follow the precision */
     if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) { /* after hd_set_params */
         hd__gpu_alloc_illumination(ctx, &be->gg, 0);
         return r;
     }
-    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    if ((r = hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats);
 }
 
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
-    hd_result r;
     HD__VK_IDLE(ctx);
-    if ((r = hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
 }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height)
@@ -1511,15 +1511,13 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img.buffer) {
         if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
     }
-    return hd__vk_flush(ctx);
+    return HD_SUCCESS;
 }
 
 /* ---- stages ------------------------------------------------------------------------------------ */
@@ -1562,7 +1560,7 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__vk_stage(ctx, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
 }
 
@@ -1579,7 +1577,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int nz = nzb * ctx->channels;
     VkPipeline pipe;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
@@ -1604,7 +1602,6 @@ static hd_result hd__be_project(hd__ctx *ctx)
     VkPipeline sum, proj;
     int n = hd__project_table_n(ctx);
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
                        n);
@@ -1616,10 +1613,10 @@ static hd_result hd__be_project(hd__ctx *ctx)
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
         (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)
         return r;
-    if (!be->lsum_ok) {
+    if (!be->gg.lsum_ok) {
         r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0);
         if (r != HD_SUCCESS) return r;
-        be->lsum_ok = 1;
+        be->gg.lsum_ok = 1;
     }
     if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
@@ -1646,33 +1643,23 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
-    HD__VK_LOST_CHECK(ctx);
-    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, NULL, 0);
-}
-
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
-{
-    HD__VK_LOST_CHECK(ctx);
     return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, zz, count);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
 HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    HD__VK_LOST_CHECK(ctx);
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__vk_upload_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
 static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 {
-    hd_result r;
     HD__VK_IDLE(ctx);
-    if ((r = hd__gpu_alloc_lights(ctx, &ctx->be->gg, count)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
 }
 
 /* One convection step of light `light`: its volume -> the spare, copied back (the CPU backend
@@ -1696,7 +1683,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     hd_result r;
     int l;
     VkPipeline pipe;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     for (l = 0; l < ctx->be->gg.nlv; ++l)
@@ -1730,8 +1717,8 @@ static hd_result hd__be_path(hd__ctx *ctx)
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
 
-/* The levels' dims, the row-sum buffers, the parameter slots and the set pool; nothing of theirs
-   may be in flight when they are freed (each step ends waited for). */
+/* The row-sum buffers, the parameter slots and the set pool; nothing of theirs may be in flight
+   when they are freed (each step ends waited for). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
@@ -1739,8 +1726,6 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
-    int l;
-    for (l = 0; l < be->gg.levels; ++l) hd__mg_level_dims(be->gg.fine, l, mg->lv[l].dims);
     hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
     if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
     mg->pool = VK_NULL_HANDLE;
@@ -1820,20 +1805,12 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Every level's parameter block (the CPU's hd__cpu_mg_params) and the fine one into their slots
-   (nothing is in flight: each step ends waited for). */
-static void hd__vk_mg_params(hd__ctx *ctx)
+/* Parameter block kp into slot l (level l's; slot `levels`: the fine one). Nothing is in flight:
+   each step ends waited for. */
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    int l;
-    for (l = 0; l < g->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l];
-        hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-        L->kp = kp;
-        memcpy((char *)mg->params.map + (size_t)l * mg->slot_bytes, &kp, sizeof kp);
-    }
-    memcpy((char *)mg->params.map + (size_t)g->levels * mg->slot_bytes, &ctx->kp, sizeof ctx->kp);
+    memcpy((char *)ctx->be->mg.params.map + (size_t)l * ctx->be->mg.slot_bytes, kp, sizeof *kp);
+    return HD_SUCCESS;
 }
 
 /* The flags the passes' pipelines are specialized for: RGB scattering and the boundary (the
@@ -1887,7 +1864,7 @@ static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, in
    level's dims, or with dims_pc 0 zeros, and channels). */
 static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int l, int channels, int dims_pc)
 {
-    const int *d = ctx->be->mg.lv[l].dims;
+    const int *d = ctx->be->gg.lv[l].dims;
     return hd__vk_mg_pass(ctx, stage, set, slot, d[0], d[1], d[2] * channels, dims_pc ? d[0] : 0, dims_pc ? d[1] : 0,
                           dims_pc ? d[2] : 0, channels);
 }
@@ -1904,9 +1881,9 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd__vk_level *L = &be->mg.lv[l];
-    int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
-    int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
+    const int *d = be->gg.lv[l].dims;
+    int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int32_t flags = be->gg.lv[l].kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
     uint32_t offset = (uint32_t)((VkDeviceSize)l * be->mg.slot_bytes);
     VkPipeline pipe;
     hd_result r;
@@ -1916,7 +1893,7 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
             pc[0] = first ^ h; pc[1] = 0; pc[2] = nzb; pc[3] = 0;
-            hd__vk_record_dispatch(be, cb, pipe, L->smooth, offset, (L->dims[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
+            hd__vk_record_dispatch(be, cb, pipe, be->mg.lv[l].smooth, offset, (d[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
         }
     return HD_SUCCESS;
 }
@@ -1955,15 +1932,14 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (be->no_f64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
                        be->no_f64);
     if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
-    hd__vk_mg_params(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS || (r = hd__gpu_mg_begin(ctx, &be->gg, fresh)) != HD_SUCCESS ||
+        (r = hd__gpu_mg_send(ctx, be->gg.levels, &ctx->kp)) != HD_SUCCESS)
+        return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
     return hd__vk_mg_sets(ctx);
 }
@@ -2043,7 +2019,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
     uint64_t u;
     int i;
     /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     memcpy(&u, &alpha, sizeof u);
     for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
     return hd__vk_mg_fine(ctx, HD__MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
@@ -2053,7 +2029,7 @@ static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
 static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 {
     struct hd__vk_mg *mg = &ctx->be->mg;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__vk_mg_fine(ctx, HD__MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
 }
 
@@ -2062,18 +2038,36 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { r
 
 /* ---- recording into the caller's command buffer ------------------------------------------------ */
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
-static hd_result hd__prepare(hd__ctx *ctx);
 static hd_result hd__iterate_method(hd__ctx *ctx);
+
+/* n iterations recorded into cb after hd__prepare's work is submitted and waited for: only
+   iterations are recorded, each with its own parameter slots. */
+static hd_result hd__vk_record(hd__ctx *ctx, VkCommandBuffer cb, int n)
+{
+    hd__backend *be = ctx->be;
+    hd_result r;
+    int i;
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    /* light, frame and a reduced frame's upsample pass (params.render_scale) */
+    if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
+    be->next_slot = 0;
+    be->have_slot = 0;
+    be->rec = cb;
+    ctx->no_measure = 1;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__iterate_method(ctx);
+    ctx->no_measure = 0;
+    if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
+    be->rec = VK_NULL_HANDLE;
+    return r;
+}
 
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
     hd_logger stale;
     hd__ctx *ctx = hd__lookup(h, &stale);
-    hd__backend *be;
-    hd_result r = HD_SUCCESS;
-    int i;
+    hd_result r;
     if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
-    be = ctx->be;
     if (!command_buffer) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
     if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
@@ -2082,20 +2076,6 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
         (ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD))
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
                        "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
-    /* uploads, allocations and clears are submitted and waited for here; only iterations are
-       recorded, each with its own parameter slot */
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    /* light, frame and a reduced frame's upsample pass (params.render_scale) */
-    if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
-    be->next_slot = 0;
-    be->have_slot = 0;
-    be->rec = (VkCommandBuffer)command_buffer;
-    ctx->no_measure = 1;
-    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__iterate_method(ctx);
-    ctx->no_measure = 0;
-    if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
-    be->rec = VK_NULL_HANDLE;
+    HD__BE_CALL(r, ctx, hd__vk_record(ctx, (VkCommandBuffer)command_buffer, n));
     return r;
 }

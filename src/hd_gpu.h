@@ -28,12 +28,27 @@ HD__MAYBE_UNUSED static const char *const hd__mg_stage_names[HD__MG_STAGES] = {
     "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
     "multigrid extrapolation"};
 
-/* What the grids are made for: E and phi's values (0: none, the path tracers), CD's lights and
-   the multigrid's levels (0: none) on fine grid `fine` with channels and sig_channels. */
+/* A multigrid level as every GPU backend sees it: the dims of its grids, and its parameter block
+   (the fine parameters with its dims, 1 / h^2, h and the rhs flag: hd__mg_level_kp) as last
+   given to the backend (kp_sent). */
+typedef struct hd__gpu_level {
+    int dims[3];
+    hd__kparams kp;
+    int kp_sent;
+} hd__gpu_level;
+
+/* What the grids are made for: E and phi's values (0: none, the path tracers) and their storage
+   (f16: E, phi and phi2 at float16, params.illumination_precision), CD's lights and the
+   multigrid's levels (0: none; lv[0..levels)) on fine grid `fine` with channels and
+   sig_channels. lsum_ok: the projection's summed light (HD__G_LSUM) holds E + phi; the backend
+   clears it with every pass that writes E or phi, hd__gpu_alloc_illumination and hd__gpu_clear
+   with theirs. */
 typedef struct hd__gpu_grids {
     size_t illum_floats;
+    int f16, lsum_ok;
     int nlv;
     int levels, channels, sig_channels, fine[3];
+    hd__gpu_level lv[HD__MG_MAX_LEVELS];
 } hd__gpu_grids;
 
 /* The multigrid's fine rows (a row sum each): y, z and channels. */
@@ -51,6 +66,8 @@ static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id);
 /* The backend's own multigrid objects for the levels its hd__gpu_grids describes: made (make =
    1; on failure hd__gpu_mg_free follows) or freed (make = 0, also when partly made). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make);
+/* Gives level l's parameter block kp to the device (level l's buffer or slot of the extras). */
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp);
 
 /* ---- the life cycle, for the backends' hd__be_alloc_* and hd__be_clear ---------------------- */
 /* Frees the multigrid's levels, vectors and extras. */
@@ -70,7 +87,7 @@ static void hd__gpu_mg_free(hd__ctx *ctx, hd__gpu_grids *g)
    anew, zeroed, with the backend's extras (*fresh = 1). */
 static hd_result hd__gpu_mg_ready(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
 {
-    int l, n, d[3];
+    int l, n;
     hd_result r;
     if (g->levels && hd__mg_stale(ctx, g->fine, g->channels, g->sig_channels)) hd__gpu_mg_free(ctx, g);
     *fresh = !g->levels;
@@ -82,7 +99,9 @@ static hd_result hd__gpu_mg_ready(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
     r = hd__gpu_grid_new(ctx, HD__G_MG_P, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's p");
     if (r == HD_SUCCESS) r = hd__gpu_grid_new(ctx, HD__G_MG_LO, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's lo");
     for (l = 0, n = hd__mg_levels(g->fine); l < n && r == HD_SUCCESS; ++l) {
-        hd__mg_level_dims(g->fine, l, d);
+        const int *d = g->lv[l].dims;
+        hd__mg_level_dims(g->fine, l, g->lv[l].dims);
+        g->lv[l].kp_sent = 0;
         g->levels = l + 1;
         if ((r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_RHS), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
                 HD_SUCCESS &&
@@ -95,6 +114,23 @@ static hd_result hd__gpu_mg_ready(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
     }
     if (r == HD_SUCCESS) r = hd__gpu_mg_extras(ctx, 1);
     if (r != HD_SUCCESS) hd__gpu_mg_free(ctx, g);
+    return r;
+}
+
+/* hd__be_mg_begin's common part: the levels made or kept (hd__gpu_mg_ready), and each level's
+   parameter block for ctx->kp sent where it changed (hd__gpu_mg_send). */
+static hd_result hd__gpu_mg_begin(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
+{
+    hd_result r = hd__gpu_mg_ready(ctx, g, fresh);
+    int l;
+    for (l = 0; l < g->levels && r == HD_SUCCESS; ++l) {
+        hd__gpu_level *L = &g->lv[l];
+        hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
+        if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) continue;
+        if ((r = hd__gpu_mg_send(ctx, l, &kp)) != HD_SUCCESS) break;
+        L->kp = kp;
+        L->kp_sent = 1;
+    }
     return r;
 }
 
@@ -116,6 +152,8 @@ static hd_result hd__gpu_alloc_illumination(hd__ctx *ctx, hd__gpu_grids *g, size
     hd__gpu_mg_free(ctx, g); /* its fine grid is this one */
     for (id = HD__G_SIG; id <= HD__G_LSUM; ++id) hd__gpu_grid_free(ctx, id);
     g->illum_floats = 0;
+    g->lsum_ok = 0;
+    g->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     if (illum_floats == 0) return HD_SUCCESS;
     if ((r = hd__gpu_grid_new(ctx, HD__G_SIG, gd[0], gd[1], gd[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS ||
         (r = hd__gpu_grid_new(ctx, HD__G_E, gd[0], gd[1], gd[2] * ctx->channels, "E")) != HD_SUCCESS ||
@@ -165,9 +203,10 @@ static void hd__gpu_free(hd__ctx *ctx, hd__gpu_grids *g)
 }
 
 /* hd__be_clear's grids: E (HD__DIRTY_DIRECT), phi and phi2 (HD__DIRTY_PHI) zeroed. */
-static hd_result hd__gpu_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__gpu_clear(hd__ctx *ctx, hd__gpu_grids *g, unsigned what)
 {
     hd_result r = HD_SUCCESS;
+    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) g->lsum_ok = 0;
     if (what & HD__DIRTY_DIRECT) r = hd__gpu_grid_zero(ctx, HD__G_E);
     if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI);
     if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI2);
