@@ -1054,8 +1054,9 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
    residual and CG's p and lo are r32f 3D textures like the backend's own; the double passes are
    GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
    storage buffer 3) and the rows in row order by the core, as on the CPU. */
-/* Bytes the solver holds on the GPU (counted in method_bytes); 0 without it. */
+/* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
 /* The levels' parameter buffers and the row sums (device and host). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
@@ -1088,9 +1089,6 @@ static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
     return hd__gl_check(ctx, "multigrid level parameters", __LINE__);
 }
 
-/* Level l's sigma_t. */
-static const hd__gl_tex *hd__gl_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
-
 /* The program of multigrid stage `stage` for the flags in counts_z (RGB, surface), compiled on
    first use: hd__gl_source up to hd_entry_glsl.h, then hd_entry_glsl_multigrid.h. */
 static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint *out)
@@ -1119,105 +1117,58 @@ static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint
     return HD_SUCCESS;
 }
 
-/* Runs multigrid stage `stage` (flags of ctx->kp) with parameter block params, image units 1..4
-   and 6 (unit 6: the other grid, hd_entry_glsl_multigrid.h), over nx x ny x nz, hd_pc = pc. */
-static hd_result hd__gl_mg_pass(hd__ctx *ctx, int stage, GLuint params, const hd__gl_tex *sig, const hd__gl_tex *E,
-                                const hd__gl_tex *phi, const hd__gl_tex *phi2, const hd__gl_tex *other, int nx, int ny,
-                                int nz, int pc_x, int pc_y, int pc_z, int pc_w)
+/* Set `set`'s grids (src/hd_gpu.h) on image units 1..4 and 6, its row sums on storage buffer 3,
+   and parameter slot `slot`: level slot's buffer, or the backend's own for the fine ctx->kp. */
+static void hd__gl_mg_binds(hd__ctx *ctx, int set, int slot, hd__gl_binds *b)
+{
+    static const int unit[5] = {1, 2, 3, 4, 6};
+    hd__backend *be = ctx->be;
+    hd__gpu_mg_binds s;
+    int i;
+    memset(b, 0, sizeof *b);
+    hd__gpu_mg_set(&be->gg, set, &s);
+    b->params = slot == be->gg.levels ? be->params : be->mg.lv[slot].params;
+    b->img[0] = &be->vol;
+    for (i = 0; i < 5; ++i) b->img[unit[i]] = s.grid[i] < 0 ? NULL : hd__gl_grid(be, s.grid[i]);
+    if (s.dot) be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.dot == 1 ? be->mg.dot_a : be->mg.dot_b);
+}
+
+/* Runs pass p with the program of its stage for the flags of ctx->kp; the direction's beta and
+   the update's alpha are the uniforms at locations 1 and 2 (hd_entry_glsl_multigrid.h). */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
     hd__backend *be = ctx->be;
     hd__gl_binds b;
     GLuint prog;
     hd_result r;
-    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
-    memset(&b, 0, sizeof b);
-    b.params = params;
-    b.img[0] = &be->vol; b.img[1] = sig; b.img[2] = E; b.img[3] = phi; b.img[4] = phi2; b.img[6] = other;
-    return hd__gl_run(ctx, prog, hd__mg_stage_names[stage - 1], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
-}
-
-/* Sets the direction's beta or the update's alpha (hd_entry_glsl_multigrid.h, locations 1, 2) on
-   stage's program. */
-static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double alpha)
-{
-    hd__backend *be = ctx->be;
-    GLuint prog;
-    hd_result r;
-    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
-    if (stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, beta);
-    else be->gl.ProgramUniform1d(prog, 2, alpha);
-    return hd__gl_check(ctx, "multigrid's uniforms", __LINE__);
+    if ((r = hd__gl_mg_program(ctx, p->stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
+    if (p->stage == HD__MG_DIR || p->stage == HD__MG_UPDATE) {
+        if (p->stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, p->beta);
+        else be->gl.ProgramUniform1d(prog, 2, p->alpha);
+        if ((r = hd__gl_check(ctx, "multigrid's uniforms", __LINE__)) != HD_SUCCESS) return r;
+    }
+    hd__gl_mg_binds(ctx, p->set, p->slot, &b);
+    return hd__gl_run(ctx, prog, hd__mg_stage_names[p->stage - 1], &b, p->n[0], p->n[1], p->n[2], p->pc[0], p->pc[1], p->pc[2],
+                      p->pc[3]);
 }
 
 /* Level l's smoothing: the diffusion program (HD_FLAG_DIFFUSE_RHS variant) on its parameter block. */
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l];
     const int *d = be->gg.lv[l].dims;
     int slot = hd__gl_diffuse_slot(be->gg.lv[l].kp.counts.z), s, h;
     int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     hd__gl_binds b;
     hd_result r;
     if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
-    memset(&b, 0, sizeof b);
-    b.params = L->params;
-    b.img[0] = &be->vol; b.img[1] = hd__gl_mg_sig(be, l); b.img[2] = &L->rhs; b.img[3] = &L->phi; b.img[4] = &L->res;
+    hd__gl_mg_binds(ctx, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, &b);
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h)
             if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (d[0] + 1) / 2, ny,
                                 nzb * be->gg.channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l];
-    const int *d = be->gg.lv[l].dims, ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, d[0], d[1],
-                          d[2] * ch, 0, 0, 0, ch);
-}
-
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    const int *d = be->gg.lv[l + 1].dims, ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, d[0], d[1],
-                          d[2] * ch, d[0], d[1], d[2], ch);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    const int *d = be->gg.lv[l].dims, ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, d[0], d[1],
-                          d[2] * ch, d[0], d[1], d[2], ch);
-}
-
-/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
-   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
-static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex *E, const hd__gl_tex *phi,
-                                   const hd__gl_tex *out, int use_lo, int negate)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    return hd__gl_mg_pass(ctx, HD__MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, use_lo, negate, 0, g->channels);
-}
-
-/* <a, b> per fine row into dot (storage buffer 3). */
-static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
-    return hd__gl_mg_pass(ctx, HD__MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, g->fine[1], g->fine[2] * g->channels, 1,
-                          0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1239,51 +1190,6 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
     return r;
 }
 
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    const int *d = g->lv[l].dims;
-    return hd__gl_mg_pass(ctx, HD__MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
-                          d[1], d[2] * g->sig_channels, d[0], d[1], d[2], g->sig_channels);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gl_tex_zero(ctx, &ctx->be->mg.lo); }
-
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    return hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &be->mg.lv[0].rhs, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    return hd__gl_mg_dot(ctx, &mg->lv[0].rhs, &mg->lv[0].phi, mg->dot_a);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    hd_result r;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
-}
-
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    hd__gl_level *L = &mg->lv[0];
-    hd_result r;
-    if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS ||
-        (r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a)) != HD_SUCCESS)
-        return r;
-    return hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b);
-}
-
 /* The row sums read into their host copy (glGetBufferSubData waits for the passes). */
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
@@ -1299,29 +1205,6 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     *a = mg->host_dot;
     *b = mg->host_dot + rows;
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    hd_result r;
-    be->gg.lsum_ok = 0;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
-}
-
-/* The fine parameters (no right-hand-side flag). */
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    be->gg.lsum_ok = 0;
-    return hd__gl_mg_pass(ctx, HD__MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, colour, 0, 0, g->channels);
 }
 
 /* The single-level solver's sweeps: each its own dispatches. */

@@ -855,22 +855,6 @@ static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
     return HD_SUCCESS;
 }
 
-/* Level l's sigma_t buffer. */
-static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg.lv[l].sig; }
-
-/* Kernel k over level l's voxels (channels of them stacked in z), its first n arguments the
-   buffers following n. */
-static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n, ...)
-{
-    const int *d = ctx->be->gg.lv[l].dims;
-    va_list ap;
-    hd_result r;
-    va_start(ap, n);
-    r = hd__cl_vmems(ctx, k, 0, n, ap);
-    va_end(ap);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)d[0], (size_t)d[1], (size_t)d[2] * (size_t)channels);
-}
-
 /* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
 static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
 {
@@ -884,7 +868,8 @@ static hd_result hd__cl_mg_level_passes(hd__ctx *ctx, int k, int l, int first, i
 {
     hd__backend *be = ctx->be;
     hd__cl_level *L = &be->mg.lv[l];
-    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, hd__cl_mg_sig(be, l), L->rhs, L->phi, L->res, be->img);
+    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, l == 0 ? be->sig : L->sig, L->rhs, L->phi, L->res,
+                              be->img);
     return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, l, 9, first, n);
 }
 
@@ -894,62 +879,69 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE), l, first, 2 * sweeps);
 }
 
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), l, 0, 2);
-}
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
-/* Each fine column's share of the coarse rows (both parities), then their sum per coarse voxel;
-   argument 5 of the first is the transfers' mask, the fine sigma_t (hd_mg_medium). */
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+/* Pass p on the kernels of hd_entry_cl.h, which take the grids of p's set (src/hd_gpu.h: m[0..4]
+   sigma_t, E, phi, phi2, other) and the parameter blocks each in its own order: the transfers
+   and the coarse sigma_t both levels' (slot's and p->level's), the others slot's alone. The
+   residuals and the prolongation run as colour passes; the restriction as each fine column's
+   share of the coarse rows (both parities, into the row buffer; argument 5 of that kernel is the
+   transfers' mask), then their sum per coarse voxel. */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = &be->mg;
-    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    hd_result r;
-    cl_int parity;
-    if ((r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 0, 4, L->params, C->params, L->res, mg->line)) != HD_SUCCESS ||
-        (r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 5, 1, hd__cl_mg_sig(be, l))) != HD_SUCCESS)
-        return r;
-    for (parity = 0; parity < 2; ++parity) {
-        HD__CL_ARG(ctx, HD__CL_MG_RESTRICT_LINE, 4, parity);
-        if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)g->lv[l].dims[0] + 1) / 2,
-                            (size_t)g->lv[l + 1].dims[1], (size_t)g->lv[l + 1].dims[2] * (size_t)g->channels)) != HD_SUCCESS)
+    const int *d = be->gg.lv[p->level].dims;
+    cl_mem m[5], par = p->slot == be->gg.levels ? be->params : mg->lv[p->slot].params, lp = mg->lv[p->level].params;
+    cl_int pc0 = p->pc[0], pc1 = p->pc[1];
+    hd__gpu_mg_binds b;
+    hd_result r = HD_SUCCESS;
+    int i, k;
+    hd__gpu_mg_set(&be->gg, p->set, &b);
+    for (i = 0; i < 5; ++i) m[i] = b.grid[i] < 0 ? NULL : *hd__cl_grid(be, b.grid[i]);
+    switch (p->stage) {
+    case HD__MG_SIG:
+        r = hd__cl_mems(ctx, k = HD__CL_MG_SIG, 0, 4, par, lp, m[0], m[4]);
+        break;
+    case HD__MG_RESIDUAL: /* the smoothing's bindings */
+        return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), p->level, 0, 2);
+    case HD__MG_RESTRICT:
+        k = HD__CL_MG_RESTRICT_LINE;
+        if ((r = hd__cl_mems(ctx, k, 0, 4, par, lp, m[2], mg->line)) != HD_SUCCESS || (r = hd__cl_mems(ctx, k, 5, 1, m[0])) != HD_SUCCESS)
             return r;
+        for (pc0 = 0; pc0 < 2 && r == HD_SUCCESS; ++pc0) {
+            HD__CL_ARG(ctx, k, 4, pc0);
+            r = hd__cl_run(ctx, k, 3, ((size_t)be->gg.lv[p->slot].dims[0] + 1) / 2, (size_t)d[1], (size_t)d[2] * (size_t)be->gg.channels);
+        }
+        if (r == HD_SUCCESS) r = hd__cl_mems(ctx, k = HD__CL_MG_RESTRICT, 0, 5, par, lp, mg->line, m[4], m[3]);
+        break;
+    case HD__MG_PROLONG:
+        if ((r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, lp, par, m[2], m[4])) == HD_SUCCESS)
+            r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, m[0]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, p->level, 4, 0, 2);
+    case HD__MG_RES_F64:
+        k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
+        HD__CL_ARG(ctx, k, 7, pc0);
+        HD__CL_ARG(ctx, k, 8, pc1);
+        r = hd__cl_mems(ctx, k, 0, 6, par, m[0], m[1], m[2], m[3], m[4]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
+    case HD__MG_DOT:
+        r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, par, m[1], m[2], b.dot == 1 ? mg->dot_a : mg->dot_b);
+        return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)p->n[0], (size_t)p->n[1], 1);
+    case HD__MG_DIR:
+        HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, p->beta);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_DIR, 0, 3, par, m[1], m[2]);
+        break;
+    case HD__MG_UPDATE:
+        HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, p->alpha);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_UPDATE, 0, 4, par, m[2], m[3], m[1]);
+        break;
+    default: /* HD__MG_EXTRAP */
+        HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, pc0);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_EXTRAP, 0, 5, par, m[0], m[1], m[2], m[3]);
+        break;
     }
-    return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, g->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__cl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    hd_result r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, L->params, C->params, C->phi, L->phi);
-    if (r == HD_SUCCESS) r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, hd__cl_mg_sig(be, l));
-    return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, l, 4, 0, 2);
-}
-
-/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
-   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
-static hd_result hd__cl_mg_res_f64(hd__ctx *ctx, cl_mem params, cl_mem E, cl_mem phi, cl_mem out, cl_int use_lo, cl_int negate)
-{
-    hd__backend *be = ctx->be;
-    int k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
-    hd_result r;
-    HD__CL_ARG(ctx, k, 7, use_lo);
-    HD__CL_ARG(ctx, k, 8, negate);
-    if ((r = hd__cl_mems(ctx, k, 0, 6, params, be->sig, E, phi, be->mg.lo, out)) != HD_SUCCESS) return r;
-    return hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
-}
-
-/* Enqueues <a, b> per fine row into dot (double per row). */
-static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    hd_result r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, mg->lv[0].params, a, b, dot);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)g->fine[1], (size_t)g->fine[2] * (size_t)g->channels, 1);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)p->n[0], (size_t)p->n[1], (size_t)p->n[2]);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -967,51 +959,6 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
     return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
 }
 
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = &be->mg;
-    return hd__cl_mg_pass(ctx, HD__CL_MG_SIG, l, ctx->be->gg.sig_channels, 4, mg->lv[l - 1].params, mg->lv[l].params,
-                          hd__cl_mg_sig(be, l - 1), mg->lv[l].sig);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(g->fine, g->channels));
-}
-
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    return hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, be->mg.lv[0].rhs, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    return hd__cl_mg_dot_rows(ctx, mg->lv[0].rhs, mg->lv[0].phi, mg->dot_a);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, beta);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_DIR, 0, ctx->be->gg.channels, 3, mg->lv[0].params, mg->lv[0].phi, mg->p);
-}
-
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    hd__cl_level *L = &mg->lv[0];
-    hd_result r;
-    if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS ||
-        (r = hd__cl_mg_dot_rows(ctx, mg->p, L->res, mg->dot_a)) != HD_SUCCESS)
-        return r;
-    return hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b);
-}
-
 /* The buffers read (blocking: after every pass enqueued before) into their host copies. */
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
 {
@@ -1025,21 +972,4 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     *a = mg->host_dot;
     *b = mg->host_dot + rows;
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    hd__backend *be = ctx->be;
-    be->gg.lsum_ok = 0;
-    HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->gg.channels, 4, be->mg.lv[0].params, be->phi, be->mg.lo, be->mg.p);
-}
-
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    hd__backend *be = ctx->be;
-    cl_int c = colour;
-    be->gg.lsum_ok = 0;
-    HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->gg.channels, 5, be->params, be->sig, be->E, be->phi, be->mg.lo);
 }

@@ -124,16 +124,9 @@ typedef struct hd__vk_image {
     int texel; /* bytes per texel: 2 (r16f), 4 (r32f), 8 (rg32f) */
 } hd__vk_image;
 
-/* CG's passes' sets (level 0 and the backend's grids) */
-enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
-       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
-#define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
-
 typedef struct hd__vk_level {
     hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
     hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
-    /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
-    VkDescriptorSet smooth, restrict_to, prolong_from, coarsen;
 } hd__vk_level;
 
 /* HD_SOLVER_MULTIGRID's objects besides the grids (hd__gpu_mg_extras) and its grids */
@@ -144,7 +137,7 @@ struct hd__vk_mg {
     hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
     VkDeviceSize slot_bytes;
     VkDescriptorPool pool;
-    VkDescriptorSet cg_sets[HD__VK_MG_CG_SETS];
+    VkDescriptorSet sets[HD__GPU_MG_SETS]; /* by src/hd_gpu.h's set numbers */
     unsigned sets_gen;        /* be->sets_gen the sets were written at */
     int sets_valid;
 };
@@ -1058,10 +1051,10 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     return HD_SUCCESS;
 }
 
-/* The most sets one pool holds: the backend's (a set per light); the multigrid's fit too (checked
-   where HD__VK_MG_SETS is defined). */
+/* The most sets one pool holds: the backend's (a set per light); the multigrid's
+   (HD__GPU_MG_SETS, src/hd_gpu.h) fit too. */
 #define HD__VK_POOL_SETS_MAX HD_MAX_LIGHTS
-typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
+typedef char hd__vk_mg_sets_fit_a_pool[HD__GPU_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 /* Empties `pool` and allocates n (<= HD__VK_POOL_SETS_MAX) sets of the backend's set layout from
    it into sets[]; reset_name and alloc_name name the calls in a failure's log line. */
@@ -1716,6 +1709,7 @@ static hd_result hd__be_path(hd__ctx *ctx)
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
 /* The row-sum buffers, the parameter slots and the set pool; nothing of theirs may be in flight
    when they are freed (each step ends waited for). */
@@ -1739,67 +1733,36 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
         (r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(be->gg.levels + 1),
                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
         return r;
-    return hd__vk_pool(ctx, HD__VK_MG_SETS, &mg->pool);
+    return hd__vk_pool(ctx, HD__GPU_MG_SETS, &mg->pool);
 }
 
-/* Level l's sigma_t. */
-static const hd__vk_image *hd__vk_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
-
-/* Writes one multigrid set: sigma_t, E, phi, phi2 (bindings 4..7), the other grid (10) and the
-   row sums (11); NULL binds a placeholder. */
-static void hd__vk_mg_write(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_image *sig, const hd__vk_image *E,
-                            const hd__vk_image *phi, const hd__vk_image *phi2, const hd__vk_image *other,
-                            const hd__vk_buffer *dot)
-{
-    hd__backend *be = ctx->be;
-    const hd__vk_image *im[HD__VK_BINDINGS];
-    const hd__vk_buffer *bu[HD__VK_BINDINGS];
-    memset(im, 0, sizeof im);
-    memset(bu, 0, sizeof bu);
-    hd__vk_common_buffers(be, bu, dot);
-    im[1] = &be->vol; im[4] = sig; im[5] = E; im[6] = phi; im[7] = phi2; im[10] = other;
-    hd__vk_write_set(ctx, set, &be->mg.params, im, bu);
-}
-
-/* Every pass's set (hd_gl.h's bindings per pass), written when the levels are new or the
-   backend's sets were rebuilt since (its grids may be new). Nothing is in flight. */
+/* Every pass's set (src/hd_gpu.h's hd__gpu_mg_set: sigma_t, E, phi, phi2 and the other grid at
+   bindings 4..7 and 10, the row sums at 11), written when the levels are new or the backend's
+   sets were rebuilt since (its grids may be new). Nothing is in flight. */
 static hd_result hd__vk_mg_sets(hd__ctx *ctx)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
+    static const int binding[5] = {4, 5, 6, 7, 10};
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = &be->mg;
-    VkDescriptorSet sets[HD__VK_MG_SETS];
-    hd__vk_level *L0 = &mg->lv[0];
     hd_result r;
-    int n = 4 * g->levels + HD__VK_MG_CG_SETS, i, l;
+    int n = HD__GPU_MG_CG(&be->gg, HD__GPU_MG_CG_SETS), s, i;
     if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
     mg->sets_valid = 0;
-    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, sets, "vkResetDescriptorPool (multigrid)",
+    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, mg->sets, "vkResetDescriptorPool (multigrid)",
                               "vkAllocateDescriptorSets (multigrid)")) != HD_SUCCESS)
         return r;
-    for (l = 0; l < g->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l], *C = l + 1 < g->levels ? &mg->lv[l + 1] : NULL;
-        L->smooth = sets[4 * l];
-        L->restrict_to = sets[4 * l + 1];
-        L->prolong_from = sets[4 * l + 2];
-        L->coarsen = sets[4 * l + 3];
-        hd__vk_mg_write(ctx, L->smooth, hd__vk_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, NULL);
-        if (C) {
-            /* both with the fine sigma_t: the transfers' mask (hd_mg_medium) */
-            hd__vk_mg_write(ctx, L->restrict_to, hd__vk_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, NULL);
-            hd__vk_mg_write(ctx, L->prolong_from, hd__vk_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, NULL);
-        }
-        if (l > 0) hd__vk_mg_write(ctx, L->coarsen, hd__vk_mg_sig(be, l - 1), NULL, NULL, NULL, &L->sig, NULL);
+    for (s = 0; s < n; ++s) {
+        const hd__vk_image *im[HD__VK_BINDINGS];
+        const hd__vk_buffer *bu[HD__VK_BINDINGS];
+        hd__gpu_mg_binds b;
+        if (!hd__gpu_mg_set(&be->gg, s, &b)) continue;
+        memset(im, 0, sizeof im);
+        memset(bu, 0, sizeof bu);
+        hd__vk_common_buffers(be, bu, b.dot == 1 ? &mg->dot_a : b.dot == 2 ? &mg->dot_b : NULL);
+        im[1] = &be->vol;
+        for (i = 0; i < 5; ++i) im[binding[i]] = b.grid[i] < 0 ? NULL : hd__vk_grid(be, b.grid[i]);
+        hd__vk_write_set(ctx, mg->sets[s], &mg->params, im, bu);
     }
-    for (i = 0; i < HD__VK_MG_CG_SETS; ++i) mg->cg_sets[i] = sets[4 * g->levels + i];
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], &be->sig, &be->E, &be->phi, &mg->lo, &L0->rhs, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], &be->sig, &L0->phi, &mg->p, &mg->lo, &L0->res, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RZ], NULL, &L0->rhs, &L0->phi, NULL, NULL, &mg->dot_a);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DIR], NULL, &L0->phi, &mg->p, NULL, NULL, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ], NULL, &mg->p, &L0->res, NULL, NULL, &mg->dot_a);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP], NULL, &L0->rhs, &mg->p, NULL, NULL, &mg->dot_b);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_UPDATE], NULL, &mg->p, &be->phi, &mg->lo, NULL, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_EXTRAP], &be->sig, &be->E, &be->phi, &mg->lo, NULL, NULL);
     mg->sets_gen = be->sets_gen;
     mg->sets_valid = 1;
     return HD_SUCCESS;
@@ -1844,36 +1807,28 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
     return HD_SUCCESS;
 }
 
-/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz into
-   the backend's command buffer. */
-static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int nx, int ny, int nz, int32_t pc0,
-                                int32_t pc1, int32_t pc2, int32_t pc3)
+/* Records pass p into the backend's command buffer with its set and parameter slot; the
+   direction's beta (its bits) and the update's alpha (low and high words: packDouble2x32's x and
+   y; the host's byte order is the device's) in hd_pc.x and .y. */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     int32_t pc[4];
+    uint64_t u;
     hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
-    pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
-    hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg.slot_bytes), nx, ny, nz, pc);
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, p->stage, &pipe)) != HD_SUCCESS) return r;
+    memcpy(pc, p->pc, sizeof pc);
+    if (p->stage == HD__MG_DIR) memcpy(&pc[0], &p->beta, sizeof p->beta);
+    if (p->stage == HD__MG_UPDATE) {
+        memcpy(&u, &p->alpha, sizeof u);
+        pc[0] = (int32_t)(uint32_t)u;
+        pc[1] = (int32_t)(uint32_t)(u >> 32);
+    }
+    hd__vk_record_dispatch(be, cb, pipe, be->mg.sets[p->set], (uint32_t)((VkDeviceSize)p->slot * be->mg.slot_bytes), p->n[0],
+                           p->n[1], p->n[2], pc);
     return HD_SUCCESS;
-}
-
-/* Pass `stage` over level l's grid of `channels` channels stacked in z, push constants (the
-   level's dims, or with dims_pc 0 zeros, and channels). */
-static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int l, int channels, int dims_pc)
-{
-    const int *d = ctx->be->gg.lv[l].dims;
-    return hd__vk_mg_pass(ctx, stage, set, slot, d[0], d[1], d[2] * channels, dims_pc ? d[0] : 0, dims_pc ? d[1] : 0,
-                          dims_pc ? d[2] : 0, channels);
-}
-
-/* Pass `stage` over the fine grid, push constants (pc0, pc1, 0, channels). */
-static hd_result hd__vk_mg_fine(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int32_t pc0, int32_t pc1)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    return hd__vk_mg_pass(ctx, stage, set, slot, g->fine[0], g->fine[1], g->fine[2] * g->channels, pc0, pc1, 0, g->channels);
 }
 
 /* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
@@ -1893,34 +1848,9 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
             pc[0] = first ^ h; pc[1] = 0; pc[2] = nzb; pc[3] = 0;
-            hd__vk_record_dispatch(be, cb, pipe, be->mg.lv[l].smooth, offset, (d[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
+            hd__vk_record_dispatch(be, cb, pipe, be->mg.sets[HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH)], offset, (d[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
         }
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_RESIDUAL, mg->lv[l].smooth, l, l, ctx->be->gg.channels, 0);
-}
-
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, ctx->be->gg.channels, 1);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, ctx->be->gg.channels, 1);
-}
-
-/* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
-static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    return hd__vk_mg_pass(ctx, HD__MG_DOT, set, 0, g->fine[1], g->fine[2] * g->channels, 1, 0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1952,51 +1882,6 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
     return hd__vk_flush(ctx);
 }
 
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_SIG, mg->lv[l].coarsen, l - 1, l, ctx->be->gg.sig_channels, 1);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
-{
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_zero_image(ctx->be, cb, ctx->be->mg.lo.image, HD__VK_G);
-    return HD_SUCCESS;
-}
-
-/* The fine residual in double (hd_mg_res_f64), f - A (phi + lo): the fine slot, use_lo. */
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], ctx->be->gg.levels, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    return hd__vk_mg_dot(ctx, ctx->be->mg.cg_sets[HD__VK_MG_SET_DOT_RZ]);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    int32_t bits;
-    memcpy(&bits, &beta, sizeof beta);
-    return hd__vk_mg_fine(ctx, HD__MG_DIR, ctx->be->mg.cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
-}
-
-/* q = A p: the double residual with negate on level 0's slot (E = z = 0, phi = p). */
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    hd_result r;
-    if ((r = hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
-        (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
-        return r;
-    return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
-}
-
 /* Submits what was recorded, the row sums made visible to the host, and waits; the sums are read
    in the host-visible buffers themselves. */
 static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
@@ -2011,26 +1896,6 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     *a = (const double *)mg->dot_a.map;
     *b = (const double *)mg->dot_b.map;
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    int32_t bits[2];
-    uint64_t u;
-    int i;
-    /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
-    ctx->be->gg.lsum_ok = 0;
-    memcpy(&u, &alpha, sizeof u);
-    for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    return hd__vk_mg_fine(ctx, HD__MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
-}
-
-/* The fine parameters: slot `levels` (no right-hand-side flag). */
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    ctx->be->gg.lsum_ok = 0;
-    return hd__vk_mg_fine(ctx, HD__MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
 }
 
 /* The single-level solver's sweeps: each its own submission. */

@@ -4,7 +4,8 @@
    declared below, with these signatures (the helpers at the end are the core's, for backends to
    use). One it lacks is a compile error ("used but never defined") and a different signature a
    conflicting declaration, so the list is the whole job of a new backend. The GPU backends make
-   their grids (hd__be_alloc_*, hd__be_clear, the multigrid's levels) through src/hd_gpu.h.
+   their grids (hd__be_alloc_*, hd__be_clear, the multigrid's levels) through src/hd_gpu.h, which
+   also defines for them the multigrid's primitives that are single passes.
 
    Common rules:
    - Every primitive returns HD_SUCCESS or a specific hd_result with one line logged through
