@@ -127,9 +127,6 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_SSBOS 6       /* storage buffers 0..5 (3: multigrid's row sums, 4: the direct light's list,
                                 5: the projection's TF table) */
 
-/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE, src/hd_gpu.h's HD__MG_*),
-   each in the 4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
-#define HD__GL_MG_PROGRAMS (4 * HD__MG_STAGES)
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
@@ -199,7 +196,7 @@ struct hd__backend {
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
     hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
-    GLuint mg_programs[HD__GL_MG_PROGRAMS]; /* by HD_MG_STAGE - 1, then the 4 flag variants */
+    GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -740,7 +737,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__be_begin(ctx) == HD_SUCCESS) {
         for (i = 0; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
-        for (i = 0; i < HD__GL_MG_PROGRAMS; ++i)
+        for (i = 0; i < HD__GPU_MG_VARIANTS; ++i)
             if (be->mg_programs[i]) be->gl.DeleteProgram(be->mg_programs[i]);
         hd__gpu_free(ctx, &be->gg);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
@@ -1094,19 +1091,17 @@ static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint *out)
 {
     hd__backend *be = ctx->be;
-    int variant = ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
-    GLuint *slot = &be->mg_programs[(stage - 1) * 4 + variant];
+    int flags, variant = hd__gpu_mg_variant(stage, counts_z, &flags);
+    GLuint *slot = &be->mg_programs[variant];
     const char *src[1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES];
     char prefix[320];
     size_t i;
     hd_result r;
     if (!*slot) {
-        /* the float residual reads the level's right-hand side (HD_DIFFUSE_FLAGS, as the sweep) */
         snprintf(prefix, sizeof prefix,
                  "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE 0\n#define HD_MG_STAGE %d\n"
                  "#define HD_DIFFUSE_FLAGS %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                 HD_MAX_LIGHTS, stage, hd__gl_diffuse_flags(variant) | (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0),
-                 HD__GL_LOCAL_X);
+                 HD_MAX_LIGHTS, stage, flags, HD__GL_LOCAL_X);
         src[0] = prefix;
         for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
         for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];

@@ -106,7 +106,6 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 15
-#define HD__VK_MG_PIPELINES (HD__MG_STAGES * 4) /* HD_SOLVER_MULTIGRID: its passes (src/hd_gpu.h) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -191,7 +190,7 @@ struct hd__backend {
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
     hd__gpu_grids gg;             /* what the grids are made for (src/hd_gpu.h) */
     struct hd__vk_mg mg;          /* HD_SOLVER_MULTIGRID's extras and grids while gg.levels */
-    VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
+    VkPipeline mg_pipes[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
@@ -1281,7 +1280,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines_half[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines_half[i], NULL);
         for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
-        for (i = 0; i < HD__VK_MG_PIPELINES; ++i)
+        for (i = 0; i < HD__GPU_MG_VARIANTS; ++i)
             if (be->mg_pipes[i]) be->fn.vkDestroyPipeline(be->device, be->mg_pipes[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
@@ -1776,13 +1775,6 @@ static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
     return HD_SUCCESS;
 }
 
-/* The flags the passes' pipelines are specialized for: RGB scattering and the boundary (the
-   variant), and the rhs flag for the levels' float residual (as hd_gl.h's programs). */
-static int hd__vk_mg_variant(int counts_z)
-{
-    return ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
-}
-
 /* The pipeline of multigrid pass `stage` for the current flags, made on first use. */
 static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
 {
@@ -1794,10 +1786,9 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
                                                   sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update,
                                                   sizeof hd__spv_mg_extrap};
     hd__backend *be = ctx->be;
-    int variant = hd__vk_mg_variant(ctx->kp.counts.z);
-    VkPipeline *slot = &be->mg_pipes[(stage - 1) * 4 + variant];
-    int32_t flags = (int32_t)(((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0) |
-                              (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0));
+    int f, variant = hd__gpu_mg_variant(stage, ctx->kp.counts.z, &f);
+    VkPipeline *slot = &be->mg_pipes[variant];
+    int32_t flags = (int32_t)f;
     hd_result r;
     if (!*slot && (r = hd__vk_pipeline_code(ctx, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
         HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__mg_stage_names[stage - 1]);

@@ -29,6 +29,18 @@ HD__MAYBE_UNUSED static const char *const hd__mg_stage_names[HD__MG_STAGES] = {
     "multigrid sigma_t", "multigrid residual", "multigrid restriction", "multigrid prolongation",
     "multigrid direction", "multigrid double residual", "multigrid dot products", "multigrid update",
     "multigrid extrapolation"};
+/* GL's programs and Vulkan's pipelines of those passes are made per stage and the flags they are
+   specialized for (HD_DIFFUSE_FLAGS: RGB scattering, the surface boundary, and for the levels'
+   float residual the right-hand side). Returns the pass's index among HD__GPU_MG_VARIANTS (by
+   stage - 1, then the 4 combinations of the first two flags); *flags its HD_DIFFUSE_FLAGS. */
+#define HD__GPU_MG_VARIANTS (4 * HD__MG_STAGES)
+HD__MAYBE_UNUSED static int hd__gpu_mg_variant(int stage, int counts_z, int *flags)
+{
+    int rgb = (counts_z & HD_FLAG_RGB_SCATTERING) != 0, surface = (counts_z & HD_FLAG_SURFACE_BOUNDARY) != 0;
+    *flags = (rgb ? HD_FLAG_RGB_SCATTERING : 0) | (surface ? HD_FLAG_SURFACE_BOUNDARY : 0) |
+             (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0);
+    return (stage - 1) * 4 + rgb + 2 * surface;
+}
 
 /* A multigrid level as every GPU backend sees it: the dims of its grids, and its parameter block
    (the fine parameters with its dims, 1 / h^2, h and the rhs flag: hd__mg_level_kp) as last
