@@ -157,6 +157,18 @@ static void hd__cpu_free_lights(hd__ctx *ctx)
     be->k.lv2 = NULL;
 }
 
+/* A call's bracket: nothing to make current, nothing left in flight (src/hd_backend.h). */
+static hd_result hd__be_begin(hd__ctx *ctx)
+{
+    (void)ctx;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+{
+    (void)ctx;
+    return r;
+}
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1045,13 +1057,7 @@ static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const
             }
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
-{
-    hd__cpu_copy_illumination(ctx, which, NULL, dst, NULL, 0);
-    return HD_SUCCESS;
-}
-
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
     hd__cpu_copy_illumination(ctx, which, NULL, dst, zz, count);
     return HD_SUCCESS;

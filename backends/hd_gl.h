@@ -127,9 +127,6 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_SSBOS 6       /* storage buffers 0..5 (3: multigrid's row sums, 4: the direct light's list,
                                 5: the projection's TF table) */
 
-/* HD_SOLVER_MULTIGRID's programs (hd_entry_glsl_multigrid.h's HD_MG_STAGE, src/hd_gpu.h's HD__MG_*),
-   each in the 4 variants of the RGB / surface flags (HD_DIFFUSE_FLAGS), compiled on first use. */
-#define HD__GL_MG_PROGRAMS (4 * HD__MG_STAGES)
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
@@ -138,10 +135,7 @@ typedef struct hd__gl_tex {
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__gl_level {
-    int dims[3];
-    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    int kp_sent;             /* params holds kp */
-    GLuint params;
+    GLuint params;           /* the level's parameter block (src/hd_gpu.h's hd__gpu_level) */
     hd__gl_tex sig;          /* coarse levels only (level 0 reads the backend's sigma_t) */
     hd__gl_tex rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
 } hd__gl_level;
@@ -180,7 +174,7 @@ struct hd__backend {
     void *(*glx_current)(void);
     void *caller_glx;
     int version;                /* major * 10 + minor */
-    int depth;                  /* nesting of hd__gl_enter */
+    int depth;                  /* nesting of hd__be_begin */
     hd__gl_state saved;
     GLuint programs[HD__GL_SLOTS]; /* by stage, then the diffusion variants; twice (float32, float16) */
     GLuint params;              /* uniform buffer of hd__kparams */
@@ -189,21 +183,20 @@ struct hd__backend {
     GLuint tf, maj, img, dummy_buffer;
     GLuint dl;                  /* the direct light's list of voxels (ctx->dl_idx), storage buffer 4 */
     hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
-    int f16;                    /* E, phi, phi2 are GL_R16F (params.illumination_precision) */
     hd__gl_tex lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (storage
+       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (storage
        buffer 5, ptab_n entries), uploaded when its inputs change (ptab_key) */
     hd__gl_tex lsum;
     GLuint ptab;
-    int lsum_ok, ptab_n;
+    int ptab_n;
     hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
     hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
-    GLuint mg_programs[HD__GL_MG_PROGRAMS]; /* by HD_MG_STAGE - 1, then the 4 flag variants */
+    GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -326,9 +319,10 @@ static hd_result hd__gl_check_current(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Makes the context current (own context) and saves the host's bindings. Nested calls (a stage
-   inside hd_gl_render_to_texture's prepare) save once. Pending GL errors are not ours. */
-static hd_result hd__gl_enter(hd__ctx *ctx)
+/* The bracket (src/hd_backend.h): makes the context current (own context) and saves the host's
+   bindings. Nested brackets (hd__be_create's, the test hooks') save once. Pending GL errors are
+   not ours. */
+static hd_result hd__be_begin(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     hd__gl_state *s = &be->saved;
@@ -383,9 +377,9 @@ static hd_result hd__gl_enter(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Restores what hd__gl_enter saved; r is the result of the call, returned unless the restore
+/* Restores what hd__be_begin saved; r is the result of the call, returned unless the restore
    itself raised a GL error. */
-static hd_result hd__gl_leave(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
 {
     hd__backend *be = ctx->be;
     hd__gl_state *s = &be->saved;
@@ -565,7 +559,7 @@ static hd__gl_tex *hd__gl_grid(hd__backend *be, int id)
 }
 static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
 {
-    GLenum fmt = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2 ? GL_R16F : GL_R32F;
+    GLenum fmt = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? GL_R16F : GL_R32F;
     return hd__gl_tex_new_as(ctx, hd__gl_grid(ctx->be, id), w, h, d, fmt, NULL, what);
 }
 static void hd__gpu_grid_free(hd__ctx *ctx, int id) { hd__gl_free_tex(ctx->be, hd__gl_grid(ctx->be, id)); }
@@ -636,7 +630,7 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     hd__backend *be = ctx->be;
     hd_result r;
     hd__gl_binds b;
-    int half = be->f16 && hd__gl_touches_illum(p);
+    int half = be->gg.f16 && hd__gl_touches_illum(p);
     int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
     if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
     hd__gl_send_params(ctx);
@@ -649,12 +643,6 @@ static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny,
     return hd__gl_run(ctx, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
 }
 
-/* Runs one stage between hd__gl_enter and hd__gl_leave. */
-#define HD__GL_STAGE(ctx, body) \
-    do { hd_result hd__r = hd__gl_enter(ctx); \
-         if (hd__r != HD_SUCCESS) return hd__r; \
-         hd__r = (body); \
-         return hd__gl_leave((ctx), hd__r); } while (0)
 
 /* ---- the context --------------------------------------------------------------------------------- */
 static int hd__gl_has_ext(const char *list, const char *name)
@@ -746,17 +734,17 @@ static void hd__be_destroy(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     int i;
     if (!be) return;
-    if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__gl_enter(ctx) == HD_SUCCESS) {
+    if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__be_begin(ctx) == HD_SUCCESS) {
         for (i = 0; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
-        for (i = 0; i < HD__GL_MG_PROGRAMS; ++i)
+        for (i = 0; i < HD__GPU_MG_VARIANTS; ++i)
             if (be->mg_programs[i]) be->gl.DeleteProgram(be->mg_programs[i]);
         hd__gpu_free(ctx, &be->gg);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
-        hd__gl_leave(ctx, HD_SUCCESS);
+        hd__be_end(ctx, HD_SUCCESS);
     }
     hd__free(ctx, be->mg.host_dot); /* left when GL was unreachable */
     if (be->own && be->egl) {
@@ -832,12 +820,13 @@ static hd_result hd__be_create(hd__ctx *ctx)
         be->gl.GetError = NULL; /* hd__be_destroy must not call into GL */
         return r;
     }
-    /* the own context is made current by hd__gl_enter, which makes the caller's current again */
-    HD__GL_STAGE(ctx, hd__gl_setup(ctx));
+    /* the own context is made current by hd__be_begin, which makes the caller's current again */
+    if ((r = hd__be_begin(ctx)) != HD_SUCCESS) return r;
+    return hd__be_end(ctx, hd__gl_setup(ctx));
 }
 
 /* ---- inputs and allocations ---------------------------------------------------------------------- */
-static hd_result hd__gl_upload_inputs(hd__ctx *ctx)
+static hd_result hd__be_upload_inputs(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     hd_result r;
@@ -847,21 +836,14 @@ static hd_result hd__gl_upload_inputs(hd__ctx *ctx)
         return r;
     return hd__gl_buffer_data(ctx, &be->maj, ncell * sizeof(float), ctx->majorant, GL_DYNAMIC_DRAW, "uploading the majorant grid");
 }
-static hd_result hd__be_upload_inputs(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_upload_inputs(ctx)); }
 
-static hd_result hd__gl_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
-{
-    ctx->be->lsum_ok = 0;
-    ctx->be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
-}
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
-    HD__GL_STAGE(ctx, hd__gl_alloc_illumination(ctx, illum_floats));
+    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
 }
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { HD__GL_STAGE(ctx, hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)); }
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable); }
 
-static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
     hd__backend *be = ctx->be;
     size_t floats = hd__image_floats(width, height, reduced), bytes = floats * sizeof(float);
@@ -880,36 +862,30 @@ static hd_result hd__gl_alloc_image(hd__ctx *ctx, int width, int height, int red
     be->img_floats = floats;
     return HD_SUCCESS;
 }
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
-{
-    HD__GL_STAGE(ctx, hd__gl_alloc_image(ctx, width, height, reduced));
-}
 
-static hd_result hd__gl_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img) {
         be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->img);
         be->gl.ClearBufferData(GL_COPY_WRITE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, NULL);
     }
     return hd__gl_check(ctx, "clearing", __LINE__);
 }
-static hd_result hd__be_clear(hd__ctx *ctx, unsigned what) { HD__GL_STAGE(ctx, hd__gl_clear(ctx, what)); }
 
 /* ---- stages ------------------------------------------------------------------------------------ */
 static hd_result hd__be_classify(hd__ctx *ctx)
 {
-    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0));
+    return hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(hd__ctx *ctx)
 {
-    HD__GL_STAGE(ctx, hd__gl_buffer_data(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, GL_STATIC_DRAW,
-                                         "the direct light's list"));
+    return hd__gl_buffer_data(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, GL_STATIC_DRAW,
+                              "the direct light's list");
 }
 
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
@@ -918,13 +894,13 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    ctx->be->lsum_ok = 0;
-    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0));
+    ctx->be->gg.lsum_ok = 0;
+    return hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
    Jacobi pass phi -> phi2 and a swap of the two names. */
-static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
+static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
 {
     hd__backend *be = ctx->be;
     hd_result r;
@@ -932,7 +908,7 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
        (uniform hd_pc.z, hd_entry_glsl.h) */
     int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int nz = nzb * ctx->channels, parity;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if (jacobi) {
         hd__gl_tex t;
         if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
@@ -944,7 +920,6 @@ static hd_result hd__gl_diffuse(hd__ctx *ctx, int jacobi)
             return r;
     return HD_SUCCESS;
 }
-static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { HD__GL_STAGE(ctx, hd__gl_diffuse(ctx, jacobi)); }
 
 /* The projection's inputs: lsum rebuilt (the light-sum stage) after a pass that changed E or phi,
    and the TF table (hd__project_table) built and uploaded when its inputs changed (ptab_key). */
@@ -954,11 +929,11 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
     int n = hd__project_table_n(ctx);
     float *t;
     hd_result r;
-    if (!be->lsum_ok) {
+    if (!be->gg.lsum_ok) {
         if ((r = hd__gl_dispatch(ctx, HD__GL_LIGHT_SUM, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0,
                                  0, 0)) != HD_SUCCESS)
             return r;
-        be->lsum_ok = 1;
+        be->gg.lsum_ok = 1;
     }
     if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
     if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
@@ -971,23 +946,21 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
     be->ptab_n = n;
     return HD_SUCCESS;
 }
-static hd_result hd__gl_project(hd__ctx *ctx)
+static hd_result hd__be_project(hd__ctx *ctx)
 {
     hd_result r = hd__gl_project_prepare(ctx);
     if (r != HD_SUCCESS) return r;
     return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, ctx->be->ptab_n, 0, 0, 0);
 }
-static hd_result hd__be_project(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_project(ctx)); }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
-static hd_result hd__gl_read_image(hd__ctx *ctx, float *dst)
+static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 {
     hd__backend *be = ctx->be;
     be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
     be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float)), dst);
     return hd__gl_check(ctx, "reading the image", __LINE__);
 }
-static hd_result hd__be_read_image(hd__ctx *ctx, float *dst) { HD__GL_STAGE(ctx, hd__gl_read_image(ctx, dst)); }
 
 /* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
    glGetTextureSubImage each, or without GL 4.5 the whole grid read and the slices copied out of
@@ -1011,13 +984,9 @@ static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, const int *l
     if (list) hd__free(ctx, all);
     return hd__gl_check(ctx, "reading an illumination grid", __LINE__);
 }
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
-    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, NULL, 0, dst));
-}
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
-{
-    HD__GL_STAGE(ctx, hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst));
+    return hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
@@ -1040,22 +1009,22 @@ static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float
 }
 HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    ctx->be->lsum_ok = 0;
-    HD__GL_STAGE(ctx, hd__gl_write_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src));
-}
-static hd_result hd__gl_finish_now(hd__ctx *ctx)
-{
-    ctx->be->gl.Finish();
-    return HD_SUCCESS;
+    ctx->be->gg.lsum_ok = 0;
+    return hd__gl_write_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
 }
 /* For src/hd_test_hooks.h: waits until the GL has done everything queued. */
-HD__MAYBE_UNUSED static hd_result hd__gl_finish(hd__ctx *ctx) { HD__GL_STAGE(ctx, hd__gl_finish_now(ctx)); }
+HD__MAYBE_UNUSED static hd_result hd__gl_finish(hd__ctx *ctx)
+{
+    hd_result r = hd__be_begin(ctx);
+    if (r == HD_SUCCESS) ctx->be->gl.Finish();
+    return r == HD_SUCCESS ? hd__be_end(ctx, r) : r;
+}
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { HD__GL_STAGE(ctx, hd__gpu_alloc_lights(ctx, &ctx->be->gg, count)); }
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count); }
 
 /* One convection step of light `light`: its volume -> the spare, and the two swap names. */
-static hd_result hd__gl_convect(hd__ctx *ctx, int light)
+static hd_result hd__be_convect(hd__ctx *ctx, int light)
 {
     hd__backend *be = ctx->be;
     hd_result r;
@@ -1065,22 +1034,17 @@ static hd_result hd__gl_convect(hd__ctx *ctx, int light)
     t = be->lv[light]; be->lv[light] = be->lv[be->gg.nlv]; be->lv[be->gg.nlv] = t;
     return HD_SUCCESS;
 }
-static hd_result hd__be_convect(hd__ctx *ctx, int light) { HD__GL_STAGE(ctx, hd__gl_convect(ctx, light)); }
 
 /* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
-static hd_result hd__gl_sum_lights(hd__ctx *ctx)
+static hd_result hd__be_sum_lights(hd__ctx *ctx)
 {
     hd_result r;
     int l;
+    ctx->be->gg.lsum_ok = 0;
     for (l = 0; l < ctx->be->gg.nlv; ++l)
         if ((r = hd__gl_dispatch(ctx, HD__GL_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return HD_SUCCESS;
-}
-static hd_result hd__be_sum_lights(hd__ctx *ctx)
-{
-    ctx->be->lsum_ok = 0;
-    HD__GL_STAGE(ctx, hd__gl_sum_lights(ctx));
 }
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
@@ -1092,10 +1056,11 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
    residual and CG's p and lo are r32f 3D textures like the backend's own; the double passes are
    GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
    storage buffer 3) and the rows in row order by the core, as on the CPU. */
-/* Bytes the solver holds on the GPU (counted in method_bytes); 0 without it. */
+/* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
-/* The levels' dims and parameter buffers and the row sums (device and host). */
+/* The levels' parameter buffers and the row sums (device and host). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
@@ -1106,8 +1071,6 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     for (l = 0; l < be->gg.levels; ++l) {
         hd__gl_level *L = &mg->lv[l];
         hd__gl_free_buffer(be, &L->params);
-        L->kp_sent = 0;
-        hd__mg_level_dims(be->gg.fine, l, L->dims);
         if (make) be->gl.GenBuffers(1, &L->params);
     }
     hd__gl_free_buffer(be, &mg->dot_a); hd__gl_free_buffer(be, &mg->dot_b);
@@ -1121,41 +1084,29 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     return hd__gl_buffer_data(ctx, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums");
 }
 
-/* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
-static hd_result hd__gl_mg_params(hd__ctx *ctx, int l)
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 {
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l];
-    hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-    if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
-    be->gl.BindBuffer(GL_UNIFORM_BUFFER, L->params);
-    be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof kp, &kp, GL_STATIC_DRAW);
-    L->kp = kp;
-    L->kp_sent = 1;
+    ctx->be->gl.BindBuffer(GL_UNIFORM_BUFFER, ctx->be->mg.lv[l].params);
+    ctx->be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof *kp, kp, GL_STATIC_DRAW);
     return hd__gl_check(ctx, "multigrid level parameters", __LINE__);
 }
-
-/* Level l's sigma_t. */
-static const hd__gl_tex *hd__gl_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
 
 /* The program of multigrid stage `stage` for the flags in counts_z (RGB, surface), compiled on
    first use: hd__gl_source up to hd_entry_glsl.h, then hd_entry_glsl_multigrid.h. */
 static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint *out)
 {
     hd__backend *be = ctx->be;
-    int variant = ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
-    GLuint *slot = &be->mg_programs[(stage - 1) * 4 + variant];
+    int flags, variant = hd__gpu_mg_variant(stage, counts_z, &flags);
+    GLuint *slot = &be->mg_programs[variant];
     const char *src[1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES];
     char prefix[320];
     size_t i;
     hd_result r;
     if (!*slot) {
-        /* the float residual reads the level's right-hand side (HD_DIFFUSE_FLAGS, as the sweep) */
         snprintf(prefix, sizeof prefix,
                  "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE 0\n#define HD_MG_STAGE %d\n"
                  "#define HD_DIFFUSE_FLAGS %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                 HD_MAX_LIGHTS, stage, hd__gl_diffuse_flags(variant) | (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0),
-                 HD__GL_LOCAL_X);
+                 HD_MAX_LIGHTS, stage, flags, HD__GL_LOCAL_X);
         src[0] = prefix;
         for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
         for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];
@@ -1166,120 +1117,67 @@ static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint
     return HD_SUCCESS;
 }
 
-/* Runs multigrid stage `stage` (flags of ctx->kp) with parameter block params, image units 1..4
-   and 6 (unit 6: the other grid, hd_entry_glsl_multigrid.h), over nx x ny x nz, hd_pc = pc. */
-static hd_result hd__gl_mg_pass(hd__ctx *ctx, int stage, GLuint params, const hd__gl_tex *sig, const hd__gl_tex *E,
-                                const hd__gl_tex *phi, const hd__gl_tex *phi2, const hd__gl_tex *other, int nx, int ny,
-                                int nz, int pc_x, int pc_y, int pc_z, int pc_w)
+/* Set `set`'s grids (src/hd_gpu.h) on image units 1..4 and 6, its row sums on storage buffer 3,
+   and parameter slot `slot`: level slot's buffer, or the backend's own for the fine ctx->kp. */
+static void hd__gl_mg_binds(hd__ctx *ctx, int set, int slot, hd__gl_binds *b)
+{
+    static const int unit[5] = {1, 2, 3, 4, 6};
+    hd__backend *be = ctx->be;
+    hd__gpu_mg_binds s;
+    int i;
+    memset(b, 0, sizeof *b);
+    hd__gpu_mg_set(&be->gg, set, &s);
+    b->params = slot == be->gg.levels ? be->params : be->mg.lv[slot].params;
+    b->img[0] = &be->vol;
+    for (i = 0; i < 5; ++i) b->img[unit[i]] = s.grid[i] < 0 ? NULL : hd__gl_grid(be, s.grid[i]);
+    if (s.dot) be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.dot == 1 ? be->mg.dot_a : be->mg.dot_b);
+}
+
+/* Runs pass p with the program of its stage for the flags of ctx->kp; the direction's beta and
+   the update's alpha are the uniforms at locations 1 and 2 (hd_entry_glsl_multigrid.h). */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
     hd__backend *be = ctx->be;
     hd__gl_binds b;
     GLuint prog;
     hd_result r;
-    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
-    memset(&b, 0, sizeof b);
-    b.params = params;
-    b.img[0] = &be->vol; b.img[1] = sig; b.img[2] = E; b.img[3] = phi; b.img[4] = phi2; b.img[6] = other;
-    return hd__gl_run(ctx, prog, hd__mg_stage_names[stage - 1], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
-}
-
-/* Sets the direction's beta or the update's alpha (hd_entry_glsl_multigrid.h, locations 1, 2) on
-   stage's program. */
-static hd_result hd__gl_mg_uniforms(hd__ctx *ctx, int stage, float beta, double alpha)
-{
-    hd__backend *be = ctx->be;
-    GLuint prog;
-    hd_result r;
-    if ((r = hd__gl_mg_program(ctx, stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
-    if (stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, beta);
-    else be->gl.ProgramUniform1d(prog, 2, alpha);
-    return hd__gl_check(ctx, "multigrid's uniforms", __LINE__);
+    if ((r = hd__gl_mg_program(ctx, p->stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
+    if (p->stage == HD__MG_DIR || p->stage == HD__MG_UPDATE) {
+        if (p->stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, p->beta);
+        else be->gl.ProgramUniform1d(prog, 2, p->alpha);
+        if ((r = hd__gl_check(ctx, "multigrid's uniforms", __LINE__)) != HD_SUCCESS) return r;
+    }
+    hd__gl_mg_binds(ctx, p->set, p->slot, &b);
+    return hd__gl_run(ctx, prog, hd__mg_stage_names[p->stage - 1], &b, p->n[0], p->n[1], p->n[2], p->pc[0], p->pc[1], p->pc[2],
+                      p->pc[3]);
 }
 
 /* Level l's smoothing: the diffusion program (HD_FLAG_DIFFUSE_RHS variant) on its parameter block. */
 static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l];
-    int slot = hd__gl_diffuse_slot(L->kp.counts.z), s, h;
-    int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    const int *d = be->gg.lv[l].dims;
+    int slot = hd__gl_diffuse_slot(be->gg.lv[l].kp.counts.z), s, h;
+    int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     hd__gl_binds b;
     hd_result r;
     if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
-    memset(&b, 0, sizeof b);
-    b.params = L->params;
-    b.img[0] = &be->vol; b.img[1] = hd__gl_mg_sig(be, l); b.img[2] = &L->rhs; b.img[3] = &L->phi; b.img[4] = &L->res;
+    hd__gl_mg_binds(ctx, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, &b);
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h)
-            if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (L->dims[0] + 1) / 2, ny,
+            if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (d[0] + 1) / 2, ny,
                                 nzb * be->gg.channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l];
-    int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_RESIDUAL, L->params, hd__gl_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, L->dims[0],
-                          L->dims[1], L->dims[2] * ch, 0, 0, 0, ch);
-}
-
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_RESTRICT, L->params, hd__gl_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, C->dims[0],
-                          C->dims[1], C->dims[2] * ch, C->dims[0], C->dims[1], C->dims[2], ch);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__gl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    int ch = be->gg.channels;
-    return hd__gl_mg_pass(ctx, HD__MG_PROLONG, C->params, hd__gl_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, L->dims[0],
-                          L->dims[1], L->dims[2] * ch, L->dims[0], L->dims[1], L->dims[2], ch);
-}
-
-/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
-   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
-static hd_result hd__gl_mg_res_f64(hd__ctx *ctx, GLuint params, const hd__gl_tex *E, const hd__gl_tex *phi,
-                                   const hd__gl_tex *out, int use_lo, int negate)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    return hd__gl_mg_pass(ctx, HD__MG_RES_F64, params, &ctx->be->sig, E, phi, &mg->lo, out, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, use_lo, negate, 0, g->channels);
-}
-
-/* <a, b> per fine row into dot (storage buffer 3). */
-static hd_result hd__gl_mg_dot(hd__ctx *ctx, const hd__gl_tex *a, const hd__gl_tex *b, GLuint dot)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, dot);
-    return hd__gl_mg_pass(ctx, HD__MG_DOT, mg->lv[0].params, NULL, a, b, NULL, NULL, g->fine[1], g->fine[2] * g->channels, 1,
-                          0, 0, 0, g->channels);
-}
-
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
-/* Makes the backend's context current for the whole step (hd__be_mg_end leaves it), makes the
-   levels and sends their parameter blocks. */
+/* Makes the levels and sends their parameter blocks. */
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
-    hd__backend *be = ctx->be;
-    hd_result r = hd__gl_enter(ctx);
-    int l;
-    if (r != HD_SUCCESS) return r;
-    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
-    for (l = 0; l < be->gg.levels; ++l)
-        if ((r = hd__gl_mg_params(ctx, l)) != HD_SUCCESS) return hd__gl_leave(ctx, r);
-    hd__gl_send_params(ctx);
-    return HD_SUCCESS;
+    hd_result r = hd__gpu_mg_begin(ctx, &ctx->be->gg, fresh);
+    if (r == HD_SUCCESS) hd__gl_send_params(ctx);
+    return r;
 }
 
 /* A step ends complete, as OpenCL's clFinish (timings per step mean the step). */
@@ -1289,52 +1187,7 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
         ctx->be->gl.Finish();
         r = hd__gl_check(ctx, "glFinish", __LINE__);
     }
-    return hd__gl_leave(ctx, r);
-}
-
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    const int *d = mg->lv[l].dims;
-    return hd__gl_mg_pass(ctx, HD__MG_SIG, mg->lv[l - 1].params, hd__gl_mg_sig(be, l - 1), NULL, NULL, NULL, &mg->lv[l].sig, d[0],
-                          d[1], d[2] * g->sig_channels, d[0], d[1], d[2], g->sig_channels);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gl_tex_zero(ctx, &ctx->be->mg.lo); }
-
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    return hd__gl_mg_res_f64(ctx, be->params, &be->E, &be->phi, &be->mg.lv[0].rhs, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    return hd__gl_mg_dot(ctx, &mg->lv[0].rhs, &mg->lv[0].phi, mg->dot_a);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    hd_result r;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_DIR, beta, 0.0)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__MG_DIR, mg->lv[0].params, NULL, &mg->lv[0].phi, &mg->p, NULL, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
-}
-
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__gl_mg *mg = &ctx->be->mg;
-    hd__gl_level *L = &mg->lv[0];
-    hd_result r;
-    if ((r = hd__gl_mg_res_f64(ctx, L->params, &L->phi, &mg->p, &L->res, 0, 1)) != HD_SUCCESS ||
-        (r = hd__gl_mg_dot(ctx, &mg->p, &L->res, mg->dot_a)) != HD_SUCCESS)
-        return r;
-    return hd__gl_mg_dot(ctx, &L->rhs, &mg->p, mg->dot_b);
+    return r;
 }
 
 /* The row sums read into their host copy (glGetBufferSubData waits for the passes). */
@@ -1354,40 +1207,16 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    hd_result r;
-    be->lsum_ok = 0;
-    if ((r = hd__gl_mg_uniforms(ctx, HD__MG_UPDATE, 0.0f, alpha)) != HD_SUCCESS) return r;
-    return hd__gl_mg_pass(ctx, HD__MG_UPDATE, mg->lv[0].params, NULL, &mg->p, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, 0, 0, 0, g->channels);
-}
-
-/* The fine parameters (no right-hand-side flag). */
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    hd__backend *be = ctx->be;
-    struct hd__gl_mg *mg = &be->mg;
-    be->lsum_ok = 0;
-    return hd__gl_mg_pass(ctx, HD__MG_EXTRAP, be->params, &be->sig, &be->E, &be->phi, &mg->lo, NULL, g->fine[0], g->fine[1],
-                          g->fine[2] * g->channels, colour, 0, 0, g->channels);
-}
-
 /* The single-level solver's sweeps: each its own dispatches. */
 static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
 
 static hd_result hd__be_path(hd__ctx *ctx)
 {
-    HD__GL_STAGE(ctx, hd__gl_dispatch(ctx, HD__GL_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0));
+    return hd__gl_dispatch(ctx, HD__GL_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0);
 }
 
 /* ---- the image into the caller's texture ---------------------------------------------------------- */
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
-static hd_result hd__prepare(hd__ctx *ctx);
 
 static hd_result hd__gl_to_texture(hd__ctx *ctx, GLuint texture)
 {
@@ -1422,6 +1251,6 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
     hd_result r;
     if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
     if (texture == 0) return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    HD__GL_STAGE(ctx, hd__gl_to_texture(ctx, (GLuint)texture));
+    HD__BE_CALL(r, ctx, hd__gl_to_texture(ctx, (GLuint)texture));
+    return r;
 }

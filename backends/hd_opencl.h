@@ -57,10 +57,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__cl_level {
-    int dims[3];
-    hd__kparams kp;          /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
-    int kp_sent;             /* params holds kp */
-    cl_mem params;
+    cl_mem params;           /* the level's parameter block (src/hd_gpu.h's hd__gpu_level) */
     cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
     cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
 } hd__cl_level;
@@ -85,13 +82,12 @@ struct hd__backend {
     cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (ptab_n
+       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (ptab_n
        entries), uploaded when its inputs change (ptab_key) */
     cl_mem lsum, ptab;
-    int lsum_ok, ptab_n;
+    int ptab_n;
     hd__ptab_key ptab_key;
     size_t tf_bytes, img_floats;
-    int f16;                 /* E, phi, phi2 hold binary16 (illumination_precision FLOAT16) */
     cl_ulong max_alloc;
     hd__kparams params_sent; /* what the params buffer holds */
     int params_valid;
@@ -334,7 +330,7 @@ static cl_mem *hd__cl_grid(hd__backend *be, int id)
 static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
 {
     size_t n = id == HD__G_LSUM || id >= HD__G_LIGHT ? (size_t)w * h * d : hd__split_slots(w, h, (size_t)d);
-    int half = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2;
+    int half = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2;
     hd__cl_release(hd__cl_grid(ctx->be, id));
     return hd__cl_buffer(ctx, hd__cl_grid(ctx->be, id), half ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float), NULL, what);
 }
@@ -350,6 +346,19 @@ static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
 }
 
 /* ---- life cycle -------------------------------------------------------------------------- */
+/* The bracket of a public call (src/hd_backend.h): a lost device refused; each stage has waited
+   for its own work already (hd__cl_finish). */
+static hd_result hd__be_begin(hd__ctx *ctx)
+{
+    HD__CL_LOST_CHECK(ctx);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+{
+    (void)ctx;
+    return r;
+}
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -405,7 +414,6 @@ static hd_result hd__be_upload_inputs(hd__ctx *ctx)
     size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
     size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     if (tf_bytes != be->tf_bytes) {
         hd__cl_release(&be->tf);
         be->tf_bytes = 0;
@@ -436,7 +444,7 @@ static size_t hd__cl_slot(const hd__ctx *ctx, int x, int y, int zz)
 /* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
 static int hd__cl_k(const hd__ctx *ctx, int k)
 {
-    if (!ctx->be->f16) return k;
+    if (!ctx->be->gg.f16) return k;
     if (k == HD__CL_DIRECT) return HD__CL_DIRECT_HALF;
     if (k == HD__CL_PROJECT) return HD__CL_PROJECT_HALF;
     if (k == HD__CL_SUM_LIGHT) return HD__CL_SUM_LIGHT_HALF;
@@ -447,17 +455,10 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
 
 static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 {
-    HD__CL_LOST_CHECK(ctx);
-    ctx->be->lsum_ok = 0;
-    ctx->be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
     return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
 }
 
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
-{
-    HD__CL_LOST_CHECK(ctx);
-    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
-}
+static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable); }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
 {
@@ -465,7 +466,6 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int red
     size_t floats = hd__image_floats(width, height, reduced);
     cl_mem img;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     if ((r = hd__cl_buffer(ctx, &img, floats * sizeof(float), NULL, reduced ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__cl_release(&img);
@@ -481,9 +481,7 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
-    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
     return (what & HD__DIRTY_IMAGE) ? hd__cl_zero(ctx, be->img, be->img_floats) : HD_SUCCESS;
 }
 
@@ -493,7 +491,6 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 static hd_result hd__cl_send_params(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
-    HD__CL_LOST_CHECK(ctx);
     if (!be->params_valid || memcmp(&be->params_sent, &ctx->kp, sizeof ctx->kp) != 0) {
         HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof ctx->kp, &ctx->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
         be->params_sent = ctx->kp;
@@ -612,7 +609,7 @@ static hd_result hd__be_direct(hd__ctx *ctx)
     hd_result r;
     int k = hd__cl_k(ctx, HD__CL_DIRECT);
     cl_int count = (cl_int)ctx->dl_count;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     HD__CL_ARG(ctx, k, 10, count);
     if ((r = hd__cl_mems(ctx, k, 9, 1, ctx->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS)
         return r;
@@ -625,7 +622,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
     hd_result r;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(ctx, k, ctx->gdims, ctx->channels, 9, 0, 2)) != HD_SUCCESS)
         return r;
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
@@ -640,12 +637,12 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
     int n = hd__project_table_n(ctx), k = hd__cl_k(ctx, HD__CL_LIGHT_SUM);
     float *t;
     hd_result r;
-    if (!be->lsum_ok) {
+    if (!be->gg.lsum_ok) {
         if ((r = hd__cl_mems(ctx, k, 9, 1, be->lsum)) != HD_SUCCESS ||
             (r = hd__cl_bind_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1],
                                  (size_t)ctx->gdims[2] * (size_t)ctx->channels)) != HD_SUCCESS)
             return r;
-        be->lsum_ok = 1;
+        be->gg.lsum_ok = 1;
     }
     if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
     if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
@@ -679,7 +676,6 @@ static hd_result hd__be_project(hd__ctx *ctx)
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 {
     hd__backend *be = ctx->be;
-    HD__CL_LOST_CHECK(ctx);
     HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(image)");
     return HD_SUCCESS;
@@ -691,7 +687,7 @@ static hd_result hd__cl_map_illumination(hd__ctx *ctx, hd_illumination which, cl
     hd__backend *be = ctx->be;
     cl_int e;
     *out = clEnqueueMapBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, flags, 0,
-                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
+                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->gg.f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
     if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
     return HD_SUCCESS;
 }
@@ -715,14 +711,13 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
     unsigned char *m;
     void *mv;
     hd_result r;
-    HD__CL_LOST_CHECK(ctx);
     if ((r = hd__cl_map_illumination(ctx, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
     m = (unsigned char *)mv;
     for (k = 0; k < nz; ++k)
         for (zz = list ? list[k] : k, y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__cl_slot(ctx, x, y, zz);
-                if (be->f16) {
+                if (be->gg.f16) {
                     uint16_t v;
                     if (src != NULL) { v = hd_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
                     else { memcpy(&v, m + 2 * s, 2); *dst++ = hd_h2f(v); }
@@ -734,12 +729,7 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
     return hd__cl_unmap_illumination(ctx, which, mv);
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
-{
-    return hd__cl_copy_illumination(ctx, which, NULL, dst, NULL, 0);
-}
-
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
     return hd__cl_copy_illumination(ctx, which, NULL, dst, zz, count);
 }
@@ -747,16 +737,12 @@ static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination w
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__cl_copy_illumination(ctx, which, src, NULL, NULL, 0);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
-{
-    HD__CL_LOST_CHECK(ctx);
-    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
-}
+static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count); }
 
 /* One convection step of light `light`: reads its volume, writes the spare, the two swap. */
 static hd_result hd__be_convect(hd__ctx *ctx, int light)
@@ -780,7 +766,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     int k = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
     hd_result r;
     int l;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
     for (l = 0; l < be->gg.nlv; ++l) {
         cl_int li = l, first = l == 0;
@@ -843,7 +829,7 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
     return b;
 }
 
-/* The levels' dims and parameter blocks, the row sums (device and host) and the row buffer. */
+/* The levels' parameter blocks, the row sums (device and host) and the row buffer. */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
@@ -854,8 +840,6 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     for (l = 0; l < be->gg.levels; ++l) {
         hd__cl_level *L = &mg->lv[l];
         hd__cl_release(&L->params);
-        L->kp_sent = 0;
-        hd__mg_level_dims(be->gg.fine, l, L->dims);
         if (make && r == HD_SUCCESS) r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters");
     }
     hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b); hd__cl_release(&mg->line);
@@ -870,38 +854,17 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     return hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(&be->gg) * sizeof(float), NULL, "multigrid's row buffer");
 }
 
-/* Level l's parameter block (the CPU's hd__cpu_mg_params), sent when it changed. */
-static hd_result hd__cl_mg_params(hd__ctx *ctx, int l)
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 {
-    hd__cl_level *L = &ctx->be->mg.lv[l];
-    hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-    if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) return HD_SUCCESS;
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, L->params, CL_TRUE, 0, sizeof kp, &kp, 0, NULL, NULL), "clEnqueueWriteBuffer(multigrid level parameters)");
-    L->kp = kp;
-    L->kp_sent = 1;
+    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, ctx->be->mg.lv[l].params, CL_TRUE, 0, sizeof *kp, kp, 0, NULL, NULL),
+               "clEnqueueWriteBuffer(multigrid level parameters)");
     return HD_SUCCESS;
-}
-
-/* Level l's sigma_t buffer. */
-static cl_mem hd__cl_mg_sig(const hd__backend *be, int l) { return l == 0 ? be->sig : be->mg.lv[l].sig; }
-
-/* Kernel k over level l's voxels (channels of them stacked in z), its first n arguments the
-   buffers following n. */
-static hd_result hd__cl_mg_pass(hd__ctx *ctx, int k, int l, int channels, int n, ...)
-{
-    const int *d = ctx->be->mg.lv[l].dims;
-    va_list ap;
-    hd_result r;
-    va_start(ap, n);
-    r = hd__cl_vmems(ctx, k, 0, n, ap);
-    va_end(ap);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)d[0], (size_t)d[1], (size_t)d[2] * (size_t)channels);
 }
 
 /* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
 static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
 {
-    return hd__cl_colour_passes(ctx, k, ctx->be->mg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
+    return hd__cl_colour_passes(ctx, k, ctx->be->gg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
 }
 
 /* n colour passes of kernel k with level l bound to its nine HD__CL_BUFFERS arguments: sigma_t,
@@ -911,7 +874,8 @@ static hd_result hd__cl_mg_level_passes(hd__ctx *ctx, int k, int l, int first, i
 {
     hd__backend *be = ctx->be;
     hd__cl_level *L = &be->mg.lv[l];
-    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, hd__cl_mg_sig(be, l), L->rhs, L->phi, L->res, be->img);
+    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, l == 0 ? be->sig : L->sig, L->rhs, L->phi, L->res,
+                              be->img);
     return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, l, 9, first, n);
 }
 
@@ -921,127 +885,84 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE), l, first, 2 * sweeps);
 }
 
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), l, 0, 2);
-}
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
-/* Each fine column's share of the coarse rows (both parities), then their sum per coarse voxel;
-   argument 5 of the first is the transfers' mask, the fine sigma_t (hd_mg_medium). */
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+/* Pass p on the kernels of hd_entry_cl.h, which take the grids of p's set (src/hd_gpu.h: m[0..4]
+   sigma_t, E, phi, phi2, other) and the parameter blocks each in its own order: the transfers
+   and the coarse sigma_t both levels' (slot's and p->level's), the others slot's alone. The
+   residuals and the prolongation run as colour passes; the restriction as each fine column's
+   share of the coarse rows (both parities, into the row buffer; argument 5 of that kernel is the
+   transfers' mask), then their sum per coarse voxel. */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
     hd__backend *be = ctx->be;
     struct hd__cl_mg *mg = &be->mg;
-    hd__cl_level *L = &mg->lv[l], *C = &mg->lv[l + 1];
-    hd_result r;
-    cl_int parity;
-    if ((r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 0, 4, L->params, C->params, L->res, mg->line)) != HD_SUCCESS ||
-        (r = hd__cl_mems(ctx, HD__CL_MG_RESTRICT_LINE, 5, 1, hd__cl_mg_sig(be, l))) != HD_SUCCESS)
-        return r;
-    for (parity = 0; parity < 2; ++parity) {
-        HD__CL_ARG(ctx, HD__CL_MG_RESTRICT_LINE, 4, parity);
-        if ((r = hd__cl_run(ctx, HD__CL_MG_RESTRICT_LINE, 3, ((size_t)L->dims[0] + 1) / 2, (size_t)C->dims[1],
-                            (size_t)C->dims[2] * (size_t)g->channels)) != HD_SUCCESS)
+    const int *d = be->gg.lv[p->level].dims;
+    cl_mem m[5], par = p->slot == be->gg.levels ? be->params : mg->lv[p->slot].params, lp = mg->lv[p->level].params;
+    cl_int pc0 = p->pc[0], pc1 = p->pc[1];
+    hd__gpu_mg_binds b;
+    hd_result r = HD_SUCCESS;
+    int i, k;
+    hd__gpu_mg_set(&be->gg, p->set, &b);
+    for (i = 0; i < 5; ++i) m[i] = b.grid[i] < 0 ? NULL : *hd__cl_grid(be, b.grid[i]);
+    switch (p->stage) {
+    case HD__MG_SIG:
+        r = hd__cl_mems(ctx, k = HD__CL_MG_SIG, 0, 4, par, lp, m[0], m[4]);
+        break;
+    case HD__MG_RESIDUAL: /* the smoothing's bindings */
+        return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), p->level, 0, 2);
+    case HD__MG_RESTRICT:
+        k = HD__CL_MG_RESTRICT_LINE;
+        if ((r = hd__cl_mems(ctx, k, 0, 4, par, lp, m[2], mg->line)) != HD_SUCCESS || (r = hd__cl_mems(ctx, k, 5, 1, m[0])) != HD_SUCCESS)
             return r;
+        for (pc0 = 0; pc0 < 2 && r == HD_SUCCESS; ++pc0) {
+            HD__CL_ARG(ctx, k, 4, pc0);
+            r = hd__cl_run(ctx, k, 3, ((size_t)be->gg.lv[p->slot].dims[0] + 1) / 2, (size_t)d[1], (size_t)d[2] * (size_t)be->gg.channels);
+        }
+        if (r == HD_SUCCESS) r = hd__cl_mems(ctx, k = HD__CL_MG_RESTRICT, 0, 5, par, lp, mg->line, m[4], m[3]);
+        break;
+    case HD__MG_PROLONG:
+        if ((r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, lp, par, m[2], m[4])) == HD_SUCCESS)
+            r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, m[0]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, p->level, 4, 0, 2);
+    case HD__MG_RES_F64:
+        k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
+        HD__CL_ARG(ctx, k, 7, pc0);
+        HD__CL_ARG(ctx, k, 8, pc1);
+        r = hd__cl_mems(ctx, k, 0, 6, par, m[0], m[1], m[2], m[3], m[4]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
+    case HD__MG_DOT:
+        r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, par, m[1], m[2], b.dot == 1 ? mg->dot_a : mg->dot_b);
+        return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)p->n[0], (size_t)p->n[1], 1);
+    case HD__MG_DIR:
+        HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, p->beta);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_DIR, 0, 3, par, m[1], m[2]);
+        break;
+    case HD__MG_UPDATE:
+        HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, p->alpha);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_UPDATE, 0, 4, par, m[2], m[3], m[1]);
+        break;
+    default: /* HD__MG_EXTRAP */
+        HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, pc0);
+        r = hd__cl_mems(ctx, k = HD__CL_MG_EXTRAP, 0, 5, par, m[0], m[1], m[2], m[3]);
+        break;
     }
-    return hd__cl_mg_pass(ctx, HD__CL_MG_RESTRICT, l + 1, g->channels, 5, L->params, C->params, mg->line, C->rhs, C->phi);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    hd__cl_level *L = &be->mg.lv[l], *C = &be->mg.lv[l + 1];
-    hd_result r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, L->params, C->params, C->phi, L->phi);
-    if (r == HD_SUCCESS) r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, hd__cl_mg_sig(be, l));
-    return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, l, 4, 0, 2);
-}
-
-/* The fine residual in double into out: f - A (phi + lo) (params, E, phi: the backend's, use_lo)
-   or, negate, A p (level 0's parameters, E = z = 0, phi = p). */
-static hd_result hd__cl_mg_res_f64(hd__ctx *ctx, cl_mem params, cl_mem E, cl_mem phi, cl_mem out, cl_int use_lo, cl_int negate)
-{
-    hd__backend *be = ctx->be;
-    int k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
-    hd_result r;
-    HD__CL_ARG(ctx, k, 7, use_lo);
-    HD__CL_ARG(ctx, k, 8, negate);
-    if ((r = hd__cl_mems(ctx, k, 0, 6, params, be->sig, E, phi, be->mg.lo, out)) != HD_SUCCESS) return r;
-    return hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
-}
-
-/* Enqueues <a, b> per fine row into dot (double per row). */
-static hd_result hd__cl_mg_dot_rows(hd__ctx *ctx, cl_mem a, cl_mem b, cl_mem dot)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    hd_result r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, mg->lv[0].params, a, b, dot);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)g->fine[1], (size_t)g->fine[2] * (size_t)g->channels, 1);
+    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)p->n[0], (size_t)p->n[1], (size_t)p->n[2]);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
 static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
 {
-    hd__backend *be = ctx->be;
     hd_result r;
-    int l;
-    HD__CL_LOST_CHECK(ctx);
-    if (!be->fp64)
+    if (!ctx->be->fp64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
-    for (l = 0; l < be->gg.levels; ++l)
-        if ((r = hd__cl_mg_params(ctx, l)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_mg_begin(ctx, &ctx->be->gg, fresh)) != HD_SUCCESS) return r;
     return hd__cl_send_params(ctx);
 }
 
 static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
 {
     return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
-}
-
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    hd__backend *be = ctx->be;
-    struct hd__cl_mg *mg = &be->mg;
-    return hd__cl_mg_pass(ctx, HD__CL_MG_SIG, l, ctx->be->gg.sig_channels, 4, mg->lv[l - 1].params, mg->lv[l].params,
-                          hd__cl_mg_sig(be, l - 1), mg->lv[l].sig);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    return hd__cl_zero(ctx, mg->lo, hd__cl_mg_slots(g->fine, g->channels));
-}
-
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    hd__backend *be = ctx->be;
-    return hd__cl_mg_res_f64(ctx, be->params, be->E, be->phi, be->mg.lv[0].rhs, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    return hd__cl_mg_dot_rows(ctx, mg->lv[0].rhs, mg->lv[0].phi, mg->dot_a);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, beta);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_DIR, 0, ctx->be->gg.channels, 3, mg->lv[0].params, mg->lv[0].phi, mg->p);
-}
-
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__cl_mg *mg = &ctx->be->mg;
-    hd__cl_level *L = &mg->lv[0];
-    hd_result r;
-    if ((r = hd__cl_mg_res_f64(ctx, L->params, L->phi, mg->p, L->res, 0, 1)) != HD_SUCCESS ||
-        (r = hd__cl_mg_dot_rows(ctx, mg->p, L->res, mg->dot_a)) != HD_SUCCESS)
-        return r;
-    return hd__cl_mg_dot_rows(ctx, L->rhs, mg->p, mg->dot_b);
 }
 
 /* The buffers read (blocking: after every pass enqueued before) into their host copies. */
@@ -1057,21 +978,4 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     *a = mg->host_dot;
     *b = mg->host_dot + rows;
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    hd__backend *be = ctx->be;
-    be->lsum_ok = 0;
-    HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, alpha);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_UPDATE, 0, be->gg.channels, 4, be->mg.lv[0].params, be->phi, be->mg.lo, be->mg.p);
-}
-
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    hd__backend *be = ctx->be;
-    cl_int c = colour;
-    be->lsum_ok = 0;
-    HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, c);
-    return hd__cl_mg_pass(ctx, HD__CL_MG_EXTRAP, 0, be->gg.channels, 5, be->params, be->sig, be->E, be->phi, be->mg.lo);
 }

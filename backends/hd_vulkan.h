@@ -107,7 +107,6 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
 #define HD__VK_BINDINGS 15
-#define HD__VK_MG_PIPELINES (HD__MG_STAGES * 4) /* HD_SOLVER_MULTIGRID: its passes (src/hd_gpu.h) x 4 flag variants (RGB, surface) */
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -125,18 +124,9 @@ typedef struct hd__vk_image {
     int texel; /* bytes per texel: 2 (r16f), 4 (r32f), 8 (rg32f) */
 } hd__vk_image;
 
-/* CG's passes' sets (level 0 and the backend's grids) */
-enum { HD__VK_MG_SET_RES_R, HD__VK_MG_SET_RES_Q, HD__VK_MG_SET_DOT_RZ, HD__VK_MG_SET_DIR, HD__VK_MG_SET_DOT_PQ,
-       HD__VK_MG_SET_DOT_RP, HD__VK_MG_SET_UPDATE, HD__VK_MG_SET_EXTRAP, HD__VK_MG_CG_SETS };
-#define HD__VK_MG_SETS (4 * HD__MG_MAX_LEVELS + HD__VK_MG_CG_SETS)
-
 typedef struct hd__vk_level {
-    int dims[3];
-    hd__kparams kp;           /* the fine parameters with this level's dims, 1 / h^2, h and the rhs flag */
     hd__vk_image sig;         /* coarse levels only (level 0 reads the backend's sigma_t) */
     hd__vk_image rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
-    /* sets: smoothing and residual; restriction to l + 1; prolongation from l + 1; sigma_t from l - 1 */
-    VkDescriptorSet smooth, restrict_to, prolong_from, coarsen;
 } hd__vk_level;
 
 /* HD_SOLVER_MULTIGRID's objects besides the grids (hd__gpu_mg_extras) and its grids */
@@ -147,7 +137,7 @@ struct hd__vk_mg {
     hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
     VkDeviceSize slot_bytes;
     VkDescriptorPool pool;
-    VkDescriptorSet cg_sets[HD__VK_MG_CG_SETS];
+    VkDescriptorSet sets[HD__GPU_MG_SETS]; /* by src/hd_gpu.h's set numbers */
     unsigned sets_gen;        /* be->sets_gen the sets were written at */
     int sets_valid;
 };
@@ -204,21 +194,20 @@ struct hd__backend {
     hd__vk_buffer tf, maj, img, staging, dummy_buffer;
     hd__vk_buffer dl;             /* the direct light's list of voxels (ctx->dl_idx), binding 12 */
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
-    int f16;                      /* E, phi, phi2 are r16f (params.illumination_precision) */
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
     hd__gpu_grids gg;             /* what the grids are made for (src/hd_gpu.h) */
     struct hd__vk_mg mg;          /* HD_SOLVER_MULTIGRID's extras and grids while gg.levels */
-    VkPipeline mg_pipes[HD__VK_MG_PIPELINES]; /* its passes, per pass and flags variant, made on first use */
+    VkPipeline mg_pipes[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
-       lsum_ok (cleared by every pass that writes E or phi), and the step's TF table (binding 13,
+       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (binding 13,
        host-visible, ptab_cap entries, sized with the TF), written when its inputs change
        (ptab_key) */
     hd__vk_image lsum;
     hd__vk_buffer ptab;
-    int lsum_ok, ptab_n, ptab_cap;
+    int ptab_n, ptab_cap;
     hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     VkDeviceSize mem_used, mem_limit;
@@ -270,10 +259,10 @@ static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int lin
          if (hd__e < 0) return hd__vk_fail((ctx), hd__e, (name), __LINE__); } while (0)
 #define HD__VK_LOST_CHECK(ctx) \
     do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
-/* HD__VK_LOST_CHECK, then what the backend recorded submitted and waited for (hd__vk_flush), so
-   nothing is in flight; returns from the calling function on failure. */
+/* What the backend recorded submitted and waited for (hd__vk_flush), so nothing is in flight;
+   returns from the calling function on failure. */
 #define HD__VK_IDLE(ctx) \
-    do { hd_result hd__r; HD__VK_LOST_CHECK(ctx); if ((hd__r = hd__vk_flush(ctx)) != HD_SUCCESS) return hd__r; } while (0)
+    do { hd_result hd__r = hd__vk_flush(ctx); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
 
 /* The validation layer's messages: logged as errors and counted (the tests fail on any). */
 static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -780,7 +769,7 @@ static void hd__gpu_grid_free(hd__ctx *ctx, int id)
 }
 static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
 {
-    VkFormat fmt = ctx->be->f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
+    VkFormat fmt = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
     hd__gpu_grid_free(ctx, id);
     return hd__vk_image_new_as(ctx, hd__vk_grid(ctx->be, id), w, h, d, fmt, what);
 }
@@ -971,7 +960,7 @@ static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
 {
     hd__backend *be = ctx->be;
     hd_result r;
-    if (!be->f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
+    if (!be->gg.f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
         *out = be->pipelines[p];
         return HD_SUCCESS;
     }
@@ -988,17 +977,17 @@ static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
-        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi && be->diffuse_half[i] == be->f16) {
+        if (be->diffuse_flags[i] == flags && be->diffuse_jacobi[i] == jacobi && be->diffuse_half[i] == be->gg.f16) {
             *out = be->diffuse[i];
             return HD_SUCCESS;
         }
     if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag, solver and precision combinations for the diffusion stage",
                        HD__VK_DIFFUSE_VARIANTS);
-    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->gg.f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
     be->diffuse_flags[be->ndiffuse] = flags;
     be->diffuse_jacobi[be->ndiffuse] = jacobi;
-    be->diffuse_half[be->ndiffuse] = be->f16;
+    be->diffuse_half[be->ndiffuse] = be->gg.f16;
     *out = be->diffuse[be->ndiffuse++];
     return HD_SUCCESS;
 }
@@ -1069,10 +1058,10 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     return HD_SUCCESS;
 }
 
-/* The most sets one pool holds: the backend's (a set per light); the multigrid's fit too (checked
-   where HD__VK_MG_SETS is defined). */
+/* The most sets one pool holds: the backend's (a set per light); the multigrid's
+   (HD__GPU_MG_SETS, src/hd_gpu.h) fit too. */
 #define HD__VK_POOL_SETS_MAX HD_MAX_LIGHTS
-typedef char hd__vk_mg_sets_fit_a_pool[HD__VK_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
+typedef char hd__vk_mg_sets_fit_a_pool[HD__GPU_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 /* Empties `pool` and allocates n (<= HD__VK_POOL_SETS_MAX) sets of the backend's set layout from
    it into sets[]; reset_name and alloc_name name the calls in a failure's log line. */
@@ -1144,7 +1133,7 @@ static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buf
             w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
             w[i].pBufferInfo = &bi[i];
         } else {
-            const hd__vk_image *x = im[i] && im[i]->image ? im[i] : be->f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
+            const hd__vk_image *x = im[i] && im[i]->image ? im[i] : be->gg.f16 && i >= 5 && i <= 7 ? &be->dummy16 : &be->dummy;
             ii[i].sampler = VK_NULL_HANDLE;
             ii[i].imageView = x->view;
             ii[i].imageLayout = VK_IMAGE_LAYOUT_GENERAL;
@@ -1262,7 +1251,6 @@ static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pi
 static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
 {
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (!ctx->be->sets_valid) {
         if (ctx->be->rec)
             return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: resources changed while recording (internal error)");
@@ -1273,6 +1261,15 @@ static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
 }
 
 /* ---- life cycle -------------------------------------------------------------------------------- */
+/* The bracket of a public call (src/hd_backend.h): a lost device refused; at the end, what is
+   still recorded (a clear, a new grid's zeroing) submitted and waited for. */
+static hd_result hd__be_begin(hd__ctx *ctx)
+{
+    HD__VK_LOST_CHECK(ctx);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r) { return r != HD_SUCCESS ? r : hd__vk_flush(ctx); }
+
 static void hd__be_destroy(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1291,7 +1288,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines_half[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines_half[i], NULL);
         for (i = 0; i < be->ndiffuse; ++i) be->fn.vkDestroyPipeline(be->device, be->diffuse[i], NULL);
-        for (i = 0; i < HD__VK_MG_PIPELINES; ++i)
+        for (i = 0; i < HD__GPU_MG_VARIANTS; ++i)
             if (be->mg_pipes[i]) be->fn.vkDestroyPipeline(be->device, be->mg_pipes[i], NULL);
         if (be->dpool) be->fn.vkDestroyDescriptorPool(be->device, be->dpool, NULL);
         if (be->layout) be->fn.vkDestroyPipelineLayout(be->device, be->layout, NULL);
@@ -1478,23 +1475,18 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
     hd__backend *be = ctx->be;
     hd_result r;
     HD__VK_IDLE(ctx);
-    be->lsum_ok = 0;
     be->sets_valid = 0; /* the placeholders bound for absent E / phi / phi2 follow the precision */
     if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) { /* after hd_set_params */
         hd__gpu_alloc_illumination(ctx, &be->gg, 0);
         return r;
     }
-    be->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
-    if ((r = hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats);
 }
 
 static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
 {
-    hd_result r;
     HD__VK_IDLE(ctx);
-    if ((r = hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
 }
 
 static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
@@ -1528,15 +1520,13 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
-    if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
-    if ((r = hd__gpu_clear(ctx, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img.buffer) {
         if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
     }
-    return hd__vk_flush(ctx);
+    return HD_SUCCESS;
 }
 
 /* ---- stages ------------------------------------------------------------------------------------ */
@@ -1579,7 +1569,7 @@ static hd_result hd__be_direct_list(hd__ctx *ctx)
 static hd_result hd__be_direct(hd__ctx *ctx)
 {
     int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__vk_stage(ctx, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
 }
 
@@ -1596,7 +1586,7 @@ static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
     int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     int nz = nzb * ctx->channels;
     VkPipeline pipe;
-    be->lsum_ok = 0;
+    be->gg.lsum_ok = 0;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
@@ -1621,7 +1611,6 @@ static hd_result hd__be_project(hd__ctx *ctx)
     VkPipeline sum, proj;
     int n = hd__project_table_n(ctx);
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
                        n);
@@ -1633,10 +1622,10 @@ static hd_result hd__be_project(hd__ctx *ctx)
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
         (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)
         return r;
-    if (!be->lsum_ok) {
+    if (!be->gg.lsum_ok) {
         r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0);
         if (r != HD_SUCCESS) return r;
-        be->lsum_ok = 1;
+        be->gg.lsum_ok = 1;
     }
     if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
@@ -1663,33 +1652,23 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst)
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
 {
-    HD__VK_LOST_CHECK(ctx);
-    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, NULL, 0);
-}
-
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
-{
-    HD__VK_LOST_CHECK(ctx);
     return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, zz, count);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
 HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
 {
-    HD__VK_LOST_CHECK(ctx);
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     return hd__vk_upload_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
 static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 {
-    hd_result r;
     HD__VK_IDLE(ctx);
-    if ((r = hd__gpu_alloc_lights(ctx, &ctx->be->gg, count)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
 }
 
 /* One convection step of light `light`: its volume -> the spare, copied back (the CPU backend
@@ -1713,7 +1692,7 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
     hd_result r;
     int l;
     VkPipeline pipe;
-    ctx->be->lsum_ok = 0;
+    ctx->be->gg.lsum_ok = 0;
     if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
     for (l = 0; l < ctx->be->gg.nlv; ++l)
@@ -1746,9 +1725,10 @@ static hd_result hd__be_path(hd__ctx *ctx)
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
 
-/* The levels' dims, the row-sum buffers, the parameter slots and the set pool; nothing of theirs
-   may be in flight when they are freed (each step ends waited for). */
+/* The row-sum buffers, the parameter slots and the set pool; nothing of theirs may be in flight
+   when they are freed (each step ends waited for). */
 static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
 {
     hd__backend *be = ctx->be;
@@ -1756,8 +1736,6 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
-    int l;
-    for (l = 0; l < be->gg.levels; ++l) hd__mg_level_dims(be->gg.fine, l, mg->lv[l].dims);
     hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
     if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
     mg->pool = VK_NULL_HANDLE;
@@ -1771,93 +1749,47 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
         (r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(be->gg.levels + 1),
                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
         return r;
-    return hd__vk_pool(ctx, HD__VK_MG_SETS, &mg->pool);
+    return hd__vk_pool(ctx, HD__GPU_MG_SETS, &mg->pool);
 }
 
-/* Level l's sigma_t. */
-static const hd__vk_image *hd__vk_mg_sig(const hd__backend *be, int l) { return l == 0 ? &be->sig : &be->mg.lv[l].sig; }
-
-/* Writes one multigrid set: sigma_t, E, phi, phi2 (bindings 4..7), the other grid (10) and the
-   row sums (11); NULL binds a placeholder. */
-static void hd__vk_mg_write(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_image *sig, const hd__vk_image *E,
-                            const hd__vk_image *phi, const hd__vk_image *phi2, const hd__vk_image *other,
-                            const hd__vk_buffer *dot)
-{
-    hd__backend *be = ctx->be;
-    const hd__vk_image *im[HD__VK_BINDINGS];
-    const hd__vk_buffer *bu[HD__VK_BINDINGS];
-    memset(im, 0, sizeof im);
-    memset(bu, 0, sizeof bu);
-    hd__vk_common_buffers(be, bu, dot);
-    im[1] = &be->vol; im[4] = sig; im[5] = E; im[6] = phi; im[7] = phi2; im[10] = other;
-    hd__vk_write_set(ctx, set, &be->mg.params, im, bu);
-}
-
-/* Every pass's set (hd_gl.h's bindings per pass), written when the levels are new or the
-   backend's sets were rebuilt since (its grids may be new). Nothing is in flight. */
+/* Every pass's set (src/hd_gpu.h's hd__gpu_mg_set: sigma_t, E, phi, phi2 and the other grid at
+   bindings 4..7 and 10, the row sums at 11), written when the levels are new or the backend's
+   sets were rebuilt since (its grids may be new). Nothing is in flight. */
 static hd_result hd__vk_mg_sets(hd__ctx *ctx)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
+    static const int binding[5] = {4, 5, 6, 7, 10};
     hd__backend *be = ctx->be;
     struct hd__vk_mg *mg = &be->mg;
-    VkDescriptorSet sets[HD__VK_MG_SETS];
-    hd__vk_level *L0 = &mg->lv[0];
     hd_result r;
-    int n = 4 * g->levels + HD__VK_MG_CG_SETS, i, l;
+    int n = HD__GPU_MG_CG(&be->gg, HD__GPU_MG_CG_SETS), s, i;
     if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
     mg->sets_valid = 0;
-    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, sets, "vkResetDescriptorPool (multigrid)",
+    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, mg->sets, "vkResetDescriptorPool (multigrid)",
                               "vkAllocateDescriptorSets (multigrid)")) != HD_SUCCESS)
         return r;
-    for (l = 0; l < g->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l], *C = l + 1 < g->levels ? &mg->lv[l + 1] : NULL;
-        L->smooth = sets[4 * l];
-        L->restrict_to = sets[4 * l + 1];
-        L->prolong_from = sets[4 * l + 2];
-        L->coarsen = sets[4 * l + 3];
-        hd__vk_mg_write(ctx, L->smooth, hd__vk_mg_sig(be, l), &L->rhs, &L->phi, &L->res, NULL, NULL);
-        if (C) {
-            /* both with the fine sigma_t: the transfers' mask (hd_mg_medium) */
-            hd__vk_mg_write(ctx, L->restrict_to, hd__vk_mg_sig(be, l), NULL, &L->res, &C->phi, &C->rhs, NULL);
-            hd__vk_mg_write(ctx, L->prolong_from, hd__vk_mg_sig(be, l), NULL, &C->phi, NULL, &L->phi, NULL);
-        }
-        if (l > 0) hd__vk_mg_write(ctx, L->coarsen, hd__vk_mg_sig(be, l - 1), NULL, NULL, NULL, &L->sig, NULL);
+    for (s = 0; s < n; ++s) {
+        const hd__vk_image *im[HD__VK_BINDINGS];
+        const hd__vk_buffer *bu[HD__VK_BINDINGS];
+        hd__gpu_mg_binds b;
+        if (!hd__gpu_mg_set(&be->gg, s, &b)) continue;
+        memset(im, 0, sizeof im);
+        memset(bu, 0, sizeof bu);
+        hd__vk_common_buffers(be, bu, b.dot == 1 ? &mg->dot_a : b.dot == 2 ? &mg->dot_b : NULL);
+        im[1] = &be->vol;
+        for (i = 0; i < 5; ++i) im[binding[i]] = b.grid[i] < 0 ? NULL : hd__vk_grid(be, b.grid[i]);
+        hd__vk_write_set(ctx, mg->sets[s], &mg->params, im, bu);
     }
-    for (i = 0; i < HD__VK_MG_CG_SETS; ++i) mg->cg_sets[i] = sets[4 * g->levels + i];
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_R], &be->sig, &be->E, &be->phi, &mg->lo, &L0->rhs, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_RES_Q], &be->sig, &L0->phi, &mg->p, &mg->lo, &L0->res, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RZ], NULL, &L0->rhs, &L0->phi, NULL, NULL, &mg->dot_a);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DIR], NULL, &L0->phi, &mg->p, NULL, NULL, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ], NULL, &mg->p, &L0->res, NULL, NULL, &mg->dot_a);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP], NULL, &L0->rhs, &mg->p, NULL, NULL, &mg->dot_b);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_UPDATE], NULL, &mg->p, &be->phi, &mg->lo, NULL, NULL);
-    hd__vk_mg_write(ctx, mg->cg_sets[HD__VK_MG_SET_EXTRAP], &be->sig, &be->E, &be->phi, &mg->lo, NULL, NULL);
     mg->sets_gen = be->sets_gen;
     mg->sets_valid = 1;
     return HD_SUCCESS;
 }
 
-/* Every level's parameter block (the CPU's hd__cpu_mg_params) and the fine one into their slots
-   (nothing is in flight: each step ends waited for). */
-static void hd__vk_mg_params(hd__ctx *ctx)
+/* Parameter block kp into slot l (level l's; slot `levels`: the fine one). Nothing is in flight:
+   each step ends waited for. */
+static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    int l;
-    for (l = 0; l < g->levels; ++l) {
-        hd__vk_level *L = &mg->lv[l];
-        hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-        L->kp = kp;
-        memcpy((char *)mg->params.map + (size_t)l * mg->slot_bytes, &kp, sizeof kp);
-    }
-    memcpy((char *)mg->params.map + (size_t)g->levels * mg->slot_bytes, &ctx->kp, sizeof ctx->kp);
-}
-
-/* The flags the passes' pipelines are specialized for: RGB scattering and the boundary (the
-   variant), and the rhs flag for the levels' float residual (as hd_gl.h's programs). */
-static int hd__vk_mg_variant(int counts_z)
-{
-    return ((counts_z & HD_FLAG_RGB_SCATTERING) ? 1 : 0) + ((counts_z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0);
+    memcpy((char *)ctx->be->mg.params.map + (size_t)l * ctx->be->mg.slot_bytes, kp, sizeof *kp);
+    return HD_SUCCESS;
 }
 
 /* The pipeline of multigrid pass `stage` for the current flags, made on first use. */
@@ -1871,10 +1803,9 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
                                                   sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update,
                                                   sizeof hd__spv_mg_extrap};
     hd__backend *be = ctx->be;
-    int variant = hd__vk_mg_variant(ctx->kp.counts.z);
-    VkPipeline *slot = &be->mg_pipes[(stage - 1) * 4 + variant];
-    int32_t flags = (int32_t)(((variant & 1) ? HD_FLAG_RGB_SCATTERING : 0) | ((variant & 2) ? HD_FLAG_SURFACE_BOUNDARY : 0) |
-                              (stage == HD__MG_RESIDUAL ? HD_FLAG_DIFFUSE_RHS : 0));
+    int f, variant = hd__gpu_mg_variant(stage, ctx->kp.counts.z, &f);
+    VkPipeline *slot = &be->mg_pipes[variant];
+    int32_t flags = (int32_t)f;
     hd_result r;
     if (!*slot && (r = hd__vk_pipeline_code(ctx, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
         HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__mg_stage_names[stage - 1]);
@@ -1884,36 +1815,28 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
     return HD_SUCCESS;
 }
 
-/* Records multigrid pass `stage` with set `set` and parameter slot `slot` over nx x ny x nz into
-   the backend's command buffer. */
-static hd_result hd__vk_mg_pass(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int nx, int ny, int nz, int32_t pc0,
-                                int32_t pc1, int32_t pc2, int32_t pc3)
+/* Records pass p into the backend's command buffer with its set and parameter slot; the
+   direction's beta (its bits) and the update's alpha (low and high words: packDouble2x32's x and
+   y; the host's byte order is the device's) in hd_pc.x and .y. */
+static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 {
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     int32_t pc[4];
+    uint64_t u;
     hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, stage, &pipe)) != HD_SUCCESS) return r;
-    pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
-    hd__vk_record_dispatch(be, cb, pipe, set, (uint32_t)((VkDeviceSize)slot * be->mg.slot_bytes), nx, ny, nz, pc);
+    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, p->stage, &pipe)) != HD_SUCCESS) return r;
+    memcpy(pc, p->pc, sizeof pc);
+    if (p->stage == HD__MG_DIR) memcpy(&pc[0], &p->beta, sizeof p->beta);
+    if (p->stage == HD__MG_UPDATE) {
+        memcpy(&u, &p->alpha, sizeof u);
+        pc[0] = (int32_t)(uint32_t)u;
+        pc[1] = (int32_t)(uint32_t)(u >> 32);
+    }
+    hd__vk_record_dispatch(be, cb, pipe, be->mg.sets[p->set], (uint32_t)((VkDeviceSize)p->slot * be->mg.slot_bytes), p->n[0],
+                           p->n[1], p->n[2], pc);
     return HD_SUCCESS;
-}
-
-/* Pass `stage` over level l's grid of `channels` channels stacked in z, push constants (the
-   level's dims, or with dims_pc 0 zeros, and channels). */
-static hd_result hd__vk_mg_level(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int l, int channels, int dims_pc)
-{
-    const int *d = ctx->be->mg.lv[l].dims;
-    return hd__vk_mg_pass(ctx, stage, set, slot, d[0], d[1], d[2] * channels, dims_pc ? d[0] : 0, dims_pc ? d[1] : 0,
-                          dims_pc ? d[2] : 0, channels);
-}
-
-/* Pass `stage` over the fine grid, push constants (pc0, pc1, 0, channels). */
-static hd_result hd__vk_mg_fine(hd__ctx *ctx, int stage, VkDescriptorSet set, int slot, int32_t pc0, int32_t pc1)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    return hd__vk_mg_pass(ctx, stage, set, slot, g->fine[0], g->fine[1], g->fine[2] * g->channels, pc0, pc1, 0, g->channels);
 }
 
 /* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
@@ -1921,9 +1844,9 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 {
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd__vk_level *L = &be->mg.lv[l];
-    int ny = (L->dims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (L->dims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
-    int32_t flags = L->kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
+    const int *d = be->gg.lv[l].dims;
+    int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int32_t flags = be->gg.lv[l].kp.counts.z & (HD_FLAG_RGB_SCATTERING | HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
     uint32_t offset = (uint32_t)((VkDeviceSize)l * be->mg.slot_bytes);
     VkPipeline pipe;
     hd_result r;
@@ -1933,34 +1856,9 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
             pc[0] = first ^ h; pc[1] = 0; pc[2] = nzb; pc[3] = 0;
-            hd__vk_record_dispatch(be, cb, pipe, L->smooth, offset, (L->dims[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
+            hd__vk_record_dispatch(be, cb, pipe, be->mg.sets[HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH)], offset, (d[0] + 1) / 2, ny, nzb * be->gg.channels, pc);
         }
     return HD_SUCCESS;
-}
-
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_RESIDUAL, mg->lv[l].smooth, l, l, ctx->be->gg.channels, 0);
-}
-
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_RESTRICT, mg->lv[l].restrict_to, l, l + 1, ctx->be->gg.channels, 1);
-}
-
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_PROLONG, mg->lv[l].prolong_from, l + 1, l, ctx->be->gg.channels, 1);
-}
-
-/* <a, b> per fine row (the set's E and phi) into its row-sum buffer. */
-static hd_result hd__vk_mg_dot(hd__ctx *ctx, VkDescriptorSet set)
-{
-    const hd__gpu_grids *g = &ctx->be->gg;
-    return hd__vk_mg_pass(ctx, HD__MG_DOT, set, 0, g->fine[1], g->fine[2] * g->channels, 1, 0, 0, 0, g->channels);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
@@ -1972,15 +1870,14 @@ static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    HD__VK_LOST_CHECK(ctx);
     if (be->no_f64)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
                        be->no_f64);
     if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__gpu_mg_ready(ctx, &be->gg, fresh)) != HD_SUCCESS) return r;
-    hd__vk_mg_params(ctx);
+    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS || (r = hd__gpu_mg_begin(ctx, &be->gg, fresh)) != HD_SUCCESS ||
+        (r = hd__gpu_mg_send(ctx, be->gg.levels, &ctx->kp)) != HD_SUCCESS)
+        return r;
     if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
     return hd__vk_mg_sets(ctx);
 }
@@ -1991,51 +1888,6 @@ static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
     if (r != HD_SUCCESS) return r;
     if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
     return hd__vk_flush(ctx);
-}
-
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_level(ctx, HD__MG_SIG, mg->lv[l].coarsen, l - 1, l, ctx->be->gg.sig_channels, 1);
-}
-
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
-{
-    VkCommandBuffer cb = VK_NULL_HANDLE;
-    hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_zero_image(ctx->be, cb, ctx->be->mg.lo.image, HD__VK_G);
-    return HD_SUCCESS;
-}
-
-/* The fine residual in double (hd_mg_res_f64), f - A (phi + lo): the fine slot, use_lo. */
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    return hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_R], ctx->be->gg.levels, 1, 0);
-}
-
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
-{
-    return hd__vk_mg_dot(ctx, ctx->be->mg.cg_sets[HD__VK_MG_SET_DOT_RZ]);
-}
-
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
-{
-    int32_t bits;
-    memcpy(&bits, &beta, sizeof beta);
-    return hd__vk_mg_fine(ctx, HD__MG_DIR, ctx->be->mg.cg_sets[HD__VK_MG_SET_DIR], 0, bits, 0);
-}
-
-/* q = A p: the double residual with negate on level 0's slot (E = z = 0, phi = p). */
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    hd_result r;
-    if ((r = hd__vk_mg_fine(ctx, HD__MG_RES_F64, mg->cg_sets[HD__VK_MG_SET_RES_Q], 0, 0, 1)) != HD_SUCCESS ||
-        (r = hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_PQ])) != HD_SUCCESS)
-        return r;
-    return hd__vk_mg_dot(ctx, mg->cg_sets[HD__VK_MG_SET_DOT_RP]);
 }
 
 /* Submits what was recorded, the row sums made visible to the host, and waits; the sums are read
@@ -2054,32 +1906,11 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
-{
-    int32_t bits[2];
-    uint64_t u;
-    int i;
-    /* alpha's low and high words (packDouble2x32's x and y): the host's byte order is the device's */
-    ctx->be->lsum_ok = 0;
-    memcpy(&u, &alpha, sizeof u);
-    for (i = 0; i < 2; ++i) bits[i] = (int32_t)(uint32_t)(u >> (32 * i));
-    return hd__vk_mg_fine(ctx, HD__MG_UPDATE, ctx->be->mg.cg_sets[HD__VK_MG_SET_UPDATE], 0, bits[0], bits[1]);
-}
-
-/* The fine parameters: slot `levels` (no right-hand-side flag). */
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
-{
-    struct hd__vk_mg *mg = &ctx->be->mg;
-    ctx->be->lsum_ok = 0;
-    return hd__vk_mg_fine(ctx, HD__MG_EXTRAP, mg->cg_sets[HD__VK_MG_SET_EXTRAP], ctx->be->gg.levels, colour, 0);
-}
-
 /* The single-level solver's sweeps: each its own submission. */
 static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
 
 /* ---- recording into the caller's command buffer ------------------------------------------------ */
 static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
-static hd_result hd__prepare(hd__ctx *ctx);
 static hd_result hd__iterate_method(hd__ctx *ctx);
 static hd_result hd__light_iteration(hd__ctx *ctx);
 static hd_result hd__project_frame(hd__ctx *ctx);
@@ -2151,27 +1982,13 @@ static hd_result hd__vk_record_iteration(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+/* n iterations recorded into cb after hd__prepare's work is submitted and waited for: only
+   iterations are recorded, each with its own parameter slots. */
+static hd_result hd__vk_record(hd__ctx *ctx, VkCommandBuffer cb, int n)
 {
-    hd_logger stale;
-    hd__ctx *ctx = hd__lookup(h, &stale);
-    hd__backend *be;
-    hd_result r = HD_SUCCESS;
+    hd__backend *be = ctx->be;
+    hd_result r;
     int i;
-    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
-    be = ctx->be;
-    if (!command_buffer) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
-    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
-    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
-    if (ctx->params.solver == HD_SOLVER_MULTIGRID && !ctx->params.disable_diffusion &&
-        (ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
-                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
-    /* uploads, allocations and clears are submitted and waited for here; only iterations are
-       recorded, each with its own parameter slot */
-    hd__vk_read_frame_time(ctx);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
     /* reduced frames need the image buffer's second region, which cannot be made mid-recording */
     if (!hd__method_is_pt(ctx->params.method) && ctx->params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS) return r;
     if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
@@ -2181,7 +1998,7 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
     if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
     be->next_slot = 0;
     be->have_slot = 0;
-    be->rec = (VkCommandBuffer)command_buffer;
+    be->rec = cb;
     ctx->no_measure = 1;
     for (i = 0; i < n && r == HD_SUCCESS; ++i)
         r = ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD ? hd__vk_record_iteration(ctx)
@@ -2190,5 +2007,24 @@ HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
     if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
     else be->ts_pending = 0;                           /* a failed recording is not submitted */
     be->rec = VK_NULL_HANDLE;
+    return r;
+}
+
+HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+{
+    hd_logger stale;
+    hd__ctx *ctx = hd__lookup(h, &stale);
+    hd_result r;
+    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
+    if (!command_buffer) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
+    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
+    if (ctx->params.solver == HD_SOLVER_MULTIGRID && !ctx->params.disable_diffusion &&
+        (ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD))
+        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
+                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
+    hd__vk_read_frame_time(ctx);
+    HD__BE_CALL(r, ctx, hd__vk_record(ctx, (VkCommandBuffer)command_buffer, n));
     return r;
 }

@@ -225,7 +225,7 @@ static void experiments(hd_context h, int quick)
     t0 = hd__now();
     hd__be_direct(ctx); clFinish(be->queue);
     t_db = hd__now() - t0;
-    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e_b);
+    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, NULL, 0, e_b);
     bind9(be, kd);
     clSetKernelArg(kd, 9, sizeof vimg, &vimg);
     clSetKernelArg(kd, 10, sizeof smp, &smp);
@@ -234,7 +234,7 @@ static void experiments(hd_context h, int quick)
     clEnqueueNDRangeKernel(be->queue, kd, 3, NULL, gd, NULL, 0, NULL, NULL);
     clFinish(be->queue);
     t_di = hd__now() - t0;
-    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e_i);
+    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, NULL, 0, e_i);
     for (i = 0; i < (int)npix; ++i) { d2 += (double)(img_i[i] - img_b[i]) * (img_i[i] - img_b[i]); r2 += (double)img_b[i] * img_b[i]; }
     for (i = 0; i < (int)ngrid; ++i) { de2 += (double)(e_i[i] - e_b[i]) * (e_i[i] - e_b[i]); re2 += (double)e_b[i] * e_b[i]; }
     printf("volume reads, projection %dx%d: buffer+software trilinear %.1f ms, 3D image+linear sampler %.1f ms (image/buffer time %.2fx), image vs buffer rel L2 %.1e\n",

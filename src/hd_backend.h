@@ -4,7 +4,8 @@
    declared below, with these signatures (the helpers at the end are the core's, for backends to
    use). One it lacks is a compile error ("used but never defined") and a different signature a
    conflicting declaration, so the list is the whole job of a new backend. The GPU backends make
-   their grids (hd__be_alloc_*, hd__be_clear, the multigrid's levels) through src/hd_gpu.h.
+   their grids (hd__be_alloc_*, hd__be_clear, the multigrid's levels) through src/hd_gpu.h, which
+   also defines for them the multigrid's primitives that are single passes.
 
    Common rules:
    - Every primitive returns HD_SUCCESS or a specific hd_result with one line logged through
@@ -29,6 +30,31 @@ static const char *hd__be_name(void);
 static hd_result hd__be_create(hd__ctx *ctx);
 /* Releases everything the backend holds, ctx->be included; safe on a partly created backend. */
 static void hd__be_destroy(hd__ctx *ctx);
+
+/* ---- the bracket of a public call ------------------------------------------------------------
+   The core opens one bracket per public call that reaches the device (hd_iterate, hd_render, the
+   read-backs, ...; a backend's own entry points such as hd_gl_render_to_texture do the same) and
+   runs hd__prepare and every primitive below inside it; hd__be_create and hd__be_destroy run
+   outside any. */
+/* Refuses a device lost earlier (HD_ERROR_DEVICE_LOST, logged), makes the backend's context
+   current on this thread and saves the caller's state the primitives will change (GL). On
+   failure nothing is open and hd__be_end is not called. */
+static hd_result hd__be_begin(hd__ctx *ctx);
+/* Closes the bracket whatever r is (the call's first error, or HD_SUCCESS): what the backend
+   recorded but did not submit is submitted and waited for (on success), the caller's state and
+   context restored. Returns r, or its own error where r is HD_SUCCESS. */
+static hd_result hd__be_end(hd__ctx *ctx, hd_result r);
+/* The core's hd__prepare (src/hd_context.h): the device state brought up to date with the setters. */
+static hd_result hd__prepare(hd__ctx *ctx);
+/* r = the result of hd__prepare and then of expr, both in one bracket; expr is not evaluated when
+   an earlier step failed. */
+#define HD__BE_CALL(r, ctx, expr) \
+    do { \
+        if (((r) = hd__be_begin(ctx)) == HD_SUCCESS) { \
+            if (((r) = hd__prepare(ctx)) == HD_SUCCESS) (r) = (expr); \
+            (r) = hd__be_end((ctx), (r)); \
+        } \
+    } while (0)
 
 /* ---- allocation (the core calls these from hd__prepare when its dirty bits say so) ----------- */
 /* The volume, TF and majorant of ctx are new: upload them (classification follows). */
@@ -82,12 +108,11 @@ static hd_result hd__be_path(hd__ctx *ctx);
 /* ---- read-back (blocking: every earlier primitive's result) ------------------------------------ */
 /* The image as RGBA floats, ctx->camera.width x height, rows top to bottom. */
 static hd_result hd__be_read_image(hd__ctx *ctx, float *dst);
-/* E (HD_ILLUMINATION_DIRECT) or phi (SCATTERED) as floats, x fastest, channels stacked in z. */
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst);
-/* Some z slices of the same stacking (slice zz: channel zz / gdims[2], z zz % gdims[2]), zz[0..
-   count) in that order, each gdims[0] * gdims[1] floats, one after another into dst: the light's
-   convergence estimate reads only what it measures. */
-static hd_result hd__be_read_illumination_slices(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst);
+/* E (HD_ILLUMINATION_DIRECT) or phi (SCATTERED) as floats, x fastest, channels stacked in z:
+   with zz NULL the whole grid; else the z slices zz[0..count) of that stacking (slice zz: channel
+   zz / gdims[2], z zz % gdims[2]) in that order, each gdims[0] * gdims[1] floats, one after
+   another into dst (the light's convergence estimate reads only what it measures). */
+static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst);
 
 /* ---- HD_SOLVER_MULTIGRID's per-level primitives -------------------------------------------------
    The core's hd__mg_step (src/hd_multigrid.h) runs conjugate gradients preconditioned by a

@@ -868,7 +868,7 @@ static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq,
     float *prev = ctx->conv_prev + (which == HD_ILLUMINATION_DIRECT ? 0 : m);
     double d = 0.0, l = 0.0;
     int c, j, nz = ctx->conv_nz;
-    if ((r = hd__be_read_illumination_slices(ctx, which, ctx->conv_zz, nz * ctx->channels, ctx->conv_tmp)) != HD_SUCCESS) return r;
+    if ((r = hd__be_read_illumination(ctx, which, ctx->conv_zz, nz * ctx->channels, ctx->conv_tmp)) != HD_SUCCESS) return r;
     for (c = 0; c < ctx->channels; ++c)
         for (j = 0; j < nz; ++j)
             for (i = ctx->conv_off[j]; i < ctx->conv_off[j + 1]; ++i) {
@@ -1149,19 +1149,24 @@ static hd_result hd__iterate_method(hd__ctx *ctx)
     }
 }
 
+/* n iterations of step (one iteration of hd_iterate or hd_refine), stopping at the first error. */
+static hd_result hd__iterate_n(hd__ctx *ctx, int n, hd_result (*step)(hd__ctx *))
+{
+    hd_result r = HD_SUCCESS;
+    int i;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = step(ctx);
+    return r;
+}
+
 HDDEF hd_result hd_iterate(hd_context h, int n)
 {
     hd_result r;
-    int i;
     HD__GET_CTX(ctx, h);
     if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: n = %d, must be >= 1", n);
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: more than 2^31 iterations; reset with a new seed");
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    for (i = 0; i < n; ++i) {
-        if ((r = hd__iterate_method(ctx)) != HD_SUCCESS) return r;
-    }
-    return HD_SUCCESS;
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__iterate_method));
+    return r;
 }
 
 /* A light iteration of hd_refine or hd_render. When the light converges, the frames in the
@@ -1182,7 +1187,6 @@ static hd_result hd__refine_once(hd__ctx *ctx)
 HDDEF hd_result hd_refine(hd_context h, int n)
 {
     hd_result r;
-    int i;
     HD__GET_CTX(ctx, h);
     if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_refine: n = %d, must be >= 1", n);
     if (hd__method_is_pt(ctx->params.method))
@@ -1190,19 +1194,15 @@ HDDEF hd_result hd_refine(hd_context h, int n)
                        hd_method_name(ctx->params.method));
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
         return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_refine: more than 2^31 iterations; reset with a new seed");
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    for (i = 0; i < n; ++i)
-        if ((r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__refine_once));
+    return r;
 }
 
-HDDEF hd_result hd_render(hd_context h)
+/* hd_render's work after hd__prepare. */
+static hd_result hd__render(hd__ctx *ctx)
 {
     hd_result r;
-    double t0, last = 0.0, budget;
-    HD__GET_CTX(ctx, h);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    t0 = hd__now();
+    double t0 = hd__now(), last = 0.0, budget;
     budget = (double)ctx->params.render_budget;
     if (hd__method_is_pt(ctx->params.method)) {
         /* the image is the path tracers' state: each call adds at least one path per pixel */
@@ -1229,6 +1229,14 @@ HDDEF hd_result hd_render(hd_context h)
         ctx->converged_frames++;
     }
     return hd__project_frame(ctx);
+}
+
+HDDEF hd_result hd_render(hd_context h)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    HD__BE_CALL(r, ctx, hd__render(ctx));
+    return r;
 }
 
 #if !defined(HYBRIDDIFF_BACKEND_GL)
@@ -1258,8 +1266,8 @@ HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
     if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_image_f32: dst is NULL");
     need = (size_t)ctx->camera.width * ctx->camera.height * 4;
     if (dst_floats < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_f32: %zu floats given, %zu needed", dst_floats, need);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    return hd__be_read_image(ctx, dst);
+    HD__BE_CALL(r, ctx, hd__be_read_image(ctx, dst));
+    return r;
 }
 
 static uint8_t hd__srgb8(float v)
@@ -1283,7 +1291,8 @@ HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes
     if (dst_bytes < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_rgba8: %zu bytes given, %zu needed", dst_bytes, need);
     tmp = (float *)hd__alloc(ctx, need * sizeof(float));
     if (!tmp) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "hd_read_image_rgba8: no memory for the conversion");
-    if ((r = hd__prepare(ctx)) == HD_SUCCESS && (r = hd__be_read_image(ctx, tmp)) == HD_SUCCESS) {
+    HD__BE_CALL(r, ctx, hd__be_read_image(ctx, tmp));
+    if (r == HD_SUCCESS) {
         float e = ctx->params.exposure;
         for (i = 0; i < n; ++i) {
             float a = tmp[4 * i + 3];
@@ -1310,8 +1319,8 @@ HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float 
                        hd_method_name(ctx->params.method));
     need = hd__illum_floats(ctx);
     if (dst_floats < need) return HD__ERR(&ctx->log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    return hd__be_read_illumination(ctx, which, dst);
+    HD__BE_CALL(r, ctx, hd__be_read_illumination(ctx, which, NULL, 0, dst));
+    return r;
 }
 
 HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)

@@ -2,28 +2,31 @@
    no stability promise). The conformance suite and the benchmarks include this file after the
    library's implementation, in the same translation unit, to compare stages across backends:
    one diffusion sweep, a solve, the projection of illumination they wrote themselves.
-   Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does. */
+   Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does, in one
+   bracket of the backend's (HD__BE_CALL). */
 
 /* The state a hook starts from: allocations, sigma_t, cleared accumulations. */
 HD__MAYBE_UNUSED static hd_result hd__test_prepare(hd_context h)
 {
+    hd_result r;
     HD__GET_CTX(ctx, h);
-    return hd__prepare(ctx);
+    HD__BE_CALL(r, ctx, HD_SUCCESS);
+    return r;
 }
 
 /* n direct-light passes (HD stage 1 only), each one iteration of the progressive mean. */
+static hd_result hd__test_direct_once(hd__ctx *ctx)
+{
+    ctx->iterations++;
+    hd__fill_kparams(ctx);
+    return hd__be_direct(ctx);
+}
 HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
 {
     hd_result r;
-    int i;
     HD__GET_CTX(ctx, h);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    for (i = 0; i < n; ++i) {
-        ctx->iterations++;
-        hd__fill_kparams(ctx);
-        if ((r = hd__be_direct(ctx)) != HD_SUCCESS) return r;
-    }
-    return HD_SUCCESS;
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__test_direct_once));
+    return r;
 }
 
 /* on = 1: HD's direct light tracks every voxel of the illumination grid; 0: only the voxels
@@ -45,16 +48,17 @@ HD__MAYBE_UNUSED static size_t hd__test_direct_count(hd_context h)
 }
 
 /* n diffusion sweeps of the selected solver (multigrid: CG steps) on the current E and phi. */
+static hd_result hd__test_diffuse_n(hd__ctx *ctx, int n)
+{
+    hd__fill_kparams(ctx);
+    return hd__iterate_n(ctx, n, hd__diffuse_once);
+}
 HD__MAYBE_UNUSED static hd_result hd__test_diffuse(hd_context h, int n)
 {
     hd_result r;
-    int i;
     HD__GET_CTX(ctx, h);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    hd__fill_kparams(ctx);
-    for (i = 0; i < n; ++i)
-        if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
+    HD__BE_CALL(r, ctx, hd__test_diffuse_n(ctx, n));
+    return r;
 }
 
 #ifdef HYBRIDDIFF_BACKEND_CPU
@@ -69,18 +73,18 @@ HD__MAYBE_UNUSED static hd_result hd__test_residual(hd_context h, double *out)
 #endif
 
 /* n projection frames of the current E and phi into the image. */
+static hd_result hd__test_project_once(hd__ctx *ctx)
+{
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    return hd__be_project(ctx);
+}
 HD__MAYBE_UNUSED static hd_result hd__test_project(hd_context h, int n)
 {
     hd_result r;
-    int i;
     HD__GET_CTX(ctx, h);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
-    for (i = 0; i < n; ++i) {
-        ctx->frames++;
-        hd__fill_kparams(ctx);
-        if ((r = hd__be_project(ctx)) != HD_SUCCESS) return r;
-    }
-    return HD_SUCCESS;
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__test_project_once));
+    return r;
 }
 
 /* Overwrites E or phi (channel-planar, hd_stats' dims and channels) with src: the only hook that
@@ -89,19 +93,19 @@ HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_i
 {
     hd_result r;
     HD__GET_CTX(ctx, h);
-    if ((r = hd__prepare(ctx)) != HD_SUCCESS) return r;
 #if defined(HYBRIDDIFF_BACKEND_CPU)
-    return hd__cpu_write_illumination(ctx, which, src);
+    HD__BE_CALL(r, ctx, hd__cpu_write_illumination(ctx, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
-    return hd__cl_write_illumination(ctx, which, src);
+    HD__BE_CALL(r, ctx, hd__cl_write_illumination(ctx, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
-    return hd__vk_write_illumination(ctx, which, src);
+    HD__BE_CALL(r, ctx, hd__vk_write_illumination(ctx, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-    return hd__gl_write_illumination(ctx, which, src);
+    HD__BE_CALL(r, ctx, hd__gl_write_illumination(ctx, which, src));
 #else
     (void)which; (void)src;
-    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
+    r = HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
 #endif
+    return r;
 }
 
 /* Waits until the device has done everything queued (for timing). */
