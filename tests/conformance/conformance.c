@@ -5,8 +5,12 @@
    illumination) must agree to a relative L2 <= 1e-5 and a relative Linf <= 1e-4; stochastic ones
    (HD direct light, whole HD iterations) with identical seeds to a relative L2 <= 1e-3: the
    counter-based RNG draws the same samples, only the rounding of log/exp may differ, which can
-   flip a rare tracking decision. Relative L2 = |b - a| / |a|, relative Linf = max|b - a| / max|a|,
-   a = reference. Every call is checked to leave the caller's buffers unchanged.
+   flip a rare tracking decision. A flipped decision changes one path or one voxel's sample by a
+   whole sample's worth, so on a device whose log/exp round differently (NVIDIA) a few outliers
+   can exceed the L2 bound alone: a stochastic case also passes with relative L2 <= 1e-2 when the
+   rest, the relative L2 without the largest 0.5 % of the differences, is <= 1e-4; an error in a
+   kernel moves most elements and fails both. Relative L2 = |b - a| / |a|, relative Linf =
+   max|b - a| / max|a|, a = reference. Every call is checked to leave the caller's buffers unchanged.
    Output: one line per case with its errors, then "N passed, N failed". A backend whose runtime
    or device is missing is reported SKIPPED with the reason (exit 0, or 1 when the environment
    sets HD_CONFORMANCE_REQUIRE=1, as CI does). `conformance-opencl --quick`: one case per stage
@@ -20,6 +24,8 @@
 #define TOL_DET_L2 1e-5
 #define TOL_DET_LINF 1e-4
 #define TOL_STOCH_L2 1e-3
+#define TOL_STOCH_OUTLIER_L2 1e-2
+#define TOL_STOCH_REST_L2 1e-4
 
 static int n_passed, n_failed, n_skipped;
 static char last_log[1024];
@@ -149,10 +155,22 @@ static int guard_intact(const guard *g)
 static void guard_free(guard *g) { free(g->data); }
 
 /* ---- comparison ------------------------------------------------------------------------------- */
-static void rel_errors(const float *ref, const float *got, size_t n, double *l2, double *linf)
+/* The errors of a case: the worst over the arrays it compares. */
+typedef struct errors {
+    double l2, linf, rest; /* rest: relative L2 without the largest 0.5 % of the differences */
+} errors;
+
+static int cmp_desc(const void *x, const void *y)
 {
-    double d2 = 0.0, r2 = 0.0, dmax = 0.0, rmax = 0.0;
-    size_t i;
+    double a = *(const double *)x, b = *(const double *)y;
+    return a < b ? 1 : a > b ? -1 : 0;
+}
+
+static void rel_errors(const float *ref, const float *got, size_t n, errors *e)
+{
+    double d2 = 0.0, r2 = 0.0, dmax = 0.0, rmax = 0.0, top = 0.0;
+    double *sq = (double *)malloc((n ? n : 1) * sizeof(double));
+    size_t i, k = n / 200 ? n / 200 : 1;
     for (i = 0; i < n; ++i) {
         double d = (double)got[i] - (double)ref[i];
         if (got[i] != got[i]) d = 1e30; /* NaN */
@@ -160,9 +178,16 @@ static void rel_errors(const float *ref, const float *got, size_t n, double *l2,
         r2 += (double)ref[i] * ref[i];
         if (fabs(d) > dmax) dmax = fabs(d);
         if (fabs((double)ref[i]) > rmax) rmax = fabs((double)ref[i]);
+        if (sq) sq[i] = d * d;
     }
-    *l2 = r2 > 0.0 ? sqrt(d2 / r2) : sqrt(d2);
-    *linf = rmax > 0.0 ? dmax / rmax : dmax;
+    if (sq && n) {
+        qsort(sq, n, sizeof(double), cmp_desc);
+        for (i = 0; i < k && i < n; ++i) top += sq[i];
+    }
+    free(sq);
+    e->l2 = r2 > 0.0 ? sqrt(d2 / r2) : sqrt(d2);
+    e->linf = rmax > 0.0 ? dmax / rmax : dmax;
+    e->rest = sq ? (r2 > 0.0 ? sqrt(fmax(d2 - top, 0.0) / r2) : sqrt(fmax(d2 - top, 0.0))) : e->l2;
 }
 
 /* The pair of contexts a case runs on. */
@@ -205,7 +230,7 @@ static void pair_destroy(pair *p)
 enum { CMP_E = 1, CMP_PHI = 2, CMP_IMAGE = 4 };
 
 /* Reads the selected outputs of both and folds their errors into the worst ones seen. */
-static void pair_compare(pair *p, int what, double *l2, double *linf)
+static void pair_compare(pair *p, int what, errors *worst)
 {
     hd_stats st;
     size_t n;
@@ -224,7 +249,7 @@ static void pair_compare(pair *p, int what, double *l2, double *linf)
     a = (float *)calloc(n, sizeof(float));
     b = (float *)calloc(n, sizeof(float));
     for (k = 0; k < 3; ++k) {
-        double e2, einf;
+        errors e;
         size_t cnt;
         hd_result r1, r2;
         if (!(what & (1 << k))) continue;
@@ -241,22 +266,28 @@ static void pair_compare(pair *p, int what, double *l2, double *linf)
         }
         if (r1 != HD_SUCCESS) { pair_fail(p, "reference read", r1); break; }
         if (r2 != HD_SUCCESS) { pair_fail(p, "backend read", r2); break; }
-        rel_errors(a, b, cnt, &e2, &einf);
-        if (e2 > *l2) *l2 = e2;
-        if (einf > *linf) *linf = einf;
+        rel_errors(a, b, cnt, &e);
+        if (e.l2 > worst->l2) worst->l2 = e.l2;
+        if (e.linf > worst->linf) worst->linf = e.linf;
+        if (e.rest > worst->rest) worst->rest = e.rest;
     }
     free(a);
     free(b);
 }
 
-static void report(const char *name, const pair *p, const guard *g, double l2, double linf, int deterministic)
+static void report(const char *name, const pair *p, const guard *g, const errors *e, int deterministic)
 {
     int inputs_ok = guard_intact(g);
-    int pass = p->ok && inputs_ok && l2 <= (deterministic ? TOL_DET_L2 : TOL_STOCH_L2) &&
-               (!deterministic || linf <= TOL_DET_LINF);
-    printf("%s %-56s rel_L2 %.2e  rel_Linf %.2e  (%s: L2 <= %.0e%s)%s%s%s\n", pass ? "PASS" : "FAIL", name, l2, linf,
-           deterministic ? "deterministic" : "stochastic", deterministic ? TOL_DET_L2 : TOL_STOCH_L2,
-           deterministic ? ", Linf <= 1e-4" : "", inputs_ok ? "" : "  INPUTS CHANGED", p->ok ? "" : "  ERROR ", p->ok ? "" : p->why);
+    int within = deterministic ? e->l2 <= TOL_DET_L2 && e->linf <= TOL_DET_LINF
+                               : e->l2 <= TOL_STOCH_L2 || (e->l2 <= TOL_STOCH_OUTLIER_L2 && e->rest <= TOL_STOCH_REST_L2);
+    int pass = p->ok && inputs_ok && within;
+    char rest[64] = "";
+    char bound[96];
+    if (deterministic) snprintf(bound, sizeof bound, "deterministic: L2 <= %.0e, Linf <= %.0e", TOL_DET_L2, TOL_DET_LINF);
+    else snprintf(bound, sizeof bound, "stochastic: L2 <= %.0e, or <= %.0e with rest <= %.0e", TOL_STOCH_L2, TOL_STOCH_OUTLIER_L2, TOL_STOCH_REST_L2);
+    if (!deterministic) snprintf(rest, sizeof rest, "  rest %.2e", e->rest);
+    printf("%s %-56s rel_L2 %.2e  rel_Linf %.2e%s  (%s)%s%s%s\n", pass ? "PASS" : "FAIL", name, e->l2, e->linf, rest, bound,
+           inputs_ok ? "" : "  INPUTS CHANGED", p->ok ? "" : "  ERROR ", p->ok ? "" : p->why);
     fflush(stdout);
     if (pass) ++n_passed;
     else ++n_failed;
@@ -267,12 +298,12 @@ static void report(const char *name, const pair *p, const guard *g, double l2, d
 static void iterate_case(const char *name, const scene *s, const guard *g, int n, int what, int deterministic)
 {
     pair p;
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     if (pair_create(&p, s)) {
         BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-        pair_compare(&p, what, &l2, &linf);
+        pair_compare(&p, what, &e);
     }
-    report(name, &p, g, l2, linf, deterministic);
+    report(name, &p, g, &e, deterministic);
     pair_destroy(&p);
 }
 
@@ -308,7 +339,7 @@ static void case_diffusion(hd_voxel_type type, const int *d, hd_solver solver, i
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
     s.params.solver = solver;
     guard_take(&g, &s);
@@ -318,9 +349,9 @@ static void case_diffusion(hd_voxel_type type, const int *d, hd_solver solver, i
         write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
         write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
         BOTH(&p, test_diffuse, (p.ref, sweeps), (p.dut, sweeps));
-        pair_compare(&p, CMP_PHI, &l2, &linf);
+        pair_compare(&p, CMP_PHI, &e);
     }
-    report(name, &p, &g, l2, linf, 1);
+    report(name, &p, &g, &e, 1);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -333,7 +364,7 @@ static void case_project(hd_voxel_type type, const int *d, int channels, int fra
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
     guard_take(&g, &s);
     snprintf(name, sizeof name, "project %d frame%s %s %dx%dx%d %dch", frames, frames > 1 ? "s" : "", type_name(type), d[0], d[1], d[2], channels);
@@ -341,9 +372,9 @@ static void case_project(hd_voxel_type type, const int *d, int channels, int fra
         write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
         write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
         BOTH(&p, test_project, (p.ref, frames), (p.dut, frames));
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_IMAGE, &e);
     }
-    report(name, &p, &g, l2, linf, 1);
+    report(name, &p, &g, &e, 1);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -358,7 +389,7 @@ static void case_project_refresh(hd_voxel_type type, const int *d, int channels)
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     hd_params q;
     scene_init(&s, type, d[0], d[1], d[2], channels == 3 ? 3 : 1, channels == 3, 0);
     guard_take(&g, &s);
@@ -370,22 +401,22 @@ static void case_project_refresh(hd_voxel_type type, const int *d, int channels)
         BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
         write_pattern(&p, HD_ILLUMINATION_DIRECT, 3.0f);
         BOTH(&p, test_project, (p.ref, 1), (p.dut, 1));
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_IMAGE, &e);
         write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.1f);
         BOTH(&p, test_project, (p.ref, 1), (p.dut, 1));
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_IMAGE, &e);
         q.step = 1.7f;
         BOTH(&p, set_params, (p.ref, &q), (p.dut, &q));
         BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_IMAGE, &e);
         q.albedo = 0.4f;
         BOTH(&p, set_params, (p.ref, &q), (p.dut, &q));
         write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
         write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
         BOTH(&p, test_project, (p.ref, 2), (p.dut, 2));
-        pair_compare(&p, CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_IMAGE, &e);
     }
-    report(name, &p, &g, l2, linf, 1);
+    report(name, &p, &g, &e, 1);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -399,7 +430,7 @@ static void case_direct(hd_voxel_type type, const int *d, int lights, int mixed,
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     scene_init(&s, type, d[0], d[1], d[2], lights, mixed, point);
     s.params.tracking = tracking;
     s.params.majorant = majorant;
@@ -409,9 +440,9 @@ static void case_direct(hd_voxel_type type, const int *d, int lights, int mixed,
              majorant > 0.0f ? " global-maj" : "");
     if (pair_create(&p, &s)) {
         BOTH(&p, test_direct, (p.ref, n), (p.dut, n));
-        pair_compare(&p, CMP_E, &l2, &linf);
+        pair_compare(&p, CMP_E, &e);
     }
-    report(name, &p, &g, l2, linf, 0);
+    report(name, &p, &g, &e, 0);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -425,7 +456,7 @@ static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     static const float tf2[] = {0.0f, 0.0f, 0.0f, 0.0f, 0.2f, 0.5f, 0.9f, 0.2f, 1.0f, 0.9f, 0.8f, 0.8f};
     hd_transfer_function tf;
     hd_camera cam;
@@ -452,9 +483,9 @@ static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed
             if (memcmp(&before, &cam, sizeof cam) != 0) pair_fail(&p, "set_camera changed its input", HD_SUCCESS);
         }
         BOTH(&p, iterate, (p.ref, n - n / 2), (p.dut, n - n / 2));
-        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &e);
     }
-    report(name, &p, &g, l2, linf, 0);
+    report(name, &p, &g, &e, 0);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -537,7 +568,7 @@ static void case_multigrid(hd_voxel_type type, const int *d, int lights, int rgb
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     hd_desc desc;
     hd_result r;
     scene_init(&s, type, d[0], d[1], d[2], lights, rgb, 1);
@@ -564,13 +595,13 @@ static void case_multigrid(hd_voxel_type type, const int *d, int lights, int rgb
                 write_pattern(&p, HD_ILLUMINATION_DIRECT, 1.0f);
                 write_pattern(&p, HD_ILLUMINATION_SCATTERED, 0.5f);
                 BOTH(&p, test_diffuse, (p.ref, steps), (p.dut, steps));
-                pair_compare(&p, CMP_PHI, &l2, &linf);
+                pair_compare(&p, CMP_PHI, &e);
             } else {
                 BOTH(&p, iterate, (p.ref, n), (p.dut, n));
-                pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+                pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &e);
             }
         }
-        report(name, &p, &g, l2, linf, steps > 0);
+        report(name, &p, &g, &e, steps > 0);
         pair_destroy(&p);
     }
     guard_free(&g);
@@ -608,7 +639,7 @@ static void case_render_at(hd_method method, hd_voxel_type type, const int *d, i
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     int k, after = scale ? 2 : 3;
     scene_init(&s, type, d[0], d[1], d[2], lights, 0, 0);
     s.params.method = method;
@@ -637,9 +668,9 @@ static void case_render_at(hd_method method, hd_voxel_type type, const int *d, i
         if (p.ok && scale && (b.frames != a.frames || b.render_scale != a.render_scale || b.image_bytes != a.image_bytes ||
                               a.render_scale != (scale > 0 ? scale : 2)))
             pair_fail(&p, "frame counts, render scale or image size differ", HD_SUCCESS);
-        pair_compare(&p, scale ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, scale ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &e);
     }
-    report(name, &p, &g, l2, linf, method == HD_METHOD_CD);
+    report(name, &p, &g, &e, method == HD_METHOD_CD);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
@@ -654,7 +685,7 @@ static void case_crop(hd_method method, hd_voxel_type type, const int *d, int li
     guard g;
     pair p;
     char name[128];
-    double l2 = 0.0, linf = 0.0;
+    errors e = {0.0, 0.0, 0.0};
     int det = method == HD_METHOD_CD, pt = method == HD_METHOD_PT_SS || method == HD_METHOD_PT_MS;
     static const float lo[3] = {0.2f, 0.35f, 0.0f}, hi[3] = {0.85f, 0.0f, 0.6f};
     hd_params cropped;
@@ -675,9 +706,9 @@ static void case_crop(hd_method method, hd_voxel_type type, const int *d, int li
             if (memcmp(&before, &cropped, sizeof cropped) != 0) pair_fail(&p, "set_params changed its input", HD_SUCCESS);
         }
         BOTH(&p, iterate, (p.ref, n - n / 2), (p.dut, n - n / 2));
-        pair_compare(&p, pt ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &l2, &linf);
+        pair_compare(&p, pt ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &e);
     }
-    report(name, &p, &g, l2, linf, det);
+    report(name, &p, &g, &e, det);
     pair_destroy(&p);
     guard_free(&g);
     scene_free(&s);
