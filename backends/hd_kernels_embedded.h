@@ -32,7 +32,7 @@ static const char *const hd__cl_source[] = {
 "   The projection is its own program (hd_opencl.h builds this source twice; HD_CL_PROJECTION_PROGRAM\n",
 "   keeps only its entry points) with fusion on: its image is a mean of jittered frames, not\n",
 "   compared bit for bit, and the march's lerps and interpolations fused into FMAs cost PoCL a\n",
-"   fifth less time per frame (docs/PERFORMANCE.md); the image moves by float rounding only. */\n",
+"   fifth less CPU time per frame (docs/PERFORMANCE.md); the image moves by float rounding only. */\n",
 "#ifdef HD_CL_PROJECTION_PROGRAM\n",
 "#pragma OPENCL FP_CONTRACT ON\n",
 "#else\n",

@@ -12,7 +12,7 @@
    The projection is its own program (hd_opencl.h builds this source twice; HD_CL_PROJECTION_PROGRAM
    keeps only its entry points) with fusion on: its image is a mean of jittered frames, not
    compared bit for bit, and the march's lerps and interpolations fused into FMAs cost PoCL a
-   fifth less time per frame (docs/PERFORMANCE.md); the image moves by float rounding only. */
+   fifth less CPU time per frame (docs/PERFORMANCE.md); the image moves by float rounding only. */
 #ifdef HD_CL_PROJECTION_PROGRAM
 #pragma OPENCL FP_CONTRACT ON
 #else
