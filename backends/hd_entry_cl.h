@@ -13,6 +13,9 @@
     k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0; \
     k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
+/* The projection's program (HD_CL_PROJECTION_PROGRAM, hd_opencl.h's hd__cl_build) holds the
+   projection's entry points only, at the end of this file; the main program everything else. */
+#ifndef HD_CL_PROJECTION_PROGRAM
 /* One work-item per voxel: global size = illumination grid (x, y, z). */
 __kernel void hd_k_classify(HD__CL_BUFFERS)
 {
@@ -83,23 +86,6 @@ HD__CL_DIRECT(hd_k_direct_half, 1)
     HD__CL_DIFFUSE(hd_k_diffuse_jacobi_surface_rgb##suffix, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING, 1, is16)
 HD__CL_DIFFUSE_SET(, 0)
 HD__CL_DIFFUSE_SET(_half, 1)
-
-/* One work-item per pixel (x, y); lsum and the table (ptab_n entries) as hd_k_project.h reads
-   them. With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass
-   (hd_k_upsample.h). */
-#define HD__CL_PROJECT(name, is16) \
-    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n) \
-    { \
-        HD__CL_KCTX; \
-        k.f16 = (is16); \
-        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
-        if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
-            hd_upsample_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
-        else \
-            hd_project_pixel(&k, (int)get_global_id(0), (int)get_global_id(1)); \
-    }
-HD__CL_PROJECT(hd_k_project, 0)
-HD__CL_PROJECT(hd_k_project_half, 1)
 
 /* lsum = E + phi: one work-item per voxel, global size = illumination grid (x, y, z * channels). */
 #define HD__CL_LIGHT_SUM(name, is16) \
@@ -337,4 +323,27 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
         hd__cl_mg_set_phi2(&k, x, y, zz, -v);
     }
 }
+#endif
+#endif /* !HD_CL_PROJECTION_PROGRAM */
+
+#ifdef HD_CL_PROJECTION_PROGRAM
+/* One work-item per pixel (x, y); the global size is rounded up to whole work-groups
+   (hd__be_project), so items past the image's width or height do nothing. lsum and the table
+   (ptab_n entries) as hd_k_project.h reads them. With HD_FLAG_UPSAMPLE the same kernel runs a
+   reduced frame's upsample pass (hd_k_upsample.h). */
+#define HD__CL_PROJECT(name, is16) \
+    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n) \
+    { \
+        int px = (int)get_global_id(0), py = (int)get_global_id(1); \
+        HD__CL_KCTX; \
+        k.f16 = (is16); \
+        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
+        if (px >= p->image.x || py >= p->image.y) return; \
+        if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
+            hd_upsample_pixel(&k, px, py); \
+        else \
+            hd_project_pixel(&k, px, py); \
+    }
+HD__CL_PROJECT(hd_k_project, 0)
+HD__CL_PROJECT(hd_k_project_half, 1)
 #endif

@@ -76,6 +76,7 @@ struct hd__backend {
     cl_device_id device;
     cl_command_queue queue;
     cl_program program;
+    cl_program project_program; /* the projection's entry points, FP contraction on (hd__cl_build) */
     cl_kernel kernels[HD__CL_KERNEL_COUNT];
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
@@ -247,24 +248,22 @@ static hd_result hd__cl_open(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* Builds the embedded source; a failure logs the build log (in pieces the logger can hold). */
-static hd_result hd__cl_build(hd__ctx *ctx)
+/* Builds the embedded source into *out with the options opts; a failure logs the build log (in
+   pieces the logger can hold). */
+static hd_result hd__cl_build_program(hd__ctx *ctx, cl_program *out, const char *opts)
 {
     hd__backend *be = ctx->be;
     cl_int e;
-    char opts[128];
-    int k;
-    be->program = clCreateProgramWithSource(be->context, (cl_uint)HD__CL_SOURCE_LINES, (const char **)hd__cl_source, NULL, &e);
-    if (e != CL_SUCCESS) { be->program = NULL; return hd__cl_fail(ctx, e, "clCreateProgramWithSource", 0, __LINE__); }
-    snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d", HD_MAX_LIGHTS);
-    e = clBuildProgram(be->program, 1, &be->device, opts, NULL, NULL);
+    *out = clCreateProgramWithSource(be->context, (cl_uint)HD__CL_SOURCE_LINES, (const char **)hd__cl_source, NULL, &e);
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clCreateProgramWithSource", 0, __LINE__); }
+    e = clBuildProgram(*out, 1, &be->device, opts, NULL, NULL);
     if (e != CL_SUCCESS) {
         size_t n = 0, i;
         char *text;
         hd_result r = hd__cl_fail(ctx, e, "clBuildProgram", 0, __LINE__);
-        clGetProgramBuildInfo(be->program, be->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
+        clGetProgramBuildInfo(*out, be->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
         text = (char *)hd__alloc(ctx, n + 1);
-        if (text && clGetProgramBuildInfo(be->program, be->device, CL_PROGRAM_BUILD_LOG, n, text, NULL) == CL_SUCCESS) {
+        if (text && clGetProgramBuildInfo(*out, be->device, CL_PROGRAM_BUILD_LOG, n, text, NULL) == CL_SUCCESS) {
             text[n] = '\0';
             for (i = 0; i < n && text[i]; i += 900)
                 hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, __LINE__, "opencl: build log: %.900s", text + i);
@@ -272,9 +271,27 @@ static hd_result hd__cl_build(hd__ctx *ctx)
         hd__free(ctx, text);
         return r;
     }
+    return HD_SUCCESS;
+}
+
+/* The two programs: every stage but the projection, and the projection alone, built with
+   HD_CL_PROJECTION_PROGRAM (hd_prelude_cl.h: a*b+c may fuse there, not in the deterministic
+   stages), so each kernel comes from the program that has it. */
+static hd_result hd__cl_build(hd__ctx *ctx)
+{
+    hd__backend *be = ctx->be;
+    cl_int e;
+    char opts[128];
+    hd_result r;
+    int k;
+    snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d", HD_MAX_LIGHTS);
+    if ((r = hd__cl_build_program(ctx, &be->program, opts)) != HD_SUCCESS) return r;
+    snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d -DHD_CL_PROJECTION_PROGRAM", HD_MAX_LIGHTS);
+    if ((r = hd__cl_build_program(ctx, &be->project_program, opts)) != HD_SUCCESS) return r;
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
+        int project = k == HD__CL_PROJECT || k == HD__CL_PROJECT_HALF;
         if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_EXTRAP) continue; /* not compiled (HD_MG_F64) */
-        be->kernels[k] = clCreateKernel(be->program, hd__cl_kernel_names[k], &e);
+        be->kernels[k] = clCreateKernel(project ? be->project_program : be->program, hd__cl_kernel_names[k], &e);
         if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(ctx, e, hd__cl_kernel_names[k], 0, __LINE__); }
     }
     return HD_SUCCESS;
@@ -371,6 +388,7 @@ static void hd__be_destroy(hd__ctx *ctx)
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
+    if (be->project_program) clReleaseProgram(be->project_program);
     if (be->queue) clReleaseCommandQueue(be->queue);
     if (be->context) clReleaseContext(be->context);
     hd__free(ctx, be);
@@ -657,17 +675,34 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* The projection's work-groups: tiles of HD__CL_PROJECT_GROUP_X x HD__CL_PROJECT_GROUP_Y pixels
+   (one row of them where the kernel allows fewer items), the global size rounded up to whole
+   tiles; the entry skips the items past the image. PoCL hands its threads runs of work-groups;
+   with the groups it picks itself (512 x 8 at 512^2: 64 groups) one thread sat idle at the end of
+   a frame while the other finished the costlier rows (docs/PERFORMANCE.md); 32 x 8 tiles keep
+   the same 8-row locality in 2048 pieces. */
+#define HD__CL_PROJECT_GROUP_X 32
+#define HD__CL_PROJECT_GROUP_Y 8
 static hd_result hd__be_project(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
     int k = hd__cl_k(ctx, HD__CL_PROJECT);
+    size_t local[3] = {HD__CL_PROJECT_GROUP_X, HD__CL_PROJECT_GROUP_Y, 1}, wg = 0, gx, gy;
     cl_int n;
     hd_result r;
     if ((r = hd__cl_project_prepare(ctx)) != HD_SUCCESS) return r;
+    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+               "clGetKernelWorkGroupInfo");
+    if (wg < local[0] * local[1]) {
+        local[0] = wg < local[0] ? (wg > 0 ? wg : 1) : local[0];
+        local[1] = 1;
+    }
+    gx = ((size_t)ctx->kp.image.x + local[0] - 1) / local[0] * local[0];
+    gy = ((size_t)ctx->kp.image.y + local[1] - 1) / local[1] * local[1];
     n = be->ptab_n;
     HD__CL_ARG(ctx, k, 11, n);
-    if ((r = hd__cl_mems(ctx, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS ||
-        (r = hd__cl_bind_run(ctx, k, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1)) != HD_SUCCESS)
+    if ((r = hd__cl_mems(ctx, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_bind(ctx, k)) != HD_SUCCESS ||
+        (r = hd__cl_run_local(ctx, k, 2, gx, gy, 1, local)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(ctx);
 }

@@ -8,8 +8,16 @@
 #define HD_FN inline __attribute__((always_inline))
 #define HD_LANG_CL 1
 /* The C reference does not fuse a*b+c (ISO C modes, -std=c99, default to -ffp-contract=off);
-   OpenCL C would by default. Off, so the deterministic stages round exactly as the CPU does. */
+   OpenCL C would by default. Off, so the deterministic stages round exactly as the CPU does.
+   The projection is its own program (hd_opencl.h builds this source twice; HD_CL_PROJECTION_PROGRAM
+   keeps only its entry points) with fusion on: its image is a mean of jittered frames, not
+   compared bit for bit, and the march's lerps and interpolations fused into FMAs cost PoCL a
+   fifth less CPU time per frame (docs/PERFORMANCE.md); the image moves by float rounding only. */
+#ifdef HD_CL_PROJECTION_PROGRAM
+#pragma OPENCL FP_CONTRACT ON
+#else
 #pragma OPENCL FP_CONTRACT OFF
+#endif
 
 typedef uint hd_u32;
 typedef float3 hd_v3;

@@ -7,10 +7,12 @@
    median and the best ms per frame. --save writes the image after the timed frames as raw
    float RGBA, --compare prints the PSNR of this run's image against such a file (peak: the
    reference's largest RGB value), --png writes it as a PNG to look at.
+   --threads adds, per thread, the ms per timed frame on a CPU, in the run queue and asleep
+   (bench/hd_thread_times.h: the workers' sleep is the time the backend left a core unused).
    --orbit takes bench-peer's scene instead (bench/hd_orbit_scene.h: the ct-skin TF, hdrender's
    camera at azimuth 0, its key light; light file build/bench_project_light_orbit.f32), the
    scene whose frame make bench-peer times against VTK.
-   Usage: hdbench_project [--orbit] [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
+   Usage: hdbench_project [--orbit] [--threads] [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
                           [--width W] [--height H] [--frames F] [--save F32] [--compare F32]
                           [--png PNG] [--tag WORD] [data/head.nrrd]
    --size N is an N x N frame; --size 1920x1080 (or --width / --height) any other.
@@ -29,6 +31,7 @@
 #include <time.h>
 #include "hd_bench_median.h"
 #include "hd_orbit_scene.h"
+#include "hd_thread_times.h"
 
 /* A CT transfer function over HU -1024..3071 (bench/hdbench.c's): skin faint, bone dense. */
 static const float bench_tf[] = {
@@ -111,7 +114,7 @@ int main(int argc, char **argv)
 {
     const char *path = "data/head.nrrd", *light_path = "build/bench_project_light.f32", *save = NULL;
     const char *compare = NULL, *png = NULL, *tag = "";
-    int light_given = 0;
+    int light_given = 0, threads = 0;
     int width = 512, height = 512, frames = 8, make_iters = 0, i;
     hd_volume_file vf;
     hd_light light;
@@ -122,6 +125,7 @@ int main(int argc, char **argv)
     float *lightbuf, *img;
     double *ms, t, cpu_ms;
     clock_t cpu0;
+    hdt_snap th0, th1;
     int32_t n;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--make-light") == 0 && i + 2 < argc) {
@@ -132,6 +136,7 @@ int main(int argc, char **argv)
             light_path = argv[++i];
             light_given = 1;
         } else if (strcmp(argv[i], "--orbit") == 0) g_use_orbit = 1;
+        else if (strcmp(argv[i], "--threads") == 0) threads = 1;
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
             const char *x = strchr(argv[++i], 'x');
             width = atoi(argv[i]);
@@ -179,18 +184,21 @@ int main(int argc, char **argv)
         hd__test_project(ctx, 2) != HD_SUCCESS || hd__test_finish(ctx) != HD_SUCCESS)
         return 1;
     ms = (double *)malloc((size_t)frames * sizeof(double));
+    hdt_take(&th0);
     cpu0 = clock();
     for (i = 0; i < frames; ++i) {
         t = hd__now();
         if (hd__test_project(ctx, 1) != HD_SUCCESS || hd__test_finish(ctx) != HD_SUCCESS) return 1;
         ms[i] = (hd__now() - t) * 1e3;
     }
+    hdt_take(&th1);
     cpu_ms = (double)(clock() - cpu0) * 1e3 / (double)CLOCKS_PER_SEC / (double)frames;
     qsort(ms, (size_t)frames, sizeof(double), hdb_cmp_double);
     if (width == height) printf("%-4s %-7s %4d^2     ", tag, hd_backend_name(), width);
     else printf("%-4s %-7s %4dx%-4d ", tag, hd_backend_name(), width, height);
     printf(" projection %8.1f ms/frame (median of %d, best %.1f; process CPU %.1f ms/frame)", ms[frames / 2], frames, ms[0],
            cpu_ms);
+    if (threads) hdt_print(&th0, &th1, frames);
     npix = (size_t)width * height;
     img = (float *)malloc(npix * 4 * sizeof(float));
     if (!img || hd_read_image_f32(ctx, img, npix * 4) != HD_SUCCESS) return 1;
