@@ -1057,14 +1057,14 @@ static void hd__frame_cost_add(hd__ctx *ctx, int s, double pixels, double second
 }
 
 /* A frame's predicted seconds at render scale s: a + b * pixels. The fixed part a (per-call
-   overhead, and at s > 1 the full-size upsample pass, which do not shrink with s) is the
-   least-squares intercept through the scales measured, clamped to [0, the newest estimate];
-   b then makes the line pass through the newest estimate, so the per-pixel cost follows the
-   current view. With one scale measured a is 0: time proportional to pixels. */
+   overhead, and at s > 1 the full-size upsample pass, which do not shrink with s) and b are the
+   least-squares line through the scales measured (a >= 0, b >= 0; a negative a fits through the
+   origin instead), scaled to pass through the newest estimate, so the level follows the current
+   view and the ratios between scales come from all of them. With one scale measured a is 0:
+   time proportional to pixels. */
 static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
 {
-    double n = 0.0, sp = 0.0, st = 0.0, spp = 0.0, spt = 0.0, a = 0.0, b, var;
-    double p_last = ctx->cost_pixels[ctx->cost_last], t_last = ctx->cost_seconds[ctx->cost_last];
+    double n = 0.0, sp = 0.0, st = 0.0, spp = 0.0, spt = 0.0, a = 0.0, b = 1.0, var, at_last;
     int k;
     for (k = 0; k < 4; ++k) {
         double p = ctx->cost_pixels[k], t = ctx->cost_seconds[k];
@@ -1072,13 +1072,13 @@ static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
         n += 1.0; sp += p; st += t; spp += p * p; spt += p * t;
     }
     var = n * spp - sp * sp;
-    if (n >= 2.0 && var > 0.0) {
+    if (n >= 2.0 && var > 0.0 && n * spt - sp * st > 0.0) {
         b = (n * spt - sp * st) / var;
         a = (st - b * sp) / n;
-        a = a < 0.0 ? 0.0 : a > t_last ? t_last : a;
+        if (a < 0.0) { a = 0.0; b = spt / spp; }
     }
-    b = (t_last - a) / p_last;
-    return a + b * hd__scale_pixels(ctx, s);
+    at_last = a + b * ctx->cost_pixels[ctx->cost_last];
+    return (a + b * hd__scale_pixels(ctx, s)) * ctx->cost_seconds[ctx->cost_last] / at_last;
 }
 
 /* The scale HD_RENDER_SCALE_AUTO gives a new image's first frame: the smallest whose predicted

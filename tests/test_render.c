@@ -470,6 +470,19 @@ static void test_render_scale_auto_cost(void)
     p.render_budget = 0.0f;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS && hdt_first_scale(ctx) == 4);
     hd_destroy(ctx);
+    /* the newest frame a scale-8 one of 15 ms, below the fixed part (a faster view, or noise):
+       every prediction scales down with it (full frames about 81 ms, scale 2 about 31 ms), so a
+       budget of 50 ms gets scale 2, not full frames (as if all were fixed cost) nor scale 8 (the
+       old rule: 15 ms * 64 for a full frame) */
+    make_desc(&d, NULL);
+    d.camera.width = d.camera.height = 512;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = 0.05f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.040) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 1, 0.100) == HD_SUCCESS && hdt_frame_cost(ctx, 8, 0.015) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 2, "a fast scale-8 frame last, budget 50 ms: scale %d, want 2", hdt_first_scale(ctx));
+    hd_destroy(ctx);
 }
 
 /* The image buffer holds the reduced frames' region only once a scale > 1 is used: full frames
