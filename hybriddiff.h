@@ -379,8 +379,9 @@ typedef struct hd_params {
                                frame doubles the resolution up to full frames, which then
                                accumulate as usual (a moving camera gets cheap frames, a still one
                                converges to the full image). The first scale is the smallest power
-                               of two whose predicted frame time (from the last frame measured) fits
-                               render_budget, or 4 while render_budget is 0 or nothing is measured.
+                               of two whose predicted frame time (a + b * pixels, fitted to the
+                               frames this context has measured at each scale) fits render_budget,
+                               8 if none does, or 4 while render_budget is 0 or nothing is measured.
                                A change of scale restarts the running mean. The first frame at a
                                scale > 1 adds a quarter of the image's memory for the reduced
                                frames (hd_stats.image_bytes); where that fails, the call returns

@@ -71,11 +71,13 @@ void hd_diffuse_block(int bx, int by, int bz)
     /* the faces: rows y0 - 1 and y0 + YK per slice, slices z0 - 1 and z0 + ZK per row */
     float sym[HD_DIFFUSE_ZK], pym[HD_DIFFUSE_ZK], syp[HD_DIFFUSE_ZK], pyp[HD_DIFFUSE_ZK];
     float szm[HD_DIFFUSE_YK], pzm[HD_DIFFUSE_YK], szp[HD_DIFFUSE_YK], pzp[HD_DIFFUSE_YK];
-    float v[HD_DB], ag = hd_diffuse_ag(HD_PRM(medium).y), agr; /* 1 - albedo g (grey; RGB per texel) */
+    float v[HD_DB], ag = hd_diffuse_ag(HD_PRM(medium).y), agr = 0.0f; /* 1 - albedo g (grey; RGB per texel) */
     HD_UNROLL for (int k = 0; k < HD_DIFFUSE_ZK; ++k)
         HD_UNROLL for (int j = 0; j < HD_DIFFUSE_YK; ++j) {
             int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi);
             int y = hd_mini(y0 + j, g.y - 1), z = hd_mini(z0 + k, g.z - 1), xc = hd_mini(x, g.x - 1);
+            sp[r] = 0.0f; /* inout arguments are copied in: defined first (hd_prelude_glsl.h) */
+            dn[r] = 0.0f;
             src[r] = hd_diffuse_own(0, xc, y, z, c, rgb, rhs, sp[r], agr, dn[r]);
             hd_diffuse_texel(x - 1, y, z, c, rgb, ag, sl[r], pl[r]);
             hd_diffuse_texel(x + 1, y, z, c, rgb, ag, sr[r], pr[r]);
@@ -105,7 +107,7 @@ void hd_diffuse_block(int bx, int by, int bz)
             int r = k * HD_DIFFUSE_YK + j, x = hd_diffuse_bx(bx, o0, j, k, jacobi), y = y0 + j, z = z0 + k;
             int rym = hd_maxi(r - 1, 0), ryp = hd_mini(r + 1, HD_DB - 1);
             int rzm = hd_maxi(r - HD_DIFFUSE_YK, 0), rzp = hd_mini(r + HD_DIFFUSE_YK, HD_DB - 1);
-            float den;
+            float den = 0.0f;
             v[r] = hd_diffuse_update_of(src[r], dn[r], sp[r], sl[r], sr[r], j > 0 ? sc[rym] : sym[k],
                                         j < HD_DIFFUSE_YK - 1 ? sc[ryp] : syp[k], k > 0 ? sc[rzm] : szm[j],
                                         k < HD_DIFFUSE_ZK - 1 ? sc[rzp] : szp[j], pl[r], pr[r],

@@ -73,7 +73,7 @@ void main()
 #elif HD_MG_STAGE == HD_MG_RESIDUAL
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w) {
         int z = zz % g.z, c = zz / g.z;
-        float den;
+        float den = 0.0f;
         float num = hd_diffuse_terms(x, y, z, c, den);
         HD_SET(phi2, 0, x, y, zz, num - den * HD_GET(phi, 0, x, y, zz));
     }

@@ -67,7 +67,8 @@ float hd_f16_round(float v)
 #define HD_STRUCT(name) struct name {
 #define HD_STRUCT_END(name) };
 
-/* Output parameters: GLSL's inout. */
+/* Output parameters: GLSL's inout, which copies the argument in, so a caller initialises what it
+   passes, even a pure output (else the copy reads an undefined value; Mesa warns of it). */
 #define HD_INOUT(type) inout type
 #define HD_DEREF(p) p
 #define HD_REF(v) v

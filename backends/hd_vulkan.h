@@ -169,7 +169,8 @@ struct hd__backend {
     int ts_state;                 /* 0: not looked at yet; 1: pool made; -1: the queue has no timestamps */
     uint64_t ts_mask;             /* the queue family's timestampValidBits as a mask */
     int ts_pending, ts_scale;     /* a recorded frame's timestamps to read, and its render scale */
-    double ts_cost_after;         /* ctx->frame_cost when it was recorded (a frame run since wins) */
+    double ts_pixels;             /* ... and the pixels it marched */
+    unsigned ts_cost_gen;         /* ctx->cost_gen when it was recorded (a frame run since wins) */
     /* pipelines and bindings */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -1916,6 +1917,8 @@ static hd_result hd__light_iteration(hd__ctx *ctx);
 static hd_result hd__project_frame(hd__ctx *ctx);
 static hd_result hd__image_room(hd__ctx *ctx);
 static int hd__method_is_pt(hd_method m);
+static double hd__scale_pixels(const hd__ctx *ctx, int s);
+static void hd__frame_cost_add(hd__ctx *ctx, int s, double pixels, double seconds);
 
 /* The timestamp pool for recorded frames, made on the first recording; none (ts_state -1) where
    the queue family has no timestamps, and then HD_RENDER_SCALE_AUTO has no frame time to go on
@@ -1945,9 +1948,9 @@ static hd_result hd__vk_timestamps(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-/* The last recorded frame's device time, scaled to full resolution, becomes the frame cost
-   HD_RENDER_SCALE_AUTO predicts from (the caller has run the command buffer by now; a frame
-   measured since by hd_iterate or hd_render is newer and is kept). */
+/* The last recorded frame's device time goes into the frame cost model HD_RENDER_SCALE_AUTO
+   predicts from (the caller has run the command buffer by now; a frame measured since by
+   hd_iterate or hd_render is newer and is kept). */
 static void hd__vk_read_frame_time(hd__ctx *ctx)
 {
     hd__backend *be = ctx->be;
@@ -1956,9 +1959,9 @@ static void hd__vk_read_frame_time(hd__ctx *ctx)
     if (!be->ts_pending) return;
     be->ts_pending = 0;
     e = be->fn.vkGetQueryPoolResults(be->device, be->ts_pool, 0, 2, sizeof t, t, sizeof t[0], VK_QUERY_RESULT_64_BIT);
-    if (e == VK_SUCCESS && ctx->frame_cost == be->ts_cost_after) {
+    if (e == VK_SUCCESS && ctx->cost_gen == be->ts_cost_gen) {
         double dt = (double)((t[1] - t[0]) & be->ts_mask) * (double)be->limits.timestampPeriod * 1e-9;
-        if (dt > 0.0) ctx->frame_cost = dt * (double)be->ts_scale * (double)be->ts_scale;
+        hd__frame_cost_add(ctx, be->ts_scale, be->ts_pixels, dt);
     }
 }
 
@@ -1977,7 +1980,8 @@ static hd_result hd__vk_record_iteration(hd__ctx *ctx)
         be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 1);
         be->ts_pending = 1;
         be->ts_scale = ctx->frame_scale;
-        be->ts_cost_after = ctx->frame_cost;
+        be->ts_pixels = hd__scale_pixels(ctx, ctx->frame_scale);
+        be->ts_cost_gen = ctx->cost_gen;
     }
     return HD_SUCCESS;
 }

@@ -6,7 +6,8 @@
    2. Frame time: K views of an orbit around the head (azimuth 360 k / K), hd_set_camera +
       hd_render each, at --frame-size, at render_scale 1, 2 and 4; prints ms per orbit frame and
       the light work they did (none once the light has converged). Built once per backend
-      (mk/bench.mk).
+      (mk/bench.mk). With --auto-budgets, then a dragged camera under HD_RENDER_SCALE_AUTO per
+      render_budget (auto_drag): the scales picked, ms per frame, frames over budget.
    3. Quality per time budget (unless --no-psnr), at --size: for each view k and each per-view
       budget b (--budgets, seconds of this machine):
         HD     the converged light, camera at view k, as many hd_render calls as finish within b
@@ -48,9 +49,9 @@
 static struct {
     const char *data, *csv, *out, *cache;
     int views, size, frame_size, ref_iters, light_iters, psnr, downsample, boundary, paper;
-    int nb, wall, single, scale, window;
+    int nb, nab, wall, single, scale, window;
     double pt_cap;
-    double budgets[MAX_BUDGETS];
+    double budgets[MAX_BUDGETS], auto_budgets[MAX_BUDGETS];
 } O;
 
 /* The budget clock: wall time, or (default) this process's CPU time over the online cores, which
@@ -100,6 +101,9 @@ static void usage(int code)
             "  --clock cpu|wall   what the budgets measure: process CPU time / online cores\n"
             "                     (default; load-independent on a shared machine) or wall time\n"
             "  --no-psnr          frame time only (what the GPU backends' builds run)\n"
+            "  --auto-budgets A,B,..  frame time part: then, for each render_budget (seconds),\n"
+            "                     one hd_render per view with HD_RENDER_SCALE_AUTO (a dragged\n"
+            "                     camera): the scales it picked, ms per frame, frames over budget\n"
             "  --single-view      one view at --size, hdrender's schedule against PT_MS afresh:\n"
             "                     the time each needs to reach HD's converged PSNR\n"
             "  --pt-cap X         single view: PT_MS stops after X times HD's time (default 8)\n"
@@ -120,6 +124,25 @@ static int parse_int(const char *s, int lo, int hi)
         exit(2);
     }
     return (int)v;
+}
+
+/* A comma-separated list of increasing positive seconds into v; returns the count. */
+static int parse_seconds(const char *opt, const char *s, double *v)
+{
+    int n = 0;
+    while (*s) {
+        char *e;
+        double x = strtod(s, &e);
+        if (e == s || !(x > 0.0) || x > 1e5 || n == MAX_BUDGETS || (n && x <= v[n - 1]) || (*e && *e != ',')) {
+            fprintf(stderr, "hdbench_orbit: %s: increasing positive seconds, comma-separated, at most %d\n", opt,
+                    MAX_BUDGETS);
+            exit(2);
+        }
+        v[n++] = x;
+        s = *e ? e + 1 : e;
+    }
+    if (!n) { fprintf(stderr, "hdbench_orbit: %s is empty\n", opt); exit(2); }
+    return n;
 }
 
 static void parse_args(int argc, char **argv)
@@ -188,23 +211,9 @@ static void parse_args(int argc, char **argv)
             if (!strcmp(v, "default")) O.paper = 0;
             else if (!strcmp(v, "paper")) O.paper = 1;
             else { fprintf(stderr, "hdbench_orbit: --preset: default or paper\n"); exit(2); }
-        } else if (!strcmp(a, "--budgets")) {
-            const char *s = NEXT();
-            O.nb = 0;
-            while (*s) {
-                char *e;
-                double v = strtod(s, &e);
-                if (e == s || !(v > 0.0) || v > 1e5 || O.nb == MAX_BUDGETS ||
-                    (O.nb && v <= O.budgets[O.nb - 1]) || (*e && *e != ',')) {
-                    fprintf(stderr, "hdbench_orbit: --budgets: increasing positive seconds, "
-                                    "comma-separated, at most %d\n", MAX_BUDGETS);
-                    exit(2);
-                }
-                O.budgets[O.nb++] = v;
-                s = *e ? e + 1 : e;
-            }
-            if (!O.nb) { fprintf(stderr, "hdbench_orbit: --budgets is empty\n"); exit(2); }
-        } else if (a[0] == '-') {
+        } else if (!strcmp(a, "--budgets")) O.nb = parse_seconds(a, NEXT(), O.budgets);
+        else if (!strcmp(a, "--auto-budgets")) O.nab = parse_seconds(a, NEXT(), O.auto_budgets);
+        else if (a[0] == '-') {
             fprintf(stderr, "hdbench_orbit: unknown option '%s' (see --help)\n", a);
             exit(2);
         } else O.data = a;
@@ -284,6 +293,42 @@ static void reference(const hdo_scene *s, int k, float *img)
     if (f) {
         fwrite(img, sizeof(float), npix * 4, f);
         fclose(f);
+    }
+}
+
+/* --auto-budgets: a dragged camera under HD_RENDER_SCALE_AUTO, for each render_budget: one
+   hd_render per view (each a new image, so each frame is at the first scale AUTO picks for it,
+   predicted from the frames measured so far), over the orbit. Prints how often each scale was
+   picked, the wall time per frame and how many frames took longer than the budget. */
+static void auto_drag(hd_context hd)
+{
+    int j, k;
+    for (j = 0; j < O.nab; ++j) {
+        hd_desc q;
+        hd_stats st;
+        int n[4] = {0, 0, 0, 0}, over = 0;
+        double sum = 0.0, worst = 0.0, l0 = light_seconds(hd);
+        check(hd_query_desc(hd, &q), "hd_query_desc");
+        q.params.render_scale = HD_RENDER_SCALE_AUTO;
+        q.params.render_budget = (float)O.auto_budgets[j];
+        check(hd_set_params(hd, &q.params), "hd_set_params");
+        for (k = 0; k < O.views; ++k) {
+            double t;
+            set_view(hd, k, O.frame_size);
+            t = hdo_now();
+            check(hd_render(hd), "hd_render");
+            t = hdo_now() - t;
+            check(hd_get_stats(hd, &st), "hd_get_stats");
+            n[st.render_scale >= 8 ? 3 : st.render_scale >= 4 ? 2 : st.render_scale >= 2 ? 1 : 0]++;
+            sum += t;
+            if (t > worst) worst = t;
+            if (t > O.auto_budgets[j]) ++over;
+        }
+        printf("auto: %s backend, %dx%d, render_budget %g ms, %d views: scale 1/2/4/8 picked %d/%d/%d/%d times, "
+               "%.1f ms per frame (wall; slowest %.1f), %d over budget, light work %.3f s\n", hd_backend_name(),
+               O.frame_size, O.frame_size, 1e3 * O.auto_budgets[j], O.views, n[0], n[1], n[2], n[3],
+               1e3 * sum / O.views, 1e3 * worst, over, light_seconds(hd) - l0);
+        fflush(stdout);
     }
 }
 
@@ -501,6 +546,7 @@ int main(int argc, char **argv)
                O.frame_size, scale, O.views, ms, O.wall ? "wall" : "CPU time / cores", cms, lit);
         fflush(stdout);
     }
+    auto_drag(hd);
     {
         hd_desc q;
         check(hd_query_desc(hd, &q), "hd_query_desc");

@@ -1035,20 +1035,73 @@ static hd_result hd__light_iteration(hd__ctx *ctx)
     return r;
 }
 
-/* The render scale of the next projection frame (params.render_scale). HD_RENDER_SCALE_AUTO: a
-   new image's first frame at the coarsest scale render_budget asks for (4 without a budget or a
-   measured frame), then half the divisor per frame down to 1. */
-static int hd__next_scale(const hd__ctx *ctx)
+/* The pixels a frame at render scale s marches at the current camera size. */
+static double hd__scale_pixels(const hd__ctx *ctx, int s)
+{
+    return (double)((ctx->camera.width + s - 1) / s) * (double)((ctx->camera.height + s - 1) / s);
+}
+
+static int hd__scale_slot(int s) { return s >= 8 ? 3 : s >= 4 ? 2 : s >= 2 ? 1 : 0; }
+
+/* Records that a frame at render scale s, marching `pixels` rays, took `seconds` (measured by
+   hd__project_frame, or on the device for a recorded one). Each scale keeps its last pixel count
+   and the mean of its new time with its previous estimate (one slow frame moves it halfway). */
+static void hd__frame_cost_add(hd__ctx *ctx, int s, double pixels, double seconds)
+{
+    int k = hd__scale_slot(s);
+    if (!(seconds > 0.0) || !(pixels > 0.0)) return;
+    ctx->cost_seconds[k] = ctx->cost_pixels[k] == pixels ? 0.5 * (ctx->cost_seconds[k] + seconds) : seconds;
+    ctx->cost_pixels[k] = pixels;
+    ctx->cost_last = k;
+    ctx->cost_gen++;
+}
+
+/* A frame's predicted seconds at render scale s: a + b * pixels. The fixed part a (per-call
+   overhead, and at s > 1 the full-size upsample pass, which do not shrink with s) and b are the
+   least-squares line through the scales measured (a >= 0, b >= 0; a negative a fits through the
+   origin instead), scaled to pass through the newest estimate, so the level follows the current
+   view and the ratios between scales come from all of them. With one scale measured a is 0:
+   time proportional to pixels. */
+static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
+{
+    double n = 0.0, sp = 0.0, st = 0.0, spp = 0.0, spt = 0.0, a = 0.0, b = 1.0, var, at_last;
+    int k;
+    for (k = 0; k < 4; ++k) {
+        double p = ctx->cost_pixels[k], t = ctx->cost_seconds[k];
+        if (!(p > 0.0)) continue;
+        n += 1.0; sp += p; st += t; spp += p * p; spt += p * t;
+    }
+    var = n * spp - sp * sp;
+    if (n >= 2.0 && var > 0.0 && n * spt - sp * st > 0.0) {
+        b = (n * spt - sp * st) / var;
+        a = (st - b * sp) / n;
+        if (a < 0.0) { a = 0.0; b = spt / spp; }
+    }
+    at_last = a + b * ctx->cost_pixels[ctx->cost_last];
+    return (a + b * hd__scale_pixels(ctx, s)) * ctx->cost_seconds[ctx->cost_last] / at_last;
+}
+
+/* The scale HD_RENDER_SCALE_AUTO gives a new image's first frame: the smallest whose predicted
+   time fits render_budget (the largest, 8, when none does); 4 without a budget or a measured
+   frame. */
+static int hd__first_scale(const hd__ctx *ctx)
 {
     int s;
+    if (!(ctx->params.render_budget > 0.0f) || ctx->cost_gen == 0) return 4;
+    for (s = 1; s < HD__MAX_RENDER_SCALE; s *= 2)
+        if (hd__frame_cost_predict(ctx, s) <= (double)ctx->params.render_budget) break;
+    return s;
+}
+
+/* The render scale of the next projection frame (params.render_scale). HD_RENDER_SCALE_AUTO: a
+   new image's first frame at hd__first_scale, then half the divisor per frame down to 1. */
+static int hd__next_scale(const hd__ctx *ctx)
+{
     if (hd__method_is_pt(ctx->params.method)) return 1;
     if (ctx->params.render_scale != HD_RENDER_SCALE_AUTO) return ctx->params.render_scale;
     if (ctx->frame_scale > 0)
         return ctx->frames > 0 && ctx->frame_scale > 1 ? ctx->frame_scale / 2 : ctx->frame_scale;
-    if (!(ctx->params.render_budget > 0.0f) || !(ctx->frame_cost > 0.0)) return 4;
-    for (s = 1; s < HD__MAX_RENDER_SCALE; s *= 2)
-        if (ctx->frame_cost / (double)(s * s) <= (double)ctx->params.render_budget) break;
-    return s;
+    return hd__first_scale(ctx);
 }
 
 /* Gives the image buffer the reduced frames' region if it lacks it (the first frame at a scale
@@ -1083,9 +1136,10 @@ static hd_result hd__use_scale(hd__ctx *ctx, int s)
 static hd_result hd__project_frame(hd__ctx *ctx)
 {
     hd_result r;
-    double t0 = hd__now(), dt;
+    double t0 = hd__now(), t1, t2;
     int s;
     if ((r = hd__use_scale(ctx, hd__next_scale(ctx))) != HD_SUCCESS) return r;
+    t1 = hd__now(); /* the frame cost starts after a first reduced frame's allocation */
     s = ctx->frame_scale;
     ctx->frames++;
     hd__fill_kparams(ctx);
@@ -1106,10 +1160,10 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     } else {
         r = hd__be_project(ctx);
     }
-    dt = hd__now() - t0;
-    ctx->seconds[2] += dt;
+    t2 = hd__now();
+    ctx->seconds[2] += t2 - t0;
     /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
-    if (r == HD_SUCCESS && !ctx->no_measure) ctx->frame_cost = dt * (double)(s * s);
+    if (r == HD_SUCCESS && !ctx->no_measure) hd__frame_cost_add(ctx, s, hd__scale_pixels(ctx, s), t2 - t1);
     return r;
 }
 

@@ -102,8 +102,12 @@ typedef struct hd__ctx {
     uint64_t converged_frames; /* projection frames since the light converged */
     int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
                                 was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
-    double frame_cost;       /* seconds of the last projection frame scaled to full resolution
-                                (its time times its scale squared); 0 before the first */
+    /* HD_RENDER_SCALE_AUTO's frame cost model (hd__frame_cost_add / _predict in hd_context.h):
+       per render scale 1, 2, 4, 8 (slot log2 s) the pixels its last frame marched (0: none yet)
+       and its smoothed seconds; the newest measurement's slot; measurements so far (0: none) */
+    double cost_pixels[4], cost_seconds[4];
+    int cost_last;
+    unsigned cost_gen;
     int image_room;          /* the image buffer holds the reduced frames' region (made when a
                                 scale > 1 is first used, hd__image_room) */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */

@@ -120,3 +120,19 @@ HD__MAYBE_UNUSED static hd_result hd__test_finish(hd_context h)
     (void)ctx;
     return HD_SUCCESS;
 }
+
+/* HD_RENDER_SCALE_AUTO's cost model without running frames: records that a frame at render
+   scale s of the current camera took `seconds`, as a measured one does. */
+HD__MAYBE_UNUSED static hd_result hd__test_frame_cost(hd_context h, int s, double seconds)
+{
+    HD__GET_CTX(ctx, h);
+    hd__frame_cost_add(ctx, s, hd__scale_pixels(ctx, s), seconds);
+    return HD_SUCCESS;
+}
+
+/* The scale HD_RENDER_SCALE_AUTO would give a new image's first frame now. */
+HD__MAYBE_UNUSED static int hd__test_first_scale(hd_context h)
+{
+    hd__ctx *ctx = hd__lookup(h, NULL);
+    return ctx ? hd__first_scale(ctx) : 0;
+}

@@ -420,6 +420,71 @@ static void test_render_scale_auto(void)
     hd_destroy(ctx);
 }
 
+/* HD_RENDER_SCALE_AUTO's cost model, fed frame times through the hooks in tests/hd_impl_cpu.c
+   (no frame runs, so the choices are exact). The times follow t = a + b * pixels with a fixed
+   part a = 20 ms (per-call overhead, the upsample pass) and b * (512 * 512) = 80 ms: full frames
+   100 ms, scale 2 40 ms, scale 4 25 ms, scale 8 21.25 ms. The old rule (the last frame's time
+   times the ratio of pixels) overestimates a full frame from a reduced one and underestimates a
+   reduced one from a full one; the model fits both. */
+hd_result hdt_frame_cost(hd_context h, int scale, double seconds);
+int hdt_first_scale(hd_context h);
+static void test_render_scale_auto_cost(void)
+{
+    hd_desc d;
+    hd_context ctx;
+    hd_params p;
+    make_desc(&d, NULL);
+    d.camera.width = d.camera.height = 512;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = 0.11f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hdt_first_scale(ctx) == 4); /* nothing measured yet */
+    /* one scale measured: time proportional to pixels (25 ms * 16 = 400 ms, 25 * 4 = 100 ms) */
+    CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 2, "one scale-4 frame, budget 110 ms: scale %d, want 2", hdt_first_scale(ctx));
+    /* a new view's 1/4 and 1/2 frames: a full frame (100 ms) fits 110 ms (the old rule: 160 ms) */
+    CHECK(hdt_frame_cost(ctx, 2, 0.040) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 1, "scale 4 and 2 measured, budget 110 ms: scale %d, want 1", hdt_first_scale(ctx));
+    /* and after a full frame, a budget of 30 ms: scale 2 (40 ms) does not fit, scale 4 does (the old
+       rule: 100 / 4 = 25 ms, scale 2, over budget) */
+    CHECK(hdt_frame_cost(ctx, 1, 0.100) == HD_SUCCESS);
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
+    p = d.params;
+    p.render_budget = 0.030f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 4, "scales 4, 2, 1 measured, budget 30 ms: scale %d, want 4", hdt_first_scale(ctx));
+    /* 22 ms fits only scale 8 (21.25 ms); below the fixed part nothing fits: the coarsest, 8 */
+    p.render_budget = 0.022f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 8, "budget 22 ms: scale %d, want 8", hdt_first_scale(ctx));
+    p.render_budget = 0.010f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS && hdt_first_scale(ctx) == 8);
+    /* the per-pixel part follows the newest frame: a view twice as dear per pixel (full frames of
+       180 ms, two of them: the estimate moves halfway per frame, 100 -> 140 -> 160 ms) fits a
+       budget of 110 ms at scale 2 (about 50 ms predicted), no longer at 1 */
+    CHECK(hdt_frame_cost(ctx, 1, 0.180) == HD_SUCCESS && hdt_frame_cost(ctx, 1, 0.180) == HD_SUCCESS);
+    p.render_budget = 0.11f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 2, "a dearer view, budget 110 ms: scale %d, want 2", hdt_first_scale(ctx));
+    /* no budget: 4, whatever was measured */
+    p.render_budget = 0.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS && hdt_first_scale(ctx) == 4);
+    hd_destroy(ctx);
+    /* the newest frame a scale-8 one of 15 ms, below the fixed part (a faster view, or noise):
+       every prediction scales down with it (full frames about 81 ms, scale 2 about 31 ms), so a
+       budget of 50 ms gets scale 2, not full frames (as if all were fixed cost) nor scale 8 (the
+       old rule: 15 ms * 64 for a full frame) */
+    make_desc(&d, NULL);
+    d.camera.width = d.camera.height = 512;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = 0.05f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.040) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 1, 0.100) == HD_SUCCESS && hdt_frame_cost(ctx, 8, 0.015) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 2, "a fast scale-8 frame last, budget 50 ms: scale %d, want 2", hdt_first_scale(ctx));
+    hd_destroy(ctx);
+}
+
 /* The image buffer holds the reduced frames' region only once a scale > 1 is used: full frames
    cost the w x h image alone (hd_stats.image_bytes says what is held). A new camera size keeps
    the region while the parameters may still ask for reduced frames. When the region cannot be
@@ -522,6 +587,7 @@ const hd_test_case hd_tests_render[] = {
     {"render_bad_input", test_render_bad_input},
     {"render_scale_upsample", test_render_scale_upsample},
     {"render_scale_auto", test_render_scale_auto},
+    {"render_scale_auto_cost", test_render_scale_auto_cost},
     {"render_scale_image_room", test_render_scale_image_room},
     {"render_scale_bad_input", test_render_scale_bad_input},
 };

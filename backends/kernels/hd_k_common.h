@@ -79,7 +79,7 @@ HD_FN int hd_lerp_axis(float u, int n, HD_INOUT(float) w)
 HD_FN float hd_sample_value(HD_KARGS hd_v3 u)
 {
     int nx = HD_PRM(dims).x, ny = HD_PRM(dims).y, nz = HD_PRM(dims).z;
-    float wx, wy, wz;
+    float wx = 0.0f, wy = 0.0f, wz = 0.0f;
     int x0 = hd_lerp_axis(u.x, nx, HD_REF(wx));
     int y0 = hd_lerp_axis(u.y, ny, HD_REF(wy));
     int z0 = hd_lerp_axis(u.z, nz, HD_REF(wz));
@@ -111,7 +111,7 @@ HD_FN int hd_table_segment(float v, int n, HD_INOUT(float) f)
 /* The transfer function: entries at i/(count-1), linearly interpolated; rgba. */
 HD_FN hd_v4 hd_tf(HD_KARGS float v)
 {
-    float f;
+    float f = 0.0f;
     int a = hd_table_segment(v, HD_PRM(dims).w, HD_REF(f));
     return HD_V4(HD_TABLE_LERP(tf, a, f, 0), HD_TABLE_LERP(tf, a, f, 1), HD_TABLE_LERP(tf, a, f, 2), HD_TABLE_LERP(tf, a, f, 3));
 }
@@ -260,7 +260,7 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
 HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
                              int mode, HD_INOUT(hd_u32) next_dim)
 {
-    float t_hit;
+    float t_hit = 0.0f;
     return hd_track(HD_KPASS p, d, tmax, key, dim0, mode, next_dim, HD_REF(t_hit));
 }
 
@@ -269,7 +269,7 @@ HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, 
 HD_FN float hd_free_flight(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
                            HD_INOUT(hd_u32) next_dim)
 {
-    float t_hit;
+    float t_hit = 0.0f;
     hd_track(HD_KPASS p, d, tmax, key, dim0, HD_TRACK_DELTA, next_dim, HD_REF(t_hit));
     return t_hit;
 }

@@ -55,7 +55,7 @@ HD_FN void hd_convect_voxel(HD_KARGS int x, int y, int z, int l)
     hd_v4 la = HD_PRM(light_a)[l];
     hd_v3 u;
     float dtau = HD_CD_STEP * hd_minf(hx, hd_minf(hy, hz));
-    float wx, wy, wz, up, rho, st, res;
+    float wx = 0.0f, wy = 0.0f, wz = 0.0f, up, rho, st, res;
     int xu, yu, zu;
     if (la.w < 0.5f) {
         u = HD_XYZ(la); /* directional: the direction the light travels */
@@ -94,7 +94,7 @@ HD_FN void hd_sum_light_voxel(HD_KARGS int x, int y, int z, int l, int first)
     hd_v3 p = HD_V3(((HD_F(x) + 0.5f) / HD_F(gx) - 0.5f) * HD_PRM(box).x,
                     ((HD_F(y) + 0.5f) / HD_F(gy) - 0.5f) * HD_PRM(box).y,
                     ((HD_F(z) + 0.5f) / HD_F(gz) - 0.5f) * HD_PRM(box).z);
-    float tmax, falloff;
+    float tmax = 0.0f, falloff = 0.0f;
     float rho = HD_GET(lv, i, x, y, z);
     int c;
     hd_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));

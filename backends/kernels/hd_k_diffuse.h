@@ -195,7 +195,7 @@ HD_FN void hd_diffuse_surface_axis(float scale, float h, float sp, float self, f
                                    int in0, int in1, float fl, HD_INOUT(float) num, HD_INOUT(float) dn,
                                    HD_INOUT(float) cnt)
 {
-    float a0, a1, o0, o1;
+    float a0 = 0.0f, a1 = 0.0f, o0 = 0.0f, o1 = 0.0f;
     float d0 = hd_diffuse_surface_den(scale, h, sp, s0, in0, fl, self, HD_REF(a0), HD_REF(o0));
     float d1 = hd_diffuse_surface_den(scale, h, sp, s1, in1, fl, self, HD_REF(a1), HD_REF(o1));
     float r = 1.0f / (d0 * d1), u0 = a0 * d1, u1 = a1 * d0;
@@ -260,7 +260,7 @@ HD_FN float hd_diffuse_surface_rhs_of(HD_KARGS int rhs, float num, float dn, flo
                                       float p_ym, float p_yp, float p_zm, float p_zp, int in_xm, int in_xp, int in_ym,
                                       int in_yp, int in_zm, int in_zp, HD_INOUT(float) den)
 {
-    float fl = HD_PRM(grid).w, cnt = 0.0f, self;
+    float fl = HD_PRM(grid).w, cnt = 0.0f, self = 0.0f;
     int extrap = rhs == 0 ? 1 : 0;
     num = hd_diffuse_surface_start(num, sp, fl, HD_REF(self));
     hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, self, s_xm, s_xp, p_xm, p_xp, in_xm, in_xp, fl,
@@ -324,10 +324,10 @@ HD_FN float hd_diffuse_terms_loaded(HD_KARGS int x, int y, int z, int c, int in_
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, sxy = gx * gy;
     int i = (z * gy + y) * gx + x;
-    float sp, ag, dn, fl = HD_PRM(grid).w;
+    float sp = 0.0f, ag = 0.0f, dn = 0.0f, fl = HD_PRM(grid).w;
     float num = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     if (surface != 0) {
-        float cnt = 0.0f, self;
+        float cnt = 0.0f, self = 0.0f;
         num = hd_diffuse_surface_start(num, sp, fl, HD_REF(self));
         hd_diffuse_surface_axis(HD_PRM(grid).x, HD_PRM(gridh).x, sp, self,
                                 hd_diffuse_nb_sigp(HD_KPASS in_xm, i - 1, x - 1, y, z, c, rgb, ag),
@@ -404,7 +404,7 @@ HD_FN void hd_diffuse_row(HD_KARGS int y, int z, int c, int parity, int jacobi)
     int x = jacobi != 0 ? 0 : ((y + z + parity) & 1);
     int xstep = jacobi != 0 ? 1 : 2;
     for (; x < gx; x += xstep) {
-        float den;
+        float den = 0.0f;
         float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
         if (jacobi != 0) HD_SET(phi2, base + x, x, y, z + c * gz, num / den);
         else HD_SET(phi, base + x, x, y, z + c * gz, num / den);
@@ -417,7 +417,7 @@ HD_FN float hd_diffuse_residual(HD_KARGS int x, int y, int z, int c, HD_INOUT(fl
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x, ic = i + c * gx * gy * gz;
-    float den;
+    float den = 0.0f;
     float num = hd_diffuse_terms(HD_KPASS x, y, z, c, HD_REF(den));
     int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
     /* sigma_s E with the channel's albedo (per channel with RGB scattering, as the update uses) */
@@ -443,7 +443,7 @@ HD_FN int hd_diffuse_extrapolate(HD_KARGS int x, int y, int z, int c, HD_INOUT(f
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y;
     int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
-    float den, num, sp;
+    float den = 0.0f, num, sp;
     if ((HD_DIFFUSE_FLAGS & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS)) != HD_FLAG_SURFACE_BOUNDARY) return 0;
     sp = hd_diffuse_sigp(HD_KPASS (z * gy + y) * gx + x, x, y, z, c, rgb, hd_diffuse_ag(HD_KPASS HD_PRM(medium).y));
     if (hd_diffuse_open_of(sp, 1, HD_PRM(grid).w) != 0.0f) return 0;

@@ -17,8 +17,8 @@ HD_FN void hd_direct_voxel(HD_KARGS int x, int y, int z)
     hd_v3 p = HD_V3(((HD_F(x) + 0.5f) / HD_F(gx) - 0.5f) * HD_PRM(box).x,
                     ((HD_F(y) + 0.5f) / HD_F(gy) - 0.5f) * HD_PRM(box).y,
                     ((HD_F(z) + 0.5f) / HD_F(gz) - 0.5f) * HD_PRM(box).z);
-    float tmax, falloff, T, w;
-    hd_u32 next_dim;
+    float tmax = 0.0f, falloff = 0.0f, T, w;
+    hd_u32 next_dim = 0u;
     int c;
     hd_v3 d = hd_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
     T = hd_transmittance(HD_KPASS p, d, tmax, key, 1u, HD_PRM(counts).y, HD_REF(next_dim));

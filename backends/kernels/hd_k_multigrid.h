@@ -244,7 +244,7 @@ HD_FN double hd_mg_res_f64(HD_KARGS int x, int y, int z, int c, int surface, int
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z, sxy = gx * gy;
     int i = (z * gy + y) * gx + x, ic = i + c * sxy * gz;
     int rhs = (HD_PRM(counts).z & HD_FLAG_DIFFUSE_RHS) != 0 ? 1 : 0;
-    float sp, ag, dn;
+    float sp = 0.0f, ag = 0.0f, dn = 0.0f;
     float src = hd_diffuse_own(HD_KPASS i, x, y, z, c, rgb, rhs, HD_REF(sp), HD_REF(ag), HD_REF(dn));
     double pi = hd_mg_phi_f64(HD_KPASS ic, x, y, z + c * gz, use_lo), r = HD_D(src) - HD_D(dn) * pi;
     if (surface != 0 && sp + sp < HD_PRM(grid).w) return -pi;

@@ -81,7 +81,7 @@ HD_FN void hd_path_pixel(HD_KARGS int px, int py)
     hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_PATH);
     hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
     hd_v3 d = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
-    float t1;
+    float t1 = 0.0f;
     float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
     int nl = HD_PRM(counts).x, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
     float albedo = HD_PRM(medium).y, g = HD_PRM(medium).z;
@@ -96,11 +96,11 @@ HD_FN void hd_path_pixel(HD_KARGS int px, int py)
         tmax = 0.0f;
     }
     while (tmax > 0.0f) {
-        hd_u32 nd;
+        hd_u32 nd = 0u;
         float t = hd_free_flight(HD_KPASS p, d, tmax, key, dim, HD_REF(nd));
         hd_v4 c;
         int l;
-        float lt, falloff, tr, f;
+        float lt = 0.0f, falloff = 0.0f, tr, f;
         hd_v3 ld;
         dim = nd;
         if (!(t < tmax)) {

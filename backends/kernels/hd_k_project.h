@@ -9,7 +9,7 @@
 HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
 {
     int nx = HD_PRM(gdims).x, ny = HD_PRM(gdims).y, nz = HD_PRM(gdims).z;
-    float wx, wy, wz;
+    float wx = 0.0f, wy = 0.0f, wz = 0.0f;
     int x0 = hd_lerp_axis(u.x, nx, HD_REF(wx));
     int y0 = hd_lerp_axis(u.y, ny, HD_REF(wy));
     int z0 = hd_lerp_axis(u.z, nz, HD_REF(wz));
@@ -87,7 +87,7 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
    interpolated opacity differs from the exact one only by the exponential's curvature. */
 HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
 {
-    float f;
+    float f = 0.0f;
     int a = hd_table_segment(v, HD_PTAB_N, HD_REF(f));
     return HD_V4(HD_TABLE_LERP(ptab, a, f, 0), HD_TABLE_LERP(ptab, a, f, 1), HD_TABLE_LERP(ptab, a, f, 2),
                  HD_TABLE_LERP(ptab, a, f, 3));
@@ -161,7 +161,7 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).y), HD_U(HD_PRM(frame).z), HD_STREAM_PROJECT);
     hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
     hd_v3 d = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
-    float t1;
+    float t1 = 0.0f;
     float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
     float dt = HD_PRM(march).x;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;

@@ -21,6 +21,10 @@
       no iteration; with it current again the context goes on from the iterations that ran.
    6. a device limit that holds the image but not its reduced frames' region: the first frame at
       render scale 2 fails with HD_ERROR_UNSUPPORTED and one logged error, full frames go on.
+   7. the driver compiles every stage without a warning: the backend's own (debug) context, the
+      shader cache off (MESA_SHADER_CACHE_DISABLE, set before EGL starts), each method, solver
+      and boundary iterated once; no "gl debug" line logged (Mesa warned "used uninitialized"
+      of every variable passed to an inout parameter before it was initialised).
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -348,6 +352,47 @@ static void nc_log(void *u, hd_log_level level, hd_result code, const char *msg,
     if (level == HD_LOG_ERROR) { ++nc_errors; nc_last = code; }
 }
 
+/* Check 7: no driver warning from compiling any stage (the KHR_debug messages the backend logs
+   as "gl debug" warnings in a debug build). */
+static int warn_count;
+static void warn_log(void *u, hd_log_level level, hd_result code, const char *msg, const char *f, int l)
+{
+    (void)u; (void)code; (void)f; (void)l;
+    if (level == HD_LOG_WARNING && strstr(msg, "gl debug")) {
+        if (++warn_count <= 3) printf("  %s\n", msg);
+    }
+}
+static void check_shader_warnings(void)
+{
+    static uint8_t vox[16 * 16 * 16];
+    static const hd_method methods[3] = {HD_METHOD_HD, HD_METHOD_CD, HD_METHOD_PT_MS};
+    static const hd_solver solvers[2] = {HD_SOLVER_RED_BLACK, HD_SOLVER_MULTIGRID};
+    static const hd_boundary bounds[2] = {HD_BOUNDARY_BOX, HD_BOUNDARY_SURFACE};
+    int m, s, b, runs = 0;
+    warn_count = 0;
+    for (m = 0; m < 3; ++m)
+        for (s = 0; s < 2; ++s)
+            for (b = 0; b < 2; ++b) {
+                hd_desc d;
+                hd_context c;
+                hd_result r;
+                make_desc(&d, vox, 16);
+                d.logger.func = warn_log;
+                d.params.method = methods[m];
+                d.params.solver = solvers[s];
+                d.params.diffusion_boundary = bounds[b];
+                r = hd_create(&d, &c);
+                CHECK(r == HD_SUCCESS, "shader warnings: hd_create: %s", hd_result_string(r));
+                if (r != HD_SUCCESS) continue;
+                CHECK(hd_iterate(c, 1) == HD_SUCCESS, "shader warnings: hd_iterate");
+                hd_destroy(c);
+                ++runs;
+            }
+    CHECK(warn_count == 0, "shader warnings: %d gl debug warnings over %d contexts", warn_count, runs);
+    printf("%s shader warnings: %d over %d contexts (3 methods x 2 solvers x 2 boundaries, shader cache off)\n",
+           warn_count == 0 ? "PASS" : "FAIL", warn_count, runs);
+}
+
 /* Check 5: calls on a caller's-context backend whose context is not current. */
 static void check_not_current(EGLDisplay dpy, EGLConfig cfg, const EGLint *attrs, EGLContext host)
 {
@@ -441,11 +486,15 @@ int main(void)
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
     static const EGLint ctx_attrs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
                                        EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-    PFNEGLGETPLATFORMDISPLAYEXTPROC gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
-    EGLDisplay dpy = gpd ? gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL) : EGL_NO_DISPLAY;
+    PFNEGLGETPLATFORMDISPLAYEXTPROC gpd;
+    EGLDisplay dpy;
     EGLConfig cfg;
     EGLint n = 0;
     EGLContext host;
+    /* check 7 needs every stage compiled by the driver, not loaded from Mesa's disk cache */
+    setenv("MESA_SHADER_CACHE_DISABLE", "true", 1);
+    gpd = (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
+    dpy = gpd ? gpd(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL) : EGL_NO_DISPLAY;
     if (dpy == EGL_NO_DISPLAY || !eglInitialize(dpy, NULL, NULL) || !eglBindAPI(EGL_OPENGL_API) ||
         !eglChooseConfig(dpy, cfg_attrs, &cfg, 1, &n) || n < 1 ||
         (host = eglCreateContext(dpy, cfg, EGL_NO_CONTEXT, ctx_attrs)) == EGL_NO_CONTEXT ||
@@ -458,6 +507,7 @@ int main(void)
     run_calls(1, "caller's context");
     check_not_current(dpy, cfg, ctx_attrs, host);
     check_image_room();
+    check_shader_warnings();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
     {
