@@ -162,6 +162,75 @@ HD_FN float hd_box_entry(HD_KARGS hd_v3 o, hd_v3 d, HD_INOUT(float) t_exit)
     return t0;
 }
 
+/* ---- the majorant grid's cell walk -------------------------------------------------------- */
+/* A ray p + t d walked through the majorant grid (cells of mdims.w voxels) cell by cell, a 3D
+   DDA: hd_track's and the projection march's (hd_k_project.h) one setup and step, so both cross
+   the same faces at the same t. */
+HD_STRUCT(hd_cell_walk)
+    int cx, cy, cz;   /* the current cell */
+    int sx, sy, sz;   /* the step along each axis, +1 or -1 */
+    float nx, ny, nz; /* t where the ray crosses the current cell's next face on each axis */
+    float dx, dy, dz; /* t between two faces on each axis (3e38 on an axis the ray runs along) */
+HD_STRUCT_END(hd_cell_walk)
+
+/* The walk of p + t d (p in world coordinates, inside the box or on it) from t = 0: the ray in
+   cell coordinates is g(t) = g0 + t gd, its first cell g0's, clamped into the grid. */
+HD_FN hd_cell_walk hd_cell_walk_begin(HD_KARGS hd_v3 p, hd_v3 d)
+{
+    hd_cell_walk w;
+    float inf = 3.0e38f;
+    float cell = HD_F(HD_PRM(mdims).w);
+    hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);
+    hd_v3 g0 = hd_vmul(hd_world_to_tex(HD_KPASS p), cs);
+    hd_v3 gd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);
+    w.cx = hd_clampi(HD_I(hd_floor(g0.x)), 0, HD_PRM(mdims).x - 1);
+    w.cy = hd_clampi(HD_I(hd_floor(g0.y)), 0, HD_PRM(mdims).y - 1);
+    w.cz = hd_clampi(HD_I(hd_floor(g0.z)), 0, HD_PRM(mdims).z - 1);
+    w.sx = gd.x > 0.0f ? 1 : -1;
+    w.sy = gd.y > 0.0f ? 1 : -1;
+    w.sz = gd.z > 0.0f ? 1 : -1;
+    w.nx = gd.x != 0.0f ? (HD_F(w.cx + (w.sx > 0 ? 1 : 0)) - g0.x) / gd.x : inf;
+    w.ny = gd.y != 0.0f ? (HD_F(w.cy + (w.sy > 0 ? 1 : 0)) - g0.y) / gd.y : inf;
+    w.nz = gd.z != 0.0f ? (HD_F(w.cz + (w.sz > 0 ? 1 : 0)) - g0.z) / gd.z : inf;
+    w.dx = gd.x != 0.0f ? hd_absf(1.0f / gd.x) : inf;
+    w.dy = gd.y != 0.0f ? hd_absf(1.0f / gd.y) : inf;
+    w.dz = gd.z != 0.0f ? hd_absf(1.0f / gd.z) : inf;
+    return w;
+}
+
+/* The axis (0: x, 1: y, 2: z) whose face the ray crosses first when it leaves the current cell. */
+HD_FN int hd_cell_walk_axis(hd_cell_walk w)
+{
+    return w.nx <= w.ny && w.nx <= w.nz ? 0 : (w.ny <= w.nz ? 1 : 2);
+}
+
+/* Where (t) the ray leaves the current cell across axis ax's face. */
+HD_FN float hd_cell_walk_exit(hd_cell_walk w, int ax)
+{
+    return ax == 0 ? w.nx : (ax == 1 ? w.ny : w.nz);
+}
+
+/* 1 when stepping across axis ax's face leaves the grid of md (mdims) cells, else 0. */
+HD_FN int hd_cell_walk_leaves(hd_cell_walk w, int ax, hd_i4 md)
+{
+    int next = ax == 0 ? w.cx + w.sx : (ax == 1 ? w.cy + w.sy : w.cz + w.sz);
+    return next < 0 || next >= (ax == 0 ? md.x : (ax == 1 ? md.y : md.z)) ? 1 : 0;
+}
+
+/* Steps into the neighbouring cell across axis ax's face. */
+HD_FN void hd_cell_walk_step(HD_INOUT(hd_cell_walk) w, int ax)
+{
+    if (ax == 0) { HD_DEREF(w).cx += HD_DEREF(w).sx; HD_DEREF(w).nx += HD_DEREF(w).dx; }
+    else if (ax == 1) { HD_DEREF(w).cy += HD_DEREF(w).sy; HD_DEREF(w).ny += HD_DEREF(w).dy; }
+    else { HD_DEREF(w).cz += HD_DEREF(w).sz; HD_DEREF(w).nz += HD_DEREF(w).dz; }
+}
+
+/* The current cell's index in the majorant grid of md (mdims) cells, x fastest. */
+HD_FN int hd_cell_walk_index(hd_cell_walk w, hd_i4 md)
+{
+    return (w.cz * md.y + w.cy) * md.x + w.cx;
+}
+
 /* ---- transmittance tracking --------------------------------------------------------------- */
 /* One unbiased estimate of the transmittance along p + t d, t in [0, tmax] (p inside the box,
    d unit). Null-collision tracking with a local majorant per cell of the majorant grid, walked
@@ -183,30 +252,14 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
     float t = 0.0f;
     float tau = -1.0f; /* optical depth to the next collision, drawn when first needed (< 0: none) */
     int done = 0;
-    /* The ray in majorant-cell coordinates (cells of mdims.w voxels): g(t) = g0 + t * gd. */
-    hd_v3 u0 = hd_world_to_tex(HD_KPASS p);
-    float cell = HD_F(HD_PRM(mdims).w);
-    float csx = HD_F(HD_PRM(dims).x) / cell, csy = HD_F(HD_PRM(dims).y) / cell;
-    float csz = HD_F(HD_PRM(dims).z) / cell;
-    hd_v3 g0 = HD_V3(u0.x * csx, u0.y * csy, u0.z * csz);
-    hd_v3 gd = HD_V3(d.x / HD_PRM(box).x * csx, d.y / HD_PRM(box).y * csy, d.z / HD_PRM(box).z * csz);
-    int cx = hd_clampi(HD_I(hd_floor(g0.x)), 0, HD_PRM(mdims).x - 1);
-    int cy = hd_clampi(HD_I(hd_floor(g0.y)), 0, HD_PRM(mdims).y - 1);
-    int cz = hd_clampi(HD_I(hd_floor(g0.z)), 0, HD_PRM(mdims).z - 1);
-    int sx = gd.x > 0.0f ? 1 : -1, sy = gd.y > 0.0f ? 1 : -1, sz = gd.z > 0.0f ? 1 : -1;
-    float inf = 3.0e38f;
-    float nx = gd.x != 0.0f ? (HD_F(cx + (sx > 0 ? 1 : 0)) - g0.x) / gd.x : inf;
-    float ny = gd.y != 0.0f ? (HD_F(cy + (sy > 0 ? 1 : 0)) - g0.y) / gd.y : inf;
-    float nz = gd.z != 0.0f ? (HD_F(cz + (sz > 0 ? 1 : 0)) - g0.z) / gd.z : inf;
-    float dx = gd.x != 0.0f ? hd_absf(1.0f / gd.x) : inf;
-    float dy = gd.y != 0.0f ? hd_absf(1.0f / gd.y) : inf;
-    float dz = gd.z != 0.0f ? hd_absf(1.0f / gd.z) : inf;
+    hd_cell_walk w = hd_cell_walk_begin(HD_KPASS p, d);
     int global_majorant = (HD_PRM(counts).z & HD_FLAG_GLOBAL_MAJORANT) != 0 ? 1 : 0;
     int steps = 0; /* collisions and cells, at most HD_MAX_TRACK_STEPS */
     while (done == 0 && t < tmax) {
-        float t_end = global_majorant != 0 ? tmax : hd_minf(hd_minf(nx, ny), hd_minf(nz, tmax));
+        int ax;
+        float t_end = global_majorant != 0 ? tmax : hd_minf(hd_minf(w.nx, w.ny), hd_minf(w.nz, tmax));
         float mu = global_majorant != 0 ? HD_PRM(medium).w
-                 : HD_GET1(maj, (cz * HD_PRM(mdims).y + cy) * HD_PRM(mdims).x + cx);
+                 : HD_GET1(maj, hd_cell_walk_index(w, HD_PRM(mdims)));
         if (mu > 0.0f) {
             float inv_mu = 1.0f / mu;
             for (;;) {
@@ -247,10 +300,10 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
         if (global_majorant != 0) break;
         steps += 1;
         if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; hit = t; break; }
-        /* step into the next cell along the axis whose boundary comes first */
-        if (nx <= ny && nx <= nz) { cx += sx; nx += dx; if (cx < 0 || cx >= HD_PRM(mdims).x) break; }
-        else if (ny <= nz) { cy += sy; ny += dy; if (cy < 0 || cy >= HD_PRM(mdims).y) break; }
-        else { cz += sz; nz += dz; if (cz < 0 || cz >= HD_PRM(mdims).z) break; }
+        /* step into the next cell along the axis whose boundary comes first, or leave the grid */
+        ax = hd_cell_walk_axis(w);
+        if (hd_cell_walk_leaves(w, ax, HD_PRM(mdims)) != 0) break;
+        hd_cell_walk_step(HD_REF(w), ax);
     }
     HD_DEREF(next_dim) = dim;
     HD_DEREF(t_hit) = hit;

@@ -148,13 +148,13 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
    the step advances however far the eye is; the chord is at most the box diagonal and n stays
    below HD_MAX_MARCH_STEPS. Empty space is skipped through the majorant grid (cells of mdims.w
    voxels, each majorant bounding every trilinear sample inside the cell with a one-voxel halo,
-   hd_context.h): the ray walks the grid cell by cell (a 3D DDA, as hd_track), and in a cell whose
-   majorant is 0 every sample has sigma_t = 0 and adds nothing, so the walk moves on without
-   touching its samples; the first cell with medium after such a run starts at the first sample
-   past its entry. The samples taken are the same as without the skip (a rounding difference at a
-   cell face stays inside the halo). The walk visits each cell once and ends at the grid's far
-   face or at len (the grid's last cell reaches to len); the march stops once the transmittance
-   falls below march.z. */
+   hd_context.h): the ray walks the grid cell by cell (hd_cell_walk, the 3D DDA hd_track also
+   walks), and in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing, so
+   the walk moves on without touching its samples; the first cell with medium after such a run
+   starts at the first sample past its entry. The samples taken are the same as without the skip
+   (a rounding difference at a cell face stays inside the halo). The walk visits each cell once
+   and ends at the grid's far face or at len (the grid's last cell reaches to len); the march
+   stops once the transmittance falls below march.z. */
 HD_FN void hd_project_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
@@ -168,44 +168,27 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
     hd_v3 pe = hd_madd(o, d, t0);
     float len = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
     float s0 = hd_rand(key, 2u) * dt;
-    /* the ray in majorant-cell coordinates: q(s) = q0 + s * qd */
-    float cell = HD_F(HD_PRM(mdims).w);
-    hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);
-    hd_v3 q0 = hd_vmul(hd_world_to_tex(HD_KPASS pe), cs);
-    hd_v3 qd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);
+    /* the walk over majorant cells (hd_k_common.h): its t is s, from the box entry pe */
+    hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
-    float inf = 3.0e38f;
-    int cx = hd_clampi(HD_I(hd_floor(q0.x)), 0, md.x - 1);
-    int cy = hd_clampi(HD_I(hd_floor(q0.y)), 0, md.y - 1);
-    int cz = hd_clampi(HD_I(hd_floor(q0.z)), 0, md.z - 1);
-    int sx = qd.x > 0.0f ? 1 : -1, sy = qd.y > 0.0f ? 1 : -1, sz = qd.z > 0.0f ? 1 : -1;
-    /* nx, ny, nz: where the ray crosses the current cell's next face on each axis; dx, dy, dz:
-       the distance between two faces */
-    float nx = qd.x != 0.0f ? (HD_F(cx + (sx > 0 ? 1 : 0)) - q0.x) / qd.x : inf;
-    float ny = qd.y != 0.0f ? (HD_F(cy + (sy > 0 ? 1 : 0)) - q0.y) / qd.y : inf;
-    float nz = qd.z != 0.0f ? (HD_F(cz + (sz > 0 ? 1 : 0)) - q0.z) / qd.z : inf;
-    float dx = qd.x != 0.0f ? hd_absf(1.0f / qd.x) : inf;
-    float dy = qd.y != 0.0f ? hd_absf(1.0f / qd.y) : inf;
-    float dz = qd.z != 0.0f ? hd_absf(1.0f / qd.z) : inf;
     float idt = 1.0f / dt;
     float se = 0.0f; /* where the ray entered the current cell */
     int skipped = 1;  /* the cells since the last sample were empty: n must catch up with se */
     int n = 0;
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
     int fresh = 1;    /* the current cell's exit and majorant are still to be read */
-    int occupied = 0, ax = 0, next = 0;
+    int occupied = 0, ax = 0;
     float sc = 0.0f, s = 0.0f;
     for (;;) {
         if (fresh != 0) {
             /* the axis whose face comes first, and whether stepping across it leaves the grid */
             float sn;
             int last;
-            ax = nx <= ny && nx <= nz ? 0 : (ny <= nz ? 1 : 2);
-            sn = ax == 0 ? nx : (ax == 1 ? ny : nz);
-            next = ax == 0 ? cx + sx : (ax == 1 ? cy + sy : cz + sz);
-            last = next < 0 || next >= (ax == 0 ? md.x : (ax == 1 ? md.y : md.z)) ? 1 : 0;
+            ax = hd_cell_walk_axis(w);
+            sn = hd_cell_walk_exit(w, ax);
+            last = hd_cell_walk_leaves(w, ax, md);
             sc = last != 0 || !(sn < len) ? len : sn;
-            occupied = HD_GET1(maj, (cz * md.y + cy) * md.x + cx) > 0.0f ? 1 : 0;
+            occupied = HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f ? 1 : 0;
             if (occupied != 0) {
                 if (skipped != 0) {
                     float m = hd_floor((se - s0) * idt) + 1.0f;
@@ -233,9 +216,7 @@ HD_FN void hd_project_pixel(HD_KARGS int px, int py)
         }
         if (!(sc < len) || n >= HD_MAX_MARCH_STEPS || cells <= 1) break;
         se = sc;
-        if (ax == 0) { cx = next; nx += dx; }
-        else if (ax == 1) { cy = next; ny += dy; }
-        else { cz = next; nz += dz; }
+        hd_cell_walk_step(HD_REF(w), ax);
         --cells;
         fresh = 1;
     }
