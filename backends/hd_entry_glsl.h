@@ -139,7 +139,10 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
-    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h) */
+    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h). hd_pc.y > 1: row y
+       of the dispatch draws image row y * hd_pc.y mod height (src/hd_gpu.h, hd__gpu_row_stride),
+       so that each contiguous run of work groups covers the whole image */
+    if (hd_pc.y > 1) y = int(uint(y) * uint(hd_pc.y) % uint(HD_PRM(image).y));
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
         if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);
         else hd_project_pixel(x, y);

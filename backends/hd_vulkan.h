@@ -180,6 +180,7 @@ struct hd__backend {
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
+    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in hd__gpu_row_stride's order */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -1401,6 +1402,8 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->fn.vkGetPhysicalDeviceProperties(be->phys, &props);
     be->fn.vkGetPhysicalDeviceMemoryProperties(be->phys, &be->memprops);
     be->limits = props.limits;
+    /* lavapipe runs the work groups of a dispatch as one contiguous run per thread */
+    be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     memcpy(be->device_name, props.deviceName, sizeof be->device_name);
     be->device_name[sizeof be->device_name - 1] = '\0';
     HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
@@ -1627,7 +1630,9 @@ static hd_result hd__be_project(hd__ctx *ctx)
         if (r != HD_SUCCESS) return r;
         be->gg.lsum_ok = 1;
     }
-    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n,
+                             be->spread_rows ? hd__gpu_row_stride(ctx->kp.image.y) : 1, 0, 0)) != HD_SUCCESS)
+        return r;
     return hd__vk_flush(ctx);
 }
 

@@ -421,4 +421,27 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 /* lo = 0. */
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gpu_grid_zero(ctx, HD__G_MG_LO); }
 
+/* The row stride of the projection's dispatch (hd_entry_glsl.h: work group row y draws image row
+   y p mod h) on CPU devices: llvmpipe and lavapipe hand each of their threads one contiguous run of
+   a dispatch's work groups, so with rows in order one thread marches the top of the image and
+   another the bottom, and the one with less medium waits. p is the integer coprime to h nearest
+   h (3 - sqrt 5) / 2: the rows of any run then spread evenly over the image (a Kronecker sequence
+   of the golden ratio). 1 (in order) below 3 rows. */
+HD__MAYBE_UNUSED static int hd__gpu_row_stride(int h)
+{
+    int c = (int)(0.381966 * (double)h + 0.5), d, k;
+    for (d = 0; h >= 3 && d < h; ++d)
+        for (k = 0; k < 2; ++k) {
+            int p = k ? c + d : c - d, a = h, b = p;
+            if (p <= 1 || p >= h) continue;
+            while (b) {
+                int t = a % b;
+                a = b;
+                b = t;
+            }
+            if (a == 1) return p;
+        }
+    return 1;
+}
+
 #endif
