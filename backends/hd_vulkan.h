@@ -180,7 +180,7 @@ struct hd__backend {
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
-    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in hd__gpu_row_stride's order */
+    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in blocks spread (src/hd_gpu.h) */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -1612,7 +1612,7 @@ static hd_result hd__be_project(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline sum, proj;
-    int n = hd__project_table_n(ctx);
+    int n = hd__project_table_n(ctx), nb, p;
     hd_result r;
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
@@ -1630,8 +1630,10 @@ static hd_result hd__be_project(hd__ctx *ctx)
         if (r != HD_SUCCESS) return r;
         be->gg.lsum_ok = 1;
     }
-    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n,
-                             be->spread_rows ? hd__gpu_row_stride(ctx->kp.image.y) : 1, 0, 0)) != HD_SUCCESS)
+    nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
+    p = be->spread_rows ? hd__gpu_row_stride(nb) : 1;
+    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1, n, p,
+                             HD__GPU_ROW_BLOCK, 0)) != HD_SUCCESS)
         return r;
     return hd__vk_flush(ctx);
 }

@@ -27,10 +27,11 @@
         HD_ERROR_OUT_OF_DEVICE_MEMORY at many points of the levels' allocation, and a device
         lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
         destroyed with no object left (validation on, no message).
-   And, with no device: the projection's row order on CPU devices (hd__gpu_row_stride) visits
-   every image row once at every height up to 4096 and near HD_MAX_IMAGE_DIM, and splitting the
-   dispatch's rows into 2, 3, 4, 8 or 16 contiguous runs (llvmpipe's and lavapipe's threads) gives
-   each run rows from every quarter of the image, within 35 % of a quarter of its rows each.
+   And, with no device: the order of the projection's blocks of rows on CPU devices
+   (hd__gpu_row_stride) visits every block once at every count up to 4096 and near
+   HD_MAX_IMAGE_DIM, and splitting the dispatch's blocks into 2, 3, 4, 8 or 16 contiguous runs
+   (llvmpipe's and lavapipe's threads) gives each run blocks from every quarter of the image,
+   within 35 % of a quarter of its blocks each.
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
@@ -683,10 +684,10 @@ static void test_record_auto_scale(void)
            first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
 }
 
-/* Every height's stride makes y -> y p mod h a permutation (p coprime to h), and each contiguous
-   run of dispatch rows, as a thread pool of T threads splits them, draws about a quarter of its
-   rows from each quarter of the image (rows in order would give one run the top and one the
-   bottom). */
+/* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
+   contiguous run of the dispatch's blocks, as a thread pool of T threads splits them, draws about
+   a quarter of its blocks from each quarter of the image (blocks in order would give one run the
+   top and one the bottom). */
 static void test_row_order(void)
 {
     static const int threads[] = {2, 3, 4, 8, 16};
@@ -700,7 +701,7 @@ static void test_row_order(void)
             b = t;
         }
         if (p < 1 || (h > 1 && p >= h) || a != 1) {
-            if (bad++ < 5) fprintf(stderr, "  height %d: stride %d is not coprime to it\n", h, p);
+            if (bad++ < 5) fprintf(stderr, "  %d blocks: stride %d is not coprime to it\n", h, p);
             continue;
         }
         for (i = 0; i < (int)(sizeof threads / sizeof threads[0]); ++i) {
@@ -713,14 +714,14 @@ static void test_row_order(void)
                     double dev = fabs(count[q] - n / 4.0) / (n / 4.0);
                     if (dev > worst) worst = dev;
                     if (dev > 0.35 && bad++ < 5)
-                        fprintf(stderr, "  height %d, %d runs: run %d has %d of its %d rows in quarter %d\n", h, T, k, count[q], n, q);
+                        fprintf(stderr, "  %d blocks, %d runs: run %d has %d of its %d blocks in quarter %d\n", h, T, k, count[q], n, q);
                 }
             }
         }
     }
     CHECK(bad == 0);
-    printf("%s the projection's row order: a permutation at every height, each thread's run of rows %.0f %% from a quarter "
-           "of them per image quarter at worst\n", bad ? "FAIL" : "PASS", 100.0 * worst);
+    printf("%s the projection's block order: a permutation at every block count, each thread's run of blocks %.0f %% from "
+           "a quarter of them per image quarter at worst\n", bad ? "FAIL" : "PASS", 100.0 * worst);
 }
 
 int main(void)
