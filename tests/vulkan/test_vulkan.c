@@ -31,7 +31,8 @@
    (hd__gpu_row_stride) visits every block once at every count up to 4096 and near
    HD_MAX_IMAGE_DIM, and splitting the dispatch's blocks into 2, 3, 4, 8 or 16 contiguous runs
    (llvmpipe's and lavapipe's threads) gives each run blocks from every quarter of the image,
-   within 35 % of a quarter of its blocks each.
+   within 35 % of a quarter of its blocks each. A 40x100 view of the background (4 blocks, the
+   last partial) is the background at every pixel: every row drawn.
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
@@ -724,10 +725,35 @@ static void test_row_order(void)
            "a quarter of them per image quarter at worst\n", bad ? "FAIL" : "PASS", 100.0 * worst);
 }
 
+/* Every image row is drawn with the rows spread (on lavapipe): a 40x100 view (blocks of 32, 32,
+   32 and 4 rows) that misses the volume is the background, exactly, at every pixel. */
+static void test_rows_covered(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    static float img[40 * 100 * 4];
+    int i, bad = 0;
+    d.camera.width = 40;
+    d.camera.height = 100;
+    d.camera.eye[2] = 3.0f;
+    d.camera.target[2] = 6.0f; /* looking away from the volume */
+    d.camera.up[1] = 1.0f;
+    d.params.background[0] = 0.25f; d.params.background[1] = 0.5f; d.params.background[2] = 0.75f;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(h, img, sizeof img / sizeof img[0]) == HD_SUCCESS);
+    for (i = 0; i < 40 * 100; ++i)
+        bad += img[4 * i] != 0.25f || img[4 * i + 1] != 0.5f || img[4 * i + 2] != 0.75f || img[4 * i + 3] != 0.0f;
+    hd_destroy(h);
+    CHECK(bad == 0);
+    printf("%s every row of a 40x100 projection drawn (%d of 4000 pixels not the background)\n", bad ? "FAIL" : "PASS", bad);
+}
+
 int main(void)
 {
     test_row_order();
     if (test_messenger()) {
+        test_rows_covered();
         test_caller_device();
         test_out_of_memory();
         test_device_lost();
