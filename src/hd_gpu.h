@@ -431,13 +431,13 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gpu_grid_zero(ctx,
    of neighbouring rows read the same cache lines: single rows spread so cost llvmpipe more CPU
    time than the balance saved (docs/PERFORMANCE.md). */
 #define HD__GPU_ROW_BLOCK 32
-HD__MAYBE_UNUSED static int hd__gpu_row_stride(int h)
+HD__MAYBE_UNUSED static int hd__gpu_row_stride(int n)
 {
-    int c = (int)(0.381966 * (double)h + 0.5), d, k;
-    for (d = 0; h >= 3 && d < h; ++d)
+    int c = (int)(0.381966 * (double)n + 0.5), d, k;
+    for (d = 0; n >= 3 && d < n; ++d)
         for (k = 0; k < 2; ++k) {
-            int p = k ? c + d : c - d, a = h, b = p;
-            if (p <= 1 || p >= h) continue;
+            int p = k ? c + d : c - d, a = n, b = p;
+            if (p <= 1 || p >= n) continue;
             while (b) {
                 int t = a % b;
                 a = b;
