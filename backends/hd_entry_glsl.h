@@ -141,7 +141,14 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
-    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h) */
+    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h). hd_pc.y > 1: the
+       dispatch's rows in blocks of hd_pc.z, block b drawing the image's block b * hd_pc.y mod
+       blocks (src/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of work groups
+       covers the whole image */
+    if (hd_pc.y > 1) {
+        int rb = hd_pc.z, nb = (HD_PRM(image).y + rb - 1) / rb;
+        y = int(uint(y / rb) * uint(hd_pc.y) % uint(nb)) * rb + y % rb;
+    }
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
         if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);
         else hd_project_pixel(x, y);

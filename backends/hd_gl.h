@@ -194,6 +194,7 @@ struct hd__backend {
     size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
+    int spread_rows;            /* 1 (llvmpipe): the projection's rows in blocks spread (src/hd_gpu.h) */
     hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
     GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
@@ -768,6 +769,8 @@ static hd_result hd__gl_setup(hd__ctx *ctx)
     be->version = major * 10 + minor;
     HD__INFO(&ctx->log, "gl: %s, %s (%s context)", (const char *)be->gl.GetString(GL_RENDERER),
              (const char *)be->gl.GetString(GL_VERSION), be->own ? "own EGL" : "the caller's");
+    /* llvmpipe runs the work groups of a dispatch as one contiguous run per thread */
+    be->spread_rows = be->gl.GetString(GL_RENDERER) && strstr((const char *)be->gl.GetString(GL_RENDERER), "llvmpipe");
     if (be->version < 43)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
     be->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &be->max_3d);
@@ -948,9 +951,11 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
 }
 static hd_result hd__be_project(hd__ctx *ctx)
 {
+    int nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK, p = ctx->be->spread_rows ? hd__gpu_row_stride(nb) : 1;
     hd_result r = hd__gl_project_prepare(ctx);
     if (r != HD_SUCCESS) return r;
-    return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, ctx->kp.image.y, 1, ctx->be->ptab_n, 0, 0, 0);
+    return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1,
+                           ctx->be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------- */

@@ -181,6 +181,7 @@ struct hd__backend {
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
+    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in blocks spread (src/hd_gpu.h) */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -1402,6 +1403,8 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->fn.vkGetPhysicalDeviceProperties(be->phys, &props);
     be->fn.vkGetPhysicalDeviceMemoryProperties(be->phys, &be->memprops);
     be->limits = props.limits;
+    /* lavapipe runs the work groups of a dispatch as one contiguous run per thread */
+    be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     memcpy(be->device_name, props.deviceName, sizeof be->device_name);
     be->device_name[sizeof be->device_name - 1] = '\0';
     HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
@@ -1610,7 +1613,7 @@ static hd_result hd__be_project(hd__ctx *ctx)
     hd__backend *be = ctx->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline sum, proj;
-    int n = hd__project_table_n(ctx);
+    int n = hd__project_table_n(ctx), nb, p;
     hd_result r;
     if (!be->ptab.map || be->ptab_cap != n)
         return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
@@ -1628,7 +1631,11 @@ static hd_result hd__be_project(hd__ctx *ctx)
         if (r != HD_SUCCESS) return r;
         be->gg.lsum_ok = 1;
     }
-    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, ctx->kp.image.y, 1, n, 0, 0, 0)) != HD_SUCCESS) return r;
+    nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
+    p = be->spread_rows ? hd__gpu_row_stride(nb) : 1;
+    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1, n, p,
+                             HD__GPU_ROW_BLOCK, 0)) != HD_SUCCESS)
+        return r;
     return hd__vk_flush(ctx);
 }
 

@@ -371,6 +371,7 @@ static void hd__ctx_free(hd__ctx *ctx)
     hd__free(ctx, ctx->cell_range);
     hd__free(ctx, ctx->majorant);
     hd__free(ctx, ctx->tf);
+    hd__free(ctx, ctx->srgb);
     hd__free(ctx, ctx);
 }
 
@@ -1333,11 +1334,50 @@ static uint8_t hd__srgb8(float v)
     return (uint8_t)(s * 255.0f + 0.5f);
 }
 
+/* hd__srgb8 of the floats in [2^-9, 1), the range where it calls powf, by table: the floats there
+   in groups of 2^12 consecutive ones (their top 20 bits); entry k is the code every float of
+   group k maps to, or 0x100 where the group's first and last floats map to different codes (a
+   code boundary inside: those floats take hd__srgb8 itself). hd__srgb8 is non-decreasing, so a
+   group whose ends agree maps to that code throughout, and the table gives its bytes exactly at
+   a table lookup per value. NULL when there is no memory for it (hd__srgb8 then does it all). */
+#define HD__SRGB_LO 0x3B000000u /* 2^-9 */
+#define HD__SRGB_HI 0x3F800000u /* 1.0f */
+#define HD__SRGB_SHIFT 12
+static const uint16_t *hd__srgb_table(hd__ctx *ctx)
+{
+    uint32_t k, n = (HD__SRGB_HI - HD__SRGB_LO) >> HD__SRGB_SHIFT;
+    if (ctx->srgb || !(ctx->srgb = (uint16_t *)hd__alloc(ctx, n * sizeof(uint16_t)))) return ctx->srgb;
+    for (k = 0; k < n; ++k) {
+        uint32_t a = HD__SRGB_LO + (k << HD__SRGB_SHIFT), b = a + (1u << HD__SRGB_SHIFT) - 1u;
+        float fa, fb;
+        uint8_t ca, cb;
+        memcpy(&fa, &a, sizeof fa);
+        memcpy(&fb, &b, sizeof fb);
+        ca = hd__srgb8(fa);
+        cb = hd__srgb8(fb);
+        ctx->srgb[k] = ca == cb ? ca : 0x100;
+    }
+    return ctx->srgb;
+}
+
+/* hd__srgb8(v), through table t (hd__srgb_table) where it holds v's code. */
+static uint8_t hd__srgb8_by(const uint16_t *t, float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    if (t && u - HD__SRGB_LO < HD__SRGB_HI - HD__SRGB_LO) {
+        uint16_t c = t[(u - HD__SRGB_LO) >> HD__SRGB_SHIFT];
+        if (c < 0x100) return (uint8_t)c;
+    }
+    return hd__srgb8(v);
+}
+
 HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes)
 {
     hd_result r;
     size_t need, i, n;
     float *tmp;
+    const uint16_t *t;
     HD__GET_CTX(ctx, h);
     if (!dst) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_read_image_rgba8: dst is NULL");
     n = (size_t)ctx->camera.width * ctx->camera.height;
@@ -1348,11 +1388,12 @@ HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes
     HD__BE_CALL(r, ctx, hd__be_read_image(ctx, tmp));
     if (r == HD_SUCCESS) {
         float e = ctx->params.exposure;
+        t = hd__srgb_table(ctx);
         for (i = 0; i < n; ++i) {
             float a = tmp[4 * i + 3];
-            dst[4 * i] = hd__srgb8(tmp[4 * i] * e);
-            dst[4 * i + 1] = hd__srgb8(tmp[4 * i + 1] * e);
-            dst[4 * i + 2] = hd__srgb8(tmp[4 * i + 2] * e);
+            dst[4 * i] = hd__srgb8_by(t, tmp[4 * i] * e);
+            dst[4 * i + 1] = hd__srgb8_by(t, tmp[4 * i + 1] * e);
+            dst[4 * i + 2] = hd__srgb8_by(t, tmp[4 * i + 2] * e);
             dst[4 * i + 3] = (uint8_t)(a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)(a * 255.0f + 0.5f));
         }
     }

@@ -421,4 +421,31 @@ static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
 /* lo = 0. */
 static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gpu_grid_zero(ctx, HD__G_MG_LO); }
 
+/* The projection's dispatch on CPU devices: llvmpipe and lavapipe hand each of their threads one
+   contiguous run of a dispatch's work groups, so with the rows in order one thread marches the top
+   of the image and another the bottom, and the one with less medium waits. The dispatch's rows
+   go in blocks of HD__GPU_ROW_BLOCK, block b drawing the image's block b p mod n
+   (hd_entry_glsl.h) for n blocks and p = hd__gpu_row_stride(n): the integer coprime to n nearest
+   n (3 - sqrt 5) / 2, so that the blocks of any run spread evenly over the image (a Kronecker
+   sequence of the golden ratio). 1 (in order) below 3 blocks. The blocks are tall because rays
+   of neighbouring rows read the same cache lines: single rows spread so cost llvmpipe more CPU
+   time than the balance saved (docs/PERFORMANCE.md). */
+#define HD__GPU_ROW_BLOCK 32
+HD__MAYBE_UNUSED static int hd__gpu_row_stride(int n)
+{
+    int c = (int)(0.381966 * (double)n + 0.5), d, k;
+    for (d = 0; n >= 3 && d < n; ++d)
+        for (k = 0; k < 2; ++k) {
+            int p = k ? c + d : c - d, a = n, b = p;
+            if (p <= 1 || p >= n) continue;
+            while (b) {
+                int t = a % b;
+                a = b;
+                b = t;
+            }
+            if (a == 1) return p;
+        }
+    return 1;
+}
+
 #endif

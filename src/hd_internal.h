@@ -122,6 +122,7 @@ typedef struct hd__ctx {
     uint8_t *dl_bits;        /* the same voxels, one bit each (read by the convergence estimate) */
     int dl_all;              /* track every voxel (a test hook: the reference for the mask) */
     unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
+    uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
     hd__backend *be;
 } hd__ctx;
 

@@ -510,7 +510,52 @@ static void test_bad_calls(void)
     CHECK(hd_get_stats(stale, NULL) == HD_ERROR_INVALID_HANDLE);
 }
 
+/* The sRGB encoding of hd_read_image_rgba8, written out: 0 for v <= 0 (and NaN), 255 from 1. */
+static uint8_t srgb8_ref(float v)
+{
+    float s;
+    if (!(v > 0.0f)) return 0;
+    if (v >= 1.0f) return 255;
+    s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)(s * 255.0f + 0.5f);
+}
+
+/* hd_read_image_rgba8 is the sRGB encoding of hd_read_image_f32 * exposure, byte for byte, at
+   exposures from 2^-14 to 2^6 in steps of 2^(1/20): the image's values then pass through every
+   code, both branches of the encoding and many values next to each code's boundary. */
+static void test_rgba8_encoding(void)
+{
+    hd_desc d;
+    hd_context ctx;
+    float img[48 * 48 * 4];
+    uint8_t px[48 * 48 * 4];
+    long bad = 0, checked = 0;
+    int k, i, c;
+    make_desc(&d, NULL);
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_iterate(ctx, 4) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(ctx, img, sizeof img / sizeof img[0]) == HD_SUCCESS);
+    for (k = 0; k <= 400; ++k) {
+        float e = (float)pow(2.0, -14.0 + k / 20.0);
+        d.params.exposure = e;
+        CHECK(hd_set_params(ctx, &d.params) == HD_SUCCESS);
+        CHECK(hd_read_image_rgba8(ctx, px, sizeof px) == HD_SUCCESS);
+        for (i = 0; i < 48 * 48; ++i)
+            for (c = 0; c < 3; ++c) {
+                uint8_t want = srgb8_ref(img[4 * i + c] * e);
+                checked += img[4 * i + c] * e > 0.0f && img[4 * i + c] * e < 1.0f;
+                if (px[4 * i + c] != want && bad++ < 5)
+                    fprintf(stderr, "  exposure %g, pixel %d channel %d: %d, want %d (value %.9g)\n", (double)e, i, c,
+                            px[4 * i + c], want, (double)(img[4 * i + c] * e));
+            }
+    }
+    CHECK(bad == 0);
+    CHECK(checked > 100000); /* the sweep reached the encoding's curve, not only 0 and 255 */
+    hd_destroy(ctx);
+}
+
 const hd_test_case hd_tests_core[] = {
+    {"core_rgba8_encoding", test_rgba8_encoding},
     {"core_create_defaults", test_create_defaults},
     {"core_params_preset", test_params_preset},
     {"core_determinism_threads_seed", test_determinism},

@@ -27,6 +27,12 @@
         HD_ERROR_OUT_OF_DEVICE_MEMORY at many points of the levels' allocation, and a device
         lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
         destroyed with no object left (validation on, no message).
+   And, with no device: the order of the projection's blocks of rows on CPU devices
+   (hd__gpu_row_stride) visits every block once at every count up to 4096 and near
+   HD_MAX_IMAGE_DIM, and splitting the dispatch's blocks into 2, 3, 4, 8 or 16 contiguous runs
+   (llvmpipe's and lavapipe's threads) gives each run blocks from every quarter of the image,
+   within 35 % of a quarter of its blocks each. A 40x100 view of the background (4 blocks, the
+   last partial) is the background at every pixel: every row drawn.
    A missing Vulkan driver or validation layer is reported SKIPPED with the reason (exit 0). */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
@@ -679,9 +685,75 @@ static void test_record_auto_scale(void)
            first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
 }
 
+/* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
+   contiguous run of the dispatch's blocks, as a thread pool of T threads splits them, draws about
+   a quarter of its blocks from each quarter of the image (blocks in order would give one run the
+   top and one the bottom). */
+static void test_row_order(void)
+{
+    static const int threads[] = {2, 3, 4, 8, 16};
+    int h, bad = 0, i;
+    double worst = 0.0;
+    for (h = 1; h <= HD_MAX_IMAGE_DIM; h = h == 4096 ? HD_MAX_IMAGE_DIM - 64 : h + 1) {
+        int p = hd__gpu_row_stride(h), a = h, b = p;
+        while (b) {
+            int t = a % b;
+            a = b;
+            b = t;
+        }
+        if (p < 1 || (h > 1 && p >= h) || a != 1) {
+            if (bad++ < 5) fprintf(stderr, "  %d blocks: stride %d is not coprime to it\n", h, p);
+            continue;
+        }
+        for (i = 0; i < (int)(sizeof threads / sizeof threads[0]); ++i) {
+            int T = threads[i], n = h / T, k, y, q;
+            if (h < 64 * T) continue;
+            for (k = 0; k < T; ++k) {
+                int count[4] = {0, 0, 0, 0};
+                for (y = k * n; y < (k + 1) * n; ++y) count[(int)((long long)y * p % h * 4 / h)]++;
+                for (q = 0; q < 4; ++q) {
+                    double dev = fabs(count[q] - n / 4.0) / (n / 4.0);
+                    if (dev > worst) worst = dev;
+                    if (dev > 0.35 && bad++ < 5)
+                        fprintf(stderr, "  %d blocks, %d runs: run %d has %d of its %d blocks in quarter %d\n", h, T, k, count[q], n, q);
+                }
+            }
+        }
+    }
+    CHECK(bad == 0);
+    printf("%s the projection's block order: a permutation at every block count, each thread's run of blocks %.0f %% from "
+           "a quarter of them per image quarter at worst\n", bad ? "FAIL" : "PASS", 100.0 * worst);
+}
+
+/* Every image row is drawn with the rows spread (on lavapipe): a 40x100 view (blocks of 32, 32,
+   32 and 4 rows) that misses the volume is the background, exactly, at every pixel. */
+static void test_rows_covered(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    static float img[40 * 100 * 4];
+    int i, bad = 0;
+    d.camera.width = 40;
+    d.camera.height = 100;
+    d.camera.eye[2] = 3.0f;
+    d.camera.target[2] = 6.0f; /* looking away from the volume */
+    d.camera.up[1] = 1.0f;
+    d.params.background[0] = 0.25f; d.params.background[1] = 0.5f; d.params.background[2] = 0.75f;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(h, img, sizeof img / sizeof img[0]) == HD_SUCCESS);
+    for (i = 0; i < 40 * 100; ++i)
+        bad += img[4 * i] != 0.25f || img[4 * i + 1] != 0.5f || img[4 * i + 2] != 0.75f || img[4 * i + 3] != 0.0f;
+    hd_destroy(h);
+    CHECK(bad == 0);
+    printf("%s every row of a 40x100 projection drawn (%d of 4000 pixels not the background)\n", bad ? "FAIL" : "PASS", bad);
+}
+
 int main(void)
 {
+    test_row_order();
     if (test_messenger()) {
+        test_rows_covered();
         test_caller_device();
         test_out_of_memory();
         test_device_lost();
