@@ -969,12 +969,15 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
 
 /* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
    glGetTextureSubImage each, or without GL 4.5 the whole grid read and the slices copied out of
-   it. GL_R16F grids come back widened to float by the GL, exactly (every half is a float). */
+   it. GL_R16F grids come back widened to float by the GL, exactly (every half is a float). The
+   image units are unbound first (the next dispatch binds its own): NVIDIA's driver reads a
+   texture still bound as a writable image slowly, about 2 ms a slice on an H200. */
 static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, const int *list, int count, float *dst)
 {
     size_t slice = (size_t)t->extent[0] * t->extent[1];
     float *all = dst;
     int k;
+    for (k = 0; k < HD__GL_IMAGE_UNITS; ++k) ctx->be->gl.BindImageTexture((GLuint)k, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
     if (list && ctx->be->gl.GetTextureSubImage) {
         for (k = 0; k < count; ++k)
             ctx->be->gl.GetTextureSubImage(t->name, 0, 0, 0, list[k], t->extent[0], t->extent[1], 1, GL_RED, GL_FLOAT,
