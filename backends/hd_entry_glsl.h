@@ -156,17 +156,18 @@ void main()
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
     if (hd_pc.w > 0) {
-        /* the work queue (CPU devices, src/hd_gpu.h): hd_pc.w units of a work group's width x hd_pc.z rows,
-           row-major; each work group takes the next unit from the counter hd_queue[0] (zero
-           before the dispatch) until the counter passes hd_pc.w, so a device that splits the
-           dispatch statically between its threads still hands out the rows on demand */
+        /* the work queue (CPU devices, src/hd_gpu.h): hd_pc.w units of a work group's width x
+           hd_pc.z rows, row-major, one per work group; each work group draws the unit it takes
+           from the counter hd_queue[0] (zero before the dispatch), not the one its index names,
+           so the threads of a device that splits the dispatch statically still sweep the image
+           side by side. (A work group looping over units until none were left drew wrong pixels
+           on llvmpipe and lavapipe, Mesa 22.3, with barrier() in the loop.) */
         int rb = hd_pc.z, wx = int(gl_WorkGroupSize.x), nbx = (HD_PRM(image).x + wx - 1) / wx, lx = int(gl_LocalInvocationID.x);
-        for (;;) {
-            if (lx == 0) hd_queue_unit = atomicAdd(hd_queue[0], 1u);
-            barrier();
+        if (lx == 0) hd_queue_unit = atomicAdd(hd_queue[0], 1u);
+        memoryBarrierShared();
+        barrier();
+        {
             uint u = hd_queue_unit;
-            barrier(); /* every invocation has read the unit before invocation 0 takes the next */
-            if (u >= uint(hd_pc.w)) break;
             int x0 = int(u % uint(nbx)) * wx + lx, y0 = int(u / uint(nbx)) * rb;
             for (int k = 0; k < rb; ++k) hd_project_at(x0, y0 + k);
         }

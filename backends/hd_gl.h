@@ -195,7 +195,7 @@ struct hd__backend {
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
     int spread_rows;            /* HD__GPU_ROWS_*: how the projection's dispatch takes its rows (src/hd_gpu.h) */
-    int queue_rows, queue_groups; /* HD__GPU_ROWS_QUEUE's unit height and work groups (src/hd_gpu.h) */
+    int queue_rows;             /* HD__GPU_ROWS_QUEUE's unit height (src/hd_gpu.h) */
     hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
     GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
@@ -777,7 +777,6 @@ static hd_result hd__gl_setup(hd__ctx *ctx)
                           ? HD__GPU_ROWS_CPU_DEVICE
                           : HD__GPU_ROWS_IN_ORDER;
     be->queue_rows = HD__GPU_QUEUE_ROWS;
-    be->queue_groups = HD__GPU_QUEUE_GROUPS;
     if (be->version < 43)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
     be->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &be->max_3d);
@@ -964,15 +963,15 @@ static hd_result hd__be_project(hd__ctx *ctx)
     hd_result r = hd__gl_project_prepare(ctx);
     if (r != HD_SUCCESS) return r;
     if (be->spread_rows == HD__GPU_ROWS_QUEUE) {
-        /* the counter zeroed in the command stream, after the previous dispatch's barrier */
+        /* a work group per unit (the x by y grid keeps each count within the device's limits); the
+           counter zeroed in the command stream, after the previous dispatch's barrier */
         static const GLuint zero[4] = {0, 0, 0, 0};
-        int units = ((ctx->kp.image.x + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X) *
-                    ((ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows);
+        int nby = (ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows;
+        int units = ((ctx->kp.image.x + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X) * nby;
         if ((r = hd__gl_buffer_data(ctx, &be->queue, sizeof zero, zero, GL_DYNAMIC_DRAW, "the projection's work queue")) !=
             HD_SUCCESS)
             return r;
-        return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, HD__GL_LOCAL_X * (be->queue_groups < units ? be->queue_groups : units), 1, 1, be->ptab_n,
-                               1, be->queue_rows, units);
+        return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, nby, 1, be->ptab_n, 1, be->queue_rows, units);
     }
     return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1,
                            be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);

@@ -182,7 +182,7 @@ struct hd__backend {
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
     int spread_rows;              /* HD__GPU_ROWS_*: how the projection's dispatch takes its rows (src/hd_gpu.h) */
-    int queue_rows, queue_groups; /* HD__GPU_ROWS_QUEUE's unit height and work groups (src/hd_gpu.h) */
+    int queue_rows;             /* HD__GPU_ROWS_QUEUE's unit height (src/hd_gpu.h) */
     hd__vk_buffer rowq;           /* the projection's work queue counter (binding 15), zeroed before each dispatch */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
@@ -1410,7 +1410,6 @@ static hd_result hd__be_create(hd__ctx *ctx)
     /* lavapipe runs the work groups of a dispatch as one contiguous run per thread */
     be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? HD__GPU_ROWS_CPU_DEVICE : HD__GPU_ROWS_IN_ORDER;
     be->queue_rows = HD__GPU_QUEUE_ROWS;
-    be->queue_groups = HD__GPU_QUEUE_GROUPS;
     memcpy(be->device_name, props.deviceName, sizeof be->device_name);
     be->device_name[sizeof be->device_name - 1] = '\0';
     HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
@@ -1641,13 +1640,14 @@ static hd_result hd__be_project(hd__ctx *ctx)
         be->gg.lsum_ok = 1;
     }
     if (be->spread_rows == HD__GPU_ROWS_QUEUE) {
-        /* the counter zeroed in the command buffer, after the previous dispatch (a recorded frame
-           submitted again zeroes it again); the dispatch's own barrier orders the fill before it */
-        int units = ((ctx->kp.image.x + (int)HD__VK_LOCAL_X - 1) / (int)HD__VK_LOCAL_X) * ((ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows);
+        /* a work group per unit; the counter zeroed in the command buffer after the previous
+           dispatch (a recorded frame submitted again zeroes it again), the dispatch's own
+           barrier ordering the fill before it */
+        int nby = (ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows;
+        int units = ((ctx->kp.image.x + (int)HD__VK_LOCAL_X - 1) / (int)HD__VK_LOCAL_X) * nby;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdFillBuffer(cb, be->rowq.buffer, 0, VK_WHOLE_SIZE, 0u);
-        if ((r = hd__vk_dispatch(ctx, cb, proj, 0, (int)HD__VK_LOCAL_X * (be->queue_groups < units ? be->queue_groups : units), 1, 1, n, 1,
-                                 be->queue_rows, units)) != HD_SUCCESS)
+        if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, nby, 1, n, 1, be->queue_rows, units)) != HD_SUCCESS)
             return r;
         return hd__vk_flush(ctx);
     }

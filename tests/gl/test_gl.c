@@ -485,8 +485,7 @@ static void check_image_room(void)
 
 /* Every pixel of a 200x100 view that misses the volume is the background, exactly, with each way
    of taking the projection's rows (src/hd_gpu.h): the work queue (llvmpipe's default; 4 x 13
-   units of 64 x 8 for 16 work groups, the last partial in x and y), the spread blocks and the
-   rows in order; a second frame after a new background checks that the queue's counter is
+   units of 64 x 8, the last partial in x and y), the spread blocks and the rows in order; a second frame after a new background checks that the queue's counter is
    zeroed before each dispatch. */
 static void check_rows_covered(void)
 {

@@ -742,10 +742,9 @@ static int rows_check(hd_context h, const char *how, float k)
 
 /* Every image pixel is drawn by each way of taking the projection's rows (src/hd_gpu.h): a
    200x100 view that misses the volume is the background, exactly, at every pixel. The work
-   queue (lavapipe's default) has 4 x 13 units of 64 x 8 (the last partial in x and y) for 16
-   work groups, so each group takes several; a second frame after a new background checks that
-   the counter is zeroed before each dispatch (else it draws nothing). The spread's blocks are
-   32, 32, 32 and 4 rows. */
+   queue (lavapipe's default) has 4 x 13 units of 64 x 8 (the last partial in x and y); a second
+   frame after a new background checks that the counter is zeroed before each dispatch (else it
+   draws nothing). The spread's blocks are 32, 32, 32 and 4 rows. */
 static void test_rows_covered(void)
 {
     hd_desc d = test_desc();
