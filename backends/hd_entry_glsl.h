@@ -160,8 +160,8 @@ void main()
            hd_pc.z rows, row-major, one per work group; each work group draws the unit it takes
            from the counter hd_queue[0] (zero before the dispatch), not the one its index names,
            so the threads of a device that splits the dispatch statically still sweep the image
-           side by side. (A work group looping over units until none were left drew wrong pixels
-           on llvmpipe and lavapipe, Mesa 22.3, with barrier() in the loop.) */
+           side by side. One unit per work group: with barrier() in a loop over units, llvmpipe
+           and lavapipe (Mesa 22.3) draw wrong pixels (docs/PERFORMANCE.md). */
         int rb = hd_pc.z, wx = int(gl_WorkGroupSize.x), nbx = (HD_PRM(image).x + wx - 1) / wx, lx = int(gl_LocalInvocationID.x);
         if (lx == 0) hd_queue_unit = atomicAdd(hd_queue[0], 1u);
         memoryBarrierShared();
