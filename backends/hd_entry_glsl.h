@@ -128,20 +128,6 @@ void hd_diffuse_block(int bx, int by, int bz)
 }
 #endif
 
-#if HD_STAGE == HD_STAGE_PROJECT
-shared uint hd_queue_unit; /* the unit invocation 0 took, for the whole work group */
-
-/* Pixel (x, y) of the projection (with HD_FLAG_UPSAMPLE: of a reduced frame's upsample pass,
-   hd_k_upsample.h). */
-void hd_project_at(int x, int y)
-{
-    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
-        if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);
-        else hd_project_pixel(x, y);
-    }
-}
-#endif
-
 void main()
 {
     int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y), z = int(gl_GlobalInvocationID.z);
@@ -155,32 +141,18 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hd_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
-    if (hd_pc.w > 0) {
-        /* the work queue (CPU devices, src/hd_gpu.h): hd_pc.w units of a work group's width x
-           hd_pc.z rows, row-major, one per work group; each work group draws the unit it takes
-           from the counter hd_queue[0] (zero before the dispatch), not the one its index names,
-           so the threads of a device that splits the dispatch statically still sweep the image
-           side by side. One unit per work group: with barrier() in a loop over units, llvmpipe
-           and lavapipe (Mesa 22.3) draw wrong pixels (docs/PERFORMANCE.md). */
-        int rb = hd_pc.z, wx = int(gl_WorkGroupSize.x), nbx = (HD_PRM(image).x + wx - 1) / wx, lx = int(gl_LocalInvocationID.x);
-        if (lx == 0) hd_queue_unit = atomicAdd(hd_queue[0], 1u);
-        memoryBarrierShared();
-        barrier();
-        {
-            uint u = hd_queue_unit;
-            int x0 = int(u % uint(nbx)) * wx + lx, y0 = int(u / uint(nbx)) * rb;
-            for (int k = 0; k < rb; ++k) hd_project_at(x0, y0 + k);
-        }
-        return;
-    }
-    /* hd_pc.y > 1: the dispatch's rows in blocks of hd_pc.z, block b drawing the image's block
-       b * hd_pc.y mod blocks (src/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of
-       work groups covers the whole image */
+    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h). hd_pc.y > 1: the
+       dispatch's rows in blocks of hd_pc.z, block b drawing the image's block b * hd_pc.y mod
+       blocks (src/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of work groups
+       covers the whole image */
     if (hd_pc.y > 1) {
         int rb = hd_pc.z, nb = (HD_PRM(image).y + rb - 1) / rb;
         y = int(uint(y / rb) * uint(hd_pc.y) % uint(nb)) * rb + y % rb;
     }
-    hd_project_at(x, y);
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
+        if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hd_upsample_pixel(x, y);
+        else hd_project_pixel(x, y);
+    }
 #elif HD_STAGE == HD_STAGE_CONVECT
     if (x < g.x && y < g.y && z < g.z) hd_convect_voxel(x, y, z, hd_pc.z);
 #elif HD_STAGE == HD_STAGE_SUM_LIGHT

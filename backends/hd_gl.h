@@ -124,8 +124,8 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_DIFFUSE_ZK 4
 #define HD__GL_DIFFUSE_YK 2
 #define HD__GL_IMAGE_UNITS 8 /* hd_bind_gl_glsl.h: image units 0..7, GL 4.3's minimum */
-#define HD__GL_SSBOS 7       /* storage buffers 0..6 (3: multigrid's row sums, 4: the direct light's list,
-                                5: the projection's TF table, 6: its work queue counter) */
+#define HD__GL_SSBOS 6       /* storage buffers 0..5 (3: multigrid's row sums, 4: the direct light's list,
+                                5: the projection's TF table) */
 
 typedef struct hd__gl_tex {
     GLuint name;
@@ -188,14 +188,13 @@ struct hd__backend {
        gg.lsum_ok (src/hd_gpu.h), and the step's TF table (storage
        buffer 5, ptab_n entries), uploaded when its inputs change (ptab_key) */
     hd__gl_tex lsum;
-    GLuint ptab, queue; /* queue: the projection's work queue counter (storage buffer 6) */
+    GLuint ptab;
     int ptab_n;
     hd__ptab_key ptab_key;
     size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
-    int spread_rows;            /* HD__GPU_ROWS_*: how the projection's dispatch takes its rows (src/hd_gpu.h) */
-    int queue_rows;             /* HD__GPU_ROWS_QUEUE's unit height (src/hd_gpu.h) */
+    int spread_rows;            /* 1 (llvmpipe): the projection's rows in blocks spread (src/hd_gpu.h) */
     hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
     GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
@@ -619,7 +618,6 @@ static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const h
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img ? be->img : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, be->dl ? be->dl : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, be->ptab ? be->ptab : be->dummy_buffer);
-    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, be->queue ? be->queue : be->dummy_buffer);
     for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
         hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
@@ -746,7 +744,6 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab);
-        hd__gl_free_buffer(be, &be->queue);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
         hd__be_end(ctx, HD_SUCCESS);
     }
@@ -773,10 +770,7 @@ static hd_result hd__gl_setup(hd__ctx *ctx)
     HD__INFO(&ctx->log, "gl: %s, %s (%s context)", (const char *)be->gl.GetString(GL_RENDERER),
              (const char *)be->gl.GetString(GL_VERSION), be->own ? "own EGL" : "the caller's");
     /* llvmpipe runs the work groups of a dispatch as one contiguous run per thread */
-    be->spread_rows = be->gl.GetString(GL_RENDERER) && strstr((const char *)be->gl.GetString(GL_RENDERER), "llvmpipe")
-                          ? HD__GPU_ROWS_CPU_DEVICE
-                          : HD__GPU_ROWS_IN_ORDER;
-    be->queue_rows = HD__GPU_QUEUE_ROWS;
+    be->spread_rows = be->gl.GetString(GL_RENDERER) && strstr((const char *)be->gl.GetString(GL_RENDERER), "llvmpipe");
     if (be->version < 43)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
     be->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &be->max_3d);
@@ -957,24 +951,11 @@ static hd_result hd__gl_project_prepare(hd__ctx *ctx)
 }
 static hd_result hd__be_project(hd__ctx *ctx)
 {
-    hd__backend *be = ctx->be;
-    int nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
-    int p = be->spread_rows == HD__GPU_ROWS_SPREAD ? hd__gpu_row_stride(nb) : 1;
+    int nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK, p = ctx->be->spread_rows ? hd__gpu_row_stride(nb) : 1;
     hd_result r = hd__gl_project_prepare(ctx);
     if (r != HD_SUCCESS) return r;
-    if (be->spread_rows == HD__GPU_ROWS_QUEUE) {
-        /* a work group per unit (the x by y grid keeps each count within the device's limits); the
-           counter zeroed in the command stream, after the previous dispatch's barrier */
-        static const GLuint zero[4] = {0, 0, 0, 0};
-        int nby = (ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows;
-        int units = ((ctx->kp.image.x + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X) * nby;
-        if ((r = hd__gl_buffer_data(ctx, &be->queue, sizeof zero, zero, GL_DYNAMIC_DRAW, "the projection's work queue")) !=
-            HD_SUCCESS)
-            return r;
-        return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, nby, 1, be->ptab_n, 1, be->queue_rows, units);
-    }
     return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1,
-                           be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
+                           ctx->be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
 }
 
 /* ---- read-back ------------------------------------------------------------------------------- */

@@ -106,7 +106,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
                                      (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
-#define HD__VK_BINDINGS 16
+#define HD__VK_BINDINGS 15
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -181,9 +181,7 @@ struct hd__backend {
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
-    int spread_rows;              /* HD__GPU_ROWS_*: how the projection's dispatch takes its rows (src/hd_gpu.h) */
-    int queue_rows;             /* HD__GPU_ROWS_QUEUE's unit height (src/hd_gpu.h) */
-    hd__vk_buffer rowq;           /* the projection's work queue counter (binding 15), zeroed before each dispatch */
+    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in blocks spread (src/hd_gpu.h) */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -1095,16 +1093,15 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE};
     hd_result r;
     int i;
     /* the set's storage buffers (TF, majorants, image, row sums, direct light's list, the
-       projection's TF table and work queue) and storage images (volume, sigma_t, E, phi, phi2, two light volumes,
+       projection's TF table) and storage images (volume, sigma_t, E, phi, phi2, two light volumes,
        the projection's E + phi): above Vulkan's guaranteed minimum of 4 per stage each */
-    if (be->limits.maxPerStageDescriptorStorageBuffers < 7 || be->limits.maxPerStageDescriptorStorageImages < 8)
+    if (be->limits.maxPerStageDescriptorStorageBuffers < 6 || be->limits.maxPerStageDescriptorStorageImages < 8)
         return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
-                       "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 7 and 8 needed",
+                       "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 6 and 8 needed",
                        be->limits.maxPerStageDescriptorStorageBuffers, be->limits.maxPerStageDescriptorStorageImages);
     if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
@@ -1150,12 +1147,11 @@ static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buf
 }
 
 /* The buffers every set binds (TF, majorants, image; binding 11, multigrid's row sums, a
-   placeholder unless given; 12, the direct light's list; 13, the projection's TF table; 15, its
-   work queue counter) into bu. */
+   placeholder unless given; 12, the direct light's list; 13, the projection's TF table) into bu. */
 static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, const hd__vk_buffer *dot)
 {
     bu[2] = &be->tf; bu[3] = &be->maj; bu[8] = &be->img; bu[11] = dot ? dot : &be->dummy_buffer;
-    bu[12] = &be->dl; bu[13] = &be->ptab; bu[15] = &be->rowq;
+    bu[12] = &be->dl; bu[13] = &be->ptab;
 }
 
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
@@ -1288,7 +1284,7 @@ static void hd__be_destroy(hd__ctx *ctx)
         hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->dummy); hd__vk_free_image(ctx, &be->dummy16);
         hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
         hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
-        hd__vk_free_buffer(ctx, &be->dl); hd__vk_free_buffer(ctx, &be->ptab); hd__vk_free_buffer(ctx, &be->rowq);
+        hd__vk_free_buffer(ctx, &be->dl); hd__vk_free_buffer(ctx, &be->ptab);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -1408,8 +1404,7 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->fn.vkGetPhysicalDeviceMemoryProperties(be->phys, &be->memprops);
     be->limits = props.limits;
     /* lavapipe runs the work groups of a dispatch as one contiguous run per thread */
-    be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? HD__GPU_ROWS_CPU_DEVICE : HD__GPU_ROWS_IN_ORDER;
-    be->queue_rows = HD__GPU_QUEUE_ROWS;
+    be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     memcpy(be->device_name, props.deviceName, sizeof be->device_name);
     be->device_name[sizeof be->device_name - 1] = '\0';
     HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
@@ -1440,9 +1435,6 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if (!be->no_half && (r = hd__vk_image_new_as(ctx, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
         return r;
     if ((r = hd__vk_buffer_create(ctx, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_buffer_create(ctx, &be->rowq, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0,
-                                  "the projection's work queue")) != HD_SUCCESS)
-        return r;
     if ((r = hd__vk_image_new(ctx, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
     if ((r = hd__vk_buffer_create(ctx, &be->maj, (VkDeviceSize)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the majorant grid")) != HD_SUCCESS) return r;
@@ -1639,20 +1631,8 @@ static hd_result hd__be_project(hd__ctx *ctx)
         if (r != HD_SUCCESS) return r;
         be->gg.lsum_ok = 1;
     }
-    if (be->spread_rows == HD__GPU_ROWS_QUEUE) {
-        /* a work group per unit; the counter zeroed in the command buffer after the previous
-           dispatch (a recorded frame submitted again zeroes it again), the dispatch's own
-           barrier ordering the fill before it */
-        int nby = (ctx->kp.image.y + be->queue_rows - 1) / be->queue_rows;
-        int units = ((ctx->kp.image.x + (int)HD__VK_LOCAL_X - 1) / (int)HD__VK_LOCAL_X) * nby;
-        hd__vk_barrier(be, cb);
-        be->fn.vkCmdFillBuffer(cb, be->rowq.buffer, 0, VK_WHOLE_SIZE, 0u);
-        if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, nby, 1, n, 1, be->queue_rows, units)) != HD_SUCCESS)
-            return r;
-        return hd__vk_flush(ctx);
-    }
     nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
-    p = be->spread_rows == HD__GPU_ROWS_SPREAD ? hd__gpu_row_stride(nb) : 1;
+    p = be->spread_rows ? hd__gpu_row_stride(nb) : 1;
     if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1, n, p,
                              HD__GPU_ROW_BLOCK, 0)) != HD_SUCCESS)
         return r;

@@ -431,18 +431,6 @@ static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gpu_grid_zero(ctx,
    of neighbouring rows read the same cache lines: single rows spread so cost llvmpipe more CPU
    time than the balance saved (docs/PERFORMANCE.md). */
 #define HD__GPU_ROW_BLOCK 32
-/* How the projection's dispatch takes its rows: in order (real GPUs), spread in blocks as above,
-   or from a work queue: a counter in a storage buffer, zeroed before each projection dispatch;
-   the dispatch has one work group per unit of a group's width x HD__GPU_QUEUE_ROWS rows, and
-   each work group draws the next unit it takes from the counter (hd_entry_glsl.h), so the
-   device's threads, each given a fixed run of work groups, march neighbouring units at any time
-   and finish together. HD__GPU_ROWS_CPU_DEVICE is what CPU devices (llvmpipe, lavapipe) use
-   (docs/PERFORMANCE.md). */
-#define HD__GPU_ROWS_IN_ORDER 0
-#define HD__GPU_ROWS_SPREAD 1
-#define HD__GPU_ROWS_QUEUE 2
-#define HD__GPU_ROWS_CPU_DEVICE HD__GPU_ROWS_QUEUE
-#define HD__GPU_QUEUE_ROWS 8
 HD__MAYBE_UNUSED static int hd__gpu_row_stride(int n)
 {
     int c = (int)(0.381966 * (double)n + 0.5), d, k;

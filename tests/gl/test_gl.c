@@ -25,8 +25,6 @@
       shader cache off (MESA_SHADER_CACHE_DISABLE, set before EGL starts), each method, solver
       and boundary iterated once; no "gl debug" line logged (Mesa warned "used uninitialized"
       of every variable passed to an inout parameter before it was initialised).
-   8. every pixel of a 200x100 view of the background is drawn with the projection's rows from
-      the work queue (twice: its counter is zeroed before every dispatch), spread and in order.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -483,47 +481,6 @@ static void check_image_room(void)
     hd_destroy(c);
 }
 
-/* Every pixel of a 200x100 view that misses the volume is the background, exactly, with each way
-   of taking the projection's rows (src/hd_gpu.h): the work queue (llvmpipe's default; 4 x 13
-   units of 64 x 8, the last partial in x and y), the spread blocks and the rows in order; a second frame after a new background checks that the queue's counter is
-   zeroed before each dispatch. */
-static void check_rows_covered(void)
-{
-    static uint8_t vox[16 * 16 * 16];
-    static float img[200 * 100 * 4];
-    static const char *names[] = {"rows in order", "rows spread", "work queue"};
-    hd_desc d;
-    hd_context c;
-    hd__ctx *ctx;
-    int m, f, i;
-    make_desc(&d, vox, 16);
-    d.camera.width = 200;
-    d.camera.height = 100;
-    d.camera.eye[2] = 3.0f;
-    d.camera.target[2] = 6.0f; /* looking away from the volume */
-    d.camera.up[1] = 1.0f;
-    d.params.background[0] = 0.25f; d.params.background[1] = 0.5f; d.params.background[2] = 0.75f;
-    d.logger.func = hd_log_stderr;
-    if (hd_create(&d, &c) != HD_SUCCESS) { CHECK(0, "rows covered: hd_create"); return; }
-    ctx = hd__lookup(c, NULL);
-    for (m = HD__GPU_ROWS_QUEUE; m >= HD__GPU_ROWS_IN_ORDER; --m)
-        for (f = 1; f <= 2; ++f) {
-            hd_params p = d.params;
-            int bad = 0;
-            ctx->be->spread_rows = m;
-            p.background[0] *= (float)f; p.background[1] *= (float)f; p.background[2] *= (float)f;
-            CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_iterate(c, 1) == HD_SUCCESS &&
-                      hd_read_image_f32(c, img, sizeof img / sizeof img[0]) == HD_SUCCESS,
-                  "rows covered: %s, frame %d", names[m], f);
-            for (i = 0; i < 200 * 100; ++i)
-                bad += img[4 * i] != p.background[0] || img[4 * i + 1] != p.background[1] ||
-                       img[4 * i + 2] != p.background[2] || img[4 * i + 3] != 0.0f;
-            CHECK(bad == 0, "rows covered: %s, frame %d: %d of 20000 pixels not the background", names[m], f, bad);
-            if (!bad) printf("every pixel of a 200x100 projection drawn: %s, frame %d\n", names[m], f);
-        }
-    hd_destroy(c);
-}
-
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -550,7 +507,6 @@ int main(void)
     run_calls(1, "caller's context");
     check_not_current(dpy, cfg, ctx_attrs, host);
     check_image_room();
-    check_rows_covered();
     check_shader_warnings();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
