@@ -7,9 +7,9 @@
    The backend prepends `#version`, `#define HD_MAX_LIGHTS n` and its local size. */
 #define HD_FN
 #define HD_LANG_GLSL 1
-/* The projection's march takes one sample per iteration of its cell walk (hd_k_project.h): the
-   invocations of a GLSL stage run in SIMD lanes. */
-#define HD_MARCH_SAMPLES if
+/* The projection marches the span between its first and last non-empty cells in one loop
+   (hd_k_project.h): the invocations of a GLSL stage run in SIMD lanes. */
+#define HD_PROJECT_MARCH_SPAN 1
 #define hd_u32 uint
 #define hd_v3 vec3
 #define hd_v4 vec4

@@ -415,22 +415,33 @@ static void proj_fixture(kfix *f, int n, int w)
     }
 }
 
+/* Pixel (x, y) by the span march (hd_k_project.h; GLSL's) instead of the C prelude's cell march. */
+static void project_pixel_span(const hd__kctx *k, int x, int y)
+{
+    hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
+    float len = 0.0f, s0 = 0.0f;
+    hd_project_ray(k, x, y, &pe, &d, &len, &s0);
+    hd_project_finish(k, y * k->p->image.x + x, hd_project_march_span(k, pe, d, len, s0));
+}
+
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true
    majorant grid (cells of 8 voxels with their one-voxel halo, as the core builds it) and through
    a grid of no empty cell (every sample marched) gives the same image up to the rounding of the
-   sample positions. Oblique rays cross cell faces on all three axes. */
+   sample positions. Oblique rays cross cell faces on all three axes. The span march over the true
+   majorants (pass 2), which samples the empty cells between the two objects, gives the cell
+   march's image bit for bit. */
 static void test_projection_skip(void)
 {
     enum { N = 32, W = 40 };
     kfix f;
-    float *img[2];
-    int x, y, z, cx, cy, cz, pass, i, covered = 0;
+    float *img[3];
+    int x, y, z, cx, cy, cz, pass, i, covered = 0, empty = 0;
     double maxdiff = 0.0;
     proj_fixture(&f, N, W);
-    for (pass = 0; pass < 2; ++pass) {
+    for (pass = 0; pass < 3; ++pass) {
         img[pass] = (float *)calloc((size_t)W * W * 4, sizeof(float));
         f.k.img = img[pass];
-        /* pass 0: the true majorants (value range of the cell and its halo); pass 1: none empty */
+        /* passes 0 and 2: the true majorants (value range of the cell and its halo); 1: none empty */
         for (cz = 0; cz < 4; ++cz)
             for (cy = 0; cy < 4; ++cy)
                 for (cx = 0; cx < 4; ++cx) {
@@ -440,10 +451,14 @@ static void test_projection_skip(void)
                             for (x = cx * 8 - 1; x <= cx * 8 + 8; ++x)
                                 if (x >= 0 && y >= 0 && z >= 0 && x < N && y < N && z < N && f.vol[(z * N + y) * N + x] > m)
                                     m = f.vol[(z * N + y) * N + x];
-                    f.maj[(cz * 4 + cy) * 4 + cx] = pass == 0 ? m * 40.0f * 1.00001f : 1.0f;
+                    f.maj[(cz * 4 + cy) * 4 + cx] = pass != 1 ? m * 40.0f * 1.00001f : 1.0f;
+                    if (pass == 0 && m == 0.0f) ++empty;
                 }
         for (y = 0; y < W; ++y)
-            for (x = 0; x < W; ++x) hd_project_pixel(&f.k, x, y);
+            for (x = 0; x < W; ++x) {
+                if (pass == 2) project_pixel_span(&f.k, x, y);
+                else hd_project_pixel(&f.k, x, y);
+            }
     }
     for (i = 0; i < W * W * 4; ++i) {
         double d = fabs((double)img[0][i] - img[1][i]);
@@ -453,7 +468,10 @@ static void test_projection_skip(void)
     fprintf(stderr, "  %d of %d pixels covered, max |skip - march| %.2e\n", covered, W * W, maxdiff);
     CHECK(covered > 40); /* the test has power: both objects are hit */
     CHECK_MSG(maxdiff < 1e-5, "skipping changed the image by %.3e", maxdiff);
-    free(img[0]); free(img[1]);
+    CHECK(empty > 0); /* the skip has empty cells to skip */
+    CHECK_MSG(memcmp(img[0], img[2], (size_t)W * W * 4 * sizeof(float)) == 0,
+              "the span march's image differs from the cell march's");
+    free(img[0]); free(img[1]); free(img[2]);
     kfix_free(&f);
 }
 

@@ -133,94 +133,146 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
     HD_DEREF(T) *= keep;
 }
 
-/* HD_MARCH_SAMPLES: how the march below takes a non-empty cell's samples. `while` (the default)
-   runs them in a loop inside the walk over cells: the tight loop a processor running one ray at
-   a time wants. `if` takes one sample per iteration of the walk, a cell step in the iterations
-   without one, so rays that run in the lanes of one SIMD instruction stream (llvmpipe, lavapipe,
-   GPUs: the GLSL prelude picks it) stay in one loop whatever cell each is in; with `while` the
-   inner loop runs for as long as its slowest lane, once for every cell any lane steps through.
-   The samples, and their order, are the same either way. */
-#ifndef HD_MARCH_SAMPLES
-#define HD_MARCH_SAMPLES while
-#endif
+/* The index of the first sample past se, for a march that resumes at se after empty cells
+   (none before n): samples sit at s0 + n dt, n below HD_MAX_MARCH_STEPS. */
+HD_FN int hd_march_resume(float se, float s0, float idt, int n)
+{
+    float m = hd_floor((se - s0) * idt) + 1.0f;
+    if (!(se > s0)) return n;
+    return m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
+}
 
-/* The samples sit at s0 + n dt from the ray's entry into the box, n counted (s0: the jitter), so
-   the step advances however far the eye is; the chord is at most the box diagonal and n stays
-   below HD_MAX_MARCH_STEPS. Empty space is skipped through the majorant grid (cells of mdims.w
-   voxels, each majorant bounding every trilinear sample inside the cell with a one-voxel halo,
-   hd_context.h): the ray walks the grid cell by cell (hd_cell_walk, the 3D DDA hd_track also
-   walks), and in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing, so
-   the walk moves on without touching its samples; the first cell with medium after such a run
-   starts at the first sample past its entry. The samples taken are the same as without the skip
-   (a rounding difference at a cell face stays inside the halo). The walk visits each cell once
-   and ends at the grid's far face or at len (the grid's last cell reaches to len); the march
-   stops once the transmittance falls below march.z. */
-HD_FN void hd_project_pixel(HD_KARGS int px, int py)
+/* Pixel (px, py)'s camera ray for this frame: its entry into the box pe, unit direction d, the
+   length len of its chord (at most the box diagonal; negative for a miss) and its jitter s0. */
+HD_FN void hd_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(hd_v3) d, HD_INOUT(float) len,
+                          HD_INOUT(float) s0)
 {
     int i = py * HD_PRM(image).x + px;
     hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).y), HD_U(HD_PRM(frame).z), HD_STREAM_PROJECT);
     hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
-    hd_v3 d = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
+    hd_v3 dir = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
     float t1 = 0.0f;
-    float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
-    float dt = HD_PRM(march).x;
+    float t0 = hd_box_entry(HD_KPASS o, dir, HD_REF(t1));
+    HD_DEREF(pe) = hd_madd(o, dir, t0);
+    HD_DEREF(d) = dir;
+    HD_DEREF(len) = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
+    HD_DEREF(s0) = hd_rand(key, 2u) * HD_PRM(march).x;
+}
+
+/* The march of the ray pe + s d, s in [0, len), returns (r, g, b, T): the emission it gathered
+   and its transmittance. Its samples sit at s0 + n dt from the box entry, n counted (s0: the
+   jitter), so the step advances however far the eye is; n stays below HD_MAX_MARCH_STEPS, and
+   the march stops once T falls below march.z. Empty space is skipped through the majorant grid
+   (cells of mdims.w voxels, each majorant bounding every trilinear sample inside the cell with a
+   one-voxel halo, hd_context.h), walked cell by cell (hd_cell_walk, the 3D DDA hd_track also
+   walks): in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing. The walk
+   visits each cell once and ends at the grid's far face or at len (the grid's last cell reaches
+   to len). Two marches take the same samples, in the same order, to the same image; each
+   backend's prelude picks one (HD_PROJECT_MARCH_SPAN):
+
+   hd_project_march_cells (CPU, OpenCL) walks the cells and marches each non-empty one in turn:
+   after a run of empty cells it resumes at the first sample past the next one's entry, so no
+   sample of an empty cell is taken. The tight loop a processor running one ray at a time wants.
+
+   hd_project_march_span (GLSL: llvmpipe, lavapipe, GPUs) first walks every cell, keeping only
+   where the first non-empty cell starts and the last one ends, then marches that span in one
+   loop. Samples in empty cells inside the span add nothing (hd_project_sample returns at a zero
+   opacity; a rounding difference at a cell face stays inside the halo). Where rays run in the
+   lanes of one SIMD instruction stream and the compiler runs both sides of every branch under a
+   mask (llvmpipe and lavapipe do), every iteration of one loop that both walks and samples pays
+   for both; here the walk's iterations pay for a step and the march's for a sample. */
+HD_FN hd_v4 hd_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0)
+{
+    float dt = HD_PRM(march).x, idt = 1.0f / dt;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
-    hd_v3 pe = hd_madd(o, d, t0);
-    float len = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
-    float s0 = hd_rand(key, 2u) * dt;
-    /* the walk over majorant cells (hd_k_common.h): its t is s, from the box entry pe */
     hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
-    float idt = 1.0f / dt;
     float se = 0.0f; /* where the ray entered the current cell */
     int skipped = 1;  /* the cells since the last sample were empty: n must catch up with se */
     int n = 0;
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
-    int fresh = 1;    /* the current cell's exit and majorant are still to be read */
-    int occupied = 0, ax = 0;
-    float sc = 0.0f, s = 0.0f;
     for (;;) {
-        if (fresh != 0) {
-            /* the axis whose face comes first, and whether stepping across it leaves the grid */
-            float sn;
-            int last;
-            ax = hd_cell_walk_axis(w);
-            sn = hd_cell_walk_exit(w, ax);
-            last = hd_cell_walk_leaves(w, ax, md);
-            sc = last != 0 || !(sn < len) ? len : sn;
-            occupied = HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f ? 1 : 0;
-            if (occupied != 0) {
-                if (skipped != 0) {
-                    float m = hd_floor((se - s0) * idt) + 1.0f;
-                    if (se > s0) n = m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
-                    skipped = 0;
-                }
-                s = s0 + HD_F(n) * dt;
-            } else {
-                skipped = 1;
-            }
-            fresh = 0;
-        }
-        /* the cell's samples: all of them in a loop (while), or one per iteration of the walk
-           (if: HD_MARCH_SAMPLES above) */
-        if (occupied != 0) {
-            HD_MARCH_SAMPLES (s < sc && n < HD_MAX_MARCH_STEPS) {
+        /* the axis whose face comes first, and whether stepping across it leaves the grid */
+        int ax = hd_cell_walk_axis(w);
+        float sn = hd_cell_walk_exit(w, ax);
+        float sc = hd_cell_walk_leaves(w, ax, md) != 0 || !(sn < len) ? len : sn;
+        if (HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f) {
+            float s;
+            if (skipped != 0) n = hd_march_resume(se, s0, idt, n);
+            skipped = 0;
+            s = s0 + HD_F(n) * dt;
+            while (s < sc && n < HD_MAX_MARCH_STEPS) {
                 hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r),
                                   HD_REF(g), HD_REF(b));
                 if (T < HD_PRM(march).z) break;
                 ++n;
                 s = s0 + HD_F(n) * dt;
-                continue;
             }
-            if (T < HD_PRM(march).z) break; /* (while) the ray ended inside the cell */
+            if (T < HD_PRM(march).z) break; /* the ray ended inside the cell */
+        } else {
+            skipped = 1;
         }
         if (!(sc < len) || n >= HD_MAX_MARCH_STEPS || cells <= 1) break;
         se = sc;
         hd_cell_walk_step(HD_REF(w), ax);
         --cells;
-        fresh = 1;
     }
-    if (T < HD_PRM(march).z) T = 0.0f; /* the march stopped on it */
-    hd_accumulate_pixel(HD_KPASS i, HD_V4(r + T * HD_PRM(background).x, g + T * HD_PRM(background).y,
-                                          b + T * HD_PRM(background).z, 1.0f - T));
+    return HD_V4(r, g, b, T);
+}
+
+HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0)
+{
+    float dt = HD_PRM(march).x;
+    float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
+    hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
+    hd_i4 md = HD_PRM(mdims);
+    float se = 0.0f;                /* where the ray entered the current cell */
+    float first = len, end = 0.0f;  /* the span from the first non-empty cell's entry to the last one's exit */
+    float s;
+    int n;
+    int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
+    for (;;) {
+        int ax = hd_cell_walk_axis(w);
+        float sn = hd_cell_walk_exit(w, ax);
+        float sc = hd_cell_walk_leaves(w, ax, md) != 0 || !(sn < len) ? len : sn;
+        if (HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f) {
+            first = hd_minf(first, se);
+            end = sc;
+        }
+        if (!(sc < len) || cells <= 1) break;
+        se = sc;
+        hd_cell_walk_step(HD_REF(w), ax);
+        --cells;
+    }
+    n = hd_march_resume(first, s0, 1.0f / dt, 0);
+    s = s0 + HD_F(n) * dt;
+    while (s < end && n < HD_MAX_MARCH_STEPS) {
+        hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r), HD_REF(g),
+                          HD_REF(b));
+        if (T < HD_PRM(march).z) break;
+        ++n;
+        s = s0 + HD_F(n) * dt;
+    }
+    return HD_V4(r, g, b, T);
+}
+
+/* Folds the march's (r, g, b, T) into pixel i: the background behind it, and T = 0 where the
+   march stopped on it. */
+HD_FN void hd_project_finish(HD_KARGS int i, hd_v4 m)
+{
+    float T = m.w < HD_PRM(march).z ? 0.0f : m.w;
+    hd_accumulate_pixel(HD_KPASS i, HD_V4(m.x + T * HD_PRM(background).x, m.y + T * HD_PRM(background).y,
+                                          m.z + T * HD_PRM(background).z, 1.0f - T));
+}
+
+HD_FN void hd_project_pixel(HD_KARGS int px, int py)
+{
+    hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
+    float len = 0.0f, s0 = 0.0f;
+    hd_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0));
+#ifdef HD_PROJECT_MARCH_SPAN
+    hd_project_finish(HD_KPASS py * HD_PRM(image).x + px, hd_project_march_span(HD_KPASS pe, d, len, s0));
+#else
+    hd_project_finish(HD_KPASS py * HD_PRM(image).x + px, hd_project_march_cells(HD_KPASS pe, d, len, s0));
+#endif
 }
