@@ -11,8 +11,9 @@
    (bench/hd_thread_times.h: the workers' sleep is the time the backend left a core unused).
    --orbit takes bench-peer's scene instead (bench/hd_orbit_scene.h: the ct-skin TF, hdrender's
    camera at azimuth 0, its key light; light file build/bench_project_light_orbit.f32), the
-   scene whose frame make bench-peer times against VTK.
-   Usage: hdbench_project [--orbit] [--threads] [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
+   scene whose frame make bench-peer times against VTK; --azimuth DEG turns its camera around the
+   vertical axis as bench-peer's orbit frames do (its light stays).
+   Usage: hdbench_project [--orbit [--azimuth DEG]] [--threads] [--make-light FILE ITERS] [--light FILE] [--size N | --size WxH]
                           [--width W] [--height H] [--frames F] [--save F32] [--compare F32]
                           [--png PNG] [--tag WORD] [data/head.nrrd]
    --size N is an N x N frame; --size 1920x1080 (or --width / --height) any other.
@@ -41,11 +42,13 @@ static const float bench_tf[] = {
 
 static hdo_scene g_orbit; /* --orbit: bench-peer's scene (loaded by main) */
 static int g_use_orbit;
+static double g_azimuth; /* --azimuth: the orbit camera's azimuth in degrees (bench-peer's views) */
 
 static void fill_desc(hd_desc *d, const hd_volume_file *vf, const hd_light *light, int width, int height)
 {
     if (g_use_orbit) {
         *d = g_orbit.desc;
+        if (g_azimuth != 0.0) d->camera = hdo_orbit_camera(g_azimuth, width);
         d->camera.width = width;
         d->camera.height = height;
         d->logger.func = hd_log_stderr;
@@ -137,6 +140,7 @@ int main(int argc, char **argv)
             light_given = 1;
         } else if (strcmp(argv[i], "--orbit") == 0) g_use_orbit = 1;
         else if (strcmp(argv[i], "--threads") == 0) threads = 1;
+        else if (strcmp(argv[i], "--azimuth") == 0 && i + 1 < argc) g_azimuth = atof(argv[++i]);
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc) {
             const char *x = strchr(argv[++i], 'x');
             width = atoi(argv[i]);

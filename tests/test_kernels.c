@@ -415,48 +415,54 @@ static void proj_fixture(kfix *f, int n, int w)
     }
 }
 
-/* Pixel (x, y) by the span march (hd_k_project.h; GLSL's) instead of the C prelude's cell march. */
-static void project_pixel_span(const hd__kctx *k, int x, int y)
+/* Pixel (x, y) by the span march (hd_k_project.h; GLSL's) keeping up to `spans` spans apart,
+   instead of the C prelude's cell march. */
+static void project_pixel_span(const hd__kctx *k, int x, int y, int spans)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
     float len = 0.0f, s0 = 0.0f;
     hd_project_ray(k, x, y, &pe, &d, &len, &s0);
-    hd_project_finish(k, y * k->p->image.x + x, hd_project_march_span(k, pe, d, len, s0));
+    hd_project_finish(k, y * k->p->image.x + x, hd_project_march_span(k, pe, d, len, s0, spans));
 }
 
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true
    majorant grid (cells of 8 voxels with their one-voxel halo, as the core builds it) and through
    a grid of no empty cell (every sample marched) gives the same image up to the rounding of the
-   sample positions. Oblique rays cross cell faces on all three axes. The span march over the true
-   majorants (pass 2), which samples the empty cells between the two objects, gives the cell
-   march's image bit for bit. */
+   sample positions. Oblique rays cross cell faces on all three axes. The span march (GLSL's)
+   gives the cell march's image bit for bit: over the true majorants with the objects in spans
+   apart (HD_MARCH_SPANS) and in one merged span, which samples the empty cells between them;
+   and over majorants without the halo, which drop samples of matter next to a non-empty cell
+   (both marches must drop the same ones: a span that starts or ends a sample off shows). */
 static void test_projection_skip(void)
 {
-    enum { N = 32, W = 40 };
+    enum { N = 32, W = 40, PASSES = 6 };
+    /* pass: majorants (0 true, 1 none empty, 2 without the halo), march (0 cells, else spans) */
+    static const int maj_of[PASSES] = {0, 1, 0, 0, 2, 2}, spans_of[PASSES] = {0, 0, HD_MARCH_SPANS, 1, 0, HD_MARCH_SPANS};
     kfix f;
-    float *img[3];
+    float *img[PASSES];
+    size_t bytes = (size_t)W * W * 4 * sizeof(float);
     int x, y, z, cx, cy, cz, pass, i, covered = 0, empty = 0;
     double maxdiff = 0.0;
     proj_fixture(&f, N, W);
-    for (pass = 0; pass < 3; ++pass) {
+    for (pass = 0; pass < PASSES; ++pass) {
+        int h = maj_of[pass] == 2 ? 0 : 1; /* the halo */
         img[pass] = (float *)calloc((size_t)W * W * 4, sizeof(float));
         f.k.img = img[pass];
-        /* passes 0 and 2: the true majorants (value range of the cell and its halo); 1: none empty */
         for (cz = 0; cz < 4; ++cz)
             for (cy = 0; cy < 4; ++cy)
                 for (cx = 0; cx < 4; ++cx) {
                     float m = 0.0f;
-                    for (z = cz * 8 - 1; z <= cz * 8 + 8; ++z)
-                        for (y = cy * 8 - 1; y <= cy * 8 + 8; ++y)
-                            for (x = cx * 8 - 1; x <= cx * 8 + 8; ++x)
+                    for (z = cz * 8 - h; z < cz * 8 + 8 + h; ++z)
+                        for (y = cy * 8 - h; y < cy * 8 + 8 + h; ++y)
+                            for (x = cx * 8 - h; x < cx * 8 + 8 + h; ++x)
                                 if (x >= 0 && y >= 0 && z >= 0 && x < N && y < N && z < N && f.vol[(z * N + y) * N + x] > m)
                                     m = f.vol[(z * N + y) * N + x];
-                    f.maj[(cz * 4 + cy) * 4 + cx] = pass != 1 ? m * 40.0f * 1.00001f : 1.0f;
+                    f.maj[(cz * 4 + cy) * 4 + cx] = maj_of[pass] != 1 ? m * 40.0f * 1.00001f : 1.0f;
                     if (pass == 0 && m == 0.0f) ++empty;
                 }
         for (y = 0; y < W; ++y)
             for (x = 0; x < W; ++x) {
-                if (pass == 2) project_pixel_span(&f.k, x, y);
+                if (spans_of[pass] > 0) project_pixel_span(&f.k, x, y, spans_of[pass]);
                 else hd_project_pixel(&f.k, x, y);
             }
     }
@@ -469,9 +475,11 @@ static void test_projection_skip(void)
     CHECK(covered > 40); /* the test has power: both objects are hit */
     CHECK_MSG(maxdiff < 1e-5, "skipping changed the image by %.3e", maxdiff);
     CHECK(empty > 0); /* the skip has empty cells to skip */
-    CHECK_MSG(memcmp(img[0], img[2], (size_t)W * W * 4 * sizeof(float)) == 0,
-              "the span march's image differs from the cell march's");
-    free(img[0]); free(img[1]); free(img[2]);
+    CHECK(memcmp(img[0], img[4], bytes) != 0); /* without the halo the skip drops samples of matter */
+    CHECK_MSG(memcmp(img[0], img[2], bytes) == 0, "the span march's image differs from the cell march's (spans apart)");
+    CHECK_MSG(memcmp(img[0], img[3], bytes) == 0, "the span march's image differs from the cell march's (one span)");
+    CHECK_MSG(memcmp(img[4], img[5], bytes) == 0, "the span march's image differs from the cell march's (no halo)");
+    for (pass = 0; pass < PASSES; ++pass) free(img[pass]);
     kfix_free(&f);
 }
 
