@@ -1054,22 +1054,30 @@ static void hd__frame_cost_add(hd__ctx *ctx, int s, double pixels, double second
     ctx->cost_seconds[k] = ctx->cost_pixels[k] == pixels ? 0.5 * (ctx->cost_seconds[k] + seconds) : seconds;
     ctx->cost_pixels[k] = pixels;
     ctx->cost_last = k;
-    ctx->cost_gen++;
+    ctx->cost_at[k] = ++ctx->cost_gen;
 }
+
+/* Measurements after which a scale's estimate counts as stale: a scale the frames no longer visit
+   (a drag that never rests long enough for full frames) keeps the time of an older view or load. */
+#define HD__COST_FRESH 32u
 
 /* A frame's predicted seconds at render scale s: a + b * pixels. The fixed part a (per-call
    overhead, and at s > 1 the full-size upsample pass, which do not shrink with s) and b are the
    least-squares line through the scales measured (a >= 0, b >= 0; a negative a fits through the
    origin instead), scaled to pass through the newest estimate, so the level follows the current
-   view and the ratios between scales come from all of them. With one scale measured a is 0:
-   time proportional to pixels. */
+   view and the ratios between scales come from all of them. The line runs through the scales
+   measured in the last HD__COST_FRESH measurements when there are two or more, else through all.
+   With one scale measured a is 0: time proportional to pixels. */
 static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
 {
     double n = 0.0, sp = 0.0, st = 0.0, spp = 0.0, spt = 0.0, a = 0.0, b = 1.0, var, at_last;
-    int k;
+    int k, fresh = 0, only_fresh;
+    for (k = 0; k < 4; ++k)
+        if (ctx->cost_pixels[k] > 0.0 && ctx->cost_gen - ctx->cost_at[k] < HD__COST_FRESH) ++fresh;
+    only_fresh = fresh >= 2;
     for (k = 0; k < 4; ++k) {
         double p = ctx->cost_pixels[k], t = ctx->cost_seconds[k];
-        if (!(p > 0.0)) continue;
+        if (!(p > 0.0) || (only_fresh && ctx->cost_gen - ctx->cost_at[k] >= HD__COST_FRESH)) continue;
         n += 1.0; sp += p; st += t; spp += p * p; spt += p * t;
     }
     var = n * spp - sp * sp;

@@ -103,9 +103,11 @@ typedef struct hd__ctx {
     int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
                                 was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
     /* HD_RENDER_SCALE_AUTO's frame cost model (hd__frame_cost_add / _predict in hd_context.h):
-       per render scale 1, 2, 4, 8 (slot log2 s) the pixels its last frame marched (0: none yet)
-       and its smoothed seconds; the newest measurement's slot; measurements so far (0: none) */
+       per render scale 1, 2, 4, 8 (slot log2 s) the pixels its last frame marched (0: none yet),
+       its smoothed seconds and the measurement count when it was last measured; the newest
+       measurement's slot; measurements so far (0: none) */
     double cost_pixels[4], cost_seconds[4];
+    unsigned cost_at[4];
     int cost_last;
     unsigned cost_gen;
     int image_room;          /* the image buffer holds the reduced frames' region (made when a

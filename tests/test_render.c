@@ -485,6 +485,37 @@ static void test_render_scale_auto_cost(void)
     hd_destroy(ctx);
 }
 
+/* A scale the frames stop visiting goes stale: scales 4, 2 and 1 measured under 3x the load
+   (75, 120, 300 ms), then 40 frames alternating between scales 4 and 2 at the normal cost (25 and
+   40 ms; a drag that never rests for full frames). The line through the fresh scales alone puts a
+   full frame at 100 ms, inside a budget of 120 ms; with the stale full frame in the fit it came
+   out at about 160 ms and AUTO stayed at scale 2. With fewer than two fresh scales every measured
+   one counts: 40 frames of scale 4 alone keep the stale line's shape (a full frame over budget). */
+static void test_render_scale_auto_stale(void)
+{
+    hd_desc d;
+    hd_context ctx;
+    int i;
+    make_desc(&d, NULL);
+    d.camera.width = d.camera.height = 512;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = 0.12f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 4, 0.075) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.120) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 1, 0.300) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) > 1, "under load, budget 120 ms: scale %d, want a reduced one", hdt_first_scale(ctx));
+    for (i = 0; i < 40; ++i) CHECK(hdt_frame_cost(ctx, i % 2 ? 2 : 4, i % 2 ? 0.040 : 0.025) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 1, "the full frame's estimate stale, budget 120 ms: scale %d, want 1",
+              hdt_first_scale(ctx));
+    hd_destroy(ctx);
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 4, 0.075) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.120) == HD_SUCCESS);
+    CHECK(hdt_frame_cost(ctx, 1, 0.300) == HD_SUCCESS);
+    for (i = 0; i < 40; ++i) CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS);
+    CHECK_MSG(hdt_first_scale(ctx) == 2, "one fresh scale, budget 120 ms: scale %d, want 2", hdt_first_scale(ctx));
+    hd_destroy(ctx);
+}
+
 /* The image buffer holds the reduced frames' region only once a scale > 1 is used: full frames
    cost the w x h image alone (hd_stats.image_bytes says what is held). A new camera size keeps
    the region while the parameters may still ask for reduced frames. When the region cannot be
@@ -588,6 +619,7 @@ const hd_test_case hd_tests_render[] = {
     {"render_scale_upsample", test_render_scale_upsample},
     {"render_scale_auto", test_render_scale_auto},
     {"render_scale_auto_cost", test_render_scale_auto_cost},
+    {"render_scale_auto_stale", test_render_scale_auto_stale},
     {"render_scale_image_room", test_render_scale_image_room},
     {"render_scale_bad_input", test_render_scale_bad_input},
 };
