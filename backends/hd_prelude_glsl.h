@@ -10,6 +10,8 @@
 /* The projection marches the span between its first and last non-empty cells in one loop
    (hd_k_project.h): the invocations of a GLSL stage run in SIMD lanes. */
 #define HD_PROJECT_MARCH_SPAN 1
+/* hd_track walks to each collision's cell, then takes it (hd_k_common.h, hd_track_rounds). */
+#define HD_TRACK_ROUNDS 1
 #define hd_u32 uint
 #define hd_v3 vec3
 #define hd_v4 vec4

@@ -483,6 +483,55 @@ static void test_projection_skip(void)
     kfix_free(&f);
 }
 
+/* hd_track_rounds (GLSL's tracker) gives hd_track's T, next dim and collision distance bit for
+   bit: rays from points all over the projection fixture's scene (a sphere and a block in empty
+   space, the true majorants with their halo) toward directions all around, to the box's face and
+   stopped halfway, ratio and delta tracking, over the majorant grid, over a grid of majorants 3x
+   too high (null collisions) and with the global majorant. */
+static void test_track_rounds(void)
+{
+    enum { N = 32, RAYS = 3000 };
+    kfix f;
+    int x, y, z, cx, cy, cz, pass, mode, i, rays = 0, differ = 0, partial = 0, hits = 0, empty = 0; /* partial: 3+ draws */
+    proj_fixture(&f, N, 8);
+    for (pass = 0; pass < 3; ++pass) {
+        for (cz = 0; cz < 4; ++cz)
+            for (cy = 0; cy < 4; ++cy)
+                for (cx = 0; cx < 4; ++cx) {
+                    float m = 0.0f;
+                    for (z = cz * 8 - 1; z < cz * 8 + 9; ++z)
+                        for (y = cy * 8 - 1; y < cy * 8 + 9; ++y)
+                            for (x = cx * 8 - 1; x < cx * 8 + 9; ++x)
+                                if (x >= 0 && y >= 0 && z >= 0 && x < N && y < N && z < N && f.vol[(z * N + y) * N + x] > m)
+                                    m = f.vol[(z * N + y) * N + x];
+                    f.maj[(cz * 4 + cy) * 4 + cx] = m * 40.0f * (pass == 1 ? 3.0f : 1.00001f);
+                    if (pass == 0 && m == 0.0f) ++empty;
+                }
+        f.p.counts.z = pass == 2 ? HD_FLAG_GLOBAL_MAJORANT : 0;
+        f.p.medium.w = pass == 2 ? 40.0f * 1.5f : 0.0f;
+        for (mode = HD_TRACK_RATIO; mode <= HD_TRACK_DELTA; ++mode)
+            for (i = 0; i < RAYS; ++i) {
+                hd_u32 key = hd_rng_key((hd_u32)i, 3u, 77u, HD_STREAM_DIRECT), nd[2] = {0u, 0u};
+                hd_v3 p = HD_V3(hd_rand(key, 100u) - 0.5f, hd_rand(key, 101u) - 0.5f, hd_rand(key, 102u) - 0.5f);
+                hd_v3 j = HD_V3(hd_rand(key, 103u) - 0.5f, hd_rand(key, 104u) - 0.5f, hd_rand(key, 105u) - 0.5f);
+                /* two in three toward the sphere (centre at voxel 13, 17, 20), the rest anywhere */
+                hd_v3 d = hd_normalize(i % 3 == 2 ? j : hd_add(HD_V3(13.5f / N - 0.5f - p.x, 17.5f / N - 0.5f - p.y, 20.5f / N - 0.5f - p.z), hd_scale(j, 0.2f)));
+                float tmax = hd_box_exit(&f.k, p, d) * (i % 3 == 0 ? 0.5f : 1.0f), th[2] = {0.0f, 0.0f}, T[2];
+                T[0] = hd_track(&f.k, p, d, tmax, key, 1u, mode, &nd[0], &th[0]);
+                T[1] = hd_track_rounds(&f.k, p, d, tmax, key, 1u, mode, &nd[1], &th[1]);
+                if (memcmp(&T[0], &T[1], sizeof(float)) != 0 || nd[0] != nd[1] || memcmp(&th[0], &th[1], sizeof(float)) != 0)
+                    ++differ;
+                if (nd[0] > 3u) ++partial;
+                if (th[0] < tmax) ++hits;
+                ++rays;
+            }
+    }
+    fprintf(stderr, "  %d rays, %d with 3 draws or more, %d delta hits, %d empty cells, %d differ\n", rays, partial, hits, empty, differ);
+    CHECK(partial > rays / 3 && hits > rays / 10 && empty > 0); /* the test has power */
+    CHECK_MSG(differ == 0, "hd_track_rounds differs from hd_track on %d of %d rays", differ, rays);
+    kfix_free(&f);
+}
+
 /* The projection's shortcuts (hd_prelude_c.h; the CPU backend fills them in) give the image of
    the plain path: the summed light grid lsum = E + phi, and the step's TF table with each entry's
    opacity 1 - exp(-sigma_t dt) and premultiplied colour (hd_project_lookup), its segments inside
@@ -530,6 +579,7 @@ const hd_test_case hd_tests_kernels[] = {
     {"kernels_transmittance_step_dda", test_transmittance_step},
     {"kernels_projection_skip", test_projection_skip},
     {"kernels_projection_tables", test_projection_tables},
+    {"kernels_track_rounds", test_track_rounds},
     {"kernels_diffusion_point_source", test_diffusion_point_source},
     {"kernels_diffusion_jacobi_matches", test_diffusion_jacobi_matches},
     {"kernels_diffusion_surface_boundary", test_diffusion_surface_boundary},

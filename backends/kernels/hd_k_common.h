@@ -310,11 +310,115 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
     return T;
 }
 
+/* hd_track for rays that run in SIMD lanes under a mask (llvmpipe, lavapipe: both sides of every
+   branch run, a loop runs until every lane has left it): a walk cell by cell to the cell that
+   holds the next collision (or to the end), then, while a lane has one, that collision and the
+   next walk. hd_track's inner loop pays a collision's sample in every non-empty cell, even where
+   no lane collides; here a walk pays cell steps only and the loop one sample per collision of
+   its busiest lane. The same cells, collisions, random dims and arithmetic as hd_track, so the
+   same T, *next_dim and *t_hit. The GLSL prelude picks it (HD_TRACK_ROUNDS). */
+HD_STRUCT(hd_track_ray)
+    hd_cell_walk w;
+    float t;       /* where the ray is */
+    float tau;     /* optical depth to the next collision (< 0: not drawn) */
+    float tc;      /* the collision the walk found */
+    float inv_mu;  /* 1 / its cell's majorant */
+    hd_u32 dim;    /* the next random dim */
+    hd_u32 pending; /* 1 while tau is drawn but its dim not yet counted */
+    int steps;     /* collisions and cells, at most HD_MAX_TRACK_STEPS */
+    int found;     /* the walk found a collision (at tc) */
+    int done;      /* the walk ended: left the grid, reached tmax, or the step bound (T = 0) */
+HD_STRUCT_END(hd_track_ray)
+
+/* Draws the next free path where none is left, then walks to the cell that holds its collision.
+   The draw's dim is counted on reaching a non-empty cell, where hd_track draws it. */
+HD_FN void hd_track_walk(HD_KARGS HD_INOUT(hd_track_ray) r, float tmax, int global_majorant, HD_INOUT(float) T,
+                         HD_INOUT(float) hit, hd_u32 key)
+{
+    HD_DEREF(r).found = 0;
+    if (HD_DEREF(r).done == 0 && HD_DEREF(r).tau < 0.0f) {
+        HD_DEREF(r).tau = -hd_log(1.0f - hd_rand(key, HD_DEREF(r).dim));
+        HD_DEREF(r).pending = 1u;
+    }
+    while (HD_DEREF(r).done == 0 && HD_DEREF(r).found == 0) {
+        float t_end, mu;
+        if (HD_DEREF(r).t >= tmax) { HD_DEREF(r).done = 1; break; }
+        t_end = global_majorant != 0 ? tmax : hd_minf(hd_minf(HD_DEREF(r).w.nx, HD_DEREF(r).w.ny), hd_minf(HD_DEREF(r).w.nz, tmax));
+        mu = global_majorant != 0 ? HD_PRM(medium).w : HD_GET1(maj, hd_cell_walk_index(HD_DEREF(r).w, HD_PRM(mdims)));
+        if (mu > 0.0f) {
+            HD_DEREF(r).dim += HD_DEREF(r).pending;
+            HD_DEREF(r).pending = 0u;
+            HD_DEREF(r).inv_mu = 1.0f / mu;
+            HD_DEREF(r).tc = HD_DEREF(r).t + HD_DEREF(r).tau * HD_DEREF(r).inv_mu;
+            if (HD_DEREF(r).tc < t_end) HD_DEREF(r).found = 1;
+            else HD_DEREF(r).tau = hd_maxf(HD_DEREF(r).tau - (t_end - HD_DEREF(r).t) * mu, 0.0f); /* carries on */
+        }
+        if (HD_DEREF(r).found == 0) {
+            HD_DEREF(r).t = t_end;
+            if (global_majorant != 0) HD_DEREF(r).done = 1;
+            else {
+                int ax;
+                HD_DEREF(r).steps += 1;
+                if (HD_DEREF(r).steps >= HD_MAX_TRACK_STEPS) { HD_DEREF(T) = 0.0f; HD_DEREF(hit) = HD_DEREF(r).t; HD_DEREF(r).done = 1; }
+                else {
+                    ax = hd_cell_walk_axis(HD_DEREF(r).w);
+                    if (hd_cell_walk_leaves(HD_DEREF(r).w, ax, HD_PRM(mdims)) != 0) HD_DEREF(r).done = 1;
+                    else hd_cell_walk_step(HD_REF(HD_DEREF(r).w), ax);
+                }
+            }
+        }
+    }
+}
+
+HD_FN float hd_track_rounds(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0, int mode,
+                            HD_INOUT(hd_u32) next_dim, HD_INOUT(float) t_hit)
+{
+    float T = 1.0f;
+    float hit = tmax;
+    int global_majorant = (HD_PRM(counts).z & HD_FLAG_GLOBAL_MAJORANT) != 0 ? 1 : 0;
+    hd_track_ray r;
+    r.w = hd_cell_walk_begin(HD_KPASS p, d);
+    r.t = 0.0f; r.tau = -1.0f; r.tc = 0.0f; r.inv_mu = 1.0f;
+    r.dim = dim0; r.pending = 0u;
+    r.steps = 0; r.found = 0; r.done = 0;
+    hd_track_walk(HD_KPASS HD_REF(r), tmax, global_majorant, HD_REF(T), HD_REF(hit), key);
+    while (r.found != 0) {
+        r.t = r.tc;
+        r.tau = -1.0f;
+        r.steps += 1;
+        if (r.steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; r.done = 1; hit = r.t; }
+        else {
+            float sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, r.t)));
+            float ratio = hd_minf(sig * r.inv_mu, 1.0f);
+            if (mode == HD_TRACK_DELTA) {
+                if (hd_rand(key, r.dim) < ratio) { T = 0.0f; r.done = 1; hit = r.t; }
+                r.dim += 1u;
+            } else {
+                T *= 1.0f - ratio;
+                if (T < HD_RR_THRESHOLD) {
+                    /* survive with probability T / threshold, then weigh by its inverse */
+                    if (hd_rand(key, r.dim) * HD_RR_THRESHOLD >= T) { T = 0.0f; r.done = 1; }
+                    else T = HD_RR_THRESHOLD;
+                    r.dim += 1u;
+                }
+            }
+        }
+        hd_track_walk(HD_KPASS HD_REF(r), tmax, global_majorant, HD_REF(T), HD_REF(hit), key);
+    }
+    HD_DEREF(next_dim) = r.dim;
+    HD_DEREF(t_hit) = hit;
+    return T;
+}
+
 HD_FN float hd_transmittance(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 dim0,
                              int mode, HD_INOUT(hd_u32) next_dim)
 {
     float t_hit = 0.0f;
+#ifdef HD_TRACK_ROUNDS
+    return hd_track_rounds(HD_KPASS p, d, tmax, key, dim0, mode, next_dim, HD_REF(t_hit));
+#else
     return hd_track(HD_KPASS p, d, tmax, key, dim0, mode, next_dim, HD_REF(t_hit));
+#endif
 }
 
 /* Delta tracking to the first real collision along p + t d: its distance, or tmax when the ray
@@ -323,7 +427,11 @@ HD_FN float hd_free_flight(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd
                            HD_INOUT(hd_u32) next_dim)
 {
     float t_hit = 0.0f;
+#ifdef HD_TRACK_ROUNDS
+    hd_track_rounds(HD_KPASS p, d, tmax, key, dim0, HD_TRACK_DELTA, next_dim, HD_REF(t_hit));
+#else
     hd_track(HD_KPASS p, d, tmax, key, dim0, HD_TRACK_DELTA, next_dim, HD_REF(t_hit));
+#endif
     return t_hit;
 }
 
