@@ -403,8 +403,18 @@ static const char *const hd__gl_source[] = {
 "    float dx, dy, dz; /* t between two faces on each axis (3e38 on an axis the ray runs along) */\n",
 "HD_STRUCT_END(hd_cell_walk)\n",
 "\n",
-"/* The walk of p + t d (p in world coordinates, inside the box or on it) from t = 0: the ray in\n",
-"   cell coordinates is g(t) = g0 + t gd, its first cell g0's, clamped into the grid. */\n",
+"/* floor(v) as a cell index clamped to 0..n-1, clamped as a float first: v may be far outside the\n",
+"   grid (a camera ray that misses the box starts its walk, which takes no sample, at a far-off\n",
+"   point), and converting such a float (or NaN, which gives 0) to int is undefined in C. */\n",
+"HD_FN int hd_cell_of(float v, int n)\n",
+"{\n",
+"    float f = hd_floor(v);\n",
+"    return f >= 0.0f ? (f < HD_F(n - 1) ? HD_I(f) : n - 1) : 0;\n",
+"}\n",
+"\n",
+"/* The walk of p + t d (p in world coordinates, inside the box or on it for a walk that samples)\n",
+"   from t = 0: the ray in cell coordinates is g(t) = g0 + t gd, its first cell g0's, clamped into\n",
+"   the grid. */\n",
 "HD_FN hd_cell_walk hd_cell_walk_begin(HD_KARGS hd_v3 p, hd_v3 d)\n",
 "{\n",
 "    hd_cell_walk w;\n",
@@ -413,9 +423,9 @@ static const char *const hd__gl_source[] = {
 "    hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);\n",
 "    hd_v3 g0 = hd_vmul(hd_world_to_tex(HD_KPASS p), cs);\n",
 "    hd_v3 gd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);\n",
-"    w.cx = hd_clampi(HD_I(hd_floor(g0.x)), 0, HD_PRM(mdims).x - 1);\n",
-"    w.cy = hd_clampi(HD_I(hd_floor(g0.y)), 0, HD_PRM(mdims).y - 1);\n",
-"    w.cz = hd_clampi(HD_I(hd_floor(g0.z)), 0, HD_PRM(mdims).z - 1);\n",
+"    w.cx = hd_cell_of(g0.x, HD_PRM(mdims).x);\n",
+"    w.cy = hd_cell_of(g0.y, HD_PRM(mdims).y);\n",
+"    w.cz = hd_cell_of(g0.z, HD_PRM(mdims).z);\n",
 "    w.sx = gd.x > 0.0f ? 1 : -1;\n",
 "    w.sy = gd.y > 0.0f ? 1 : -1;\n",
 "    w.sz = gd.z > 0.0f ? 1 : -1;\n",
@@ -2377,7 +2387,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 2050 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 2060 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

@@ -173,8 +173,18 @@ HD_STRUCT(hd_cell_walk)
     float dx, dy, dz; /* t between two faces on each axis (3e38 on an axis the ray runs along) */
 HD_STRUCT_END(hd_cell_walk)
 
-/* The walk of p + t d (p in world coordinates, inside the box or on it) from t = 0: the ray in
-   cell coordinates is g(t) = g0 + t gd, its first cell g0's, clamped into the grid. */
+/* floor(v) as a cell index clamped to 0..n-1, clamped as a float first: v may be far outside the
+   grid (a camera ray that misses the box starts its walk, which takes no sample, at a far-off
+   point), and converting such a float (or NaN, which gives 0) to int is undefined in C. */
+HD_FN int hd_cell_of(float v, int n)
+{
+    float f = hd_floor(v);
+    return f >= 0.0f ? (f < HD_F(n - 1) ? HD_I(f) : n - 1) : 0;
+}
+
+/* The walk of p + t d (p in world coordinates, inside the box or on it for a walk that samples)
+   from t = 0: the ray in cell coordinates is g(t) = g0 + t gd, its first cell g0's, clamped into
+   the grid. */
 HD_FN hd_cell_walk hd_cell_walk_begin(HD_KARGS hd_v3 p, hd_v3 d)
 {
     hd_cell_walk w;
@@ -183,9 +193,9 @@ HD_FN hd_cell_walk hd_cell_walk_begin(HD_KARGS hd_v3 p, hd_v3 d)
     hd_v3 cs = HD_V3(HD_F(HD_PRM(dims).x) / cell, HD_F(HD_PRM(dims).y) / cell, HD_F(HD_PRM(dims).z) / cell);
     hd_v3 g0 = hd_vmul(hd_world_to_tex(HD_KPASS p), cs);
     hd_v3 gd = hd_vmul(HD_V3(d.x / HD_PRM(box).x, d.y / HD_PRM(box).y, d.z / HD_PRM(box).z), cs);
-    w.cx = hd_clampi(HD_I(hd_floor(g0.x)), 0, HD_PRM(mdims).x - 1);
-    w.cy = hd_clampi(HD_I(hd_floor(g0.y)), 0, HD_PRM(mdims).y - 1);
-    w.cz = hd_clampi(HD_I(hd_floor(g0.z)), 0, HD_PRM(mdims).z - 1);
+    w.cx = hd_cell_of(g0.x, HD_PRM(mdims).x);
+    w.cy = hd_cell_of(g0.y, HD_PRM(mdims).y);
+    w.cz = hd_cell_of(g0.z, HD_PRM(mdims).z);
     w.sx = gd.x > 0.0f ? 1 : -1;
     w.sy = gd.y > 0.0f ? 1 : -1;
     w.sz = gd.z > 0.0f ? 1 : -1;
