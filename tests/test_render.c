@@ -428,16 +428,24 @@ static void test_render_scale_auto(void)
    reduced one from a full one; the model fits both. */
 hd_result hdt_frame_cost(hd_context h, int scale, double seconds);
 int hdt_first_scale(hd_context h);
+
+/* A 512^2 context with HD_RENDER_SCALE_AUTO under a budget of `budget` seconds. */
+static hd_result make_auto_ctx(float budget, hd_context *ctx)
+{
+    hd_desc d;
+    make_desc(&d, NULL);
+    d.camera.width = d.camera.height = 512;
+    d.params.render_scale = HD_RENDER_SCALE_AUTO;
+    d.params.render_budget = budget;
+    return hd_create(&d, ctx);
+}
+
 static void test_render_scale_auto_cost(void)
 {
     hd_desc d;
     hd_context ctx;
     hd_params p;
-    make_desc(&d, NULL);
-    d.camera.width = d.camera.height = 512;
-    d.params.render_scale = HD_RENDER_SCALE_AUTO;
-    d.params.render_budget = 0.11f;
-    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(make_auto_ctx(0.11f, &ctx) == HD_SUCCESS);
     CHECK(hdt_first_scale(ctx) == 4); /* nothing measured yet */
     /* one scale measured: time proportional to pixels (25 ms * 16 = 400 ms, 25 * 4 = 100 ms) */
     CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS);
@@ -474,11 +482,7 @@ static void test_render_scale_auto_cost(void)
        every prediction scales down with it (full frames about 81 ms, scale 2 about 31 ms), so a
        budget of 50 ms gets scale 2, not full frames (as if all were fixed cost) nor scale 8 (the
        old rule: 15 ms * 64 for a full frame) */
-    make_desc(&d, NULL);
-    d.camera.width = d.camera.height = 512;
-    d.params.render_scale = HD_RENDER_SCALE_AUTO;
-    d.params.render_budget = 0.05f;
-    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(make_auto_ctx(0.05f, &ctx) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.040) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 1, 0.100) == HD_SUCCESS && hdt_frame_cost(ctx, 8, 0.015) == HD_SUCCESS);
     CHECK_MSG(hdt_first_scale(ctx) == 2, "a fast scale-8 frame last, budget 50 ms: scale %d, want 2", hdt_first_scale(ctx));
@@ -493,14 +497,9 @@ static void test_render_scale_auto_cost(void)
    one counts: 40 frames of scale 4 alone keep the stale line's shape (a full frame over budget). */
 static void test_render_scale_auto_stale(void)
 {
-    hd_desc d;
     hd_context ctx;
     int i;
-    make_desc(&d, NULL);
-    d.camera.width = d.camera.height = 512;
-    d.params.render_scale = HD_RENDER_SCALE_AUTO;
-    d.params.render_budget = 0.12f;
-    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(make_auto_ctx(0.12f, &ctx) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 4, 0.075) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.120) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 1, 0.300) == HD_SUCCESS);
     CHECK_MSG(hdt_first_scale(ctx) > 1, "under load, budget 120 ms: scale %d, want a reduced one", hdt_first_scale(ctx));
@@ -508,7 +507,7 @@ static void test_render_scale_auto_stale(void)
     CHECK_MSG(hdt_first_scale(ctx) == 1, "the full frame's estimate stale, budget 120 ms: scale %d, want 1",
               hdt_first_scale(ctx));
     hd_destroy(ctx);
-    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(make_auto_ctx(0.12f, &ctx) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 4, 0.075) == HD_SUCCESS && hdt_frame_cost(ctx, 2, 0.120) == HD_SUCCESS);
     CHECK(hdt_frame_cost(ctx, 1, 0.300) == HD_SUCCESS);
     for (i = 0; i < 40; ++i) CHECK(hdt_frame_cost(ctx, 4, 0.025) == HD_SUCCESS);

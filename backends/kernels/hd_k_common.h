@@ -235,6 +235,14 @@ HD_FN void hd_cell_walk_step(HD_INOUT(hd_cell_walk) w, int ax)
     else { HD_DEREF(w).cz += HD_DEREF(w).sz; HD_DEREF(w).nz += HD_DEREF(w).dz; }
 }
 
+/* Where (t) the ray leaves the current cell, axis ax's face first, or len where the walk ends
+   there: the cell is the grid's last along the ray, or reaches past len. */
+HD_FN float hd_cell_walk_end(hd_cell_walk w, int ax, hd_i4 md, float len)
+{
+    float sn = hd_cell_walk_exit(w, ax);
+    return hd_cell_walk_leaves(w, ax, md) != 0 || !(sn < len) ? len : sn;
+}
+
 /* The current cell's index in the majorant grid of md (mdims) cells, x fastest. */
 HD_FN int hd_cell_walk_index(hd_cell_walk w, hd_i4 md)
 {
@@ -242,6 +250,31 @@ HD_FN int hd_cell_walk_index(hd_cell_walk w, hd_i4 md)
 }
 
 /* ---- transmittance tracking --------------------------------------------------------------- */
+/* A tentative collision at p + t d in a cell of majorant 1 / inv_mu: HD_TRACK_DELTA ends the ray
+   there (T = 0, *hit = t) with probability sigma_t / mu; HD_TRACK_RATIO weighs T by
+   1 - sigma_t / mu, with Russian roulette below HD_RR_THRESHOLD. Takes the dims it draws from
+   *dim; returns 1 when the ray ended. hd_track's and hd_track_rounds' one collision. */
+HD_FN int hd_track_collide(HD_KARGS hd_v3 p, hd_v3 d, float t, float inv_mu, int mode, hd_u32 key,
+                           HD_INOUT(hd_u32) dim, HD_INOUT(float) T, HD_INOUT(float) hit)
+{
+    float sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
+    float ratio = hd_minf(sig * inv_mu, 1.0f);
+    int done = 0;
+    if (mode == HD_TRACK_DELTA) {
+        if (hd_rand(key, HD_DEREF(dim)) < ratio) { HD_DEREF(T) = 0.0f; done = 1; HD_DEREF(hit) = t; }
+        HD_DEREF(dim) += 1u;
+    } else {
+        HD_DEREF(T) *= 1.0f - ratio;
+        if (HD_DEREF(T) < HD_RR_THRESHOLD) {
+            /* survive with probability T / threshold, then weigh by its inverse */
+            if (hd_rand(key, HD_DEREF(dim)) * HD_RR_THRESHOLD >= HD_DEREF(T)) { HD_DEREF(T) = 0.0f; done = 1; }
+            else HD_DEREF(T) = HD_RR_THRESHOLD;
+            HD_DEREF(dim) += 1u;
+        }
+    }
+    return done;
+}
+
 /* One unbiased estimate of the transmittance along p + t d, t in [0, tmax] (p inside the box,
    d unit). Null-collision tracking with a local majorant per cell of the majorant grid, walked
    cell by cell (a 3D DDA), so empty cells cost no collision at all. The free path is drawn as an
@@ -273,7 +306,7 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
         if (mu > 0.0f) {
             float inv_mu = 1.0f / mu;
             for (;;) {
-                float sig, ratio, tc;
+                float tc;
                 if (tau < 0.0f) {
                     tau = -hd_log(1.0f - hd_rand(key, dim));
                     dim += 1u;
@@ -288,20 +321,7 @@ HD_FN float hd_track(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, hd_u32 d
                 tau = -1.0f;
                 steps += 1;
                 if (steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; done = 1; hit = t; break; }
-                sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, t)));
-                ratio = hd_minf(sig * inv_mu, 1.0f);
-                if (mode == HD_TRACK_DELTA) {
-                    if (hd_rand(key, dim) < ratio) { T = 0.0f; done = 1; hit = t; }
-                    dim += 1u;
-                } else {
-                    T *= 1.0f - ratio;
-                    if (T < HD_RR_THRESHOLD) {
-                        /* survive with probability T / threshold, then weigh by its inverse */
-                        if (hd_rand(key, dim) * HD_RR_THRESHOLD >= T) { T = 0.0f; done = 1; }
-                        else T = HD_RR_THRESHOLD;
-                        dim += 1u;
-                    }
-                }
+                done = hd_track_collide(HD_KPASS p, d, t, inv_mu, mode, key, HD_REF(dim), HD_REF(T), HD_REF(hit));
                 if (done != 0) break;
             }
         }
@@ -397,22 +417,7 @@ HD_FN float hd_track_rounds(HD_KARGS hd_v3 p, hd_v3 d, float tmax, hd_u32 key, h
         r.tau = -1.0f;
         r.steps += 1;
         if (r.steps >= HD_MAX_TRACK_STEPS) { T = 0.0f; r.done = 1; hit = r.t; }
-        else {
-            float sig = hd_sigma_t(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(p, d, r.t)));
-            float ratio = hd_minf(sig * r.inv_mu, 1.0f);
-            if (mode == HD_TRACK_DELTA) {
-                if (hd_rand(key, r.dim) < ratio) { T = 0.0f; r.done = 1; hit = r.t; }
-                r.dim += 1u;
-            } else {
-                T *= 1.0f - ratio;
-                if (T < HD_RR_THRESHOLD) {
-                    /* survive with probability T / threshold, then weigh by its inverse */
-                    if (hd_rand(key, r.dim) * HD_RR_THRESHOLD >= T) { T = 0.0f; r.done = 1; }
-                    else T = HD_RR_THRESHOLD;
-                    r.dim += 1u;
-                }
-            }
-        }
+        else r.done = hd_track_collide(HD_KPASS p, d, r.t, r.inv_mu, mode, key, HD_REF(r.dim), HD_REF(T), HD_REF(hit));
         hd_track_walk(HD_KPASS HD_REF(r), tmax, global_majorant, HD_REF(T), HD_REF(hit), key);
     }
     HD_DEREF(next_dim) = r.dim;

@@ -198,10 +198,8 @@ HD_FN hd_v4 hd_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
     int n = 0;
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
     for (;;) {
-        /* the axis whose face comes first, and whether stepping across it leaves the grid */
         int ax = hd_cell_walk_axis(w);
-        float sn = hd_cell_walk_exit(w, ax);
-        float sc = hd_cell_walk_leaves(w, ax, md) != 0 || !(sn < len) ? len : sn;
+        float sc = hd_cell_walk_end(w, ax, md, len);
         if (HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f) {
             float s;
             if (skipped != 0) n = hd_march_resume(se, s0, idt, n);
@@ -228,7 +226,7 @@ HD_FN hd_v4 hd_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
 
 HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, int spans)
 {
-    float dt = HD_PRM(march).x;
+    float dt = HD_PRM(march).x, idt = 1.0f / dt;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
     hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
@@ -240,8 +238,7 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
     for (j = 0; j < HD_MARCH_SPANS; ++j) { sa[j] = 0.0f; sb[j] = 0.0f; }
     for (;;) {
         int ax = hd_cell_walk_axis(w);
-        float sn = hd_cell_walk_exit(w, ax);
-        float sc = hd_cell_walk_leaves(w, ax, md) != 0 || !(sn < len) ? len : sn;
+        float sc = hd_cell_walk_end(w, ax, md, len);
         int occ = HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f ? 1 : 0;
         if (occ != 0) {
             if (prev == 0 && k < spans - 1) { ++k; sa[k] = se; }
@@ -254,7 +251,7 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
         --cells;
     }
     j = 0;
-    n = k >= 0 ? hd_march_resume(sa[0], s0, 1.0f / dt, 0) : 0;
+    n = k >= 0 ? hd_march_resume(sa[0], s0, idt, 0) : 0;
     s = s0 + HD_F(n) * dt;
     while (j <= k && n < HD_MAX_MARCH_STEPS) {
         if (s < sb[j]) { /* a sample of span j, else on to the next span */
@@ -264,7 +261,7 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
             ++n;
         } else {
             ++j;
-            if (j <= k) n = hd_march_resume(sa[j], s0, 1.0f / dt, n);
+            if (j <= k) n = hd_march_resume(sa[j], s0, idt, n);
         }
         s = s0 + HD_F(n) * dt;
     }
