@@ -321,12 +321,13 @@ typedef struct hd_params {
     hd_solver solver;
     hd_tracking tracking;
     uint32_t seed;
-    float background[3];    /* linear RGB radiance behind the volume, default black */
+    float background[3];    /* linear RGB radiance behind the volume, default black; each
+                               component in [0, 1e6] */
     float step;             /* ray-march step of the projection in voxels, 0 -> 0.5 */
     int frame_window;       /* the image is a running mean of at most this many frames, so it
                                follows the converging illumination; 0 -> 8 */
     float exposure;         /* scale applied before the sRGB encoding of RGBA8 output; 0 -> 1 */
-    int max_bounces;        /* PT_MS bounce cap, 0 -> 64 */
+    int max_bounces;        /* PT_MS bounce cap, 0 -> 64; 1..100000 */
     int illumination_downsample; /* E and phi (and sigma_t for the diffusion) live on a grid of
                                the volume's dims divided by this factor per axis, rounded up,
                                sampled trilinearly by the projection: 1..8, 0 -> 2 (1/8 of the
@@ -363,8 +364,8 @@ typedef struct hd_params {
                                image within about 43 dB of one with 8x as many: the projection
                                averages many voxels; docs/DESIGN-RENDER.md); finite and >= 0 */
     float render_budget;    /* seconds one hd_render call may spend refining light that has not
-                               converged, before it projects its frame: 0 -> one light iteration
-                               per call; must be finite and >= 0 */
+                               converged (or tracing paths), before it projects its frame: 0 -> one
+                               light iteration per call; in [0, 10], so every call ends */
     float crop_min[3];      /* the crop box's low corner in box coordinates: 0 at the volume's
                                low face, 1 at its high face, per axis x, y, z; default 0 */
     float crop_max[3];      /* its high corner, 0 -> 1 per axis, so zeroed params crop nothing.
@@ -470,6 +471,11 @@ HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, co
    HD_ERROR_NULL_POINTER or HD_ERROR_INVALID_ENUM (logged to log, which may be NULL). */
 HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_logger *log);
 
+/* A handle is never valid twice: each of the HD_MAX_CONTEXTS slots serves 2^24 - 1 contexts,
+   then is retired, so a process may create HD_MAX_CONTEXTS * (2^24 - 1) contexts in all (over
+   10^9 by default) before hd_create returns HD_ERROR_TOO_MANY_CONTEXTS. After hd_destroy the
+   context's logger is never called again: a call with the stale handle returns
+   HD_ERROR_INVALID_HANDLE and logs nothing. */
 HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx);
 HDDEF hd_result hd_destroy(hd_context ctx);
 /* The desc with every default filled in (lights and TF pointers refer to the context's copies,
@@ -485,8 +491,12 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering,
      illumination_precision                    -> E, phi, image (new grids)
+     max_bounces                               -> the path tracers' image (nothing for HD, CD)
      solver, sweeps, tracking, exposure,
-     light_tolerance, render_budget            -> nothing (same solution, estimator or encoding) */
+     light_tolerance, render_budget            -> nothing (same solution, estimator or encoding)
+   src/hd_params.h holds this as a table, the one place each field's default, range and
+   invalidation are written. An out-of-range enum is HD_ERROR_INVALID_ENUM, any other bad value
+   HD_ERROR_INVALID_PARAMETER, each with one logged line; a rejected call changes nothing. */
 HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_function *tf);
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);
 HDDEF hd_result hd_set_camera(hd_context ctx, const hd_camera *camera);
@@ -686,18 +696,16 @@ extern char *realpath(const char *path, char *resolved);
 #include "backends/hd_cpu.h"
 #include "backends/hd_cpu_multigrid.h"
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
-#include "src/hd_gpu.h"
+#include "backends/hd_gpu.h"
 #include "backends/hd_opencl.h"
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
-#include "src/hd_gpu.h"
+#include "backends/hd_gpu.h"
 #include "backends/hd_vulkan.h"
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-#include "src/hd_gpu.h"
+#include "backends/hd_gpu.h"
 #include "backends/hd_gl.h"
 #endif
-#include "src/hd_multigrid.h"
-#include "src/hd_validate.h"
-#include "src/hd_context.h"
+#include "src/hd_core.h"
 #include "src/hd_io.h"
 #include "src/hd_io_mhd.h"
 #include "src/hd_io_nifti.h"

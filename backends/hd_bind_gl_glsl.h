@@ -8,7 +8,7 @@
    8 storage buffers): uniform block 0 the parameter block (hd_prelude_glsl.h); image units
    0 volume, 1 sigma_t, 2 E, 3 phi, 4 phi2, 5 light volume read, 6 light volume written, 7 the
    projection's E + phi (always r32f); storage buffers 0 TF, 1 majorants, 2 image accumulation,
-   4 the direct light's list of voxels (hd_context.h, hd__direct_mask; hd_pc.x its length in the
+   4 the direct light's list of voxels (src/hd_direct_mask.h, hd__direct_mask; hd_pc.x its length in the
    direct stage), 5 the projection's TF table (hd_pc.x its entries in the projection stage). GL has no push
    constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
    uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision

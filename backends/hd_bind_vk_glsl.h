@@ -22,7 +22,7 @@
    Binding 11: HD_SOLVER_MULTIGRID's row sums (doubles, hd_entry_glsl_multigrid.h, its modules
    compiled with HD_MG_STAGE = n and HD_STAGE 0); its passes' flags, like the diffusion stage's,
    are hd_sc_flags, and their beta / alpha come in the push constants (HD_MG_PUSH_SCALARS).
-   Binding 12: the direct light's list of voxels (hd_context.h, hd__direct_mask); the direct
+   Binding 12: the direct light's list of voxels (src/hd_direct_mask.h, hd__direct_mask); the direct
    stage's push constant x is its length. Binding 13: the projection's TF table (the projection
    stage's push constant x is its entries); 14: the projection's E + phi, r32f at any precision. */
 #define HD_GLSL_CUSTOM_BUFFERS 1

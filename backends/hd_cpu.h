@@ -14,10 +14,10 @@ typedef void (*hd__cpu_job)(hd__backend *be, int item);
 /* Red-black sweeps per walk through memory (hd__cpu_red_black): by default and at most */
 #define HD__CPU_RB_WALK_SWEEPS 2
 #define HD__CPU_RB_WALK_SWEEPS_MAX 8
-static void hd__cpu_mg_free(hd__ctx *ctx); /* with the multigrid levels, below */
+static void hd__cpu_mg_free(const hd__view *vw); /* with the multigrid levels, below */
 
 struct hd__backend {
-    hd__ctx *ctx;
+    const hd__view *vw;
     int nthreads;
     int nworkers;            /* threads started besides the caller's */
     pthread_t *workers;
@@ -144,13 +144,13 @@ static void hd__cpu_parallel(hd__backend *be, hd__cpu_job job, int items)
 }
 
 /* Frees CD's light volumes. */
-static void hd__cpu_free_lights(hd__ctx *ctx)
+static void hd__cpu_free_lights(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int l;
     if (be->lv)
-        for (l = 0; l <= be->nlv; ++l) hd__free(ctx, be->lv[l]);
-    hd__free(ctx, be->lv);
+        for (l = 0; l <= be->nlv; ++l) hd__free(vw, be->lv[l]);
+    hd__free(vw, be->lv);
     be->lv = NULL;
     be->nlv = 0;
     be->k.lv = NULL;
@@ -158,20 +158,20 @@ static void hd__cpu_free_lights(hd__ctx *ctx)
 }
 
 /* A call's bracket: nothing to make current, nothing left in flight (src/hd_backend.h). */
-static hd_result hd__be_begin(hd__ctx *ctx)
+static hd_result hd__be_begin(const hd__view *vw)
 {
-    (void)ctx;
+    (void)vw;
     return HD_SUCCESS;
 }
-static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_end(const hd__view *vw, hd_result r)
 {
-    (void)ctx;
+    (void)vw;
     return r;
 }
 
-static void hd__be_destroy(hd__ctx *ctx)
+static void hd__be_destroy(hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int i;
     if (!be) return;
     if (be->sync_ready) {
@@ -184,91 +184,91 @@ static void hd__be_destroy(hd__ctx *ctx)
         pthread_cond_destroy(&be->cv_work);
         pthread_mutex_destroy(&be->mu);
     }
-    hd__free(ctx, be->workers);
-    hd__cpu_mg_free(ctx);
-    hd__free(ctx, be->sig);
-    hd__free(ctx, be->lsum);
-    hd__free(ctx, be->ptab);
-    hd__free(ctx, be->E);
-    hd__free(ctx, be->phi);
-    hd__free(ctx, be->phi2);
-    hd__free(ctx, be->Eh);
-    hd__free(ctx, be->phih);
-    hd__free(ctx, be->phi2h);
-    hd__free(ctx, be->img);
-    hd__cpu_free_lights(ctx);
-    hd__free(ctx, be);
-    ctx->be = NULL;
+    hd__free(vw, be->workers);
+    hd__cpu_mg_free(vw);
+    hd__free(vw, be->sig);
+    hd__free(vw, be->lsum);
+    hd__free(vw, be->ptab);
+    hd__free(vw, be->E);
+    hd__free(vw, be->phi);
+    hd__free(vw, be->phi2);
+    hd__free(vw, be->Eh);
+    hd__free(vw, be->phih);
+    hd__free(vw, be->phi2h);
+    hd__free(vw, be->img);
+    hd__cpu_free_lights(vw);
+    hd__free(vw, be);
+    vw->be = NULL;
 }
 
-static hd_result hd__be_create(hd__ctx *ctx)
+static hd_result hd__be_create(hd__view *vw)
 {
     hd__backend *be;
-    int n = ctx->desc.threads, i;
+    int n = vw->desc.threads, i;
     if (n <= 0) {
         long cores = sysconf(_SC_NPROCESSORS_ONLN);
         n = cores > 0 ? (int)cores : 1;
     }
     if (n > 256) n = 256;
-    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
-    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the backend");
-    ctx->be = be;
-    be->ctx = ctx;
+    be = (hd__backend *)hd__calloc(vw, 1, sizeof *be);
+    if (!be) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the backend");
+    vw->be = be;
+    be->vw = vw;
     be->nthreads = n;
-    be->k.p = &ctx->kp;
-    be->k.vol = ctx->vol;
+    be->k.p = &vw->kp;
+    be->k.vol = vw->vol;
     be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
     if (n > 1) {
-        be->workers = (pthread_t *)hd__calloc(ctx, (size_t)(n - 1), sizeof(pthread_t));
-        if (!be->workers) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d threads", n);
-        if (pthread_mutex_init(&be->mu, NULL) != 0) return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_mutex_init failed");
+        be->workers = (pthread_t *)hd__calloc(vw, (size_t)(n - 1), sizeof(pthread_t));
+        if (!be->workers) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d threads", n);
+        if (pthread_mutex_init(&be->mu, NULL) != 0) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "cpu: pthread_mutex_init failed");
         if (pthread_cond_init(&be->cv_work, NULL) != 0) {
             pthread_mutex_destroy(&be->mu);
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
+            return HD__ERR(&vw->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
         }
         if (pthread_cond_init(&be->cv_done, NULL) != 0) {
             pthread_cond_destroy(&be->cv_work);
             pthread_mutex_destroy(&be->mu);
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
+            return HD__ERR(&vw->log, HD_ERROR_BACKEND, "cpu: pthread_cond_init failed");
         }
         be->sync_ready = 1;
         for (i = 0; i < n - 1; ++i) {
             if (pthread_create(&be->workers[i], NULL, hd__cpu_worker, be) != 0) {
-                HD__INFO(&ctx->log, "cpu: started %d of %d worker threads", i, n - 1);
+                HD__INFO(&vw->log, "cpu: started %d of %d worker threads", i, n - 1);
                 break;
             }
             be->nworkers = i + 1;
         }
         be->nthreads = be->nworkers + 1;
     }
-    HD__INFO(&ctx->log, "cpu: %d threads", be->nthreads);
+    HD__INFO(&vw->log, "cpu: %d threads", be->nthreads);
     return HD_SUCCESS;
 }
 
-/* The volume lives in ctx->vol, the TF and majorants in ctx: the kernels read them in place. */
-static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+/* The volume lives in vw->vol, the TF and majorants in vw: the kernels read them in place. */
+static hd_result hd__be_upload_inputs(const hd__view *vw)
 {
-    ctx->be->k.tf = ctx->tf;
-    ctx->be->k.maj = ctx->majorant;
+    vw->be->k.tf = vw->tf;
+    vw->be->k.maj = vw->majorant;
     return HD_SUCCESS;
 }
 
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */
-static void hd__cpu_free_illum(hd__ctx *ctx, float **f, uint16_t **h)
+static void hd__cpu_free_illum(const hd__view *vw, float **f, uint16_t **h)
 {
-    hd__free(ctx, *f); hd__free(ctx, *h);
+    hd__free(vw, *f); hd__free(vw, *h);
     *f = NULL; *h = NULL;
 }
 
 /* A zeroed illumination buffer of n elements in the context's precision (the other pointer NULL);
    0 when the allocation failed. Zero bits are 0.0 in both precisions. */
-static int hd__cpu_alloc_illum(hd__ctx *ctx, size_t n, float **f, uint16_t **h)
+static int hd__cpu_alloc_illum(const hd__view *vw, size_t n, float **f, uint16_t **h)
 {
-    hd__cpu_free_illum(ctx, f, h);
-    if (ctx->params.illumination_precision == HD_PRECISION_FLOAT16) *h = (uint16_t *)hd__calloc(ctx, n, sizeof(uint16_t));
-    else *f = (float *)hd__calloc(ctx, n, sizeof(float));
+    hd__cpu_free_illum(vw, f, h);
+    if (vw->params.illumination_precision == HD_PRECISION_FLOAT16) *h = (uint16_t *)hd__calloc(vw, n, sizeof(uint16_t));
+    else *f = (float *)hd__calloc(vw, n, sizeof(float));
     return *f != NULL || *h != NULL;
 }
 
@@ -277,33 +277,33 @@ static void hd__cpu_bind_illum(hd__backend *be)
 {
     be->k.E = be->E; be->k.phi = be->phi; be->k.phi2 = be->phi2;
     be->k.Eh = be->Eh; be->k.phih = be->phih; be->k.phi2h = be->phi2h;
-    be->k.f16 = be->ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    be->k.f16 = be->vw->params.illumination_precision == HD_PRECISION_FLOAT16;
 }
 
 /* (Re)allocates sigma_t, E and phi (zeroed) for the current illumination grid, channels and
    precision. illum_floats == 0 frees them: the path tracers keep no illumination grid. */
-static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
-    hd__backend *be = ctx->be;
-    size_t slots = hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->channels);
+    hd__backend *be = vw->be;
+    size_t slots = hd__split_slots(vw->gdims[0], vw->gdims[1], (size_t)vw->gdims[2] * (size_t)vw->channels);
     int ok;
-    hd__free(ctx, be->sig);
+    hd__free(vw, be->sig);
     be->sig = be->k.sig = NULL;
-    hd__free(ctx, be->lsum);
+    hd__free(vw, be->lsum);
     be->lsum = NULL;
     be->lsum_ok = 0;
-    hd__cpu_free_illum(ctx, &be->E, &be->Eh);
-    hd__cpu_free_illum(ctx, &be->phi, &be->phih);
-    hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
+    hd__cpu_free_illum(vw, &be->E, &be->Eh);
+    hd__cpu_free_illum(vw, &be->phi, &be->phih);
+    hd__cpu_free_illum(vw, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
     be->illum_floats = be->illum_slots = 0;
     if (illum_floats == 0) return HD_SUCCESS;
-    be->sig = (float *)hd__calloc(ctx, hd__split_slots(ctx->gdims[0], ctx->gdims[1], (size_t)ctx->gdims[2] * (size_t)ctx->sig_channels),
+    be->sig = (float *)hd__calloc(vw, hd__split_slots(vw->gdims[0], vw->gdims[1], (size_t)vw->gdims[2] * (size_t)vw->sig_channels),
                                   sizeof(float));
-    ok = hd__cpu_alloc_illum(ctx, slots, &be->E, &be->Eh);
-    ok &= hd__cpu_alloc_illum(ctx, slots, &be->phi, &be->phih);
+    ok = hd__cpu_alloc_illum(vw, slots, &be->E, &be->Eh);
+    ok &= hd__cpu_alloc_illum(vw, slots, &be->phi, &be->phih);
     if (!be->sig || !ok)
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", slots);
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %zu floats of illumination", slots);
     be->illum_floats = illum_floats;
     be->illum_slots = slots;
     be->k.sig = be->sig;
@@ -312,34 +312,34 @@ static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
 }
 
 /* Jacobi's second phi buffer, allocated only while the Jacobi solver is selected. */
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
+static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int ok;
-    hd__cpu_free_illum(ctx, &be->phi2, &be->phi2h);
+    hd__cpu_free_illum(vw, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
     if (!enable || be->illum_floats == 0) return HD_SUCCESS;
-    ok = hd__cpu_alloc_illum(ctx, be->illum_slots, &be->phi2, &be->phi2h);
+    ok = hd__cpu_alloc_illum(vw, be->illum_slots, &be->phi2, &be->phi2h);
     hd__cpu_bind_illum(be);
-    if (!ok) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
+    if (!ok) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate Jacobi's buffer");
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
 {
-    hd__backend *be = ctx->be;
-    float *img = (float *)hd__calloc(ctx, hd__image_floats(width, height, reduced), sizeof(float));
+    hd__backend *be = vw->be;
+    float *img = (float *)hd__calloc(vw, hd__image_floats(width, height, reduced), sizeof(float));
     if (!img)
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image%s", width, height,
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image%s", width, height,
                        reduced ? " with room for reduced frames" : "");
-    hd__free(ctx, be->img);
+    hd__free(vw, be->img);
     be->img = be->k.img = img;
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t n = be->illum_slots;
     if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) be->lsum_ok = 0;
     if ((what & HD__DIRTY_DIRECT) && be->E) memset(be->E, 0, n * sizeof(float));
@@ -349,23 +349,23 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
     if ((what & HD__DIRTY_PHI) && be->phih) memset(be->phih, 0, n * sizeof(uint16_t));
     if ((what & HD__DIRTY_PHI) && be->phi2h) memset(be->phi2h, 0, n * sizeof(uint16_t));
     if ((what & HD__DIRTY_IMAGE) && be->img)
-        memset(be->img, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
+        memset(be->img, 0, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float));
     return HD_SUCCESS;
 }
 
 static void hd__cpu_classify_row(hd__backend *be, int r)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_classify_voxel(&be->k, x, r % gy, r / gy);
 }
 /* Direct light: items of HD__CPU_DIRECT_CHUNK consecutive entries of the tracked voxels' list. */
 #define HD__CPU_DIRECT_CHUNK 64
 static void hd__cpu_direct_chunk(hd__backend *be, int item)
 {
-    const hd__ctx *ctx = be->ctx;
+    const hd__view *vw = be->vw;
     size_t j = (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
-    if (end > ctx->dl_count) end = ctx->dl_count;
-    for (; j < end; ++j) hd_direct_index(&be->k, (int)ctx->dl_idx[j]);
+    if (end > vw->dl_count) end = vw->dl_count;
+    for (; j < end; ++j) hd_direct_index(&be->k, (int)vw->dl_idx[j]);
 }
 /* ---- diffusion -------------------------------------------------------------------------------
    A pass works on be->grid: the illumination grid itself, or a multigrid level
@@ -425,23 +425,23 @@ struct hd__cpu_mg {
     float beta;
 };
 
-static void hd__cpu_mg_free(hd__ctx *ctx)
+static void hd__cpu_mg_free(const hd__view *vw)
 {
-    struct hd__cpu_mg *mg = ctx->be->mg;
+    struct hd__cpu_mg *mg = vw->be->mg;
     int l;
     if (!mg) return;
     for (l = 0; l < mg->levels; ++l) {
-        hd__free(ctx, mg->lv[l].sig);
-        hd__free(ctx, mg->lv[l].rhs);
-        hd__free(ctx, mg->lv[l].phi);
-        hd__free(ctx, mg->lv[l].res);
+        hd__free(vw, mg->lv[l].sig);
+        hd__free(vw, mg->lv[l].rhs);
+        hd__free(vw, mg->lv[l].phi);
+        hd__free(vw, mg->lv[l].res);
     }
-    hd__free(ctx, mg->p);
-    hd__free(ctx, mg->lo);
-    hd__free(ctx, mg->dot_a);
-    hd__free(ctx, mg->dot_b);
-    hd__free(ctx, mg);
-    ctx->be->mg = NULL;
+    hd__free(vw, mg->p);
+    hd__free(vw, mg->lo);
+    hd__free(vw, mg->dot_a);
+    hd__free(vw, mg->dot_b);
+    hd__free(vw, mg);
+    vw->be->mg = NULL;
 }
 
 static int hd__cpu_row_variant(const hd__kctx *K)
@@ -921,14 +921,12 @@ static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
    call inlined: the sample's 16 loads of E and phi lose their precision test. */
 static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 {
-    int px, w = be->ctx->kp.image.x;
+    int px, w = be->vw->kp.image.x;
     hd__kctx k = be->k;
     k.lsum = be->lsum_ok ? be->lsum : NULL;
     k.ptab = be->ptab;
     k.ptab_n = be->ptab_n;
-    if (be->ctx->kp.counts.z & HD_FLAG_UPSAMPLE) { /* a reduced frame's upsample pass */
-        for (px = 0; px < w; ++px) hd_upsample_pixel(&k, px, py);
-    } else if (k.f16) {
+    if (k.f16) {
         k.f16 = 1;
         for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
     } else {
@@ -937,31 +935,38 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
     }
 }
 
-static hd_result hd__be_classify(hd__ctx *ctx)
+/* A row of a reduced frame's upsample pass. */
+static void hd__cpu_upsample_row(hd__backend *be, int py)
 {
-    hd__cpu_parallel(ctx->be, hd__cpu_classify_row, ctx->gdims[1] * ctx->gdims[2]);
+    int px, w = be->vw->kp.image.x;
+    for (px = 0; px < w; ++px) hd_upsample_pixel(&be->k, px, py);
+}
+
+static hd_result hd__be_classify(const hd__view *vw)
+{
+    hd__cpu_parallel(vw->be, hd__cpu_classify_row, vw->gdims[1] * vw->gdims[2]);
     return HD_SUCCESS;
 }
-static hd_result hd__be_direct(hd__ctx *ctx)
+static hd_result hd__be_direct(const hd__view *vw)
 {
-    size_t n = ctx->dl_count;
-    ctx->be->lsum_ok = 0;
-    hd__cpu_parallel(ctx->be, hd__cpu_direct_chunk, (int)((n + HD__CPU_DIRECT_CHUNK - 1) / HD__CPU_DIRECT_CHUNK));
+    size_t n = vw->dl_count;
+    vw->be->lsum_ok = 0;
+    hd__cpu_parallel(vw->be, hd__cpu_direct_chunk, (int)((n + HD__CPU_DIRECT_CHUNK - 1) / HD__CPU_DIRECT_CHUNK));
     return HD_SUCCESS;
 }
-/* The list of voxels to track lives in the context (ctx->dl_idx): nothing to upload. */
-static hd_result hd__be_direct_list(hd__ctx *ctx)
+/* The list of voxels to track lives in the context (vw->dl_idx): nothing to upload. */
+static hd_result hd__be_direct_list(const hd__view *vw)
 {
-    (void)ctx;
+    (void)vw;
     return HD_SUCCESS;
 }
 
 /* `sweeps` full sweeps on the illumination grid: red-black through hd__cpu_red_black (walks of
-   several sweeps, hd_context.h's hd__diffuse_sweeps hands it all of an iteration's), Jacobi one
+   several sweeps, hd_schedule.h's hd__diffuse_sweeps hands it all of an iteration's), Jacobi one
    pass and a swap each. */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
+static hd_result hd__be_diffuse_sweeps(const hd__view *vw, int jacobi, int sweeps)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__cpu_grid fine;
     int s;
     be->lsum_ok = 0;
@@ -974,7 +979,7 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
         uint16_t *th;
         be->jacobi = 1;
         be->parity = 0;
-        hd__cpu_parallel(be, hd__cpu_diffuse_block, hd__cpu_blocks(be) * ctx->channels);
+        hd__cpu_parallel(be, hd__cpu_diffuse_block, hd__cpu_blocks(be) * vw->channels);
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
         th = be->phih; be->phih = be->phi2h; be->phi2h = th;
         hd__cpu_bind_illum(be);
@@ -983,11 +988,11 @@ static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps)
     return HD_SUCCESS;
 }
 /* One full sweep: two half-sweeps (red, black) or one Jacobi pass and a swap. */
-static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi) { return hd__be_diffuse_sweeps(ctx, jacobi, 1); }
+static hd_result hd__be_diffuse(const hd__view *vw, int jacobi) { return hd__be_diffuse_sweeps(vw, jacobi, 1); }
 /* One row (channel c, z, y: r = (c * gz + z) * gy + y) of lsum = E + phi, x-fastest. */
 static void hd__cpu_lsum_row(hd__backend *be, int r)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     hd__kctx k = be->k;
     k.lsum = be->lsum;
     for (x = 0; x < gx; ++x) hd_light_sum_voxel(&k, x, r % gy, r / gy);
@@ -996,51 +1001,73 @@ static void hd__cpu_lsum_row(hd__backend *be, int r)
 /* The projection's inputs: lsum (after any pass that changed E or phi) and the TF table for the
    current TF, step and medium (hd__project_table, rebuilt when its key changes). Without room for
    either the projection reads E, phi and the TF directly. */
-static void hd__cpu_project_prepare(hd__ctx *ctx)
+static void hd__cpu_project_prepare(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int n = hd__project_table_n(ctx);
-    size_t rows = (size_t)ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
+    hd__backend *be = vw->be;
+    int n = hd__project_table_n(vw);
+    size_t rows = (size_t)vw->gdims[1] * vw->gdims[2] * vw->channels;
     if (!be->lsum && (be->E || be->Eh))
-        be->lsum = (float *)hd__alloc(ctx, rows * (size_t)ctx->gdims[0] * sizeof(float));
+        be->lsum = (float *)hd__alloc(vw, rows * (size_t)vw->gdims[0] * sizeof(float));
     if (be->lsum && !be->lsum_ok) {
         hd__cpu_parallel(be, hd__cpu_lsum_row, (int)rows);
         be->lsum_ok = 1;
     }
     if (n > be->ptab_cap) {
-        hd__free(ctx, be->ptab);
-        be->ptab = (float *)hd__alloc(ctx, (size_t)n * 4 * sizeof(float));
+        hd__free(vw, be->ptab);
+        be->ptab = (float *)hd__alloc(vw, (size_t)n * 4 * sizeof(float));
         be->ptab_cap = be->ptab ? n : 0;
         be->ptab_key.valid = 0;
     }
-    if (be->ptab && !hd__project_table_key_same(ctx, &be->ptab_key)) {
-        hd__project_table(ctx, be->ptab, n);
-        be->ptab_key = hd__project_table_key(ctx);
+    if (be->ptab && !hd__project_table_key_same(vw, &be->ptab_key)) {
+        hd__project_table(vw, be->ptab, n);
+        be->ptab_key = hd__project_table_key(vw);
     }
     be->ptab_n = n;
 }
 
-static hd_result hd__be_project(hd__ctx *ctx)
+static hd_result hd__be_project(const hd__view *vw)
 {
-    hd__cpu_project_prepare(ctx);
-    hd__cpu_parallel(ctx->be, hd__cpu_project_row, ctx->kp.image.y);
+    hd__cpu_project_prepare(vw);
+    hd__cpu_parallel(vw->be, hd__cpu_project_row, vw->kp.image.y);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+static hd_result hd__be_upsample(const hd__view *vw)
 {
-    memcpy(dst, ctx->be->img, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float));
+    hd__cpu_parallel(vw->be, hd__cpu_upsample_row, vw->kp.image.y);
+    return HD_SUCCESS;
+}
+
+/* No recording and no GL texture: the core never calls these (hd__be_features). */
+static unsigned hd__be_features(void) { return 0; }
+static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
+{
+    (void)target; (void)slots;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no recording");
+}
+static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
+static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
+static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
+static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
+{
+    (void)texture;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no GL texture");
+}
+
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
+{
+    memcpy(dst, vw->be->img, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float));
     return HD_SUCCESS;
 }
 /* Copies E or phi between the colour layout and the API's x-fastest channel-planar order, one
    direction per call: into dst (src NULL; binary16 widened exactly) or from src (dst NULL; rounded
    to nearest even), as the OpenCL backend's hd__cl_copy_illumination. Padding slots are not
    touched (they stay 0). With a slice list (list, count), only those stacked slices, in its order. */
-static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst, const int *list,
+static void hd__cpu_copy_illumination(const hd__view *vw, hd_illumination which, const float *src, float *dst, const int *list,
                                       int count)
 {
-    hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = list ? count : ctx->gdims[2] * ctx->channels, x, y, k, zz;
+    hd__backend *be = vw->be;
+    int gx = vw->gdims[0], gy = vw->gdims[1], nz = list ? count : vw->gdims[2] * vw->channels, x, y, k, zz;
     float *f = which == HD_ILLUMINATION_DIRECT ? be->E : be->phi;
     uint16_t *h = which == HD_ILLUMINATION_DIRECT ? be->Eh : be->phih;
     for (k = 0; k < nz; ++k)
@@ -1057,28 +1084,28 @@ static void hd__cpu_copy_illumination(hd__ctx *ctx, hd_illumination which, const
             }
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
 {
-    hd__cpu_copy_illumination(ctx, which, NULL, dst, zz, count);
+    hd__cpu_copy_illumination(vw, which, NULL, dst, zz, count);
     return HD_SUCCESS;
 }
 
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
-HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
-    ctx->be->lsum_ok = 0;
-    hd__cpu_copy_illumination(ctx, which, src, NULL, NULL, 0);
+    vw->be->lsum_ok = 0;
+    hd__cpu_copy_illumination(vw, which, src, NULL, NULL, 0);
     return HD_SUCCESS;
 }
 
 /* Relative residual |r| / |sigma_s E| of the diffusion equation for the current E and phi: the
    solver's convergence measure, for tests and benchmarks. Summed row by row in a fixed order. */
-HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
+HD__MAYBE_UNUSED static double hd__cpu_residual(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], gz = ctx->gdims[2], x, y, z, c;
+    hd__backend *be = vw->be;
+    int gx = vw->gdims[0], gy = vw->gdims[1], gz = vw->gdims[2], x, y, z, c;
     double r2 = 0.0, b2 = 0.0;
-    for (c = 0; c < ctx->channels; ++c)
+    for (c = 0; c < vw->channels; ++c)
         for (z = 0; z < gz; ++z)
             for (y = 0; y < gy; ++y)
                 for (x = 0; x < gx; ++x) {
@@ -1096,21 +1123,21 @@ HD__MAYBE_UNUSED static double hd__cpu_residual(hd__ctx *ctx)
    illumination grid (count lights and one spare that rotates through them as the ping-pong
    buffer of hd__be_convect); count 0 frees them (every method but CD). Zeroed = dark: CD starts
    with no light in the volume. Bytes held: 4 * (count + 1) per voxel. */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
+static hd_result hd__be_alloc_lights(const hd__view *vw, int count)
 {
-    hd__backend *be = ctx->be;
-    size_t gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+    hd__backend *be = vw->be;
+    size_t gvox = (size_t)vw->gdims[0] * vw->gdims[1] * vw->gdims[2];
     int l;
-    hd__cpu_free_lights(ctx);
+    hd__cpu_free_lights(vw);
     if (count <= 0) return HD_SUCCESS;
-    be->lv = (float **)hd__calloc(ctx, (size_t)count + 1, sizeof(float *));
-    if (!be->lv) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes", count);
+    be->lv = (float **)hd__calloc(vw, (size_t)count + 1, sizeof(float *));
+    if (!be->lv) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes", count);
     be->nlv = count;
     for (l = 0; l <= count; ++l) {
-        be->lv[l] = (float *)hd__calloc(ctx, gvox, sizeof(float));
+        be->lv[l] = (float *)hd__calloc(vw, gvox, sizeof(float));
         if (!be->lv[l]) {
-            hd__cpu_free_lights(ctx);
-            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes of %zu voxels", count, gvox);
+            hd__cpu_free_lights(vw);
+            return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate %d light volumes of %zu voxels", count, gvox);
         }
     }
     return HD_SUCCESS;
@@ -1118,52 +1145,52 @@ static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
 
 static void hd__cpu_convect_row(hd__backend *be, int r)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_convect_voxel(&be->k, x, r % gy, r / gy, be->light);
 }
 static void hd__cpu_sum_light_row(hd__backend *be, int r)
 {
-    int gx = be->ctx->gdims[0], gy = be->ctx->gdims[1], x;
+    int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     for (x = 0; x < gx; ++x) hd_sum_light_voxel(&be->k, x, r % gy, r / gy, be->light, be->light == 0);
 }
 static void hd__cpu_path_row(hd__backend *be, int py)
 {
-    int px, w = be->ctx->kp.image.x;
+    int px, w = be->vw->kp.image.x;
     for (px = 0; px < w; ++px) hd_path_pixel(&be->k, px, py);
 }
 
 /* One convection step of light `light` (hd_convect_voxel on every voxel of the illumination
    grid): reads its volume, writes the spare, and the two swap roles. Needs sigma_t (classify). */
-static hd_result hd__be_convect(hd__ctx *ctx, int light)
+static hd_result hd__be_convect(const hd__view *vw, int light)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     float *t;
     be->light = light;
     be->k.lv = be->lv[light];
     be->k.lv2 = be->lv[be->nlv];
-    hd__cpu_parallel(be, hd__cpu_convect_row, ctx->gdims[1] * ctx->gdims[2]);
+    hd__cpu_parallel(be, hd__cpu_convect_row, vw->gdims[1] * vw->gdims[2]);
     t = be->lv[light]; be->lv[light] = be->lv[be->nlv]; be->lv[be->nlv] = t;
     return HD_SUCCESS;
 }
 
 /* E = sum over the lights of colour * falloff * light volume (hd_sum_light_voxel, one pass per
    light, the first overwriting E), so the diffusion and projection of HD run on it unchanged. */
-static hd_result hd__be_sum_lights(hd__ctx *ctx)
+static hd_result hd__be_sum_lights(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int l;
     be->lsum_ok = 0;
     for (l = 0; l < be->nlv; ++l) {
         be->light = l;
         be->k.lv = be->lv[l];
-        hd__cpu_parallel(be, hd__cpu_sum_light_row, ctx->gdims[1] * ctx->gdims[2]);
+        hd__cpu_parallel(be, hd__cpu_sum_light_row, vw->gdims[1] * vw->gdims[2]);
     }
     return HD_SUCCESS;
 }
 
 /* One path per pixel (hd_path_pixel), folded into the image with weight march.y. */
-static hd_result hd__be_path(hd__ctx *ctx)
+static hd_result hd__be_path(const hd__view *vw)
 {
-    hd__cpu_parallel(ctx->be, hd__cpu_path_row, ctx->kp.image.y);
+    hd__cpu_parallel(vw->be, hd__cpu_path_row, vw->kp.image.y);
     return HD_SUCCESS;
 }

@@ -11,12 +11,12 @@
 static size_t hd__mg_slots(const int *d, int channels) { return hd__split_slots(d[0], d[1], (size_t)d[2] * (size_t)channels); }
 
 /* Bytes the solver holds (r, z, p, the fine residual and every coarse grid); 0 without it. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx)
+static size_t hd__be_solver_bytes(const hd__view *vw)
 {
-    const struct hd__cpu_mg *mg = ctx->be->mg;
+    const struct hd__cpu_mg *mg = vw->be->mg;
     size_t b = 0;
     int l;
-    if (!mg || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    if (!mg || vw->params.solver != HD_SOLVER_MULTIGRID) return 0;
     b += 2 * sizeof(double) * (size_t)mg->lv[0].dims[1] * mg->lv[0].dims[2] * (size_t)mg->channels; /* row sums */
     b += 2 * hd__mg_slots(mg->lv[0].dims, mg->channels) * sizeof(float);                             /* p, lo */
     for (l = 0; l < mg->levels; ++l) {
@@ -28,13 +28,13 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 
 /* Level l's parameter block and kernel context: the fine block with the level's dims, 1 / h^2
    and h, and the right-hand-side flag; its buffers (level 0: the backend's sigma_t). */
-static void hd__cpu_mg_params(hd__ctx *ctx, int l)
+static void hd__cpu_mg_params(const hd__view *vw, int l)
 {
-    hd__cpu_level *L = &ctx->be->mg->lv[l];
-    L->kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
-    L->k = ctx->be->k;
+    hd__cpu_level *L = &vw->be->mg->lv[l];
+    L->kp = hd__mg_level_kp(&vw->kp, l, L->dims);
+    L->k = vw->be->k;
     L->k.p = &L->kp;
-    L->k.sig = l == 0 ? ctx->be->sig : L->sig;
+    L->k.sig = l == 0 ? vw->be->sig : L->sig;
     L->k.E = L->rhs;
     L->k.phi = L->phi;
     L->k.phi2 = NULL;
@@ -45,10 +45,10 @@ static void hd__cpu_mg_params(hd__ctx *ctx, int l)
 
 /* The fine grid's two extra passes: f - A phi with the backend's own context into r, and A p
    (level 0's context with E = z, which is zero when it runs, and phi = p) into level 0's res. */
-static void hd__cpu_mg_fine_params(hd__ctx *ctx)
+static void hd__cpu_mg_fine_params(const hd__view *vw)
 {
-    struct hd__cpu_mg *mg = ctx->be->mg;
-    mg->fineg.k = &ctx->be->k;
+    struct hd__cpu_mg *mg = vw->be->mg;
+    mg->fineg.k = &vw->be->k;
     mg->fineg.res = mg->lv[0].rhs;
     mg->opkp = mg->lv[0].kp;
     mg->opk = mg->lv[0].k;
@@ -60,26 +60,26 @@ static void hd__cpu_mg_fine_params(hd__ctx *ctx)
 }
 
 /* Allocates the levels and CG's vectors for the current grid, channels and sigma_t channels. */
-static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
+static hd_result hd__cpu_mg_alloc(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__cpu_mg *mg;
     int l, n, d[3], i;
     size_t rows, fine;
-    be->mg = mg = (struct hd__cpu_mg *)hd__calloc(ctx, 1, sizeof *mg);
-    if (!mg) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the multigrid levels");
-    mg->channels = ctx->channels;
-    mg->sig_channels = ctx->sig_channels;
-    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = ctx->gdims[i];
+    be->mg = mg = (struct hd__cpu_mg *)hd__calloc(vw, 1, sizeof *mg);
+    if (!mg) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the multigrid levels");
+    mg->channels = vw->channels;
+    mg->sig_channels = vw->sig_channels;
+    for (i = 0; i < 3; ++i) mg->fine[i] = d[i] = vw->gdims[i];
     rows = (size_t)d[1] * d[2] * (size_t)mg->channels;
     fine = hd__mg_slots(d, mg->channels);
-    mg->dot_a = (double *)hd__calloc(ctx, rows, sizeof(double));
-    mg->dot_b = (double *)hd__calloc(ctx, rows, sizeof(double));
-    mg->p = (float *)hd__calloc(ctx, fine, sizeof(float));
-    mg->lo = (float *)hd__calloc(ctx, fine, sizeof(float));
+    mg->dot_a = (double *)hd__calloc(vw, rows, sizeof(double));
+    mg->dot_b = (double *)hd__calloc(vw, rows, sizeof(double));
+    mg->p = (float *)hd__calloc(vw, fine, sizeof(float));
+    mg->lo = (float *)hd__calloc(vw, fine, sizeof(float));
     if (!mg->dot_a || !mg->dot_b || !mg->p || !mg->lo) {
-        hd__cpu_mg_free(ctx);
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the conjugate gradients' vectors");
+        hd__cpu_mg_free(vw);
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate the conjugate gradients' vectors");
     }
     for (l = 0, n = hd__mg_levels(mg->fine); l < n; ++l) {
         hd__cpu_level *L = &mg->lv[l];
@@ -88,13 +88,13 @@ static hd_result hd__cpu_mg_alloc(hd__ctx *ctx)
         v = hd__mg_slots(d, mg->channels);
         memcpy(L->dims, d, sizeof d);
         mg->levels = l + 1;
-        L->res = (float *)hd__calloc(ctx, v, sizeof(float));
-        L->rhs = (float *)hd__calloc(ctx, v, sizeof(float));
-        L->phi = (float *)hd__calloc(ctx, v, sizeof(float));
-        if (l > 0) L->sig = (float *)hd__calloc(ctx, hd__mg_slots(d, mg->sig_channels), sizeof(float));
+        L->res = (float *)hd__calloc(vw, v, sizeof(float));
+        L->rhs = (float *)hd__calloc(vw, v, sizeof(float));
+        L->phi = (float *)hd__calloc(vw, v, sizeof(float));
+        if (l > 0) L->sig = (float *)hd__calloc(vw, hd__mg_slots(d, mg->sig_channels), sizeof(float));
         if (!L->res || !L->rhs || !L->phi || (l > 0 && !L->sig)) {
-            hd__cpu_mg_free(ctx);
-            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate multigrid level %d (%dx%dx%d)", l,
+            hd__cpu_mg_free(vw);
+            return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate multigrid level %d (%dx%dx%d)", l,
                            d[0], d[1], d[2]);
         }
     }
@@ -365,40 +365,40 @@ static HD__CPU_FLATTEN void hd__cpu_mg_extrap_row(hd__backend *be, int r)
 }
 
 /* ---- the primitives (src/hd_backend.h) -------------------------------------------------------- */
-static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
+static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__cpu_mg *mg = be->mg;
     hd_result r;
     int l;
-    if (mg && (mg->channels != ctx->channels || mg->sig_channels != ctx->sig_channels ||
-               memcmp(mg->fine, ctx->gdims, sizeof mg->fine) != 0))
-        hd__cpu_mg_free(ctx);
+    if (mg && (mg->channels != vw->channels || mg->sig_channels != vw->sig_channels ||
+               memcmp(mg->fine, vw->gdims, sizeof mg->fine) != 0))
+        hd__cpu_mg_free(vw);
     *fresh = !be->mg;
-    if (!be->mg && (r = hd__cpu_mg_alloc(ctx)) != HD_SUCCESS) return r;
+    if (!be->mg && (r = hd__cpu_mg_alloc(vw)) != HD_SUCCESS) return r;
     mg = be->mg;
-    for (l = 0; l < mg->levels; ++l) hd__cpu_mg_params(ctx, l);
-    hd__cpu_mg_fine_params(ctx);
+    for (l = 0; l < mg->levels; ++l) hd__cpu_mg_params(vw, l);
+    hd__cpu_mg_fine_params(vw);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_mg_end(const hd__view *vw, hd_result r)
 {
-    ctx->be->grid = NULL;
+    vw->be->grid = NULL;
     return r;
 }
 
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_coarsen(const hd__view *vw, int l)
 {
-    struct hd__cpu_mg *mg = ctx->be->mg;
+    struct hd__cpu_mg *mg = vw->be->mg;
     mg->cur = l;
-    hd__cpu_parallel(ctx->be, hd__cpu_mg_sig_row, mg->lv[l].dims[1] * mg->lv[l].dims[2] * mg->sig_channels);
+    hd__cpu_parallel(vw->be, hd__cpu_mg_sig_row, mg->lv[l].dims[1] * mg->lv[l].dims[2] * mg->sig_channels);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx)
+static hd_result hd__be_mg_zero_lo(const hd__view *vw)
 {
-    struct hd__cpu_mg *mg = ctx->be->mg;
+    struct hd__cpu_mg *mg = vw->be->mg;
     memset(mg->lo, 0, hd__mg_slots(mg->fine, mg->channels) * sizeof(float));
     return HD_SUCCESS;
 }
@@ -409,63 +409,63 @@ static void hd__cpu_mg_pass(hd__backend *be, hd__cpu_job job, int l)
     hd__cpu_parallel(be, job, hd__mg_rows(&be->mg->lv[l], be->mg->channels));
 }
 
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
+static hd_result hd__be_mg_residual_f64(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->grid = &be->mg->fineg;
     hd__cpu_mg_pass(be, hd__cpu_mg_residual_f64_row, 0);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+static hd_result hd__be_mg_smooth(const hd__view *vw, int l, int sweeps, int first)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->grid = &be->mg->lv[l].g;
     hd__cpu_red_black(be, sweeps, first);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_residual(const hd__view *vw, int l)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->grid = &be->mg->lv[l].g;
     hd__cpu_mg_pass(be, hd__cpu_residual_row, l);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_restrict(const hd__view *vw, int l)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->mg->cur = l + 1;
     hd__cpu_mg_pass(be, hd__cpu_mg_restrict_row, l + 1);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_prolong(const hd__view *vw, int l)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->mg->cur = l + 1;
     hd__cpu_mg_pass(be, hd__cpu_mg_prolong_row, l);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx)
+static hd_result hd__be_mg_dot_rz(const hd__view *vw)
 {
-    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_rz_row, 0);
+    hd__cpu_mg_pass(vw->be, hd__cpu_mg_rz_row, 0);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+static hd_result hd__be_mg_direction(const hd__view *vw, float beta)
 {
-    ctx->be->mg->beta = beta;
-    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_dir_row, 0);
+    vw->be->mg->beta = beta;
+    hd__cpu_mg_pass(vw->be, hd__cpu_mg_dir_row, 0);
     return HD_SUCCESS;
 }
 
 /* q and both dot products in one pass over the rows (hd__cpu_mg_op_row). */
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
+static hd_result hd__be_mg_apply(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->grid = &be->mg->opg;
     hd__cpu_mg_pass(be, hd__cpu_mg_op_row, 0);
     be->grid = NULL;
@@ -473,24 +473,24 @@ static hd_result hd__be_mg_apply(hd__ctx *ctx)
 }
 
 /* The passes ran to completion in hd__cpu_parallel: the row sums are the host's. */
-static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+static hd_result hd__be_mg_row_sums(const hd__view *vw, int n, const double **a, const double **b)
 {
     (void)n;
-    *a = ctx->be->mg->dot_a;
-    *b = ctx->be->mg->dot_b;
+    *a = vw->be->mg->dot_a;
+    *b = vw->be->mg->dot_b;
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
+static hd_result hd__be_mg_update(const hd__view *vw, double alpha)
 {
-    ctx->be->mg->alpha = alpha;
-    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_update_row, 0);
+    vw->be->mg->alpha = alpha;
+    hd__cpu_mg_pass(vw->be, hd__cpu_mg_update_row, 0);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
+static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour)
 {
-    ctx->be->mg->colour = colour;
-    hd__cpu_mg_pass(ctx->be, hd__cpu_mg_extrap_row, 0);
+    vw->be->mg->colour = colour;
+    hd__cpu_mg_pass(vw->be, hd__cpu_mg_extrap_row, 0);
     return HD_SUCCESS;
 }

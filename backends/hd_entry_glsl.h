@@ -143,7 +143,7 @@ void main()
 #elif HD_STAGE == HD_STAGE_PROJECT
     /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h). hd_pc.y > 1: the
        dispatch's rows in blocks of hd_pc.z, block b drawing the image's block b * hd_pc.y mod
-       blocks (src/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of work groups
+       blocks (backends/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of work groups
        covers the whole image */
     if (hd_pc.y > 1) {
         int rb = hd_pc.z, nb = (HD_PRM(image).y + rb - 1) / rb;

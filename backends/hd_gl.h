@@ -135,7 +135,7 @@ typedef struct hd__gl_tex {
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__gl_level {
-    GLuint params;           /* the level's parameter block (src/hd_gpu.h's hd__gpu_level) */
+    GLuint params;           /* the level's parameter block (backends/hd_gpu.h's hd__gpu_level) */
     hd__gl_tex sig;          /* coarse levels only (level 0 reads the backend's sigma_t) */
     hd__gl_tex rhs, phi, res; /* right-hand side, correction, residual; level 0: r, z and q = A p */
 } hd__gl_level;
@@ -162,7 +162,7 @@ typedef struct hd__gl_state {
 } hd__gl_state;
 
 struct hd__backend {
-    hd__ctx *ctx;
+    const hd__view *vw;
     hd__gl_fns gl;
     hd_proc (*gpa)(const char *);
     int own;                    /* 1: the EGL context is the backend's */
@@ -181,11 +181,11 @@ struct hd__backend {
     hd__kparams params_kp;      /* what it holds */
     int params_valid;
     GLuint tf, maj, img, dummy_buffer;
-    GLuint dl;                  /* the direct light's list of voxels (ctx->dl_idx), storage buffer 4 */
+    GLuint dl;                  /* the direct light's list of voxels (vw->dl_idx), storage buffer 4 */
     hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
     hd__gl_tex lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
-       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (storage
+       gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (storage
        buffer 5, ptab_n entries), uploaded when its inputs change (ptab_key) */
     hd__gl_tex lsum;
     GLuint ptab;
@@ -194,10 +194,10 @@ struct hd__backend {
     size_t img_floats, tf_bytes;
     GLint max_3d, max_ssbo_block;
     int diffuse_zk, diffuse_yk; /* HD__GL_DIFFUSE_ZK, _YK: what the diffusion programs are compiled for */
-    int spread_rows;            /* 1 (llvmpipe): the projection's rows in blocks spread (src/hd_gpu.h) */
-    hd__gpu_grids gg;           /* what the grids are made for (src/hd_gpu.h) */
+    int spread_rows;            /* 1 (llvmpipe): the projection's rows in blocks spread (backends/hd_gpu.h) */
+    hd__gpu_grids gg;           /* what the grids are made for (backends/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
-    GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), compiled on first use */
+    GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (backends/hd_gpu.h), compiled on first use */
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -215,12 +215,12 @@ static hd__gl_proc hd__gl_load(hd__backend *be, const char *name)
     return f;
 }
 
-static hd_result hd__gl_load_fns(hd__ctx *ctx)
+static hd_result hd__gl_load_fns(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
 #define HD__GL_LOAD(up, name) \
     be->gl.name = (PFNGL##up##PROC)hd__gl_load(be, "gl" #name); \
-    if (!be->gl.name) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: cannot load gl" #name);
+    if (!be->gl.name) return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: cannot load gl" #name);
     HD__GL_FNS(HD__GL_LOAD)
 #undef HD__GL_LOAD
 #define HD__GL_LOAD_OPT(up, name) be->gl.name = (PFNGL##up##PROC)hd__gl_load(be, "gl" #name);
@@ -245,32 +245,32 @@ static const char *hd__gl_error_name(GLenum e)
 }
 
 /* The GL errors raised since the last check, as one hd_result (logged with what failed). */
-static hd_result hd__gl_check(hd__ctx *ctx, const char *what, int line)
+static hd_result hd__gl_check(const hd__view *vw, const char *what, int line)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r = HD_SUCCESS;
     GLenum e;
     int n = 0;
     while ((e = be->gl.GetError()) != GL_NO_ERROR && n++ < 16) {
         hd_result c = e == GL_OUT_OF_MEMORY ? HD_ERROR_OUT_OF_DEVICE_MEMORY : HD_ERROR_BACKEND;
-        hd__logf(&ctx->log, HD_LOG_ERROR, c, __FILE__, line, "gl: %s after %s (0x%04x)", hd__gl_error_name(e), what, (unsigned)e);
+        hd__logf(&vw->log, HD_LOG_ERROR, c, __FILE__, line, "gl: %s after %s (0x%04x)", hd__gl_error_name(e), what, (unsigned)e);
         if (r == HD_SUCCESS) r = c;
     }
     return r;
 }
-#define HD__GL_CHECK(ctx, what) \
-    do { hd_result hd__r = hd__gl_check((ctx), (what), __LINE__); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
+#define HD__GL_CHECK(vw, what) \
+    do { hd_result hd__r = hd__gl_check((vw), (what), __LINE__); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
 
 #ifndef NDEBUG
 static void APIENTRY hd__gl_debug(GLenum source, GLenum type, GLuint id, GLenum severity, GLsizei length,
                                     const GLchar *message, const void *user)
 {
-    const hd__ctx *ctx = (const hd__ctx *)user;
+    const hd__view *vw = (const hd__view *)user;
     (void)source; (void)length; (void)severity;
     /* a performance hint (e.g. NVIDIA's note that the image buffer moves to host memory for
        hd_read_image) is information, not a fault */
     hd_log_level level = type == GL_DEBUG_TYPE_ERROR ? HD_LOG_ERROR : type == GL_DEBUG_TYPE_PERFORMANCE ? HD_LOG_INFO : HD_LOG_WARNING;
-    hd__logf(&ctx->log, level, HD_SUCCESS, __FILE__, __LINE__, "gl debug (id %u): %s", (unsigned)id, message);
+    hd__logf(&vw->log, level, HD_SUCCESS, __FILE__, __LINE__, "gl debug (id %u): %s", (unsigned)id, message);
 }
 #endif
 
@@ -297,25 +297,25 @@ static void hd__gl_restore_indexed(hd__backend *be, GLenum target, GLuint index,
    the one current at hd_create where EGL or GLX can tell, else any (GL_VERSION answers). A GL
    call without a current context does nothing, so without this check iterations would count
    as run and the image would be stale. */
-static hd_result hd__gl_check_current(hd__ctx *ctx)
+static hd_result hd__gl_check_current(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     if (be->caller_egl != EGL_NO_CONTEXT) {
         EGLContext cur = eglGetCurrentContext();
         if (cur == be->caller_egl) return HD_SUCCESS;
-        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == EGL_NO_CONTEXT
+        return HD__ERR(&vw->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == EGL_NO_CONTEXT
                        ? "gl: no EGL context is current; make the one given at hd_create (use_current_context) current"
                        : "gl: another EGL context is current than the one given at hd_create (use_current_context)");
     }
     if (be->glx_current) {
         void *cur = be->glx_current();
         if (cur == be->caller_glx) return HD_SUCCESS;
-        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == NULL
+        return HD__ERR(&vw->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT, cur == NULL
                        ? "gl: no GLX context is current; make the one given at hd_create (use_current_context) current"
                        : "gl: another GLX context is current than the one given at hd_create (use_current_context)");
     }
     if (!be->gl.GetString(GL_VERSION))
-        return HD__ERR(&ctx->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT,
+        return HD__ERR(&vw->log, HD_ERROR_GL_CONTEXT_NOT_CURRENT,
                        "gl: no GL context is current (use_current_context: the caller's must be current at every call)");
     return HD_SUCCESS;
 }
@@ -323,9 +323,9 @@ static hd_result hd__gl_check_current(hd__ctx *ctx)
 /* The bracket (src/hd_backend.h): makes the context current (own context) and saves the host's
    bindings. Nested brackets (hd__be_create's, the test hooks') save once. Pending GL errors are
    not ours. */
-static hd_result hd__be_begin(hd__ctx *ctx)
+static hd_result hd__be_begin(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__gl_state *s = &be->saved;
     GLenum e;
     int i, j;
@@ -342,18 +342,18 @@ static hd_result hd__be_begin(hd__ctx *ctx)
             /* libglvnd lets a thread have one current context across EGL and GLX: a GLX context
                (GLFW's default) makes every eglMakeCurrent on that thread fail so. */
             if (err == EGL_BAD_ACCESS && s->egl_ctx == EGL_NO_CONTEXT)
-                return HD__ERR(&ctx->log, HD_ERROR_BACKEND,
+                return HD__ERR(&vw->log, HD_ERROR_BACKEND,
                                "gl: eglMakeCurrent failed (EGL_BAD_ACCESS): another API's context (GLX) is current on this "
                                "thread; pass it (desc.gl.use_current_context = 1) or make it not current around the call");
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)err);
+            return HD__ERR(&vw->log, HD_ERROR_BACKEND, "gl: eglMakeCurrent failed (0x%04x)", (unsigned)err);
         }
         s->switched = 1;
     } else if (!be->own) {
-        hd_result r = hd__gl_check_current(ctx);
+        hd_result r = hd__gl_check_current(vw);
         if (r != HD_SUCCESS) { be->depth--; return r; }
     }
     while ((e = be->gl.GetError()) != GL_NO_ERROR)
-        HD__INFO(&ctx->log, "gl: %s was pending before this call (not hybriddiff's; cleared)", hd__gl_error_name(e));
+        HD__INFO(&vw->log, "gl: %s was pending before this call (not hybriddiff's; cleared)", hd__gl_error_name(e));
     be->gl.GetIntegerv(GL_CURRENT_PROGRAM, &s->program);
     be->gl.GetIntegerv(GL_ACTIVE_TEXTURE, &s->active_texture);
     be->gl.ActiveTexture(GL_TEXTURE0);
@@ -380,14 +380,14 @@ static hd_result hd__be_begin(hd__ctx *ctx)
 
 /* Restores what hd__be_begin saved; r is the result of the call, returned unless the restore
    itself raised a GL error. */
-static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_end(const hd__view *vw, hd_result r)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__gl_state *s = &be->saved;
     hd_result r2;
     int i;
     if (--be->depth > 0) return r;
-    r2 = hd__gl_check(ctx, "the stage", __LINE__); /* errors of this call not caught yet */
+    r2 = hd__gl_check(vw, "the stage", __LINE__); /* errors of this call not caught yet */
     if (r == HD_SUCCESS) r = r2;
     be->gl.UseProgram((GLuint)s->program);
     hd__gl_restore_indexed(be, GL_UNIFORM_BUFFER, 0, s->ubo0, s->ubo0_start, s->ubo0_size);
@@ -402,7 +402,7 @@ static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
     be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)s->tex2d);
     be->gl.BindTexture(GL_TEXTURE_3D, (GLuint)s->tex3d);
     be->gl.ActiveTexture((GLenum)s->active_texture);
-    r2 = hd__gl_check(ctx, "restoring the host's state", __LINE__);
+    r2 = hd__gl_check(vw, "restoring the host's state", __LINE__);
     if (r == HD_SUCCESS) r = r2;
     if (s->switched && s->egl_ctx != EGL_NO_CONTEXT)
         eglMakeCurrent(s->egl_dpy, s->egl_draw, s->egl_read, s->egl_ctx);
@@ -432,12 +432,12 @@ static const char *const hd__gl_to_texture_src =
     "}\n";
 
 /* Compiles and links the program of slot p (a stage, or a diffusion variant) on its first use. */
-static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, const char *name, GLuint *out);
-static hd_result hd__gl_program(hd__ctx *ctx, int p)
+static hd_result hd__gl_build(const hd__view *vw, const char *const *src, GLsizei n, const char *name, GLuint *out);
+static hd_result hd__gl_program(const hd__view *vw, int p)
 {
     int half = p >= HD__GL_SLOTS_F32, q = p % HD__GL_SLOTS_F32;
     int stage = q < HD__GL_PROGRAM_COUNT ? q : HD__GL_DIFFUSE;
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     const char *src[1 + HD__GL_SOURCE_LINES];
     char prefix[256];
     GLsizei n = 0;
@@ -458,18 +458,18 @@ static hd_result hd__gl_program(hd__ctx *ctx, int p)
         for (i = 0; i < HD__GL_SOURCE_LINES; ++i) src[1 + i] = hd__gl_source[i];
         n = (GLsizei)(1 + HD__GL_SOURCE_LINES);
     }
-    return hd__gl_build(ctx, src, n, hd__gl_stage_names[stage], &be->programs[p]);
+    return hd__gl_build(vw, src, n, hd__gl_stage_names[stage], &be->programs[p]);
 }
 
 /* Compiles and links n source strings into *out. */
-static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, const char *name, GLuint *out)
+static hd_result hd__gl_build(const hd__view *vw, const char *const *src, GLsizei n, const char *name, GLuint *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     char log[4096];
     GLuint sh, prog;
     GLint ok = 0;
     sh = be->gl.CreateShader(GL_COMPUTE_SHADER);
-    if (!sh) return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: glCreateShader(GL_COMPUTE_SHADER) failed");
+    if (!sh) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "gl: glCreateShader(GL_COMPUTE_SHADER) failed");
     be->gl.ShaderSource(sh, n, src, NULL);
     be->gl.CompileShader(sh);
     be->gl.GetShaderiv(sh, GL_COMPILE_STATUS, &ok);
@@ -477,7 +477,7 @@ static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, c
         log[0] = '\0';
         be->gl.GetShaderInfoLog(sh, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteShader(sh);
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s shader does not compile (source-string numbers: "
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "gl: the %s shader does not compile (source-string numbers: "
                        "backends/hd_glsl_embedded.h):\n%s", name, log);
     }
     prog = be->gl.CreateProgram();
@@ -489,10 +489,10 @@ static hd_result hd__gl_build(hd__ctx *ctx, const char *const *src, GLsizei n, c
         log[0] = '\0';
         be->gl.GetProgramInfoLog(prog, (GLsizei)sizeof log, NULL, log);
         be->gl.DeleteProgram(prog);
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", name, log);
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "gl: the %s program does not link:\n%s", name, log);
     }
     *out = prog;
-    HD__GL_CHECK(ctx, "building a program");
+    HD__GL_CHECK(vw, "building a program");
     return HD_SUCCESS;
 }
 
@@ -511,46 +511,46 @@ static void hd__gl_free_buffer(hd__backend *be, GLuint *b)
 
 /* A w x h x d 3D texture of format fmt (GL_R32F or GL_R16F), zeroed (or filled from src, which
    the GL converts to fmt). */
-static hd_result hd__gl_tex_new_as(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, GLenum fmt, const float *src,
+static hd_result hd__gl_tex_new_as(const hd__view *vw, hd__gl_tex *t, int w, int h, int d, GLenum fmt, const float *src,
                                    const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     hd__gl_free_tex(be, t);
     if (w > be->max_3d || h > be->max_3d || d > be->max_3d)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: %s needs a %dx%dx%d 3D texture, above GL_MAX_3D_TEXTURE_SIZE = %d",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: %s needs a %dx%dx%d 3D texture, above GL_MAX_3D_TEXTURE_SIZE = %d",
                        what, w, h, d, be->max_3d);
     be->gl.GenTextures(1, &t->name);
     be->gl.BindTexture(GL_TEXTURE_3D, t->name);
     be->gl.TexStorage3D(GL_TEXTURE_3D, 1, fmt, w, h, d);
     t->extent[0] = w; t->extent[1] = h; t->extent[2] = d;
     t->format = fmt;
-    if ((r = hd__gl_check(ctx, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
+    if ((r = hd__gl_check(vw, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
     if (src) be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, src);
     else if (be->gl.ClearTexImage && be->version >= 44) be->gl.ClearTexImage(t->name, 0, GL_RED, GL_FLOAT, NULL);
     else {
-        float *zero = (float *)hd__calloc(ctx, (size_t)w * h * d, sizeof(float));
-        if (!zero) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to clear %s", what);
+        float *zero = (float *)hd__calloc(vw, (size_t)w * h * d, sizeof(float));
+        if (!zero) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to clear %s", what);
         be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, zero);
-        hd__free(ctx, zero);
+        hd__free(vw, zero);
     }
-    if ((r = hd__gl_check(ctx, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
+    if ((r = hd__gl_check(vw, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
     return HD_SUCCESS;
 }
 
 /* A GL_R32F 3D texture, the grids' usual form. */
-static hd_result hd__gl_tex_new(hd__ctx *ctx, hd__gl_tex *t, int w, int h, int d, const float *src, const char *what)
+static hd_result hd__gl_tex_new(const hd__view *vw, hd__gl_tex *t, int w, int h, int d, const float *src, const char *what)
 {
-    return hd__gl_tex_new_as(ctx, t, w, h, d, GL_R32F, src, what);
+    return hd__gl_tex_new_as(vw, t, w, h, d, GL_R32F, src, what);
 }
 
-static hd_result hd__gl_tex_zero(hd__ctx *ctx, hd__gl_tex *t)
+static hd_result hd__gl_tex_zero(const hd__view *vw, hd__gl_tex *t)
 {
     if (!t->name) return HD_SUCCESS;
-    return hd__gl_tex_new_as(ctx, t, t->extent[0], t->extent[1], t->extent[2], t->format, NULL, "clearing an illumination grid");
+    return hd__gl_tex_new_as(vw, t, t->extent[0], t->extent[1], t->extent[2], t->format, NULL, "clearing an illumination grid");
 }
 
-/* Grid id's texture (src/hd_gpu.h): E, phi, phi2 GL_R16F at float16 storage, the others GL_R32F. */
+/* Grid id's texture (backends/hd_gpu.h): E, phi, phi2 GL_R16F at float16 storage, the others GL_R32F. */
 static hd__gl_tex *hd__gl_grid(hd__backend *be, int id)
 {
     hd__gl_tex *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
@@ -558,21 +558,21 @@ static hd__gl_tex *hd__gl_grid(hd__backend *be, int id)
     hd__gl_tex *level[4] = {&L->sig, &L->rhs, &L->phi, &L->res}; /* by HD__G_MG_SIG, _RHS, _PHI, _RES */
     return id < HD__G_MG_LEVELS ? named[id] : id >= HD__G_LIGHT ? &be->lv[id - HD__G_LIGHT] : level[(id - HD__G_MG_LEVELS) % 4];
 }
-static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+static hd_result hd__gpu_grid_new(const hd__view *vw, int id, int w, int h, int d, const char *what)
 {
-    GLenum fmt = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? GL_R16F : GL_R32F;
-    return hd__gl_tex_new_as(ctx, hd__gl_grid(ctx->be, id), w, h, d, fmt, NULL, what);
+    GLenum fmt = vw->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? GL_R16F : GL_R32F;
+    return hd__gl_tex_new_as(vw, hd__gl_grid(vw->be, id), w, h, d, fmt, NULL, what);
 }
-static void hd__gpu_grid_free(hd__ctx *ctx, int id) { hd__gl_free_tex(ctx->be, hd__gl_grid(ctx->be, id)); }
-static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id) { return hd__gl_tex_zero(ctx, hd__gl_grid(ctx->be, id)); }
+static void hd__gpu_grid_free(const hd__view *vw, int id) { hd__gl_free_tex(vw->be, hd__gl_grid(vw->be, id)); }
+static hd_result hd__gpu_grid_zero(const hd__view *vw, int id) { return hd__gl_tex_zero(vw, hd__gl_grid(vw->be, id)); }
 
-static hd_result hd__gl_buffer_data(hd__ctx *ctx, GLuint *b, size_t bytes, const void *src, GLenum usage, const char *what)
+static hd_result hd__gl_buffer_data(const hd__view *vw, GLuint *b, size_t bytes, const void *src, GLenum usage, const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     if (!*b) be->gl.GenBuffers(1, b);
     be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, *b);
     be->gl.BufferData(GL_COPY_WRITE_BUFFER, (GLsizeiptr)(bytes ? bytes : 16), src, usage);
-    return hd__gl_check(ctx, what, __LINE__);
+    return hd__gl_check(vw, what, __LINE__);
 }
 
 /* Binds every resource to its unit (placeholders for the absent ones) and the program. An image
@@ -583,14 +583,14 @@ static void hd__gl_bind_image(hd__backend *be, GLuint unit, const hd__gl_tex *t,
     be->gl.BindImageTexture(unit, u->name, 0, GL_TRUE, 0, access, u->format);
 }
 
-/* Sends ctx->kp to the backend's uniform buffer when it changed. */
-static void hd__gl_send_params(hd__ctx *ctx)
+/* Sends vw->kp to the backend's uniform buffer when it changed. */
+static void hd__gl_send_params(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    if (!be->params_valid || memcmp(&be->params_kp, &ctx->kp, sizeof ctx->kp) != 0) {
+    hd__backend *be = vw->be;
+    if (!be->params_valid || memcmp(&be->params_kp, &vw->kp, sizeof vw->kp) != 0) {
         be->gl.BindBuffer(GL_UNIFORM_BUFFER, be->params);
-        be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof ctx->kp, &ctx->kp, GL_STREAM_DRAW);
-        be->params_kp = ctx->kp;
+        be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof vw->kp, &vw->kp, GL_STREAM_DRAW);
+        be->params_kp = vw->kp;
         be->params_valid = 1;
     }
 }
@@ -605,10 +605,10 @@ typedef struct hd__gl_binds {
 
 /* Runs program prog over nx x ny x nz invocations (x in work groups of HD__GL_LOCAL_X) with the
    bindings b and hd_pc = (pc_x, pc_y, pc_z, pc_w); what names it in errors. */
-static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const hd__gl_binds *b, int nx, int ny, int nz,
+static hd_result hd__gl_run(const hd__view *vw, GLuint prog, const char *what, const hd__gl_binds *b, int nx, int ny, int nz,
                             int pc_x, int pc_y, int pc_z, int pc_w)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int i;
     be->gl.UseProgram(prog);
     be->gl.Uniform4i(0, pc_x, pc_y, pc_z, pc_w);
@@ -622,26 +622,26 @@ static hd_result hd__gl_run(hd__ctx *ctx, GLuint prog, const char *what, const h
         hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
     be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
-    return hd__gl_check(ctx, what, __LINE__);
+    return hd__gl_check(vw, what, __LINE__);
 }
 
-static hd_result hd__gl_dispatch(hd__ctx *ctx, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
+static hd_result hd__gl_dispatch(const hd__view *vw, int p, int light, int nx, int ny, int nz, int pc_x, int pc_y, int pc_z,
                                  int pc_w)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     hd__gl_binds b;
     int half = be->gg.f16 && hd__gl_touches_illum(p);
-    int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(ctx->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
-    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
-    hd__gl_send_params(ctx);
+    int slot = (p == HD__GL_DIFFUSE ? hd__gl_diffuse_slot(vw->kp.counts.z) : p) + (half ? HD__GL_SLOTS_F32 : 0);
+    if ((r = hd__gl_program(vw, slot)) != HD_SUCCESS) return r;
+    hd__gl_send_params(vw);
     b.params = be->params;
     b.img[0] = &be->vol; b.img[1] = &be->sig; b.img[2] = &be->E; b.img[3] = &be->phi; b.img[4] = &be->phi2;
     b.img[5] = light < be->gg.nlv ? &be->lv[light] : NULL;
     b.img[6] = be->gg.nlv ? &be->lv[be->gg.nlv] : NULL;
     b.img[7] = &be->lsum;
     b.half = half;
-    return hd__gl_run(ctx, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
+    return hd__gl_run(vw, be->programs[slot], hd__gl_stage_names[p], &b, nx, ny, nz, pc_x, pc_y, pc_z, pc_w);
 }
 
 
@@ -658,9 +658,9 @@ static int hd__gl_has_ext(const char *list, const char *name)
 }
 
 /* A headless display: surfaceless, else the first EGL device, else the default display. */
-static hd_result hd__gl_egl_display(hd__ctx *ctx)
+static hd_result hd__gl_egl_display(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     const char *cext = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     PFNEGLGETPLATFORMDISPLAYEXTPROC get_platform_display =
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
@@ -689,27 +689,27 @@ static hd_result hd__gl_egl_display(hd__ctx *ctx)
         if (be->dpy != EGL_NO_DISPLAY && !eglInitialize(be->dpy, &major, &minor)) be->dpy = EGL_NO_DISPLAY;
     }
     if (be->dpy == EGL_NO_DISPLAY)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no EGL display (surfaceless, device or default): 0x%04x",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no EGL display (surfaceless, device or default): 0x%04x",
                        (unsigned)eglGetError());
-    HD__INFO(&ctx->log, "gl: EGL %d.%d through %s (%s)", (int)major, (int)minor, how, eglQueryString(be->dpy, EGL_VENDOR));
+    HD__INFO(&vw->log, "gl: EGL %d.%d through %s (%s)", (int)major, (int)minor, how, eglQueryString(be->dpy, EGL_VENDOR));
     return HD_SUCCESS;
 }
 
-static hd_result hd__gl_egl_context(hd__ctx *ctx)
+static hd_result hd__gl_egl_context(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     static const EGLint config_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
     static const int versions[2][2] = {{4, 5}, {4, 3}};
     EGLConfig config = NULL;
     EGLint nconfig = 0;
     int v;
     hd_result r;
-    if ((r = hd__gl_egl_display(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_egl_display(vw)) != HD_SUCCESS) return r;
     if (!eglBindAPI(EGL_OPENGL_API))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglBindAPI(EGL_OPENGL_API) failed: 0x%04x", (unsigned)eglGetError());
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: eglBindAPI(EGL_OPENGL_API) failed: 0x%04x", (unsigned)eglGetError());
     if (!eglChooseConfig(be->dpy, config_attrs, &config, 1, &nconfig) || nconfig < 1) {
         if (!hd__gl_has_ext(eglQueryString(be->dpy, EGL_EXTENSIONS), "EGL_KHR_no_config_context"))
-            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no EGL config with EGL_OPENGL_BIT and no EGL_KHR_no_config_context");
+            return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no EGL config with EGL_OPENGL_BIT and no EGL_KHR_no_config_context");
         config = (EGLConfig)0; /* EGL_NO_CONFIG_KHR */
     }
     for (v = 0; v < 2 && !be->egl; ++v) {
@@ -725,89 +725,89 @@ static hd_result hd__gl_egl_context(hd__ctx *ctx)
         if (be->egl == EGL_NO_CONTEXT) be->egl = NULL;
     }
     if (!be->egl)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: eglCreateContext: no OpenGL 4.5 or 4.3 core context (0x%04x)",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: eglCreateContext: no OpenGL 4.5 or 4.3 core context (0x%04x)",
                        (unsigned)eglGetError());
     return HD_SUCCESS;
 }
 
-static void hd__be_destroy(hd__ctx *ctx)
+static void hd__be_destroy(hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int i;
     if (!be) return;
-    if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__be_begin(ctx) == HD_SUCCESS) {
+    if (be->gl.GetError && (be->own ? be->egl != NULL : 1) && hd__be_begin(vw) == HD_SUCCESS) {
         for (i = 0; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) be->gl.DeleteProgram(be->programs[i]);
         for (i = 0; i < HD__GPU_MG_VARIANTS; ++i)
             if (be->mg_programs[i]) be->gl.DeleteProgram(be->mg_programs[i]);
-        hd__gpu_free(ctx, &be->gg);
+        hd__gpu_free(vw, &be->gg);
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
-        hd__be_end(ctx, HD_SUCCESS);
+        hd__be_end(vw, HD_SUCCESS);
     }
-    hd__free(ctx, be->mg.host_dot); /* left when GL was unreachable */
+    hd__free(vw, be->mg.host_dot); /* left when GL was unreachable */
     if (be->own && be->egl) {
         if (eglGetCurrentContext() == be->egl) eglMakeCurrent(be->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(be->dpy, be->egl);
     }
-    hd__free(ctx, be);
-    ctx->be = NULL;
+    hd__free(vw, be);
+    vw->be = NULL;
 }
 
-static hd_result hd__gl_setup(hd__ctx *ctx)
+static hd_result hd__gl_setup(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     GLint major = 0, minor = 0, units = 0, ssbos = 0;
     hd_result r;
     if (!be->gl.GetString(GL_VERSION))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: no GL context is current (use_current_context = %d)",
-                       ctx->desc.gl.use_current_context);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no GL context is current (use_current_context = %d)",
+                       vw->desc.gl.use_current_context);
     be->gl.GetIntegerv(GL_MAJOR_VERSION, &major);
     be->gl.GetIntegerv(GL_MINOR_VERSION, &minor);
     be->version = major * 10 + minor;
-    HD__INFO(&ctx->log, "gl: %s, %s (%s context)", (const char *)be->gl.GetString(GL_RENDERER),
+    HD__INFO(&vw->log, "gl: %s, %s (%s context)", (const char *)be->gl.GetString(GL_RENDERER),
              (const char *)be->gl.GetString(GL_VERSION), be->own ? "own EGL" : "the caller's");
     /* llvmpipe runs the work groups of a dispatch as one contiguous run per thread */
     be->spread_rows = be->gl.GetString(GL_RENDERER) && strstr((const char *)be->gl.GetString(GL_RENDERER), "llvmpipe");
     if (be->version < 43)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: OpenGL %d.%d; compute shaders need 4.3", (int)major, (int)minor);
     be->gl.GetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &be->max_3d);
     be->gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &be->max_ssbo_block);
     be->gl.GetIntegerv(GL_MAX_IMAGE_UNITS, &units);
     be->gl.GetIntegerv(GL_MAX_SHADER_STORAGE_BUFFER_BINDINGS, &ssbos);
     if (units < HD__GL_IMAGE_UNITS || ssbos < HD__GL_SSBOS)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: %d image units and %d storage buffer bindings; %d and %d needed",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: %d image units and %d storage buffer bindings; %d and %d needed",
                        (int)units, (int)ssbos, HD__GL_IMAGE_UNITS, HD__GL_SSBOS);
 #ifndef NDEBUG
     if (be->own && be->gl.DebugMessageCallback && be->gl.DebugMessageControl) {
         be->gl.Enable(GL_DEBUG_OUTPUT);
-        be->gl.DebugMessageCallback(hd__gl_debug, ctx);
+        be->gl.DebugMessageCallback(hd__gl_debug, vw);
         be->gl.DebugMessageControl(GL_DONT_CARE, GL_DONT_CARE, GL_DEBUG_SEVERITY_NOTIFICATION, 0, NULL, GL_FALSE);
     }
 #endif
     be->gl.GenBuffers(1, &be->params);
-    if ((r = hd__gl_buffer_data(ctx, &be->dummy_buffer, 16, NULL, GL_STATIC_DRAW, "a placeholder buffer")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_tex_new(ctx, &be->dummy, 1, 1, 1, NULL, "a placeholder image")) != HD_SUCCESS) return r;
-    if ((r = hd__gl_tex_new_as(ctx, &be->dummy16, 1, 1, 1, GL_R16F, NULL, "a float16 placeholder image")) != HD_SUCCESS) return r;
-    return hd__gl_tex_new(ctx, &be->vol, ctx->dims[0], ctx->dims[1], ctx->dims[2], ctx->vol, "the volume");
+    if ((r = hd__gl_buffer_data(vw, &be->dummy_buffer, 16, NULL, GL_STATIC_DRAW, "a placeholder buffer")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new(vw, &be->dummy, 1, 1, 1, NULL, "a placeholder image")) != HD_SUCCESS) return r;
+    if ((r = hd__gl_tex_new_as(vw, &be->dummy16, 1, 1, 1, GL_R16F, NULL, "a float16 placeholder image")) != HD_SUCCESS) return r;
+    return hd__gl_tex_new(vw, &be->vol, vw->dims[0], vw->dims[1], vw->dims[2], vw->vol, "the volume");
 }
 
-static hd_result hd__be_create(hd__ctx *ctx)
+static hd_result hd__be_create(hd__view *vw)
 {
     hd__backend *be;
     hd_result r;
-    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
-    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the backend");
-    ctx->be = be;
-    be->ctx = ctx;
+    be = (hd__backend *)hd__calloc(vw, 1, sizeof *be);
+    if (!be) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the backend");
+    vw->be = be;
+    be->vw = vw;
     be->diffuse_zk = HD__GL_DIFFUSE_ZK;
     be->diffuse_yk = HD__GL_DIFFUSE_YK;
-    be->gpa = ctx->desc.gl.get_proc_address;
-    be->own = !ctx->desc.gl.use_current_context;
+    be->gpa = vw->desc.gl.get_proc_address;
+    be->own = !vw->desc.gl.use_current_context;
     if (be->own) {
-        if ((r = hd__gl_egl_context(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__gl_egl_context(vw)) != HD_SUCCESS) return r;
     } else {
         be->caller_egl = eglGetCurrentContext();
         if (be->caller_egl == EGL_NO_CONTEXT && be->gpa) {
@@ -817,45 +817,45 @@ static hd_result hd__be_create(hd__ctx *ctx)
             if (!be->caller_glx) be->glx_current = NULL;
         }
         if (!be->gpa && be->caller_egl == EGL_NO_CONTEXT)
-            HD__INFO(&ctx->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
+            HD__INFO(&vw->log, "gl: use_current_context with no current EGL context: loading through eglGetProcAddress anyway");
     }
-    if ((r = hd__gl_load_fns(ctx)) != HD_SUCCESS) {
+    if ((r = hd__gl_load_fns(vw)) != HD_SUCCESS) {
         be->gl.GetError = NULL; /* hd__be_destroy must not call into GL */
         return r;
     }
     /* the own context is made current by hd__be_begin, which makes the caller's current again */
-    if ((r = hd__be_begin(ctx)) != HD_SUCCESS) return r;
-    return hd__be_end(ctx, hd__gl_setup(ctx));
+    if ((r = hd__be_begin(vw)) != HD_SUCCESS) return r;
+    return hd__be_end(vw, hd__gl_setup(vw));
 }
 
 /* ---- inputs and allocations ---------------------------------------------------------------------- */
-static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+static hd_result hd__be_upload_inputs(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
-    if ((r = hd__gl_buffer_data(ctx, &be->tf, (size_t)ctx->tf_count * 4 * sizeof(float), ctx->tf, GL_DYNAMIC_DRAW,
+    size_t ncell = (size_t)vw->mdims[0] * vw->mdims[1] * vw->mdims[2];
+    if ((r = hd__gl_buffer_data(vw, &be->tf, (size_t)vw->tf_count * 4 * sizeof(float), vw->tf, GL_DYNAMIC_DRAW,
                                 "uploading the transfer function")) != HD_SUCCESS)
         return r;
-    return hd__gl_buffer_data(ctx, &be->maj, ncell * sizeof(float), ctx->majorant, GL_DYNAMIC_DRAW, "uploading the majorant grid");
+    return hd__gl_buffer_data(vw, &be->maj, ncell * sizeof(float), vw->majorant, GL_DYNAMIC_DRAW, "uploading the majorant grid");
 }
 
-static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
-    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
+    return hd__gpu_alloc_illumination(vw, &vw->be->gg, illum_floats);
 }
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable); }
+static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable) { return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable); }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t floats = hd__image_floats(width, height, reduced), bytes = floats * sizeof(float);
     GLuint img = 0;
     hd_result r;
     if (bytes > (size_t)be->max_ssbo_block)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image%s needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image%s needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
                        width, height, reduced ? " with room for reduced frames" : "", bytes, (int)be->max_ssbo_block);
-    if ((r = hd__gl_buffer_data(ctx, &img, bytes, NULL, GL_DYNAMIC_COPY, reduced ? "the image with room for reduced frames" : "the image")) !=
+    if ((r = hd__gl_buffer_data(vw, &img, bytes, NULL, GL_DYNAMIC_COPY, reduced ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__gl_free_buffer(be, &img);
         return r;
@@ -866,105 +866,108 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int red
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(vw, &be->gg, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img) {
         be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->img);
         be->gl.ClearBufferData(GL_COPY_WRITE_BUFFER, GL_R32F, GL_RED, GL_FLOAT, NULL);
     }
-    return hd__gl_check(ctx, "clearing", __LINE__);
+    return hd__gl_check(vw, "clearing", __LINE__);
 }
 
 /* ---- stages ------------------------------------------------------------------------------------ */
-static hd_result hd__be_classify(hd__ctx *ctx)
+static hd_result hd__be_classify(const hd__view *vw)
 {
-    return hd__gl_dispatch(ctx, HD__GL_CLASSIFY, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, 0, 0);
+    return hd__gl_dispatch(vw, HD__GL_CLASSIFY, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0, 0, 0, 0);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
-static hd_result hd__be_direct_list(hd__ctx *ctx)
+static hd_result hd__be_direct_list(const hd__view *vw)
 {
-    return hd__gl_buffer_data(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, GL_STATIC_DRAW,
+    return hd__gl_buffer_data(vw, &vw->be->dl, vw->dl_count * sizeof(uint32_t), vw->dl_idx, GL_STATIC_DRAW,
                               "the direct light's list");
 }
 
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
    groups along x are limited to 65535). */
 #define HD__DIRECT_ROW (HD__GL_LOCAL_X * 32768)
-static hd_result hd__be_direct(hd__ctx *ctx)
+static hd_result hd__be_direct(const hd__view *vw)
 {
-    int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    ctx->be->gg.lsum_ok = 0;
-    return hd__gl_dispatch(ctx, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0);
+    int n = (int)vw->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    vw->be->gg.lsum_ok = 0;
+    return hd__gl_dispatch(vw, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
    Jacobi pass phi -> phi2 and a swap of the two names. */
-static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     /* invocations along y and z: blocks of diffuse_yk rows and diffuse_zk slices, nzb per channel
        (uniform hd_pc.z, hd_entry_glsl.h) */
-    int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
-    int nz = nzb * ctx->channels, parity;
+    int ny = (vw->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (vw->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int nz = nzb * vw->channels, parity;
     be->gg.lsum_ok = 0;
     if (jacobi) {
         hd__gl_tex t;
-        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
+        if ((r = hd__gl_dispatch(vw, HD__GL_DIFFUSE, 0, vw->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
         t = be->phi; be->phi = be->phi2; be->phi2 = t;
         return HD_SUCCESS;
     }
     for (parity = 0; parity < 2; ++parity)
-        if ((r = hd__gl_dispatch(ctx, HD__GL_DIFFUSE, 0, (ctx->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
+        if ((r = hd__gl_dispatch(vw, HD__GL_DIFFUSE, 0, (vw->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
             return r;
     return HD_SUCCESS;
 }
 
 /* The projection's inputs: lsum rebuilt (the light-sum stage) after a pass that changed E or phi,
    and the TF table (hd__project_table) built and uploaded when its inputs changed (ptab_key). */
-static hd_result hd__gl_project_prepare(hd__ctx *ctx)
+static hd_result hd__gl_project_prepare(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int n = hd__project_table_n(ctx);
+    hd__backend *be = vw->be;
+    int n = hd__project_table_n(vw);
     float *t;
     hd_result r;
     if (!be->gg.lsum_ok) {
-        if ((r = hd__gl_dispatch(ctx, HD__GL_LIGHT_SUM, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0,
+        if ((r = hd__gl_dispatch(vw, HD__GL_LIGHT_SUM, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0,
                                  0, 0)) != HD_SUCCESS)
             return r;
         be->gg.lsum_ok = 1;
     }
-    if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
-    if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
+    if (hd__project_table_key_same(vw, &be->ptab_key)) return HD_SUCCESS;
+    if (!(t = hd__project_table_new(vw, n))) return HD_ERROR_OUT_OF_MEMORY;
     be->ptab_key.valid = 0;
     be->ptab_n = 0;
-    r = hd__gl_buffer_data(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");
-    hd__free(ctx, t);
+    r = hd__gl_buffer_data(vw, &be->ptab, (size_t)n * 4 * sizeof(float), t, GL_DYNAMIC_DRAW, "the projection's TF table");
+    hd__free(vw, t);
     if (r != HD_SUCCESS) return r;
-    be->ptab_key = hd__project_table_key(ctx);
+    be->ptab_key = hd__project_table_key(vw);
     be->ptab_n = n;
     return HD_SUCCESS;
 }
-static hd_result hd__be_project(hd__ctx *ctx)
+static hd_result hd__be_project(const hd__view *vw)
 {
-    int nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK, p = ctx->be->spread_rows ? hd__gpu_row_stride(nb) : 1;
-    hd_result r = hd__gl_project_prepare(ctx);
+    int nb = (vw->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK, p = vw->be->spread_rows ? hd__gpu_row_stride(nb) : 1;
+    hd_result r = hd__gl_project_prepare(vw);
     if (r != HD_SUCCESS) return r;
-    return hd__gl_dispatch(ctx, HD__GL_PROJECT, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1,
-                           ctx->be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
+    return hd__gl_dispatch(vw, HD__GL_PROJECT, 0, vw->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : vw->kp.image.y, 1,
+                           vw->be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
 }
 
+/* The projection's program runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_glsl.h). */
+static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+
 /* ---- read-back ------------------------------------------------------------------------------- */
-static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
-    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float)), dst);
-    return hd__gl_check(ctx, "reading the image", __LINE__);
+    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float)), dst);
+    return hd__gl_check(vw, "reading the image", __LINE__);
 }
 
 /* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
@@ -972,85 +975,85 @@ static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
    it. GL_R16F grids come back widened to float by the GL, exactly (every half is a float). The
    image units are unbound first (the next dispatch binds its own): NVIDIA's driver reads a
    texture still bound as a writable image slowly, about 2 ms a slice on an H200. */
-static hd_result hd__gl_read_tex(hd__ctx *ctx, const hd__gl_tex *t, const int *list, int count, float *dst)
+static hd_result hd__gl_read_tex(const hd__view *vw, const hd__gl_tex *t, const int *list, int count, float *dst)
 {
     size_t slice = (size_t)t->extent[0] * t->extent[1];
     float *all = dst;
     int k;
-    for (k = 0; k < HD__GL_IMAGE_UNITS; ++k) ctx->be->gl.BindImageTexture((GLuint)k, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
-    if (list && ctx->be->gl.GetTextureSubImage) {
+    for (k = 0; k < HD__GL_IMAGE_UNITS; ++k) vw->be->gl.BindImageTexture((GLuint)k, 0, 0, GL_FALSE, 0, GL_READ_ONLY, GL_R32F);
+    if (list && vw->be->gl.GetTextureSubImage) {
         for (k = 0; k < count; ++k)
-            ctx->be->gl.GetTextureSubImage(t->name, 0, 0, 0, list[k], t->extent[0], t->extent[1], 1, GL_RED, GL_FLOAT,
+            vw->be->gl.GetTextureSubImage(t->name, 0, 0, 0, list[k], t->extent[0], t->extent[1], 1, GL_RED, GL_FLOAT,
                                            (GLsizei)(slice * sizeof(float)), dst + (size_t)k * slice);
-        return hd__gl_check(ctx, "reading illumination slices", __LINE__);
+        return hd__gl_check(vw, "reading illumination slices", __LINE__);
     }
-    if (list && !(all = (float *)hd__alloc(ctx, slice * (size_t)t->extent[2] * sizeof(float))))
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to read an illumination grid");
-    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    ctx->be->gl.GetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, all);
+    if (list && !(all = (float *)hd__alloc(vw, slice * (size_t)t->extent[2] * sizeof(float))))
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to read an illumination grid");
+    vw->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    vw->be->gl.GetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, all);
     for (k = 0; list && k < count; ++k) memcpy(dst + (size_t)k * slice, all + (size_t)list[k] * slice, slice * sizeof(float));
-    if (list) hd__free(ctx, all);
-    return hd__gl_check(ctx, "reading an illumination grid", __LINE__);
+    if (list) hd__free(vw, all);
+    return hd__gl_check(vw, "reading an illumination grid", __LINE__);
 }
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
 {
-    return hd__gl_read_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, zz, count, dst);
+    return hd__gl_read_tex(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, zz, count, dst);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
 /* A GL_R16F grid gets the floats rounded to nearest even on the host (hd_f2h, the CPU backend's
    halves): the GL's own conversion may truncate, as llvmpipe's image stores do. */
-static hd_result hd__gl_write_tex(hd__ctx *ctx, const hd__gl_tex *t, const float *src)
+static hd_result hd__gl_write_tex(const hd__view *vw, const hd__gl_tex *t, const float *src)
 {
     size_t n = (size_t)t->extent[0] * t->extent[1] * t->extent[2], i;
     uint16_t *h = NULL;
     if (t->format == GL_R16F) {
-        if (!(h = (uint16_t *)hd__calloc(ctx, n, sizeof(uint16_t))))
-            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to convert an illumination grid");
+        if (!(h = (uint16_t *)hd__calloc(vw, n, sizeof(uint16_t))))
+            return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to convert an illumination grid");
         for (i = 0; i < n; ++i) h[i] = hd_f2h(src[i]);
     }
-    ctx->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
-    ctx->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED,
+    vw->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
+    vw->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED,
                               h ? GL_HALF_FLOAT : GL_FLOAT, h ? (const void *)h : (const void *)src);
-    if (h) hd__free(ctx, h);
-    return hd__gl_check(ctx, "writing an illumination grid", __LINE__);
+    if (h) hd__free(vw, h);
+    return hd__gl_check(vw, "writing an illumination grid", __LINE__);
 }
-HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
-    ctx->be->gg.lsum_ok = 0;
-    return hd__gl_write_tex(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
+    vw->be->gg.lsum_ok = 0;
+    return hd__gl_write_tex(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, src);
 }
 /* For src/hd_test_hooks.h: waits until the GL has done everything queued. */
-HD__MAYBE_UNUSED static hd_result hd__gl_finish(hd__ctx *ctx)
+HD__MAYBE_UNUSED static hd_result hd__gl_finish(const hd__view *vw)
 {
-    hd_result r = hd__be_begin(ctx);
-    if (r == HD_SUCCESS) ctx->be->gl.Finish();
-    return r == HD_SUCCESS ? hd__be_end(ctx, r) : r;
+    hd_result r = hd__be_begin(vw);
+    if (r == HD_SUCCESS) vw->be->gl.Finish();
+    return r == HD_SUCCESS ? hd__be_end(vw, r) : r;
 }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count); }
+static hd_result hd__be_alloc_lights(const hd__view *vw, int count) { return hd__gpu_alloc_lights(vw, &vw->be->gg, count); }
 
 /* One convection step of light `light`: its volume -> the spare, and the two swap names. */
-static hd_result hd__be_convect(hd__ctx *ctx, int light)
+static hd_result hd__be_convect(const hd__view *vw, int light)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     hd__gl_tex t;
-    if ((r = hd__gl_dispatch(ctx, HD__GL_CONVECT, light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
+    if ((r = hd__gl_dispatch(vw, HD__GL_CONVECT, light, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
         return r;
     t = be->lv[light]; be->lv[light] = be->lv[be->gg.nlv]; be->lv[be->gg.nlv] = t;
     return HD_SUCCESS;
 }
 
 /* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
-static hd_result hd__be_sum_lights(hd__ctx *ctx)
+static hd_result hd__be_sum_lights(const hd__view *vw)
 {
     hd_result r;
     int l;
-    ctx->be->gg.lsum_ok = 0;
-    for (l = 0; l < ctx->be->gg.nlv; ++l)
-        if ((r = hd__gl_dispatch(ctx, HD__GL_SUM_LIGHT, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+    vw->be->gg.lsum_ok = 0;
+    for (l = 0; l < vw->be->gg.nlv; ++l)
+        if ((r = hd__gl_dispatch(vw, HD__GL_SUM_LIGHT, l, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
     return HD_SUCCESS;
 }
@@ -1065,13 +1068,13 @@ static hd_result hd__be_sum_lights(hd__ctx *ctx)
    GLSL 4.00 doubles; the dot products are summed per row on the GPU (x in order, doubles into
    storage buffer 3) and the rows in row order by the core, as on the CPU. */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
-static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
+static size_t hd__be_solver_bytes(const hd__view *vw) { return hd__gpu_solver_bytes(vw, &vw->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw) { return &vw->be->gg; }
 
 /* The levels' parameter buffers and the row sums (device and host). */
-static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
+static hd_result hd__gpu_mg_extras(const hd__view *vw, int make)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__gl_mg *mg = &be->mg;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
@@ -1082,28 +1085,28 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
         if (make) be->gl.GenBuffers(1, &L->params);
     }
     hd__gl_free_buffer(be, &mg->dot_a); hd__gl_free_buffer(be, &mg->dot_b);
-    hd__free(ctx, mg->host_dot);
+    hd__free(vw, mg->host_dot);
     mg->host_dot = NULL;
     if (!make) return HD_SUCCESS;
-    if (!(mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double))))
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows");
-    if ((r = hd__gl_buffer_data(ctx, &mg->dot_a, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS)
+    if (!(mg->host_dot = (double *)hd__calloc(vw, 2 * rows, sizeof(double))))
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: cannot allocate the dot products' rows");
+    if ((r = hd__gl_buffer_data(vw, &mg->dot_a, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums")) != HD_SUCCESS)
         return r;
-    return hd__gl_buffer_data(ctx, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums");
+    return hd__gl_buffer_data(vw, &mg->dot_b, rows * sizeof(double), NULL, GL_DYNAMIC_READ, "multigrid's row sums");
 }
 
-static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
+static hd_result hd__gpu_mg_send(const hd__view *vw, int l, const hd__kparams *kp)
 {
-    ctx->be->gl.BindBuffer(GL_UNIFORM_BUFFER, ctx->be->mg.lv[l].params);
-    ctx->be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof *kp, kp, GL_STATIC_DRAW);
-    return hd__gl_check(ctx, "multigrid level parameters", __LINE__);
+    vw->be->gl.BindBuffer(GL_UNIFORM_BUFFER, vw->be->mg.lv[l].params);
+    vw->be->gl.BufferData(GL_UNIFORM_BUFFER, (GLsizeiptr)sizeof *kp, kp, GL_STATIC_DRAW);
+    return hd__gl_check(vw, "multigrid level parameters", __LINE__);
 }
 
 /* The program of multigrid stage `stage` for the flags in counts_z (RGB, surface), compiled on
    first use: hd__gl_source up to hd_entry_glsl.h, then hd_entry_glsl_multigrid.h. */
-static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint *out)
+static hd_result hd__gl_mg_program(const hd__view *vw, int stage, int counts_z, GLuint *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int flags, variant = hd__gpu_mg_variant(stage, counts_z, &flags);
     GLuint *slot = &be->mg_programs[variant];
     const char *src[1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES];
@@ -1118,19 +1121,19 @@ static hd_result hd__gl_mg_program(hd__ctx *ctx, int stage, int counts_z, GLuint
         src[0] = prefix;
         for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
         for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];
-        r = hd__gl_build(ctx, src, (GLsizei)(1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES), hd__mg_stage_names[stage - 1], slot);
+        r = hd__gl_build(vw, src, (GLsizei)(1 + HD__GL_COMMON_LINES + HD__GL_SOURCE_MG_LINES), hd__mg_stage_names[stage - 1], slot);
         if (r != HD_SUCCESS) return r;
     }
     *out = *slot;
     return HD_SUCCESS;
 }
 
-/* Set `set`'s grids (src/hd_gpu.h) on image units 1..4 and 6, its row sums on storage buffer 3,
-   and parameter slot `slot`: level slot's buffer, or the backend's own for the fine ctx->kp. */
-static void hd__gl_mg_binds(hd__ctx *ctx, int set, int slot, hd__gl_binds *b)
+/* Set `set`'s grids (backends/hd_gpu.h) on image units 1..4 and 6, its row sums on storage buffer 3,
+   and parameter slot `slot`: level slot's buffer, or the backend's own for the fine vw->kp. */
+static void hd__gl_mg_binds(const hd__view *vw, int set, int slot, hd__gl_binds *b)
 {
     static const int unit[5] = {1, 2, 3, 4, 6};
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__gpu_mg_binds s;
     int i;
     memset(b, 0, sizeof *b);
@@ -1141,39 +1144,39 @@ static void hd__gl_mg_binds(hd__ctx *ctx, int set, int slot, hd__gl_binds *b)
     if (s.dot) be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.dot == 1 ? be->mg.dot_a : be->mg.dot_b);
 }
 
-/* Runs pass p with the program of its stage for the flags of ctx->kp; the direction's beta and
+/* Runs pass p with the program of its stage for the flags of vw->kp; the direction's beta and
    the update's alpha are the uniforms at locations 1 and 2 (hd_entry_glsl_multigrid.h). */
-static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
+static hd_result hd__gpu_mg_pass(const hd__view *vw, const hd__gpu_mg_run *p)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__gl_binds b;
     GLuint prog;
     hd_result r;
-    if ((r = hd__gl_mg_program(ctx, p->stage, ctx->kp.counts.z, &prog)) != HD_SUCCESS) return r;
+    if ((r = hd__gl_mg_program(vw, p->stage, vw->kp.counts.z, &prog)) != HD_SUCCESS) return r;
     if (p->stage == HD__MG_DIR || p->stage == HD__MG_UPDATE) {
         if (p->stage == HD__MG_DIR) be->gl.ProgramUniform1f(prog, 1, p->beta);
         else be->gl.ProgramUniform1d(prog, 2, p->alpha);
-        if ((r = hd__gl_check(ctx, "multigrid's uniforms", __LINE__)) != HD_SUCCESS) return r;
+        if ((r = hd__gl_check(vw, "multigrid's uniforms", __LINE__)) != HD_SUCCESS) return r;
     }
-    hd__gl_mg_binds(ctx, p->set, p->slot, &b);
-    return hd__gl_run(ctx, prog, hd__mg_stage_names[p->stage - 1], &b, p->n[0], p->n[1], p->n[2], p->pc[0], p->pc[1], p->pc[2],
+    hd__gl_mg_binds(vw, p->set, p->slot, &b);
+    return hd__gl_run(vw, prog, hd__mg_stage_names[p->stage - 1], &b, p->n[0], p->n[1], p->n[2], p->pc[0], p->pc[1], p->pc[2],
                       p->pc[3]);
 }
 
 /* Level l's smoothing: the diffusion program (HD_FLAG_DIFFUSE_RHS variant) on its parameter block. */
-static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+static hd_result hd__be_mg_smooth(const hd__view *vw, int l, int sweeps, int first)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     const int *d = be->gg.lv[l].dims;
     int slot = hd__gl_diffuse_slot(be->gg.lv[l].kp.counts.z), s, h;
     int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
     hd__gl_binds b;
     hd_result r;
-    if ((r = hd__gl_program(ctx, slot)) != HD_SUCCESS) return r;
-    hd__gl_mg_binds(ctx, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, &b);
+    if ((r = hd__gl_program(vw, slot)) != HD_SUCCESS) return r;
+    hd__gl_mg_binds(vw, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, &b);
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h)
-            if ((r = hd__gl_run(ctx, be->programs[slot], "multigrid smoothing", &b, (d[0] + 1) / 2, ny,
+            if ((r = hd__gl_run(vw, be->programs[slot], "multigrid smoothing", &b, (d[0] + 1) / 2, ny,
                                 nzb * be->gg.channels, first ^ h, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     return HD_SUCCESS;
@@ -1181,34 +1184,34 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
 /* Makes the levels and sends their parameter blocks. */
-static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
+static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh)
 {
-    hd_result r = hd__gpu_mg_begin(ctx, &ctx->be->gg, fresh);
-    if (r == HD_SUCCESS) hd__gl_send_params(ctx);
+    hd_result r = hd__gpu_mg_begin(vw, &vw->be->gg, fresh);
+    if (r == HD_SUCCESS) hd__gl_send_params(vw);
     return r;
 }
 
 /* A step ends complete, as OpenCL's clFinish (timings per step mean the step). */
-static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_mg_end(const hd__view *vw, hd_result r)
 {
     if (r == HD_SUCCESS) {
-        ctx->be->gl.Finish();
-        r = hd__gl_check(ctx, "glFinish", __LINE__);
+        vw->be->gl.Finish();
+        r = hd__gl_check(vw, "glFinish", __LINE__);
     }
     return r;
 }
 
 /* The row sums read into their host copy (glGetBufferSubData waits for the passes). */
-static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+static hd_result hd__be_mg_row_sums(const hd__view *vw, int n, const double **a, const double **b)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__gl_mg *mg = &be->mg;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i) {
         be->gl.BindBuffer(GL_COPY_READ_BUFFER, i ? mg->dot_b : mg->dot_a);
         be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)(rows * sizeof(double)), mg->host_dot + i * rows);
-        HD__GL_CHECK(ctx, "reading multigrid's row sums");
+        HD__GL_CHECK(vw, "reading multigrid's row sums");
     }
     *a = mg->host_dot;
     *b = mg->host_dot + rows;
@@ -1216,49 +1219,49 @@ static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const
 }
 
 /* The single-level solver's sweeps: each its own dispatches. */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
+static hd_result hd__be_diffuse_sweeps(const hd__view *vw, int jacobi, int sweeps) { return hd__be_diffuse_each(vw, jacobi, sweeps); }
 
-static hd_result hd__be_path(hd__ctx *ctx)
+static hd_result hd__be_path(const hd__view *vw)
 {
-    return hd__gl_dispatch(ctx, HD__GL_PATH, 0, ctx->kp.image.x, ctx->kp.image.y, 1, 0, 0, 0, 0);
+    return hd__gl_dispatch(vw, HD__GL_PATH, 0, vw->kp.image.x, vw->kp.image.y, 1, 0, 0, 0, 0);
 }
 
 /* ---- the image into the caller's texture ---------------------------------------------------------- */
-static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
-
-static hd_result hd__gl_to_texture(hd__ctx *ctx, GLuint texture)
+static hd_result hd__gl_to_texture(const hd__view *vw, GLuint texture)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     GLint w = 0, h = 0, format = 0;
     hd_result r;
     be->gl.BindTexture(GL_TEXTURE_2D, texture);
     if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: %u is not a 2D texture name in the current context", texture);
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: %u is not a 2D texture name in the current context", texture);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
-    if (w != ctx->camera.width || h != ctx->camera.height || format != GL_RGBA8)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE,
+    if (w != vw->camera.width || h != vw->camera.height || format != GL_RGBA8)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE,
                        "hd_gl_render_to_texture: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
-                       texture, (int)w, (int)h, (unsigned)format, ctx->camera.width, ctx->camera.height);
-    if ((r = hd__gl_program(ctx, HD__GL_TO_TEXTURE)) != HD_SUCCESS) return r;
+                       texture, (int)w, (int)h, (unsigned)format, vw->camera.width, vw->camera.height);
+    if ((r = hd__gl_program(vw, HD__GL_TO_TEXTURE)) != HD_SUCCESS) return r;
     be->gl.UseProgram(be->programs[HD__GL_TO_TEXTURE]);
     be->gl.Uniform4i(0, w, h, 0, 0);
-    be->gl.Uniform1f(1, ctx->params.exposure);
+    be->gl.Uniform1f(1, vw->params.exposure);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img);
     be->gl.BindImageTexture(0, texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
     be->gl.DispatchCompute((GLuint)((w + 7) / 8), (GLuint)((h + 7) / 8), 1);
     be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
-    return hd__gl_check(ctx, "render_to_texture", __LINE__);
+    return hd__gl_check(vw, "render_to_texture", __LINE__);
 }
 
-HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }
+static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture) { return hd__gl_to_texture(vw, (GLuint)texture); }
+
+/* No recording (a Vulkan feature): the core never calls these. */
+static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
 {
-    hd_logger stale;
-    hd__ctx *ctx = hd__lookup(h, &stale);
-    hd_result r;
-    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
-    if (texture == 0) return HD__ERR(&ctx->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
-    HD__BE_CALL(r, ctx, hd__gl_to_texture(ctx, (GLuint)texture));
-    return r;
+    (void)target; (void)slots;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
 }
+static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
+static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
+static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }

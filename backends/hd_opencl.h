@@ -57,7 +57,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__cl_level {
-    cl_mem params;           /* the level's parameter block (src/hd_gpu.h's hd__gpu_level) */
+    cl_mem params;           /* the level's parameter block (backends/hd_gpu.h's hd__gpu_level) */
     cl_mem sig;              /* coarse levels only (level 0 reads the backend's sigma_t) */
     cl_mem rhs, phi, res;    /* right-hand side, correction, residual; level 0: r, z and q = A p */
 } hd__cl_level;
@@ -71,7 +71,7 @@ struct hd__cl_mg {
 };
 
 struct hd__backend {
-    hd__ctx *ctx;
+    const hd__view *vw;
     cl_context context;
     cl_device_id device;
     cl_command_queue queue;
@@ -80,10 +80,10 @@ struct hd__backend {
     cl_kernel kernels[HD__CL_KERNEL_COUNT];
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
-    cl_mem dl;               /* the direct light's list of voxels (ctx->dl_idx), direct kernels' argument 9 */
+    cl_mem dl;               /* the direct light's list of voxels (vw->dl_idx), direct kernels' argument 9 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
-       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (ptab_n
+       gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (ptab_n
        entries), uploaded when its inputs change (ptab_key) */
     cl_mem lsum, ptab;
     int ptab_n;
@@ -94,7 +94,7 @@ struct hd__backend {
     int params_valid;
     int lost;                /* a call reported a lost device: every later call fails fast */
     int fp64;                /* the device has cl_khr_fp64 (multigrid's double passes) */
-    hd__gpu_grids gg;        /* what the grids are made for (src/hd_gpu.h) */
+    hd__gpu_grids gg;        /* what the grids are made for (backends/hd_gpu.h) */
     struct hd__cl_mg mg;     /* multigrid's extras and grids while gg.levels */
 };
 
@@ -134,7 +134,7 @@ static const char *hd__cl_error_name(cl_int e)
 
 /* Logs the failing call with its CL error name and returns the hd_result it means. alloc: the
    call allocates, so a lack of resources is a lack of device memory, not a lost device. */
-static hd_result hd__cl_fail(hd__ctx *ctx, cl_int e, const char *call, int alloc, int line)
+static hd_result hd__cl_fail(const hd__view *vw, cl_int e, const char *call, int alloc, int line)
 {
     hd_result r = HD_ERROR_BACKEND;
     if (e == CL_MEM_OBJECT_ALLOCATION_FAILURE || e == CL_INVALID_BUFFER_SIZE || (alloc && e == CL_OUT_OF_RESOURCES))
@@ -143,21 +143,21 @@ static hd_result hd__cl_fail(hd__ctx *ctx, cl_int e, const char *call, int alloc
         r = HD_ERROR_OUT_OF_MEMORY;
     else if (e == CL_DEVICE_NOT_AVAILABLE || e == CL_OUT_OF_RESOURCES || e == CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
         r = HD_ERROR_DEVICE_LOST;
-    if (r == HD_ERROR_DEVICE_LOST && ctx->be) ctx->be->lost = 1;
-    hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, line, "opencl: %s failed: %s (%d)", call,
+    if (r == HD_ERROR_DEVICE_LOST && vw->be) vw->be->lost = 1;
+    hd__logf(&vw->log, HD_LOG_ERROR, r, __FILE__, line, "opencl: %s failed: %s (%d)", call,
              hd__cl_error_name(e), (int)e);
     return r;
 }
 /* Returns from the calling function when a CL call failed. */
-#define HD__CL_TRY(ctx, call_expr, name) \
+#define HD__CL_TRY(vw, call_expr, name) \
     do { cl_int hd__e = (call_expr); \
-         if (hd__e != CL_SUCCESS) return hd__cl_fail((ctx), hd__e, (name), 0, __LINE__); } while (0)
+         if (hd__e != CL_SUCCESS) return hd__cl_fail((vw), hd__e, (name), 0, __LINE__); } while (0)
 
-#define HD__CL_LOST_CHECK(ctx) \
-    do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "opencl: the device was lost earlier"); } while (0)
+#define HD__CL_LOST_CHECK(vw) \
+    do { if ((vw)->be->lost) return HD__ERR(&(vw)->log, HD_ERROR_DEVICE_LOST, "opencl: the device was lost earlier"); } while (0)
 /* Sets kernel k's argument i to the scalar lvalue v; returns from the calling function on failure. */
-#define HD__CL_ARG(ctx, k, i, v) \
-    HD__CL_TRY(ctx, clSetKernelArg((ctx)->be->kernels[k], (cl_uint)(i), sizeof(v), &(v)), "clSetKernelArg(" #v ")")
+#define HD__CL_ARG(vw, k, i, v) \
+    HD__CL_TRY(vw, clSetKernelArg((vw)->be->kernels[k], (cl_uint)(i), sizeof(v), &(v)), "clSetKernelArg(" #v ")")
 
 /* ---- device selection -------------------------------------------------------------------- */
 static int hd__cl_name_matches(cl_device_id dev, const char *want, char *name, size_t cap)
@@ -169,19 +169,19 @@ static int hd__cl_name_matches(cl_device_id dev, const char *want, char *name, s
 }
 
 /* Picks a device of the first platform that has one: by name, else a GPU, else any. */
-static hd_result hd__cl_pick_device(hd__ctx *ctx, cl_device_id *out)
+static hd_result hd__cl_pick_device(const hd__view *vw, cl_device_id *out)
 {
     cl_platform_id plats[16];
     cl_uint np = 0, p, pass;
     cl_int e;
-    const char *want = ctx->desc.opencl.device_name;
+    const char *want = vw->desc.opencl.device_name;
     char name[256];
     if (!want || !*want) want = getenv("HD_CL_DEVICE");
     e = clGetPlatformIDs(16, plats, &np);
     if (e == -1001 || (e == CL_SUCCESS && np == 0))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no OpenCL platform is installed (clGetPlatformIDs: %s)",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no OpenCL platform is installed (clGetPlatformIDs: %s)",
                        hd__cl_error_name(e == CL_SUCCESS ? -1001 : e));
-    if (e != CL_SUCCESS) return hd__cl_fail(ctx, e, "clGetPlatformIDs", 0, __LINE__);
+    if (e != CL_SUCCESS) return hd__cl_fail(vw, e, "clGetPlatformIDs", 0, __LINE__);
     if (np > 16) np = 16;
     for (pass = 0; pass < 2; ++pass) {
         for (p = 0; p < np; ++p) {
@@ -202,38 +202,38 @@ static hd_result hd__cl_pick_device(hd__ctx *ctx, cl_device_id *out)
         }
     }
     if (want && *want)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no available device's name contains \"%s\"", want);
-    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: no available OpenCL device with a compiler");
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no available device's name contains \"%s\"", want);
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no available OpenCL device with a compiler");
 }
 
 /* The caller's queue, context and device, or ones the backend makes. Every object is retained
    once here and released once in hd__be_destroy. */
-static hd_result hd__cl_open(hd__ctx *ctx)
+static hd_result hd__cl_open(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int e;
-    if (ctx->desc.opencl.queue) {
-        be->queue = (cl_command_queue)ctx->desc.opencl.queue;
-        HD__CL_TRY(ctx, clRetainCommandQueue(be->queue), "clRetainCommandQueue(desc.opencl.queue)");
-        HD__CL_TRY(ctx, clGetCommandQueueInfo(be->queue, CL_QUEUE_CONTEXT, sizeof be->context, &be->context, NULL), "clGetCommandQueueInfo(CL_QUEUE_CONTEXT)");
-        HD__CL_TRY(ctx, clRetainContext(be->context), "clRetainContext");
-        HD__CL_TRY(ctx, clGetCommandQueueInfo(be->queue, CL_QUEUE_DEVICE, sizeof be->device, &be->device, NULL), "clGetCommandQueueInfo(CL_QUEUE_DEVICE)");
+    if (vw->desc.opencl.queue) {
+        be->queue = (cl_command_queue)vw->desc.opencl.queue;
+        HD__CL_TRY(vw, clRetainCommandQueue(be->queue), "clRetainCommandQueue(desc.opencl.queue)");
+        HD__CL_TRY(vw, clGetCommandQueueInfo(be->queue, CL_QUEUE_CONTEXT, sizeof be->context, &be->context, NULL), "clGetCommandQueueInfo(CL_QUEUE_CONTEXT)");
+        HD__CL_TRY(vw, clRetainContext(be->context), "clRetainContext");
+        HD__CL_TRY(vw, clGetCommandQueueInfo(be->queue, CL_QUEUE_DEVICE, sizeof be->device, &be->device, NULL), "clGetCommandQueueInfo(CL_QUEUE_DEVICE)");
         return HD_SUCCESS;
     }
-    if (ctx->desc.opencl.context) {
-        be->context = (cl_context)ctx->desc.opencl.context;
-        HD__CL_TRY(ctx, clRetainContext(be->context), "clRetainContext(desc.opencl.context)");
-        if (ctx->desc.opencl.device) {
-            be->device = (cl_device_id)ctx->desc.opencl.device;
+    if (vw->desc.opencl.context) {
+        be->context = (cl_context)vw->desc.opencl.context;
+        HD__CL_TRY(vw, clRetainContext(be->context), "clRetainContext(desc.opencl.context)");
+        if (vw->desc.opencl.device) {
+            be->device = (cl_device_id)vw->desc.opencl.device;
         } else {
-            HD__CL_TRY(ctx, clGetContextInfo(be->context, CL_CONTEXT_DEVICES, sizeof be->device, &be->device, NULL), "clGetContextInfo(CL_CONTEXT_DEVICES)");
+            HD__CL_TRY(vw, clGetContextInfo(be->context, CL_CONTEXT_DEVICES, sizeof be->device, &be->device, NULL), "clGetContextInfo(CL_CONTEXT_DEVICES)");
         }
     } else {
         hd_result r;
-        if (ctx->desc.opencl.device) be->device = (cl_device_id)ctx->desc.opencl.device;
-        else if ((r = hd__cl_pick_device(ctx, &be->device)) != HD_SUCCESS) return r;
+        if (vw->desc.opencl.device) be->device = (cl_device_id)vw->desc.opencl.device;
+        else if ((r = hd__cl_pick_device(vw, &be->device)) != HD_SUCCESS) return r;
         be->context = clCreateContext(NULL, 1, &be->device, NULL, NULL, &e);
-        if (e != CL_SUCCESS) { be->context = NULL; return hd__cl_fail(ctx, e, "clCreateContext", 0, __LINE__); }
+        if (e != CL_SUCCESS) { be->context = NULL; return hd__cl_fail(vw, e, "clCreateContext", 0, __LINE__); }
     }
     /* OpenCL 1.2's call; a <CL/cl.h> the including file read first for 2.0+ marks it deprecated */
 #if defined(__GNUC__) || defined(__clang__)
@@ -244,31 +244,31 @@ static hd_result hd__cl_open(hd__ctx *ctx)
 #if defined(__GNUC__) || defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
-    if (e != CL_SUCCESS) { be->queue = NULL; return hd__cl_fail(ctx, e, "clCreateCommandQueue", 0, __LINE__); }
+    if (e != CL_SUCCESS) { be->queue = NULL; return hd__cl_fail(vw, e, "clCreateCommandQueue", 0, __LINE__); }
     return HD_SUCCESS;
 }
 
 /* Builds the embedded source into *out with the options opts; a failure logs the build log (in
    pieces the logger can hold). */
-static hd_result hd__cl_build_program(hd__ctx *ctx, cl_program *out, const char *opts)
+static hd_result hd__cl_build_program(const hd__view *vw, cl_program *out, const char *opts)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int e;
     *out = clCreateProgramWithSource(be->context, (cl_uint)HD__CL_SOURCE_LINES, (const char **)hd__cl_source, NULL, &e);
-    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clCreateProgramWithSource", 0, __LINE__); }
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(vw, e, "clCreateProgramWithSource", 0, __LINE__); }
     e = clBuildProgram(*out, 1, &be->device, opts, NULL, NULL);
     if (e != CL_SUCCESS) {
         size_t n = 0, i;
         char *text;
-        hd_result r = hd__cl_fail(ctx, e, "clBuildProgram", 0, __LINE__);
+        hd_result r = hd__cl_fail(vw, e, "clBuildProgram", 0, __LINE__);
         clGetProgramBuildInfo(*out, be->device, CL_PROGRAM_BUILD_LOG, 0, NULL, &n);
-        text = (char *)hd__alloc(ctx, n + 1);
+        text = (char *)hd__alloc(vw, n + 1);
         if (text && clGetProgramBuildInfo(*out, be->device, CL_PROGRAM_BUILD_LOG, n, text, NULL) == CL_SUCCESS) {
             text[n] = '\0';
             for (i = 0; i < n && text[i]; i += 900)
-                hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, __LINE__, "opencl: build log: %.900s", text + i);
+                hd__logf(&vw->log, HD_LOG_ERROR, r, __FILE__, __LINE__, "opencl: build log: %.900s", text + i);
         }
-        hd__free(ctx, text);
+        hd__free(vw, text);
         return r;
     }
     return HD_SUCCESS;
@@ -277,22 +277,22 @@ static hd_result hd__cl_build_program(hd__ctx *ctx, cl_program *out, const char 
 /* The two programs: every stage but the projection, and the projection alone, built with
    HD_CL_PROJECTION_PROGRAM (hd_prelude_cl.h: a*b+c may fuse there, not in the deterministic
    stages), so each kernel comes from the program that has it. */
-static hd_result hd__cl_build(hd__ctx *ctx)
+static hd_result hd__cl_build(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int e;
     char opts[128];
     hd_result r;
     int k;
     snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d", HD_MAX_LIGHTS);
-    if ((r = hd__cl_build_program(ctx, &be->program, opts)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_build_program(vw, &be->program, opts)) != HD_SUCCESS) return r;
     snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d -DHD_CL_PROJECTION_PROGRAM", HD_MAX_LIGHTS);
-    if ((r = hd__cl_build_program(ctx, &be->project_program, opts)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_build_program(vw, &be->project_program, opts)) != HD_SUCCESS) return r;
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
         int project = k == HD__CL_PROJECT || k == HD__CL_PROJECT_HALF;
         if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_EXTRAP) continue; /* not compiled (HD_MG_F64) */
         be->kernels[k] = clCreateKernel(project ? be->project_program : be->program, hd__cl_kernel_names[k], &e);
-        if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(ctx, e, hd__cl_kernel_names[k], 0, __LINE__); }
+        if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(vw, e, hd__cl_kernel_names[k], 0, __LINE__); }
     }
     return HD_SUCCESS;
 }
@@ -305,34 +305,34 @@ static void hd__cl_release(cl_mem *m)
 }
 
 /* A device buffer of `bytes`, filled from host (copied) or with zeros. */
-static hd_result hd__cl_buffer(hd__ctx *ctx, cl_mem *out, size_t bytes, const void *host, const char *what)
+static hd_result hd__cl_buffer(const hd__view *vw, cl_mem *out, size_t bytes, const void *host, const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int e;
     float zero = 0.0f;
     *out = NULL;
     if (bytes == 0) bytes = 16;
     if ((cl_ulong)bytes > be->max_alloc)
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_DEVICE_MEMORY, "opencl: %s needs %zu bytes, above the device's largest allocation (%llu)",
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_DEVICE_MEMORY, "opencl: %s needs %zu bytes, above the device's largest allocation (%llu)",
                        what, bytes, (unsigned long long)be->max_alloc);
     *out = clCreateBuffer(be->context, CL_MEM_READ_WRITE | (host ? CL_MEM_COPY_HOST_PTR : 0), bytes, (void *)host, &e);
-    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clCreateBuffer", 1, __LINE__); }
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(vw, e, "clCreateBuffer", 1, __LINE__); }
     if (!host) {
         e = clEnqueueFillBuffer(be->queue, *out, &zero, sizeof zero, 0, bytes & ~(size_t)3, 0, NULL, NULL);
-        if (e != CL_SUCCESS) return hd__cl_fail(ctx, e, "clEnqueueFillBuffer", 1, __LINE__);
+        if (e != CL_SUCCESS) return hd__cl_fail(vw, e, "clEnqueueFillBuffer", 1, __LINE__);
     }
     return HD_SUCCESS;
 }
 
-static hd_result hd__cl_zero(hd__ctx *ctx, cl_mem m, size_t floats)
+static hd_result hd__cl_zero(const hd__view *vw, cl_mem m, size_t floats)
 {
     float zero = 0.0f;
     if (!m || floats == 0) return HD_SUCCESS;
-    HD__CL_TRY(ctx, clEnqueueFillBuffer(ctx->be->queue, m, &zero, sizeof zero, 0, floats * sizeof(float), 0, NULL, NULL), "clEnqueueFillBuffer");
+    HD__CL_TRY(vw, clEnqueueFillBuffer(vw->be->queue, m, &zero, sizeof zero, 0, floats * sizeof(float), 0, NULL, NULL), "clEnqueueFillBuffer");
     return HD_SUCCESS;
 }
 
-/* Grid id's buffer (src/hd_gpu.h). */
+/* Grid id's buffer (backends/hd_gpu.h). */
 static cl_mem *hd__cl_grid(hd__backend *be, int id)
 {
     cl_mem *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
@@ -344,45 +344,45 @@ static cl_mem *hd__cl_grid(hd__backend *be, int id)
 /* E, phi, phi2: in the colour layout (hd__split_slots), 2 bytes per binary16 element rounded up
    to whole floats (hd__cl_buffer's 4-byte fill reaches the end); sigma_t and the multigrid's
    grids in the colour layout too; the summed light and the light volumes x-fastest floats. */
-static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+static hd_result hd__gpu_grid_new(const hd__view *vw, int id, int w, int h, int d, const char *what)
 {
     size_t n = id == HD__G_LSUM || id >= HD__G_LIGHT ? (size_t)w * h * d : hd__split_slots(w, h, (size_t)d);
-    int half = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2;
-    hd__cl_release(hd__cl_grid(ctx->be, id));
-    return hd__cl_buffer(ctx, hd__cl_grid(ctx->be, id), half ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float), NULL, what);
+    int half = vw->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2;
+    hd__cl_release(hd__cl_grid(vw->be, id));
+    return hd__cl_buffer(vw, hd__cl_grid(vw->be, id), half ? (n * 2 + 3) & ~(size_t)3 : n * sizeof(float), NULL, what);
 }
 
-static void hd__gpu_grid_free(hd__ctx *ctx, int id) { hd__cl_release(hd__cl_grid(ctx->be, id)); }
+static void hd__gpu_grid_free(const hd__view *vw, int id) { hd__cl_release(hd__cl_grid(vw->be, id)); }
 
-static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
+static hd_result hd__gpu_grid_zero(const hd__view *vw, int id)
 {
-    cl_mem m = *hd__cl_grid(ctx->be, id);
+    cl_mem m = *hd__cl_grid(vw->be, id);
     size_t bytes = 0;
-    if (m) HD__CL_TRY(ctx, clGetMemObjectInfo(m, CL_MEM_SIZE, sizeof bytes, &bytes, NULL), "clGetMemObjectInfo(CL_MEM_SIZE)");
-    return hd__cl_zero(ctx, m, bytes / sizeof(float));
+    if (m) HD__CL_TRY(vw, clGetMemObjectInfo(m, CL_MEM_SIZE, sizeof bytes, &bytes, NULL), "clGetMemObjectInfo(CL_MEM_SIZE)");
+    return hd__cl_zero(vw, m, bytes / sizeof(float));
 }
 
 /* ---- life cycle -------------------------------------------------------------------------- */
 /* The bracket of a public call (src/hd_backend.h): a lost device refused; each stage has waited
    for its own work already (hd__cl_finish). */
-static hd_result hd__be_begin(hd__ctx *ctx)
+static hd_result hd__be_begin(const hd__view *vw)
 {
-    HD__CL_LOST_CHECK(ctx);
+    HD__CL_LOST_CHECK(vw);
     return HD_SUCCESS;
 }
-static hd_result hd__be_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_end(const hd__view *vw, hd_result r)
 {
-    (void)ctx;
+    (void)vw;
     return r;
 }
 
-static void hd__be_destroy(hd__ctx *ctx)
+static void hd__be_destroy(hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int k;
     if (!be) return;
     if (be->queue) clFinish(be->queue);
-    hd__gpu_free(ctx, &be->gg);
+    hd__gpu_free(vw, &be->gg);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf); hd__cl_release(&be->maj);
     hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
@@ -391,78 +391,78 @@ static void hd__be_destroy(hd__ctx *ctx)
     if (be->project_program) clReleaseProgram(be->project_program);
     if (be->queue) clReleaseCommandQueue(be->queue);
     if (be->context) clReleaseContext(be->context);
-    hd__free(ctx, be);
-    ctx->be = NULL;
+    hd__free(vw, be);
+    vw->be = NULL;
 }
 
-static hd_result hd__be_create(hd__ctx *ctx)
+static hd_result hd__be_create(hd__view *vw)
 {
     hd__backend *be;
     hd_result r;
     char name[256] = {0}, version[128] = {0};
     cl_ulong const_size = 0;
-    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
-    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
-    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the backend");
-    ctx->be = be;
-    be->ctx = ctx;
-    if ((r = hd__cl_open(ctx)) != HD_SUCCESS) return r;
+    size_t ncell = (size_t)vw->mdims[0] * vw->mdims[1] * vw->mdims[2];
+    be = (hd__backend *)hd__calloc(vw, 1, sizeof *be);
+    if (!be) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the backend");
+    vw->be = be;
+    be->vw = vw;
+    if ((r = hd__cl_open(vw)) != HD_SUCCESS) return r;
     clGetDeviceInfo(be->device, CL_DEVICE_NAME, sizeof name - 1, name, NULL);
     clGetDeviceInfo(be->device, CL_DEVICE_VERSION, sizeof version - 1, version, NULL);
-    HD__CL_TRY(ctx, clGetDeviceInfo(be->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof be->max_alloc, &be->max_alloc, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
-    HD__CL_TRY(ctx, clGetDeviceInfo(be->device, CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE, sizeof const_size, &const_size, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE)");
+    HD__CL_TRY(vw, clGetDeviceInfo(be->device, CL_DEVICE_MAX_MEM_ALLOC_SIZE, sizeof be->max_alloc, &be->max_alloc, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_MEM_ALLOC_SIZE)");
+    HD__CL_TRY(vw, clGetDeviceInfo(be->device, CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE, sizeof const_size, &const_size, NULL), "clGetDeviceInfo(CL_DEVICE_MAX_CONSTANT_BUFFER_SIZE)");
     if (const_size < sizeof(hd__kparams))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: %s holds %llu bytes of __constant memory, the parameters need %zu",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: %s holds %llu bytes of __constant memory, the parameters need %zu",
                        name, (unsigned long long)const_size, sizeof(hd__kparams));
     {
         cl_device_fp_config fp64 = 0; /* 0 without double support (OpenCL 1.2: cl_khr_fp64) */
         if (clGetDeviceInfo(be->device, CL_DEVICE_DOUBLE_FP_CONFIG, sizeof fp64, &fp64, NULL) == CL_SUCCESS) be->fp64 = fp64 != 0;
     }
-    HD__INFO(&ctx->log, "opencl: device %s (%s)%s", name, version, be->fp64 ? "" : ", no double precision (no multigrid solver)");
-    if ((r = hd__cl_build(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->params, sizeof(hd__kparams), NULL, "the parameter block")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->vol, ctx->nvox * sizeof(float), ctx->vol, "the volume")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(ctx, &be->maj, ncell * sizeof(float), NULL, "the majorant grid")) != HD_SUCCESS) return r;
+    HD__INFO(&vw->log, "opencl: device %s (%s)%s", name, version, be->fp64 ? "" : ", no double precision (no multigrid solver)");
+    if ((r = hd__cl_build(vw)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(vw, &be->params, sizeof(hd__kparams), NULL, "the parameter block")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(vw, &be->vol, vw->nvox * sizeof(float), vw->vol, "the volume")) != HD_SUCCESS) return r;
+    if ((r = hd__cl_buffer(vw, &be->maj, ncell * sizeof(float), NULL, "the majorant grid")) != HD_SUCCESS) return r;
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+static hd_result hd__be_upload_inputs(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
-    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    hd__backend *be = vw->be;
+    size_t tf_bytes = (size_t)vw->tf_count * 4 * sizeof(float);
+    size_t ncell = (size_t)vw->mdims[0] * vw->mdims[1] * vw->mdims[2];
     hd_result r;
     if (tf_bytes != be->tf_bytes) {
         hd__cl_release(&be->tf);
         be->tf_bytes = 0;
-        if ((r = hd__cl_buffer(ctx, &be->tf, tf_bytes, NULL, "the transfer function")) != HD_SUCCESS) return r;
+        if ((r = hd__cl_buffer(vw, &be->tf, tf_bytes, NULL, "the transfer function")) != HD_SUCCESS) return r;
         be->tf_bytes = tf_bytes;
     }
-    /* blocking: ctx->tf and ctx->majorant may change as soon as this returns */
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->tf, CL_TRUE, 0, tf_bytes, ctx->tf, 0, NULL, NULL), "clEnqueueWriteBuffer(tf)");
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->maj, CL_TRUE, 0, ncell * sizeof(float), ctx->majorant, 0, NULL, NULL), "clEnqueueWriteBuffer(majorant)");
+    /* blocking: vw->tf and vw->majorant may change as soon as this returns */
+    HD__CL_TRY(vw, clEnqueueWriteBuffer(be->queue, be->tf, CL_TRUE, 0, tf_bytes, vw->tf, 0, NULL, NULL), "clEnqueueWriteBuffer(tf)");
+    HD__CL_TRY(vw, clEnqueueWriteBuffer(be->queue, be->maj, CL_TRUE, 0, ncell * sizeof(float), vw->majorant, 0, NULL, NULL), "clEnqueueWriteBuffer(majorant)");
     return HD_SUCCESS;
 }
 
 /* Elements of a colour-layout grid of `slices` z-slices (gz per channel): each row of gx voxels
    takes 2 * ((gx + 1) / 2) slots, one of them padding when gx is odd. */
 #define HD__BE_SPLIT_LAYOUT 1 /* hd_get_stats counts the layout's padding slots */
-static size_t hd__cl_slots(const hd__ctx *ctx, size_t slices)
+static size_t hd__cl_slots(const hd__view *vw, size_t slices)
 {
-    return hd__split_slots(ctx->gdims[0], ctx->gdims[1], slices);
+    return hd__split_slots(vw->gdims[0], vw->gdims[1], slices);
 }
 
 /* The slot of voxel (x, y, zz) in the colour layout: hd_prelude_cl.h's HD__CL_AT, host side (the
    CPU backend's layout too, hd_prelude_c.h). */
-static size_t hd__cl_slot(const hd__ctx *ctx, int x, int y, int zz)
+static size_t hd__cl_slot(const hd__view *vw, int x, int y, int zz)
 {
-    return hd__split_slot(ctx->gdims[0], ctx->gdims[1], x, y, zz);
+    return hd__split_slot(vw->gdims[0], vw->gdims[1], x, y, zz);
 }
 
 /* The kernel of stage k for the storage precision: its _half twin with binary16 illumination. */
-static int hd__cl_k(const hd__ctx *ctx, int k)
+static int hd__cl_k(const hd__view *vw, int k)
 {
-    if (!ctx->be->gg.f16) return k;
+    if (!vw->be->gg.f16) return k;
     if (k == HD__CL_DIRECT) return HD__CL_DIRECT_HALF;
     if (k == HD__CL_PROJECT) return HD__CL_PROJECT_HALF;
     if (k == HD__CL_SUM_LIGHT) return HD__CL_SUM_LIGHT_HALF;
@@ -471,20 +471,20 @@ static int hd__cl_k(const hd__ctx *ctx, int k)
     return k;
 }
 
-static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
-    return hd__gpu_alloc_illumination(ctx, &ctx->be->gg, illum_floats);
+    return hd__gpu_alloc_illumination(vw, &vw->be->gg, illum_floats);
 }
 
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable) { return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable); }
+static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable) { return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable); }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t floats = hd__image_floats(width, height, reduced);
     cl_mem img;
     hd_result r;
-    if ((r = hd__cl_buffer(ctx, &img, floats * sizeof(float), NULL, reduced ? "the image with room for reduced frames" : "the image")) !=
+    if ((r = hd__cl_buffer(vw, &img, floats * sizeof(float), NULL, reduced ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__cl_release(&img);
         return r;
@@ -495,95 +495,95 @@ static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int red
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
-    return (what & HD__DIRTY_IMAGE) ? hd__cl_zero(ctx, be->img, be->img_floats) : HD_SUCCESS;
+    if ((r = hd__gpu_clear(vw, &be->gg, what)) != HD_SUCCESS) return r;
+    return (what & HD__DIRTY_IMAGE) ? hd__cl_zero(vw, be->img, be->img_floats) : HD_SUCCESS;
 }
 
 /* ---- dispatch ------------------------------------------------------------------------------ */
-/* Sends ctx->kp to the params buffer when it changed since the last send (blocking: the host
+/* Sends vw->kp to the params buffer when it changed since the last send (blocking: the host
    copy changes every iteration). */
-static hd_result hd__cl_send_params(hd__ctx *ctx)
+static hd_result hd__cl_send_params(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    if (!be->params_valid || memcmp(&be->params_sent, &ctx->kp, sizeof ctx->kp) != 0) {
-        HD__CL_TRY(ctx, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof ctx->kp, &ctx->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
-        be->params_sent = ctx->kp;
+    hd__backend *be = vw->be;
+    if (!be->params_valid || memcmp(&be->params_sent, &vw->kp, sizeof vw->kp) != 0) {
+        HD__CL_TRY(vw, clEnqueueWriteBuffer(be->queue, be->params, CL_TRUE, 0, sizeof vw->kp, &vw->kp, 0, NULL, NULL), "clEnqueueWriteBuffer(params)");
+        be->params_sent = vw->kp;
         be->params_valid = 1;
     }
     return HD_SUCCESS;
 }
 
 /* Sets kernel k's arguments first, first + 1, ... to the n buffers (cl_mem) in ap. */
-static hd_result hd__cl_vmems(hd__ctx *ctx, int k, cl_uint first, int n, va_list ap)
+static hd_result hd__cl_vmems(const hd__view *vw, int k, cl_uint first, int n, va_list ap)
 {
     cl_int e = CL_SUCCESS;
     int i;
     for (i = 0; i < n && e == CL_SUCCESS; ++i) {
         cl_mem m = va_arg(ap, cl_mem);
-        e = clSetKernelArg(ctx->be->kernels[k], first + (cl_uint)i, sizeof m, &m);
+        e = clSetKernelArg(vw->be->kernels[k], first + (cl_uint)i, sizeof m, &m);
     }
-    return e == CL_SUCCESS ? HD_SUCCESS : hd__cl_fail(ctx, e, "clSetKernelArg", 0, __LINE__);
+    return e == CL_SUCCESS ? HD_SUCCESS : hd__cl_fail(vw, e, "clSetKernelArg", 0, __LINE__);
 }
 
 /* The same with the n buffers following n. */
-static hd_result hd__cl_mems(hd__ctx *ctx, int k, cl_uint first, int n, ...)
+static hd_result hd__cl_mems(const hd__view *vw, int k, cl_uint first, int n, ...)
 {
     va_list ap;
     hd_result r;
     va_start(ap, n);
-    r = hd__cl_vmems(ctx, k, first, n, ap);
+    r = hd__cl_vmems(vw, k, first, n, ap);
     va_end(ap);
     return r;
 }
 
-/* Sends ctx->kp if it changed (hd__cl_send_params) and binds the buffers to kernel k's first
+/* Sends vw->kp if it changed (hd__cl_send_params) and binds the buffers to kernel k's first
    nine arguments. */
-static hd_result hd__cl_bind(hd__ctx *ctx, int k)
+static hd_result hd__cl_bind(const hd__view *vw, int k)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    if ((r = hd__cl_send_params(ctx)) != HD_SUCCESS) return r;
-    return hd__cl_mems(ctx, k, 0, 9, be->params, be->vol, be->tf, be->maj, be->sig, be->E, be->phi, be->phi2, be->img);
+    if ((r = hd__cl_send_params(vw)) != HD_SUCCESS) return r;
+    return hd__cl_mems(vw, k, 0, 9, be->params, be->vol, be->tf, be->maj, be->sig, be->E, be->phi, be->phi2, be->img);
 }
 
-static hd_result hd__cl_run_local(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz, const size_t *local)
+static hd_result hd__cl_run_local(const hd__view *vw, int k, cl_uint dims, size_t gx, size_t gy, size_t gz, const size_t *local)
 {
     size_t global[3];
     global[0] = gx; global[1] = gy; global[2] = gz;
     if (gx == 0 || gy == 0 || gz == 0) return HD_SUCCESS;
-    HD__CL_TRY(ctx, clEnqueueNDRangeKernel(ctx->be->queue, ctx->be->kernels[k], dims, NULL, global, local, 0, NULL, NULL),
+    HD__CL_TRY(vw, clEnqueueNDRangeKernel(vw->be->queue, vw->be->kernels[k], dims, NULL, global, local, 0, NULL, NULL),
                hd__cl_kernel_names[k]);
     return HD_SUCCESS;
 }
 
-static hd_result hd__cl_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+static hd_result hd__cl_run(const hd__view *vw, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
 {
-    return hd__cl_run_local(ctx, k, dims, gx, gy, gz, NULL);
+    return hd__cl_run_local(vw, k, dims, gx, gy, gz, NULL);
 }
 
 /* Binds kernel k (hd__cl_bind) and runs it over gx x gy x gz. */
-static hd_result hd__cl_bind_run(hd__ctx *ctx, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
+static hd_result hd__cl_bind_run(const hd__view *vw, int k, cl_uint dims, size_t gx, size_t gy, size_t gz)
 {
-    hd_result r = hd__cl_bind(ctx, k);
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, dims, gx, gy, gz);
+    hd_result r = hd__cl_bind(vw, k);
+    return r != HD_SUCCESS ? r : hd__cl_run(vw, k, dims, gx, gy, gz);
 }
 
 /* Waits for the queue. Each stage returns when its work is done, as on the CPU, so the core's
    per-stage clocks measure the device rather than the enqueueing (cost: one clFinish per stage). */
-static hd_result hd__cl_finish(hd__ctx *ctx)
+static hd_result hd__cl_finish(const hd__view *vw)
 {
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    HD__CL_TRY(vw, clFinish(vw->be->queue), "clFinish");
     return HD_SUCCESS;
 }
 
 /* The variant of a kernel family (diffusion, residuals) for the boundary and RGB flags. */
-static int hd__cl_variant(const hd__ctx *ctx, int first)
+static int hd__cl_variant(const hd__view *vw, int first)
 {
-    return first + ((ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((ctx->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
+    return first + ((vw->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY) ? 2 : 0) + ((vw->kp.counts.z & HD_FLAG_RGB_SCATTERING) ? 1 : 0);
 }
 
 /* n passes of kernel k over alternate colours of a grid of dims d (channels stacked in z), the
@@ -592,85 +592,85 @@ static int hd__cl_variant(const hd__ctx *ctx, int first)
    vectorises a work-group along x, and its own choice of local size can cut a row into pieces as
    small as one item (it did for a prime row length). A row longer than the kernel's largest
    work-group leaves the choice to the runtime. */
-static hd_result hd__cl_colour_passes(hd__ctx *ctx, int k, const int *d, int channels, cl_uint arg, int first, int n)
+static hd_result hd__cl_colour_passes(const hd__view *vw, int k, const int *d, int channels, cl_uint arg, int first, int n)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t hx = ((size_t)d[0] + 1) / 2, local[3], wg = 0;
     hd_result r;
     int i;
-    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+    HD__CL_TRY(vw, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
                "clGetKernelWorkGroupInfo");
     local[0] = hx; local[1] = 1; local[2] = 1;
     for (i = 0; i < n; ++i) {
         cl_int parity = (first ^ i) & 1;
-        HD__CL_ARG(ctx, k, arg, parity);
-        if ((r = hd__cl_run_local(ctx, k, 3, hx, (size_t)d[1], (size_t)d[2] * (size_t)channels, hx <= wg ? local : NULL)) != HD_SUCCESS)
+        HD__CL_ARG(vw, k, arg, parity);
+        if ((r = hd__cl_run_local(vw, k, 3, hx, (size_t)d[1], (size_t)d[2] * (size_t)channels, hx <= wg ? local : NULL)) != HD_SUCCESS)
             return r;
     }
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_classify(hd__ctx *ctx)
+static hd_result hd__be_classify(const hd__view *vw)
 {
-    return hd__cl_bind_run(ctx, HD__CL_CLASSIFY, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2]);
+    return hd__cl_bind_run(vw, HD__CL_CLASSIFY, 3, (size_t)vw->gdims[0], (size_t)vw->gdims[1], (size_t)vw->gdims[2]);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
-static hd_result hd__be_direct_list(hd__ctx *ctx)
+static hd_result hd__be_direct_list(const hd__view *vw)
 {
-    hd__cl_release(&ctx->be->dl);
-    return hd__cl_buffer(ctx, &ctx->be->dl, ctx->dl_count * sizeof(uint32_t), ctx->dl_idx, "the direct light's list");
+    hd__cl_release(&vw->be->dl);
+    return hd__cl_buffer(vw, &vw->be->dl, vw->dl_count * sizeof(uint32_t), vw->dl_idx, "the direct light's list");
 }
 
-static hd_result hd__be_direct(hd__ctx *ctx)
+static hd_result hd__be_direct(const hd__view *vw)
 {
     hd_result r;
-    int k = hd__cl_k(ctx, HD__CL_DIRECT);
-    cl_int count = (cl_int)ctx->dl_count;
-    ctx->be->gg.lsum_ok = 0;
-    HD__CL_ARG(ctx, k, 10, count);
-    if ((r = hd__cl_mems(ctx, k, 9, 1, ctx->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(ctx, k, 1, ctx->dl_count, 1, 1)) != HD_SUCCESS)
+    int k = hd__cl_k(vw, HD__CL_DIRECT);
+    cl_int count = (cl_int)vw->dl_count;
+    vw->be->gg.lsum_ok = 0;
+    HD__CL_ARG(vw, k, 10, count);
+    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(vw, k, 1, vw->dl_count, 1, 1)) != HD_SUCCESS)
         return r;
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
 }
 
 /* One full sweep: two half-sweeps (red, black), or Jacobi's two colour passes and a swap. */
-static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
 {
-    hd__backend *be = ctx->be;
-    int k = hd__cl_k(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
+    hd__backend *be = vw->be;
+    int k = hd__cl_k(vw, hd__cl_variant(vw, HD__CL_DIFFUSE + (jacobi ? 4 : 0)));
     hd_result r;
     be->gg.lsum_ok = 0;
-    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(ctx, k, ctx->gdims, ctx->channels, 9, 0, 2)) != HD_SUCCESS)
+    if ((r = hd__cl_bind(vw, k)) != HD_SUCCESS || (r = hd__cl_colour_passes(vw, k, vw->gdims, vw->channels, 9, 0, 2)) != HD_SUCCESS)
         return r;
     if (jacobi) { cl_mem t = be->phi; be->phi = be->phi2; be->phi2 = t; }
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
 }
 
 /* The projection's inputs: lsum rebuilt (hd_k_light_sum) after a pass that changed E or phi, and
    the TF table (hd__project_table) built and uploaded when its inputs changed (ptab_key). */
-static hd_result hd__cl_project_prepare(hd__ctx *ctx)
+static hd_result hd__cl_project_prepare(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int n = hd__project_table_n(ctx), k = hd__cl_k(ctx, HD__CL_LIGHT_SUM);
+    hd__backend *be = vw->be;
+    int n = hd__project_table_n(vw), k = hd__cl_k(vw, HD__CL_LIGHT_SUM);
     float *t;
     hd_result r;
     if (!be->gg.lsum_ok) {
-        if ((r = hd__cl_mems(ctx, k, 9, 1, be->lsum)) != HD_SUCCESS ||
-            (r = hd__cl_bind_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1],
-                                 (size_t)ctx->gdims[2] * (size_t)ctx->channels)) != HD_SUCCESS)
+        if ((r = hd__cl_mems(vw, k, 9, 1, be->lsum)) != HD_SUCCESS ||
+            (r = hd__cl_bind_run(vw, k, 3, (size_t)vw->gdims[0], (size_t)vw->gdims[1],
+                                 (size_t)vw->gdims[2] * (size_t)vw->channels)) != HD_SUCCESS)
             return r;
         be->gg.lsum_ok = 1;
     }
-    if (hd__project_table_key_same(ctx, &be->ptab_key)) return HD_SUCCESS;
-    if (!(t = hd__project_table_new(ctx, n))) return HD_ERROR_OUT_OF_MEMORY;
+    if (hd__project_table_key_same(vw, &be->ptab_key)) return HD_SUCCESS;
+    if (!(t = hd__project_table_new(vw, n))) return HD_ERROR_OUT_OF_MEMORY;
     hd__cl_release(&be->ptab);
     be->ptab_key.valid = 0;
     be->ptab_n = 0;
-    r = hd__cl_buffer(ctx, &be->ptab, (size_t)n * 4 * sizeof(float), t, "the projection's TF table");
-    hd__free(ctx, t);
+    r = hd__cl_buffer(vw, &be->ptab, (size_t)n * 4 * sizeof(float), t, "the projection's TF table");
+    hd__free(vw, t);
     if (r != HD_SUCCESS) return r;
-    be->ptab_key = hd__project_table_key(ctx);
+    be->ptab_key = hd__project_table_key(vw);
     be->ptab_n = n;
     return HD_SUCCESS;
 }
@@ -683,75 +683,94 @@ static hd_result hd__cl_project_prepare(hd__ctx *ctx)
    the same 8-row locality in 2048 pieces. */
 #define HD__CL_PROJECT_GROUP_X 32
 #define HD__CL_PROJECT_GROUP_Y 8
-static hd_result hd__be_project(hd__ctx *ctx)
+static hd_result hd__be_project(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int k = hd__cl_k(ctx, HD__CL_PROJECT);
+    hd__backend *be = vw->be;
+    int k = hd__cl_k(vw, HD__CL_PROJECT);
     size_t local[3] = {HD__CL_PROJECT_GROUP_X, HD__CL_PROJECT_GROUP_Y, 1}, wg = 0, gx, gy;
     cl_int n;
     hd_result r;
-    if ((r = hd__cl_project_prepare(ctx)) != HD_SUCCESS) return r;
-    HD__CL_TRY(ctx, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
+    if ((r = hd__cl_project_prepare(vw)) != HD_SUCCESS) return r;
+    HD__CL_TRY(vw, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
                "clGetKernelWorkGroupInfo");
     if (wg < local[0] * local[1]) {
         local[0] = wg < local[0] ? (wg > 0 ? wg : 1) : local[0];
         local[1] = 1;
     }
-    gx = ((size_t)ctx->kp.image.x + local[0] - 1) / local[0] * local[0];
-    gy = ((size_t)ctx->kp.image.y + local[1] - 1) / local[1] * local[1];
+    gx = ((size_t)vw->kp.image.x + local[0] - 1) / local[0] * local[0];
+    gy = ((size_t)vw->kp.image.y + local[1] - 1) / local[1] * local[1];
     n = be->ptab_n;
-    HD__CL_ARG(ctx, k, 11, n);
-    if ((r = hd__cl_mems(ctx, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_bind(ctx, k)) != HD_SUCCESS ||
-        (r = hd__cl_run_local(ctx, k, 2, gx, gy, 1, local)) != HD_SUCCESS)
+    HD__CL_ARG(vw, k, 11, n);
+    if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_bind(vw, k)) != HD_SUCCESS ||
+        (r = hd__cl_run_local(vw, k, 2, gx, gy, 1, local)) != HD_SUCCESS)
         return r;
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
+}
+
+/* The projection's kernel runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_cl.h). */
+static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+
+/* No recording and no GL texture: the core never calls these (hd__be_features). */
+static unsigned hd__be_features(void) { return 0; }
+static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
+{
+    (void)target; (void)slots;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no recording");
+}
+static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
+static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
+static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
+static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
+{
+    (void)texture;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no GL texture");
 }
 
 /* ---- read-back ------------------------------------------------------------------------------ */
-static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {
-    hd__backend *be = ctx->be;
-    HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
+    hd__backend *be = vw->be;
+    HD__CL_TRY(vw, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(image)");
     return HD_SUCCESS;
 }
 
 /* Maps E or phi (which) for reading or writing; *out is NULL on failure (logged). */
-static hd_result hd__cl_map_illumination(hd__ctx *ctx, hd_illumination which, cl_map_flags flags, void **out)
+static hd_result hd__cl_map_illumination(const hd__view *vw, hd_illumination which, cl_map_flags flags, void **out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int e;
     *out = clEnqueueMapBuffer(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, CL_TRUE, flags, 0,
-                              hd__cl_slots(ctx, (size_t)ctx->gdims[2] * ctx->channels) * (be->gg.f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
-    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(ctx, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
+                              hd__cl_slots(vw, (size_t)vw->gdims[2] * vw->channels) * (be->gg.f16 ? 2 : sizeof(float)), 0, NULL, NULL, &e);
+    if (e != CL_SUCCESS) { *out = NULL; return hd__cl_fail(vw, e, "clEnqueueMapBuffer(illumination)", 0, __LINE__); }
     return HD_SUCCESS;
 }
 
-static hd_result hd__cl_unmap_illumination(hd__ctx *ctx, hd_illumination which, void *mapped)
+static hd_result hd__cl_unmap_illumination(const hd__view *vw, hd_illumination which, void *mapped)
 {
-    hd__backend *be = ctx->be;
-    HD__CL_TRY(ctx, clEnqueueUnmapMemObject(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, mapped, 0, NULL, NULL),
+    hd__backend *be = vw->be;
+    HD__CL_TRY(vw, clEnqueueUnmapMemObject(be->queue, which == HD_ILLUMINATION_DIRECT ? be->E : be->phi, mapped, 0, NULL, NULL),
                "clEnqueueUnmapMemObject(illumination)");
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
 }
 
 /* Copies E or phi between the colour layout, mapped, and the API's x-fastest channel-planar
    order, one direction per call: into dst (src NULL; binary16 widened with the CPU's exact
    hd_h2f) or from src (dst NULL; rounded with the CPU's hd_f2h). */
-static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, const float *src, float *dst, const int *list,
+static hd_result hd__cl_copy_illumination(const hd__view *vw, hd_illumination which, const float *src, float *dst, const int *list,
                                           int count)
 {
-    hd__backend *be = ctx->be;
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], nz = list ? count : ctx->gdims[2] * ctx->channels, x, y, k, zz;
+    hd__backend *be = vw->be;
+    int gx = vw->gdims[0], gy = vw->gdims[1], nz = list ? count : vw->gdims[2] * vw->channels, x, y, k, zz;
     unsigned char *m;
     void *mv;
     hd_result r;
-    if ((r = hd__cl_map_illumination(ctx, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_map_illumination(vw, which, src != NULL ? CL_MAP_WRITE : CL_MAP_READ, &mv)) != HD_SUCCESS) return r;
     m = (unsigned char *)mv;
     for (k = 0; k < nz; ++k)
         for (zz = list ? list[k] : k, y = 0; y < gy; ++y)
             for (x = 0; x < gx; ++x) {
-                size_t s = hd__cl_slot(ctx, x, y, zz);
+                size_t s = hd__cl_slot(vw, x, y, zz);
                 if (be->gg.f16) {
                     uint16_t v;
                     if (src != NULL) { v = hd_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
@@ -761,69 +780,69 @@ static hd_result hd__cl_copy_illumination(hd__ctx *ctx, hd_illumination which, c
                     else memcpy(dst++, m + 4 * s, 4);
                 }
             }
-    return hd__cl_unmap_illumination(ctx, which, mv);
+    return hd__cl_unmap_illumination(vw, which, mv);
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
 {
-    return hd__cl_copy_illumination(ctx, which, NULL, dst, zz, count);
+    return hd__cl_copy_illumination(vw, which, NULL, dst, zz, count);
 }
 
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
-HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
-    ctx->be->gg.lsum_ok = 0;
-    return hd__cl_copy_illumination(ctx, which, src, NULL, NULL, 0);
+    vw->be->gg.lsum_ok = 0;
+    return hd__cl_copy_illumination(vw, which, src, NULL, NULL, 0);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count) { return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count); }
+static hd_result hd__be_alloc_lights(const hd__view *vw, int count) { return hd__gpu_alloc_lights(vw, &vw->be->gg, count); }
 
 /* One convection step of light `light`: reads its volume, writes the spare, the two swap. */
-static hd_result hd__be_convect(hd__ctx *ctx, int light)
+static hd_result hd__be_convect(const hd__view *vw, int light)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     cl_int l = light;
     cl_mem t;
     hd_result r;
-    HD__CL_ARG(ctx, HD__CL_CONVECT, 11, l);
-    if ((r = hd__cl_mems(ctx, HD__CL_CONVECT, 9, 2, be->lv[light], be->lv[be->gg.nlv])) != HD_SUCCESS ||
-        (r = hd__cl_bind_run(ctx, HD__CL_CONVECT, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+    HD__CL_ARG(vw, HD__CL_CONVECT, 11, l);
+    if ((r = hd__cl_mems(vw, HD__CL_CONVECT, 9, 2, be->lv[light], be->lv[be->gg.nlv])) != HD_SUCCESS ||
+        (r = hd__cl_bind_run(vw, HD__CL_CONVECT, 3, (size_t)vw->gdims[0], (size_t)vw->gdims[1], (size_t)vw->gdims[2])) != HD_SUCCESS)
         return r;
     t = be->lv[light]; be->lv[light] = be->lv[be->gg.nlv]; be->lv[be->gg.nlv] = t;
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
 }
 
 /* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
-static hd_result hd__be_sum_lights(hd__ctx *ctx)
+static hd_result hd__be_sum_lights(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    int k = hd__cl_k(ctx, HD__CL_SUM_LIGHT);
+    hd__backend *be = vw->be;
+    int k = hd__cl_k(vw, HD__CL_SUM_LIGHT);
     hd_result r;
     int l;
     be->gg.lsum_ok = 0;
-    if ((r = hd__cl_bind(ctx, k)) != HD_SUCCESS) return r;
+    if ((r = hd__cl_bind(vw, k)) != HD_SUCCESS) return r;
     for (l = 0; l < be->gg.nlv; ++l) {
         cl_int li = l, first = l == 0;
-        HD__CL_ARG(ctx, k, 10, li);
-        HD__CL_ARG(ctx, k, 11, first);
-        if ((r = hd__cl_mems(ctx, k, 9, 1, be->lv[l])) != HD_SUCCESS ||
-            (r = hd__cl_run(ctx, k, 3, (size_t)ctx->gdims[0], (size_t)ctx->gdims[1], (size_t)ctx->gdims[2])) != HD_SUCCESS)
+        HD__CL_ARG(vw, k, 10, li);
+        HD__CL_ARG(vw, k, 11, first);
+        if ((r = hd__cl_mems(vw, k, 9, 1, be->lv[l])) != HD_SUCCESS ||
+            (r = hd__cl_run(vw, k, 3, (size_t)vw->gdims[0], (size_t)vw->gdims[1], (size_t)vw->gdims[2])) != HD_SUCCESS)
             return r;
     }
-    return hd__cl_finish(ctx);
+    return hd__cl_finish(vw);
 }
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------ */
 /* One path per pixel, folded into the image with weight march.y. */
-static hd_result hd__be_path(hd__ctx *ctx)
+static hd_result hd__be_path(const hd__view *vw)
 {
-    hd_result r = hd__cl_bind_run(ctx, HD__CL_PATH, 2, (size_t)ctx->kp.image.x, (size_t)ctx->kp.image.y, 1);
-    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
+    hd_result r = hd__cl_bind_run(vw, HD__CL_PATH, 2, (size_t)vw->kp.image.x, (size_t)vw->kp.image.y, 1);
+    return r != HD_SUCCESS ? r : hd__cl_finish(vw);
 }
 
 /* The single-level solver's sweeps: each its own pair of passes. */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
+static hd_result hd__be_diffuse_sweeps(const hd__view *vw, int jacobi, int sweeps) { return hd__be_diffuse_each(vw, jacobi, sweeps); }
 
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
    The per-level primitives of src/hd_multigrid.h's step (docs/DESIGN-MULTIGRID.md) on the
@@ -848,12 +867,12 @@ static size_t hd__cl_mg_line_floats(const hd__gpu_grids *g)
 
 /* Bytes the solver holds on the device (as the CPU's hd__be_solver_bytes: counted in
    method_bytes); 0 without it. Its grids are padded to the colour layout. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx)
+static size_t hd__be_solver_bytes(const hd__view *vw)
 {
-    const hd__gpu_grids *g = &ctx->be->gg;
+    const hd__gpu_grids *g = &vw->be->gg;
     size_t b;
     int l, d[3];
-    if (!g->levels || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    if (!g->levels || vw->params.solver != HD_SOLVER_MULTIGRID) return 0;
     b = 2 * sizeof(double) * hd__gpu_mg_rows(g) + 2 * sizeof(float) * hd__cl_mg_slots(g->fine, g->channels);
     b += sizeof(float) * hd__cl_mg_line_floats(g);
     for (l = 0; l < g->levels; ++l) {
@@ -865,9 +884,9 @@ static size_t hd__be_solver_bytes(const hd__ctx *ctx)
 }
 
 /* The levels' parameter blocks, the row sums (device and host) and the row buffer. */
-static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
+static hd_result hd__gpu_mg_extras(const hd__view *vw, int make)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__cl_mg *mg = &be->mg;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r = HD_SUCCESS;
@@ -875,62 +894,62 @@ static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
     for (l = 0; l < be->gg.levels; ++l) {
         hd__cl_level *L = &mg->lv[l];
         hd__cl_release(&L->params);
-        if (make && r == HD_SUCCESS) r = hd__cl_buffer(ctx, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters");
+        if (make && r == HD_SUCCESS) r = hd__cl_buffer(vw, &L->params, sizeof(hd__kparams), NULL, "a multigrid level's parameters");
     }
     hd__cl_release(&mg->dot_a); hd__cl_release(&mg->dot_b); hd__cl_release(&mg->line);
-    hd__free(ctx, mg->host_dot);
+    hd__free(vw, mg->host_dot);
     mg->host_dot = NULL;
     if (!make || r != HD_SUCCESS) return r;
-    if (!(mg->host_dot = (double *)hd__calloc(ctx, 2 * rows, sizeof(double))))
-        return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows");
-    if ((r = hd__cl_buffer(ctx, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__cl_buffer(ctx, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS)
+    if (!(mg->host_dot = (double *)hd__calloc(vw, 2 * rows, sizeof(double))))
+        return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "opencl: cannot allocate the dot products' rows");
+    if ((r = hd__cl_buffer(vw, &mg->dot_a, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS ||
+        (r = hd__cl_buffer(vw, &mg->dot_b, rows * sizeof(double), NULL, "multigrid's row sums")) != HD_SUCCESS)
         return r;
-    return hd__cl_buffer(ctx, &mg->line, hd__cl_mg_line_floats(&be->gg) * sizeof(float), NULL, "multigrid's row buffer");
+    return hd__cl_buffer(vw, &mg->line, hd__cl_mg_line_floats(&be->gg) * sizeof(float), NULL, "multigrid's row buffer");
 }
 
-static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
+static hd_result hd__gpu_mg_send(const hd__view *vw, int l, const hd__kparams *kp)
 {
-    HD__CL_TRY(ctx, clEnqueueWriteBuffer(ctx->be->queue, ctx->be->mg.lv[l].params, CL_TRUE, 0, sizeof *kp, kp, 0, NULL, NULL),
+    HD__CL_TRY(vw, clEnqueueWriteBuffer(vw->be->queue, vw->be->mg.lv[l].params, CL_TRUE, 0, sizeof *kp, kp, 0, NULL, NULL),
                "clEnqueueWriteBuffer(multigrid level parameters)");
     return HD_SUCCESS;
 }
 
 /* n colour passes of kernel k over level l (hd__cl_colour_passes), the parity argument `arg`. */
-static hd_result hd__cl_mg_passes(hd__ctx *ctx, int k, int l, cl_uint arg, int first, int n)
+static hd_result hd__cl_mg_passes(const hd__view *vw, int k, int l, cl_uint arg, int first, int n)
 {
-    return hd__cl_colour_passes(ctx, k, ctx->be->gg.lv[l].dims, ctx->be->gg.channels, arg, first, n);
+    return hd__cl_colour_passes(vw, k, vw->be->gg.lv[l].dims, vw->be->gg.channels, arg, first, n);
 }
 
 /* n colour passes of kernel k with level l bound to its nine HD__CL_BUFFERS arguments: sigma_t,
    E = the right-hand side, phi = the correction, phi2 = the residual (written by the residual
    kernels only). */
-static hd_result hd__cl_mg_level_passes(hd__ctx *ctx, int k, int l, int first, int n)
+static hd_result hd__cl_mg_level_passes(const hd__view *vw, int k, int l, int first, int n)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd__cl_level *L = &be->mg.lv[l];
-    hd_result r = hd__cl_mems(ctx, k, 0, 9, L->params, be->vol, be->tf, be->maj, l == 0 ? be->sig : L->sig, L->rhs, L->phi, L->res,
+    hd_result r = hd__cl_mems(vw, k, 0, 9, L->params, be->vol, be->tf, be->maj, l == 0 ? be->sig : L->sig, L->rhs, L->phi, L->res,
                               be->img);
-    return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, l, 9, first, n);
+    return r != HD_SUCCESS ? r : hd__cl_mg_passes(vw, k, l, 9, first, n);
 }
 
 /* Level l's smoothing: the diffusion kernel on its parameter block. */
-static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+static hd_result hd__be_mg_smooth(const hd__view *vw, int l, int sweeps, int first)
 {
-    return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_DIFFUSE), l, first, 2 * sweeps);
+    return hd__cl_mg_level_passes(vw, hd__cl_variant(vw, HD__CL_DIFFUSE), l, first, 2 * sweeps);
 }
 
-static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
+static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw) { return &vw->be->gg; }
 
-/* Pass p on the kernels of hd_entry_cl.h, which take the grids of p's set (src/hd_gpu.h: m[0..4]
+/* Pass p on the kernels of hd_entry_cl.h, which take the grids of p's set (backends/hd_gpu.h: m[0..4]
    sigma_t, E, phi, phi2, other) and the parameter blocks each in its own order: the transfers
    and the coarse sigma_t both levels' (slot's and p->level's), the others slot's alone. The
    residuals and the prolongation run as colour passes; the restriction as each fine column's
    share of the coarse rows (both parities, into the row buffer; argument 5 of that kernel is the
    transfers' mask), then their sum per coarse voxel. */
-static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
+static hd_result hd__gpu_mg_pass(const hd__view *vw, const hd__gpu_mg_run *p)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__cl_mg *mg = &be->mg;
     const int *d = be->gg.lv[p->level].dims;
     cl_mem m[5], par = p->slot == be->gg.levels ? be->params : mg->lv[p->slot].params, lp = mg->lv[p->level].params;
@@ -942,73 +961,73 @@ static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
     for (i = 0; i < 5; ++i) m[i] = b.grid[i] < 0 ? NULL : *hd__cl_grid(be, b.grid[i]);
     switch (p->stage) {
     case HD__MG_SIG:
-        r = hd__cl_mems(ctx, k = HD__CL_MG_SIG, 0, 4, par, lp, m[0], m[4]);
+        r = hd__cl_mems(vw, k = HD__CL_MG_SIG, 0, 4, par, lp, m[0], m[4]);
         break;
     case HD__MG_RESIDUAL: /* the smoothing's bindings */
-        return hd__cl_mg_level_passes(ctx, hd__cl_variant(ctx, HD__CL_MG_RESIDUAL), p->level, 0, 2);
+        return hd__cl_mg_level_passes(vw, hd__cl_variant(vw, HD__CL_MG_RESIDUAL), p->level, 0, 2);
     case HD__MG_RESTRICT:
         k = HD__CL_MG_RESTRICT_LINE;
-        if ((r = hd__cl_mems(ctx, k, 0, 4, par, lp, m[2], mg->line)) != HD_SUCCESS || (r = hd__cl_mems(ctx, k, 5, 1, m[0])) != HD_SUCCESS)
+        if ((r = hd__cl_mems(vw, k, 0, 4, par, lp, m[2], mg->line)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 5, 1, m[0])) != HD_SUCCESS)
             return r;
         for (pc0 = 0; pc0 < 2 && r == HD_SUCCESS; ++pc0) {
-            HD__CL_ARG(ctx, k, 4, pc0);
-            r = hd__cl_run(ctx, k, 3, ((size_t)be->gg.lv[p->slot].dims[0] + 1) / 2, (size_t)d[1], (size_t)d[2] * (size_t)be->gg.channels);
+            HD__CL_ARG(vw, k, 4, pc0);
+            r = hd__cl_run(vw, k, 3, ((size_t)be->gg.lv[p->slot].dims[0] + 1) / 2, (size_t)d[1], (size_t)d[2] * (size_t)be->gg.channels);
         }
-        if (r == HD_SUCCESS) r = hd__cl_mems(ctx, k = HD__CL_MG_RESTRICT, 0, 5, par, lp, mg->line, m[4], m[3]);
+        if (r == HD_SUCCESS) r = hd__cl_mems(vw, k = HD__CL_MG_RESTRICT, 0, 5, par, lp, mg->line, m[4], m[3]);
         break;
     case HD__MG_PROLONG:
-        if ((r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 0, 4, lp, par, m[2], m[4])) == HD_SUCCESS)
-            r = hd__cl_mems(ctx, HD__CL_MG_PROLONG, 5, 1, m[0]);
-        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, HD__CL_MG_PROLONG, p->level, 4, 0, 2);
+        if ((r = hd__cl_mems(vw, HD__CL_MG_PROLONG, 0, 4, lp, par, m[2], m[4])) == HD_SUCCESS)
+            r = hd__cl_mems(vw, HD__CL_MG_PROLONG, 5, 1, m[0]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(vw, HD__CL_MG_PROLONG, p->level, 4, 0, 2);
     case HD__MG_RES_F64:
-        k = hd__cl_variant(ctx, HD__CL_MG_RES_F64);
-        HD__CL_ARG(ctx, k, 7, pc0);
-        HD__CL_ARG(ctx, k, 8, pc1);
-        r = hd__cl_mems(ctx, k, 0, 6, par, m[0], m[1], m[2], m[3], m[4]);
-        return r != HD_SUCCESS ? r : hd__cl_mg_passes(ctx, k, 0, 6, 0, 2);
+        k = hd__cl_variant(vw, HD__CL_MG_RES_F64);
+        HD__CL_ARG(vw, k, 7, pc0);
+        HD__CL_ARG(vw, k, 8, pc1);
+        r = hd__cl_mems(vw, k, 0, 6, par, m[0], m[1], m[2], m[3], m[4]);
+        return r != HD_SUCCESS ? r : hd__cl_mg_passes(vw, k, 0, 6, 0, 2);
     case HD__MG_DOT:
-        r = hd__cl_mems(ctx, HD__CL_MG_DOT, 0, 4, par, m[1], m[2], b.dot == 1 ? mg->dot_a : mg->dot_b);
-        return r != HD_SUCCESS ? r : hd__cl_run(ctx, HD__CL_MG_DOT, 2, (size_t)p->n[0], (size_t)p->n[1], 1);
+        r = hd__cl_mems(vw, HD__CL_MG_DOT, 0, 4, par, m[1], m[2], b.dot == 1 ? mg->dot_a : mg->dot_b);
+        return r != HD_SUCCESS ? r : hd__cl_run(vw, HD__CL_MG_DOT, 2, (size_t)p->n[0], (size_t)p->n[1], 1);
     case HD__MG_DIR:
-        HD__CL_ARG(ctx, HD__CL_MG_DIR, 3, p->beta);
-        r = hd__cl_mems(ctx, k = HD__CL_MG_DIR, 0, 3, par, m[1], m[2]);
+        HD__CL_ARG(vw, HD__CL_MG_DIR, 3, p->beta);
+        r = hd__cl_mems(vw, k = HD__CL_MG_DIR, 0, 3, par, m[1], m[2]);
         break;
     case HD__MG_UPDATE:
-        HD__CL_ARG(ctx, HD__CL_MG_UPDATE, 4, p->alpha);
-        r = hd__cl_mems(ctx, k = HD__CL_MG_UPDATE, 0, 4, par, m[2], m[3], m[1]);
+        HD__CL_ARG(vw, HD__CL_MG_UPDATE, 4, p->alpha);
+        r = hd__cl_mems(vw, k = HD__CL_MG_UPDATE, 0, 4, par, m[2], m[3], m[1]);
         break;
     default: /* HD__MG_EXTRAP */
-        HD__CL_ARG(ctx, HD__CL_MG_EXTRAP, 5, pc0);
-        r = hd__cl_mems(ctx, k = HD__CL_MG_EXTRAP, 0, 5, par, m[0], m[1], m[2], m[3]);
+        HD__CL_ARG(vw, HD__CL_MG_EXTRAP, 5, pc0);
+        r = hd__cl_mems(vw, k = HD__CL_MG_EXTRAP, 0, 5, par, m[0], m[1], m[2], m[3]);
         break;
     }
-    return r != HD_SUCCESS ? r : hd__cl_run(ctx, k, 3, (size_t)p->n[0], (size_t)p->n[1], (size_t)p->n[2]);
+    return r != HD_SUCCESS ? r : hd__cl_run(vw, k, 3, (size_t)p->n[0], (size_t)p->n[1], (size_t)p->n[2]);
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
-static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
+static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh)
 {
     hd_result r;
-    if (!ctx->be->fp64)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
-    if ((r = hd__gpu_mg_begin(ctx, &ctx->be->gg, fresh)) != HD_SUCCESS) return r;
-    return hd__cl_send_params(ctx);
+    if (!vw->be->fp64)
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: solver MULTIGRID needs double precision (cl_khr_fp64), which this device lacks");
+    if ((r = hd__gpu_mg_begin(vw, &vw->be->gg, fresh)) != HD_SUCCESS) return r;
+    return hd__cl_send_params(vw);
 }
 
-static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_mg_end(const hd__view *vw, hd_result r)
 {
-    return r != HD_SUCCESS ? r : hd__cl_finish(ctx);
+    return r != HD_SUCCESS ? r : hd__cl_finish(vw);
 }
 
 /* The buffers read (blocking: after every pass enqueued before) into their host copies. */
-static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+static hd_result hd__be_mg_row_sums(const hd__view *vw, int n, const double **a, const double **b)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__cl_mg *mg = &be->mg;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     int i;
     for (i = 0; i < n && i < 2; ++i)
-        HD__CL_TRY(ctx, clEnqueueReadBuffer(be->queue, i ? mg->dot_b : mg->dot_a, CL_TRUE, 0, rows * sizeof(double),
+        HD__CL_TRY(vw, clEnqueueReadBuffer(be->queue, i ? mg->dot_b : mg->dot_a, CL_TRUE, 0, rows * sizeof(double),
                                             mg->host_dot + i * rows, 0, NULL, NULL), "clEnqueueReadBuffer(multigrid row sums)");
     *a = mg->host_dot;
     *b = mg->host_dot + rows;

@@ -134,16 +134,16 @@ struct hd__vk_mg {
     hd__vk_level lv[HD__MG_MAX_LEVELS];
     hd__vk_image p, lo;       /* the search direction; the iterate's low part (phi + lo) */
     hd__vk_buffer dot_a, dot_b; /* per-row partial sums (double), host-visible */
-    hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: ctx->kp */
+    hd__vk_buffer params;     /* slot l: level l's parameter block; slot `levels`: vw->kp */
     VkDeviceSize slot_bytes;
     VkDescriptorPool pool;
-    VkDescriptorSet sets[HD__GPU_MG_SETS]; /* by src/hd_gpu.h's set numbers */
+    VkDescriptorSet sets[HD__GPU_MG_SETS]; /* by backends/hd_gpu.h's set numbers */
     unsigned sets_gen;        /* be->sets_gen the sets were written at */
     int sets_valid;
 };
 
 struct hd__backend {
-    hd__ctx *ctx;
+    const hd__view *vw;
     hd__vk_fns fn;
     PFN_vkGetInstanceProcAddr gipa;
     VkInstance instance;
@@ -168,9 +168,7 @@ struct hd__backend {
     VkQueryPool ts_pool;
     int ts_state;                 /* 0: not looked at yet; 1: pool made; -1: the queue has no timestamps */
     uint64_t ts_mask;             /* the queue family's timestampValidBits as a mask */
-    int ts_pending, ts_scale;     /* a recorded frame's timestamps to read, and its render scale */
-    double ts_pixels;             /* ... and the pixels it marched */
-    unsigned ts_cost_gen;         /* ctx->cost_gen when it was recorded (a frame run since wins) */
+    int ts_pending;               /* a recorded frame's timestamps to read (hd__be_record_seconds) */
     /* pipelines and bindings */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -181,7 +179,7 @@ struct hd__backend {
     int diffuse_half[HD__VK_DIFFUSE_VARIANTS];   /* ... from the r16f SPIR-V */
     int ndiffuse;
     int32_t diffuse_zk, diffuse_yk; /* HD__VK_DIFFUSE_ZK, _YK: what the pipelines are specialized for */
-    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in blocks spread (src/hd_gpu.h) */
+    int spread_rows;              /* 1 (a CPU device: lavapipe): the projection's rows in blocks spread (backends/hd_gpu.h) */
     VkDescriptorPool dpool;
     VkDescriptorSet sets[HD_MAX_LIGHTS];
     int sets_valid;
@@ -194,17 +192,17 @@ struct hd__backend {
     hd__kparams slot_kp;          /* what the current slot holds */
     /* resources */
     hd__vk_buffer tf, maj, img, staging, dummy_buffer;
-    hd__vk_buffer dl;             /* the direct light's list of voxels (ctx->dl_idx), binding 12 */
+    hd__vk_buffer dl;             /* the direct light's list of voxels (vw->dl_idx), binding 12 */
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
-    hd__gpu_grids gg;             /* what the grids are made for (src/hd_gpu.h) */
+    hd__gpu_grids gg;             /* what the grids are made for (backends/hd_gpu.h) */
     struct hd__vk_mg mg;          /* HD_SOLVER_MULTIGRID's extras and grids while gg.levels */
-    VkPipeline mg_pipes[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (src/hd_gpu.h), made on first use */
+    VkPipeline mg_pipes[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (backends/hd_gpu.h), made on first use */
     unsigned sets_gen;            /* bumped whenever hd__vk_sets rebuilds: the multigrid sets follow */
     hd__vk_image lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__be_project): E + phi (binding 14, r32f), valid while
-       gg.lsum_ok (src/hd_gpu.h), and the step's TF table (binding 13,
+       gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (binding 13,
        host-visible, ptab_cap entries, sized with the TF), written when its inputs change
        (ptab_key) */
     hd__vk_image lsum;
@@ -238,7 +236,7 @@ static const char *hd__vk_result_name(VkResult e)
 }
 
 /* Logs the failing call with its VkResult name and returns the hd_result it means. */
-static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int line)
+static hd_result hd__vk_fail(const hd__view *vw, VkResult e, const char *call, int line)
 {
     hd_result r = HD_ERROR_BACKEND;
     if (e == VK_ERROR_OUT_OF_DEVICE_MEMORY || e == VK_ERROR_FRAGMENTATION || e == VK_ERROR_FRAGMENTED_POOL ||
@@ -251,20 +249,20 @@ static hd_result hd__vk_fail(hd__ctx *ctx, VkResult e, const char *call, int lin
     else if (e == VK_ERROR_INITIALIZATION_FAILED || e == VK_ERROR_INCOMPATIBLE_DRIVER || e == VK_ERROR_LAYER_NOT_PRESENT ||
              e == VK_ERROR_EXTENSION_NOT_PRESENT || e == VK_ERROR_FEATURE_NOT_PRESENT || e == VK_ERROR_FORMAT_NOT_SUPPORTED)
         r = HD_ERROR_UNSUPPORTED;
-    if (r == HD_ERROR_DEVICE_LOST && ctx->be) ctx->be->lost = 1;
-    hd__logf(&ctx->log, HD_LOG_ERROR, r, __FILE__, line, "vulkan: %s failed: %s (%d)", call, hd__vk_result_name(e), (int)e);
+    if (r == HD_ERROR_DEVICE_LOST && vw->be) vw->be->lost = 1;
+    hd__logf(&vw->log, HD_LOG_ERROR, r, __FILE__, line, "vulkan: %s failed: %s (%d)", call, hd__vk_result_name(e), (int)e);
     return r;
 }
 /* Returns from the calling function when a Vulkan call failed. */
-#define HD__VK_TRY(ctx, call_expr, name) \
+#define HD__VK_TRY(vw, call_expr, name) \
     do { VkResult hd__e = (call_expr); \
-         if (hd__e < 0) return hd__vk_fail((ctx), hd__e, (name), __LINE__); } while (0)
-#define HD__VK_LOST_CHECK(ctx) \
-    do { if ((ctx)->be->lost) return HD__ERR(&(ctx)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
+         if (hd__e < 0) return hd__vk_fail((vw), hd__e, (name), __LINE__); } while (0)
+#define HD__VK_LOST_CHECK(vw) \
+    do { if ((vw)->be->lost) return HD__ERR(&(vw)->log, HD_ERROR_DEVICE_LOST, "vulkan: the device was lost earlier"); } while (0)
 /* What the backend recorded submitted and waited for (hd__vk_flush), so nothing is in flight;
    returns from the calling function on failure. */
-#define HD__VK_IDLE(ctx) \
-    do { hd_result hd__r = hd__vk_flush(ctx); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
+#define HD__VK_IDLE(vw) \
+    do { hd_result hd__r = hd__vk_flush(vw); if (hd__r != HD_SUCCESS) return hd__r; } while (0)
 
 /* The validation layer's messages: logged as errors and counted (the tests fail on any). */
 static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -274,19 +272,19 @@ static VKAPI_ATTR VkBool32 VKAPI_CALL hd__vk_messenger(VkDebugUtilsMessageSeveri
     hd__backend *be = (hd__backend *)user;
     (void)types;
     be->validation_messages++;
-    hd__logf(&be->ctx->log, HD_LOG_ERROR, HD_ERROR_BACKEND, __FILE__, __LINE__, "vulkan validation (%s): %s",
+    hd__logf(&be->vw->log, HD_LOG_ERROR, HD_ERROR_BACKEND, __FILE__, __LINE__, "vulkan validation (%s): %s",
              severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
              data && data->pMessage ? data->pMessage : "(no message)");
     return VK_FALSE;
 }
 
 /* ---- instance, device, functions ------------------------------------------------------------- */
-static hd_result hd__vk_load_instance_fns(hd__ctx *ctx)
+static hd_result hd__vk_load_instance_fns(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
 #define HD__VK_LOAD(name) \
     if (!(be->fn.name = (PFN_##name)be->gipa(be->instance, #name))) \
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(\"%s\") returned NULL", #name);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(\"%s\") returned NULL", #name);
     HD__VK_INSTANCE_FNS(HD__VK_LOAD)
 #undef HD__VK_LOAD
     be->fn.vkCreateDebugUtilsMessengerEXT = (PFN_vkCreateDebugUtilsMessengerEXT)be->gipa(be->instance, "vkCreateDebugUtilsMessengerEXT");
@@ -294,12 +292,12 @@ static hd_result hd__vk_load_instance_fns(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_load_device_fns(hd__ctx *ctx)
+static hd_result hd__vk_load_device_fns(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
 #define HD__VK_LOAD(name) \
     if (!(be->fn.name = (PFN_##name)be->fn.vkGetDeviceProcAddr(be->device, #name))) \
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetDeviceProcAddr(\"%s\") returned NULL", #name);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetDeviceProcAddr(\"%s\") returned NULL", #name);
     HD__VK_DEVICE_FNS(HD__VK_LOAD)
 #undef HD__VK_LOAD
     return HD_SUCCESS;
@@ -323,9 +321,9 @@ static struct {
 } hd__vk_kept = {PTHREAD_MUTEX_INITIALIZER, {NULL}, {VK_NULL_HANDLE}};
 
 /* The backend's own headless instance, with the validation layer when asked. */
-static hd_result hd__vk_create_instance(hd__ctx *ctx)
+static hd_result hd__vk_create_instance(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkApplicationInfo app;
     VkInstanceCreateInfo ici;
     VkDebugUtilsMessengerCreateInfoEXT dci;
@@ -333,10 +331,10 @@ static hd_result hd__vk_create_instance(hd__ctx *ctx)
     VkValidationFeatureEnableEXT enables[1];
     const char *layer = "VK_LAYER_KHRONOS_validation";
     const char *ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
-    int validate = ctx->desc.vulkan.enable_validation || hd__vk_env_flag("HD_VK_VALIDATION");
+    int validate = vw->desc.vulkan.enable_validation || hd__vk_env_flag("HD_VK_VALIDATION");
 #define HD__VK_LOAD(name) \
     if (!(be->fn.name = (PFN_##name)be->gipa(NULL, #name))) \
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(NULL, \"%s\") returned NULL", #name);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: vkGetInstanceProcAddr(NULL, \"%s\") returned NULL", #name);
     HD__VK_GLOBAL_FNS(HD__VK_LOAD)
 #undef HD__VK_LOAD
     memset(&app, 0, sizeof app);
@@ -358,14 +356,14 @@ static hd_result hd__vk_create_instance(hd__ctx *ctx)
         uint32_t n = 0, i;
         int found = 0;
         VkLayerProperties *props;
-        HD__VK_TRY(ctx, be->fn.vkEnumerateInstanceLayerProperties(&n, NULL), "vkEnumerateInstanceLayerProperties");
-        props = (VkLayerProperties *)hd__calloc(ctx, n ? n : 1, sizeof *props);
-        if (!props) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for the layer list");
+        HD__VK_TRY(vw, be->fn.vkEnumerateInstanceLayerProperties(&n, NULL), "vkEnumerateInstanceLayerProperties");
+        props = (VkLayerProperties *)hd__calloc(vw, n ? n : 1, sizeof *props);
+        if (!props) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for the layer list");
         if (be->fn.vkEnumerateInstanceLayerProperties(&n, props) >= 0)
             for (i = 0; i < n; ++i) found |= strcmp(props[i].layerName, layer) == 0;
-        hd__free(ctx, props);
+        hd__free(vw, props);
         if (!found)
-            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: validation asked for, but %s is not installed (Debian: vulkan-validationlayers)", layer);
+            return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: validation asked for, but %s is not installed (Debian: vulkan-validationlayers)", layer);
         enables[0] = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
         memset(&vf, 0, sizeof vf);
         vf.sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT;
@@ -392,16 +390,16 @@ static hd_result hd__vk_create_instance(hd__ctx *ctx)
             be->kept_instance = 1;
         }
         pthread_mutex_unlock(&hd__vk_kept.mu);
-        HD__VK_TRY(ctx, vr, "vkCreateInstance");
+        HD__VK_TRY(vw, vr, "vkCreateInstance");
     } else {
-        HD__VK_TRY(ctx, be->fn.vkCreateInstance(&ici, NULL, &be->instance), "vkCreateInstance");
+        HD__VK_TRY(vw, be->fn.vkCreateInstance(&ici, NULL, &be->instance), "vkCreateInstance");
     }
-    if (hd__vk_load_instance_fns(ctx) != HD_SUCCESS) return HD_ERROR_UNSUPPORTED;
+    if (hd__vk_load_instance_fns(vw) != HD_SUCCESS) return HD_ERROR_UNSUPPORTED;
     if (validate) {
         if (!be->fn.vkCreateDebugUtilsMessengerEXT || !be->fn.vkDestroyDebugUtilsMessengerEXT)
-            return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: VK_EXT_debug_utils has no vkCreateDebugUtilsMessengerEXT");
-        HD__VK_TRY(ctx, be->fn.vkCreateDebugUtilsMessengerEXT(be->instance, &dci, NULL, &be->messenger), "vkCreateDebugUtilsMessengerEXT");
-        HD__INFO(&ctx->log, "vulkan: VK_LAYER_KHRONOS_validation with synchronization validation");
+            return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: VK_EXT_debug_utils has no vkCreateDebugUtilsMessengerEXT");
+        HD__VK_TRY(vw, be->fn.vkCreateDebugUtilsMessengerEXT(be->instance, &dci, NULL, &be->messenger), "vkCreateDebugUtilsMessengerEXT");
+        HD__INFO(&vw->log, "vulkan: VK_LAYER_KHRONOS_validation with synchronization validation");
     }
     return HD_SUCCESS;
 }
@@ -418,19 +416,19 @@ static int hd__vk_compute_family(hd__backend *be, VkPhysicalDevice phys)
 }
 
 /* By name (desc or $HD_VK_DEVICE, substring), else by type: discrete, integrated, virtual, CPU. */
-static hd_result hd__vk_pick_device(hd__ctx *ctx)
+static hd_result hd__vk_pick_device(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkPhysicalDevice devs[16];
     uint32_t n = 16, i;
-    const char *want = ctx->desc.vulkan.device_name;
+    const char *want = vw->desc.vulkan.device_name;
     static const int rank[] = {4, 1, 0, 2, 3}; /* OTHER, INTEGRATED, DISCRETE, VIRTUAL, CPU */
     int best = -1, best_rank = 99;
     VkResult e;
     if (!want || !*want) want = getenv("HD_VK_DEVICE");
     e = be->fn.vkEnumeratePhysicalDevices(be->instance, &n, devs);
-    if (e < 0) return hd__vk_fail(ctx, e, "vkEnumeratePhysicalDevices", __LINE__);
-    if (n == 0) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan device (is a driver such as mesa-vulkan-drivers installed?)");
+    if (e < 0) return hd__vk_fail(vw, e, "vkEnumeratePhysicalDevices", __LINE__);
+    if (n == 0) return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan device (is a driver such as mesa-vulkan-drivers installed?)");
     for (i = 0; i < n && i < 16; ++i) {
         VkPhysicalDeviceProperties p;
         int r;
@@ -441,17 +439,17 @@ static hd_result hd__vk_pick_device(hd__ctx *ctx)
         if (r < best_rank) { best_rank = r; best = (int)i; }
     }
     if (best < 0) {
-        if (want && *want) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 compute device's name contains \"%s\"", want);
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 device with a compute queue");
+        if (want && *want) return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 compute device's name contains \"%s\"", want);
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no Vulkan 1.1 device with a compute queue");
     }
     be->phys = devs[best];
     be->queue_family = (uint32_t)hd__vk_compute_family(be, be->phys);
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_create_device(hd__ctx *ctx)
+static hd_result hd__vk_create_device(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkDeviceQueueCreateInfo qci;
     VkDeviceCreateInfo dci;
     VkPhysicalDeviceFeatures have, want;
@@ -470,7 +468,7 @@ static hd_result hd__vk_create_device(hd__ctx *ctx)
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qci;
     dci.pEnabledFeatures = &want;
-    HD__VK_TRY(ctx, be->fn.vkCreateDevice(be->phys, &dci, NULL, &be->device), "vkCreateDevice");
+    HD__VK_TRY(vw, be->fn.vkCreateDevice(be->phys, &dci, NULL, &be->device), "vkCreateDevice");
     return HD_SUCCESS;
 }
 
@@ -486,15 +484,15 @@ static int hd__vk_memory_type(hd__backend *be, uint32_t bits, VkMemoryPropertyFl
 }
 
 /* One vkAllocateMemory, counted against $HD_VK_MEMORY_LIMIT. */
-static hd_result hd__vk_allocate(hd__ctx *ctx, const VkMemoryRequirements *req, VkMemoryPropertyFlags want,
+static hd_result hd__vk_allocate(const hd__view *vw, const VkMemoryRequirements *req, VkMemoryPropertyFlags want,
                                  VkMemoryPropertyFlags prefer, VkDeviceMemory *out, const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkMemoryAllocateInfo mai;
     int type = hd__vk_memory_type(be, req->memoryTypeBits, want, prefer);
-    if (type < 0) return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: no memory type for %s", what);
+    if (type < 0) return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no memory type for %s", what);
     if (be->mem_limit && be->mem_used + req->size > be->mem_limit) {
-        hd__logf(&ctx->log, HD_LOG_ERROR, HD_ERROR_OUT_OF_DEVICE_MEMORY, __FILE__, __LINE__,
+        hd__logf(&vw->log, HD_LOG_ERROR, HD_ERROR_OUT_OF_DEVICE_MEMORY, __FILE__, __LINE__,
                  "vulkan: vkAllocateMemory(%s, %llu bytes) failed: VK_ERROR_OUT_OF_DEVICE_MEMORY (HD_VK_MEMORY_LIMIT %llu, %llu in use)",
                  what, (unsigned long long)req->size, (unsigned long long)be->mem_limit, (unsigned long long)be->mem_used);
         return HD_ERROR_OUT_OF_DEVICE_MEMORY;
@@ -503,14 +501,14 @@ static hd_result hd__vk_allocate(hd__ctx *ctx, const VkMemoryRequirements *req, 
     mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     mai.allocationSize = req->size;
     mai.memoryTypeIndex = (uint32_t)type;
-    HD__VK_TRY(ctx, be->fn.vkAllocateMemory(be->device, &mai, NULL, out), "vkAllocateMemory");
+    HD__VK_TRY(vw, be->fn.vkAllocateMemory(be->device, &mai, NULL, out), "vkAllocateMemory");
     be->mem_used += req->size;
     return HD_SUCCESS;
 }
 
-static void hd__vk_free_buffer(hd__ctx *ctx, hd__vk_buffer *b)
+static void hd__vk_free_buffer(const hd__view *vw, hd__vk_buffer *b)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     if (b->buffer) be->fn.vkDestroyBuffer(be->device, b->buffer, NULL);
     if (b->memory) {
         if (b->map) be->fn.vkUnmapMemory(be->device, b->memory);
@@ -521,9 +519,9 @@ static void hd__vk_free_buffer(hd__ctx *ctx, hd__vk_buffer *b)
     be->sets_valid = 0;
 }
 
-static void hd__vk_free_image(hd__ctx *ctx, hd__vk_image *im)
+static void hd__vk_free_image(const hd__view *vw, hd__vk_image *im)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     if (im->view) be->fn.vkDestroyImageView(be->device, im->view, NULL);
     if (im->image) be->fn.vkDestroyImage(be->device, im->image, NULL);
     if (im->memory) {
@@ -535,10 +533,10 @@ static void hd__vk_free_image(hd__ctx *ctx, hd__vk_image *im)
 }
 
 /* A buffer; host != 0: host-visible, coherent and mapped (else device-local). */
-static hd_result hd__vk_buffer_create(hd__ctx *ctx, hd__vk_buffer *b, VkDeviceSize bytes, VkBufferUsageFlags usage,
+static hd_result hd__vk_buffer_create(const hd__view *vw, hd__vk_buffer *b, VkDeviceSize bytes, VkBufferUsageFlags usage,
                                       int host, const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkBufferCreateInfo bci;
     VkMemoryRequirements req;
     hd_result r;
@@ -550,24 +548,24 @@ static hd_result hd__vk_buffer_create(hd__ctx *ctx, hd__vk_buffer *b, VkDeviceSi
     bci.size = bytes;
     bci.usage = usage;
     bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-    HD__VK_TRY(ctx, be->fn.vkCreateBuffer(be->device, &bci, NULL, &b->buffer), "vkCreateBuffer");
+    HD__VK_TRY(vw, be->fn.vkCreateBuffer(be->device, &bci, NULL, &b->buffer), "vkCreateBuffer");
     be->fn.vkGetBufferMemoryRequirements(be->device, b->buffer, &req);
-    r = hd__vk_allocate(ctx, &req, host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+    r = hd__vk_allocate(vw, &req, host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
                                         : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT,
                         host ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT : 0, &b->memory, what);
     if (r != HD_SUCCESS) return r;
     b->bytes = req.size;
-    HD__VK_TRY(ctx, be->fn.vkBindBufferMemory(be->device, b->buffer, b->memory, 0), "vkBindBufferMemory");
-    if (host) HD__VK_TRY(ctx, be->fn.vkMapMemory(be->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->map), "vkMapMemory");
+    HD__VK_TRY(vw, be->fn.vkBindBufferMemory(be->device, b->buffer, b->memory, 0), "vkBindBufferMemory");
+    if (host) HD__VK_TRY(vw, be->fn.vkMapMemory(be->device, b->memory, 0, VK_WHOLE_SIZE, 0, &b->map), "vkMapMemory");
     return HD_SUCCESS;
 }
 
 /* A storage image3D of format fmt (R16, R32 or R32G32 SFLOAT), also usable as `usage` (e.g. sampled);
    layout GENERAL once the next command buffer has run. */
-static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, VkFormat fmt,
+static hd_result hd__vk_image_create_as(const hd__view *vw, hd__vk_image *im, int w, int h, int d, VkFormat fmt,
                                         VkImageUsageFlags usage, const char *what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkImageCreateInfo ici;
     VkImageViewCreateInfo vci;
     VkMemoryRequirements req;
@@ -576,7 +574,7 @@ static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, i
     be->sets_valid = 0;
     if ((uint32_t)w > be->limits.maxImageDimension3D || (uint32_t)h > be->limits.maxImageDimension3D ||
         (uint32_t)d > be->limits.maxImageDimension3D)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: %s needs a %dx%dx%d image, above maxImageDimension3D = %u",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: %s needs a %dx%dx%d image, above maxImageDimension3D = %u",
                        what, w, h, d, be->limits.maxImageDimension3D);
     memset(&ici, 0, sizeof ici);
     ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
@@ -590,11 +588,11 @@ static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, i
     ici.usage = usage | VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
     ici.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    HD__VK_TRY(ctx, be->fn.vkCreateImage(be->device, &ici, NULL, &im->image), "vkCreateImage");
+    HD__VK_TRY(vw, be->fn.vkCreateImage(be->device, &ici, NULL, &im->image), "vkCreateImage");
     be->fn.vkGetImageMemoryRequirements(be->device, im->image, &req);
-    if ((r = hd__vk_allocate(ctx, &req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, &im->memory, what)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_allocate(vw, &req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0, &im->memory, what)) != HD_SUCCESS) return r;
     im->bytes = req.size;
-    HD__VK_TRY(ctx, be->fn.vkBindImageMemory(be->device, im->image, im->memory, 0), "vkBindImageMemory");
+    HD__VK_TRY(vw, be->fn.vkBindImageMemory(be->device, im->image, im->memory, 0), "vkBindImageMemory");
     memset(&vci, 0, sizeof vci);
     vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
     vci.image = im->image;
@@ -603,32 +601,32 @@ static hd_result hd__vk_image_create_as(hd__ctx *ctx, hd__vk_image *im, int w, i
     vci.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
     vci.subresourceRange.levelCount = 1;
     vci.subresourceRange.layerCount = 1;
-    HD__VK_TRY(ctx, be->fn.vkCreateImageView(be->device, &vci, NULL, &im->view), "vkCreateImageView");
+    HD__VK_TRY(vw, be->fn.vkCreateImageView(be->device, &vci, NULL, &im->view), "vkCreateImageView");
     im->extent[0] = w; im->extent[1] = h; im->extent[2] = d;
     im->texel = fmt == VK_FORMAT_R32G32_SFLOAT ? 8 : fmt == VK_FORMAT_R16_SFLOAT ? 2 : 4;
     return HD_SUCCESS;
 }
 
 /* An r32f storage image3D, the grids' usual form. */
-static hd_result hd__vk_image_create(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+static hd_result hd__vk_image_create(const hd__view *vw, hd__vk_image *im, int w, int h, int d, const char *what)
 {
-    return hd__vk_image_create_as(ctx, im, w, h, d, VK_FORMAT_R32_SFLOAT, 0, what);
+    return hd__vk_image_create_as(vw, im, w, h, d, VK_FORMAT_R32_SFLOAT, 0, what);
 }
 
 /* ---- command buffers -------------------------------------------------------------------------- */
 /* The command buffer to record into: the caller's (hd_vulkan_record) or the backend's, begun. */
-static hd_result hd__vk_cmd(hd__ctx *ctx, VkCommandBuffer *out)
+static hd_result hd__vk_cmd(const hd__view *vw, VkCommandBuffer *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBufferBeginInfo bi;
-    HD__VK_LOST_CHECK(ctx);
+    HD__VK_LOST_CHECK(vw);
     if (be->rec) { *out = be->rec; return HD_SUCCESS; }
     if (!be->open) {
-        HD__VK_TRY(ctx, be->fn.vkResetCommandBuffer(be->cmd, 0), "vkResetCommandBuffer");
+        HD__VK_TRY(vw, be->fn.vkResetCommandBuffer(be->cmd, 0), "vkResetCommandBuffer");
         memset(&bi, 0, sizeof bi);
         bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
         bi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-        HD__VK_TRY(ctx, be->fn.vkBeginCommandBuffer(be->cmd, &bi), "vkBeginCommandBuffer");
+        HD__VK_TRY(vw, be->fn.vkBeginCommandBuffer(be->cmd, &bi), "vkBeginCommandBuffer");
         be->open = 1;
     }
     *out = be->cmd;
@@ -636,23 +634,23 @@ static hd_result hd__vk_cmd(hd__ctx *ctx, VkCommandBuffer *out)
 }
 
 /* Submits what the backend recorded and waits for it (nothing when recording for the caller). */
-static hd_result hd__vk_flush(hd__ctx *ctx)
+static hd_result hd__vk_flush(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkSubmitInfo si;
     VkResult e;
     if (be->rec || !be->open) return HD_SUCCESS;
     be->open = 0;
-    HD__VK_TRY(ctx, be->fn.vkEndCommandBuffer(be->cmd), "vkEndCommandBuffer");
+    HD__VK_TRY(vw, be->fn.vkEndCommandBuffer(be->cmd), "vkEndCommandBuffer");
     memset(&si, 0, sizeof si);
     si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
     si.commandBufferCount = 1;
     si.pCommandBuffers = &be->cmd;
-    if (++be->submits == be->lose_at) return hd__vk_fail(ctx, VK_ERROR_DEVICE_LOST, "vkQueueSubmit (HD_VK_LOSE_DEVICE)", __LINE__);
-    HD__VK_TRY(ctx, be->fn.vkQueueSubmit(be->queue, 1, &si, be->fence), "vkQueueSubmit");
+    if (++be->submits == be->lose_at) return hd__vk_fail(vw, VK_ERROR_DEVICE_LOST, "vkQueueSubmit (HD_VK_LOSE_DEVICE)", __LINE__);
+    HD__VK_TRY(vw, be->fn.vkQueueSubmit(be->queue, 1, &si, be->fence), "vkQueueSubmit");
     e = be->fn.vkWaitForFences(be->device, 1, &be->fence, VK_TRUE, UINT64_MAX);
-    if (e != VK_SUCCESS) return hd__vk_fail(ctx, e < 0 ? e : VK_ERROR_DEVICE_LOST, "vkWaitForFences", __LINE__);
-    HD__VK_TRY(ctx, be->fn.vkResetFences(be->device, 1, &be->fence), "vkResetFences");
+    if (e != VK_SUCCESS) return hd__vk_fail(vw, e < 0 ? e : VK_ERROR_DEVICE_LOST, "vkWaitForFences", __LINE__);
+    HD__VK_TRY(vw, be->fn.vkResetFences(be->device, 1, &be->fence), "vkResetFences");
     be->next_slot = 0; /* the parameter slots are free again */
     be->have_slot = 0;
     return HD_SUCCESS;
@@ -733,28 +731,28 @@ static void hd__vk_zero_image(hd__backend *be, VkCommandBuffer cb, VkImage im, V
 }
 
 /* New images: UNDEFINED -> GENERAL (the only layout they are used in), then zeroed. */
-static hd_result hd__vk_image_init(hd__ctx *ctx, hd__vk_image *im)
+static hd_result hd__vk_image_init(const hd__view *vw, hd__vk_image *im)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_zero_image(ctx->be, cb, im->image, VK_IMAGE_LAYOUT_UNDEFINED);
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    hd__vk_zero_image(vw->be, cb, im->image, VK_IMAGE_LAYOUT_UNDEFINED);
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_image_new_as(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, VkFormat fmt, const char *what)
+static hd_result hd__vk_image_new_as(const hd__view *vw, hd__vk_image *im, int w, int h, int d, VkFormat fmt, const char *what)
 {
     hd_result r;
-    if ((r = hd__vk_image_create_as(ctx, im, w, h, d, fmt, 0, what)) != HD_SUCCESS) return r;
-    return hd__vk_image_init(ctx, im);
+    if ((r = hd__vk_image_create_as(vw, im, w, h, d, fmt, 0, what)) != HD_SUCCESS) return r;
+    return hd__vk_image_init(vw, im);
 }
 
-static hd_result hd__vk_image_new(hd__ctx *ctx, hd__vk_image *im, int w, int h, int d, const char *what)
+static hd_result hd__vk_image_new(const hd__view *vw, hd__vk_image *im, int w, int h, int d, const char *what)
 {
-    return hd__vk_image_new_as(ctx, im, w, h, d, VK_FORMAT_R32_SFLOAT, what);
+    return hd__vk_image_new_as(vw, im, w, h, d, VK_FORMAT_R32_SFLOAT, what);
 }
 
-/* Grid id's image (src/hd_gpu.h): E, phi, phi2 r16f at float16 storage, the others r32f. */
+/* Grid id's image (backends/hd_gpu.h): E, phi, phi2 r16f at float16 storage, the others r32f. */
 static hd__vk_image *hd__vk_grid(hd__backend *be, int id)
 {
     hd__vk_image *named[HD__G_MG_LEVELS] = {&be->sig, &be->E, &be->phi, &be->phi2, &be->lsum, &be->mg.p, &be->mg.lo};
@@ -763,36 +761,36 @@ static hd__vk_image *hd__vk_grid(hd__backend *be, int id)
     return id < HD__G_MG_LEVELS ? named[id] : id >= HD__G_LIGHT ? &be->lv[id - HD__G_LIGHT] : level[(id - HD__G_MG_LEVELS) % 4];
 }
 /* What was recorded is submitted first: it may name the image (a new one's zeroing). */
-static void hd__gpu_grid_free(hd__ctx *ctx, int id)
+static void hd__gpu_grid_free(const hd__view *vw, int id)
 {
-    hd__vk_image *im = hd__vk_grid(ctx->be, id);
-    if (im->image && ctx->be->open && !ctx->be->lost) hd__vk_flush(ctx);
-    hd__vk_free_image(ctx, im);
+    hd__vk_image *im = hd__vk_grid(vw->be, id);
+    if (im->image && vw->be->open && !vw->be->lost) hd__vk_flush(vw);
+    hd__vk_free_image(vw, im);
 }
-static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what)
+static hd_result hd__gpu_grid_new(const hd__view *vw, int id, int w, int h, int d, const char *what)
 {
-    VkFormat fmt = ctx->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
-    hd__gpu_grid_free(ctx, id);
-    return hd__vk_image_new_as(ctx, hd__vk_grid(ctx->be, id), w, h, d, fmt, what);
+    VkFormat fmt = vw->be->gg.f16 && id >= HD__G_E && id <= HD__G_PHI2 ? VK_FORMAT_R16_SFLOAT : VK_FORMAT_R32_SFLOAT;
+    hd__gpu_grid_free(vw, id);
+    return hd__vk_image_new_as(vw, hd__vk_grid(vw->be, id), w, h, d, fmt, what);
 }
-static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id)
+static hd_result hd__gpu_grid_zero(const hd__view *vw, int id)
 {
-    const hd__vk_image *im = hd__vk_grid(ctx->be, id);
+    const hd__vk_image *im = hd__vk_grid(vw->be, id);
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if (!im->image) return HD_SUCCESS;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_barrier(ctx->be, cb);
-    hd__vk_zero_image(ctx->be, cb, im->image, HD__VK_G);
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    hd__vk_barrier(vw->be, cb);
+    hd__vk_zero_image(vw->be, cb, im->image, HD__VK_G);
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_staging(hd__ctx *ctx, VkDeviceSize bytes)
+static hd_result hd__vk_staging(const hd__view *vw, VkDeviceSize bytes)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     if (be->staging.buffer && be->staging.bytes >= bytes) return HD_SUCCESS;
-    hd__vk_free_buffer(ctx, &be->staging);
-    return hd__vk_buffer_create(ctx, &be->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+    hd__vk_free_buffer(vw, &be->staging);
+    return hd__vk_buffer_create(vw, &be->staging, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                                 1, "the staging buffer");
 }
 
@@ -810,34 +808,34 @@ static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
 
 /* Whole image <- host floats (x fastest), submitted and waited for; an r16f image gets them
    rounded to nearest even (hd_f2h, the CPU backend's rounding). */
-static hd_result hd__vk_upload_image(hd__ctx *ctx, hd__vk_image *im, const float *src)
+static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
     VkBufferImageCopy reg = hd__vk_region(im);
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r; /* the staging buffer is free */
-    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r; /* the staging buffer is free */
+    if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
     if (im->texel == 2) {
         size_t i;
         for (i = 0; i < bytes / 2; ++i) ((uint16_t *)be->staging.map)[i] = hd_f2h(src[i]);
     } else {
         memcpy(be->staging.map, src, bytes);
     }
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
     hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
     be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
     hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
 /* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar), or
    with a slice list (list, count) those z slices only, in its order, in one copy; an r16f
    image's halves are widened exactly (hd_h2f). */
-static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *dst, const int *list, int count)
+static hd_result hd__vk_download_image(const hd__view *vw, hd__vk_image *im, float *dst, const int *list, int count)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t slice = (size_t)im->extent[0] * im->extent[1] * (size_t)im->texel;
     size_t bytes = slice * (size_t)(list ? count : im->extent[2]);
     VkBufferImageCopy one = hd__vk_region(im), *regs = &one;
@@ -846,8 +844,8 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
     int k;
     if (list) {
         if (count <= 0) return HD_SUCCESS;
-        if (!(regs = (VkBufferImageCopy *)hd__calloc(ctx, (size_t)count, sizeof *regs)))
-            return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for %d copy regions", count);
+        if (!(regs = (VkBufferImageCopy *)hd__calloc(vw, (size_t)count, sizeof *regs)))
+            return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for %d copy regions", count);
         for (k = 0; k < count; ++k) {
             regs[k] = one;
             regs[k].bufferOffset = (VkDeviceSize)k * slice;
@@ -855,15 +853,15 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
             regs[k].imageExtent.depth = 1;
         }
     }
-    if ((r = hd__vk_flush(ctx)) == HD_SUCCESS && (r = hd__vk_staging(ctx, bytes)) == HD_SUCCESS &&
-        (r = hd__vk_cmd(ctx, &cb)) == HD_SUCCESS) {
+    if ((r = hd__vk_flush(vw)) == HD_SUCCESS && (r = hd__vk_staging(vw, bytes)) == HD_SUCCESS &&
+        (r = hd__vk_cmd(vw, &cb)) == HD_SUCCESS) {
         hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_SRC, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
         be->fn.vkCmdCopyImageToBuffer(cb, im->image, HD__VK_SRC, be->staging.buffer, list ? (uint32_t)count : 1u, regs);
         hd__vk_layout(be, cb, im->image, HD__VK_SRC, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
         hd__vk_barrier(be, cb);
-        r = hd__vk_flush(ctx);
+        r = hd__vk_flush(vw);
     }
-    if (regs != &one) hd__free(ctx, regs);
+    if (regs != &one) hd__free(vw, regs);
     if (r != HD_SUCCESS) return r;
     if (im->texel == 2) {
         size_t i;
@@ -877,10 +875,10 @@ static hd_result hd__vk_download_image(hd__ctx *ctx, hd__vk_image *im, float *ds
 /* ---- pipelines -------------------------------------------------------------------------------- */
 /* A compute pipeline of SPIR-V `code` (entry "main") with layout and the specialization spec
    (NULL for none); the shader module lives only while the pipeline is made. */
-static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, size_t bytes, const VkSpecializationInfo *spec,
+static hd_result hd__vk_compute_pipeline(const hd__view *vw, const uint32_t *code, size_t bytes, const VkSpecializationInfo *spec,
                                          VkPipelineLayout layout, VkPipeline *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkShaderModuleCreateInfo smci;
     VkComputePipelineCreateInfo cpci;
     VkShaderModule sm;
@@ -889,7 +887,7 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
     smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
     smci.codeSize = bytes;
     smci.pCode = code;
-    HD__VK_TRY(ctx, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
+    HD__VK_TRY(vw, be->fn.vkCreateShaderModule(be->device, &smci, NULL, &sm), "vkCreateShaderModule");
     memset(&cpci, 0, sizeof cpci);
     cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
     cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -900,7 +898,7 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
     cpci.layout = layout;
     e = be->fn.vkCreateComputePipelines(be->device, VK_NULL_HANDLE, 1, &cpci, NULL, out);
     be->fn.vkDestroyShaderModule(be->device, sm, NULL);
-    if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(ctx, e, "vkCreateComputePipelines", __LINE__); }
+    if (e < 0) { *out = VK_NULL_HANDLE; return hd__vk_fail(vw, e, "vkCreateComputePipelines", __LINE__); }
     return HD_SUCCESS;
 }
 
@@ -915,10 +913,10 @@ static hd_result hd__vk_compute_pipeline(hd__ctx *ctx, const uint32_t *code, siz
    texel its voxels share once. Constant 2 is the solver (jacobi), so the
    store of the other one is not compiled (docs/DESIGN-VULKAN.md has the gain). flags: constant
    0's value, NULL for the other stages (bench/hdbench_vulkan.c's --ab also calls this). */
-static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
+static hd_result hd__vk_pipeline_code(const hd__view *vw, const uint32_t *code, size_t bytes, const int32_t *flags, int32_t jacobi,
                                       VkPipeline *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkSpecializationMapEntry sme[4];
     VkSpecializationInfo spec;
     int32_t data[4];
@@ -936,11 +934,11 @@ static hd_result hd__vk_pipeline_code(hd__ctx *ctx, const uint32_t *code, size_t
     spec.pMapEntries = sme;
     spec.dataSize = sizeof data;
     spec.pData = data;
-    return hd__vk_compute_pipeline(ctx, code, bytes, flags ? &spec : NULL, be->layout, out);
+    return hd__vk_compute_pipeline(vw, code, bytes, flags ? &spec : NULL, be->layout, out);
 }
 
 /* Stage p's pipeline; half: from its r16f SPIR-V (only the stages that touch E / phi have one). */
-static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jacobi, int half, VkPipeline *out)
+static hd_result hd__vk_pipeline(const hd__view *vw, int p, int32_t flags, int32_t jacobi, int half, VkPipeline *out)
 {
     static const uint32_t *const code[2][HD__VK_PIPELINE_COUNT] = {
         {hd__spv_classify, hd__spv_direct, hd__spv_diffuse, hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path,
@@ -953,29 +951,29 @@ static hd_result hd__vk_pipeline(hd__ctx *ctx, int p, int32_t flags, int32_t jac
         {0, sizeof hd__spv_direct_half, sizeof hd__spv_diffuse_half, sizeof hd__spv_project_half, 0, sizeof hd__spv_sum_light_half, 0,
          sizeof hd__spv_light_sum_half}};
     half = half && code[1][p] != NULL;
-    return hd__vk_pipeline_code(ctx, code[half][p], size[half][p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
+    return hd__vk_pipeline_code(vw, code[half][p], size[half][p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
 }
 
 /* The pipeline of stage p (not the diffusion stage) for the current precision: a float16 one
    made on first use, kept until hd_destroy. */
-static hd_result hd__vk_stage_pipeline(hd__ctx *ctx, int p, VkPipeline *out)
+static hd_result hd__vk_stage_pipeline(const hd__view *vw, int p, VkPipeline *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     if (!be->gg.f16 || (p != HD__VK_DIRECT && p != HD__VK_PROJECT && p != HD__VK_SUM_LIGHT && p != HD__VK_LIGHT_SUM)) {
         *out = be->pipelines[p];
         return HD_SUCCESS;
     }
-    if (!be->pipelines_half[p] && (r = hd__vk_pipeline(ctx, p, 0, 0, 1, &be->pipelines_half[p])) != HD_SUCCESS) return r;
+    if (!be->pipelines_half[p] && (r = hd__vk_pipeline(vw, p, 0, 0, 1, &be->pipelines_half[p])) != HD_SUCCESS) return r;
     *out = be->pipelines_half[p];
     return HD_SUCCESS;
 }
 
 /* The diffusion pipeline for the flags word `flags` and the solver, made on first use and kept
    until hd_destroy (a command buffer recorded by hd_vulkan_record may still name an older one). */
-static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_t jacobi, VkPipeline *out)
+static hd_result hd__vk_diffuse_pipeline_for(const hd__view *vw, int32_t flags, int32_t jacobi, VkPipeline *out)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     int i;
     for (i = 0; i < be->ndiffuse; ++i)
@@ -984,9 +982,9 @@ static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_
             return HD_SUCCESS;
         }
     if (be->ndiffuse == HD__VK_DIFFUSE_VARIANTS)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: more than %d flag, solver and precision combinations for the diffusion stage",
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: more than %d flag, solver and precision combinations for the diffusion stage",
                        HD__VK_DIFFUSE_VARIANTS);
-    if ((r = hd__vk_pipeline(ctx, HD__VK_DIFFUSE, flags, jacobi, be->gg.f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
+    if ((r = hd__vk_pipeline(vw, HD__VK_DIFFUSE, flags, jacobi, be->gg.f16, &be->diffuse[be->ndiffuse])) != HD_SUCCESS) return r;
     be->diffuse_flags[be->ndiffuse] = flags;
     be->diffuse_jacobi[be->ndiffuse] = jacobi;
     be->diffuse_half[be->ndiffuse] = be->gg.f16;
@@ -994,27 +992,27 @@ static hd_result hd__vk_diffuse_pipeline_for(hd__ctx *ctx, int32_t flags, int32_
     return HD_SUCCESS;
 }
 
-/* ... for the current flags (ctx->kp). */
-static hd_result hd__vk_diffuse_pipeline(hd__ctx *ctx, int32_t jacobi, VkPipeline *out)
+/* ... for the current flags (vw->kp). */
+static hd_result hd__vk_diffuse_pipeline(const hd__view *vw, int32_t jacobi, VkPipeline *out)
 {
-    return hd__vk_diffuse_pipeline_for(ctx, ctx->kp.counts.z, jacobi, out);
+    return hd__vk_diffuse_pipeline_for(vw, vw->kp.counts.z, jacobi, out);
 }
 
 /* A compute descriptor-set layout of n bindings (binding i of types[i], one descriptor each)
    and the pipeline layout of that one set with push_bytes of push constants (the library's
    layouts and the benchmarks' share this). */
 #define HD__VK_MAX_SET_BINDINGS 16
-static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uint32_t n, uint32_t push_bytes,
+static hd_result hd__vk_layouts(const hd__view *vw, const VkDescriptorType *types, uint32_t n, uint32_t push_bytes,
                                 VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkDescriptorSetLayoutBinding b[HD__VK_MAX_SET_BINDINGS];
     VkDescriptorSetLayoutCreateInfo lci;
     VkPushConstantRange pcr;
     VkPipelineLayoutCreateInfo plci;
     uint32_t i;
     if (n > HD__VK_MAX_SET_BINDINGS)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: %u bindings in one set, at most %d", n, HD__VK_MAX_SET_BINDINGS);
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: %u bindings in one set, at most %d", n, HD__VK_MAX_SET_BINDINGS);
     memset(b, 0, sizeof b);
     for (i = 0; i < n; ++i) {
         b[i].binding = i;
@@ -1026,7 +1024,7 @@ static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uin
     lci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
     lci.bindingCount = n;
     lci.pBindings = b;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, set_layout), "vkCreateDescriptorSetLayout");
+    HD__VK_TRY(vw, be->fn.vkCreateDescriptorSetLayout(be->device, &lci, NULL, set_layout), "vkCreateDescriptorSetLayout");
     memset(&pcr, 0, sizeof pcr);
     pcr.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
     pcr.size = push_bytes;
@@ -1036,16 +1034,16 @@ static hd_result hd__vk_layouts(hd__ctx *ctx, const VkDescriptorType *types, uin
     plci.pSetLayouts = set_layout;
     plci.pushConstantRangeCount = 1;
     plci.pPushConstantRanges = &pcr;
-    HD__VK_TRY(ctx, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, layout), "vkCreatePipelineLayout");
+    HD__VK_TRY(vw, be->fn.vkCreatePipelineLayout(be->device, &plci, NULL, layout), "vkCreatePipelineLayout");
     return HD_SUCCESS;
 }
 
 /* A descriptor pool for `sets` sets of the backend's set layout (hd__vk_pipelines' types: per set
    1 dynamic uniform buffer, 8 storage images, 6 storage buffers): the backend's sets and the
    multigrid's (HD_SOLVER_MULTIGRID) each have one. */
-static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool)
+static hd_result hd__vk_pool(const hd__view *vw, uint32_t sets, VkDescriptorPool *pool)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkDescriptorPoolSize ps[3];
     VkDescriptorPoolCreateInfo dpci;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = sets;
@@ -1056,38 +1054,38 @@ static hd_result hd__vk_pool(hd__ctx *ctx, uint32_t sets, VkDescriptorPool *pool
     dpci.maxSets = sets;
     dpci.poolSizeCount = 3;
     dpci.pPoolSizes = ps;
-    HD__VK_TRY(ctx, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, pool), "vkCreateDescriptorPool");
+    HD__VK_TRY(vw, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, pool), "vkCreateDescriptorPool");
     return HD_SUCCESS;
 }
 
 /* The most sets one pool holds: the backend's (a set per light); the multigrid's
-   (HD__GPU_MG_SETS, src/hd_gpu.h) fit too. */
+   (HD__GPU_MG_SETS, backends/hd_gpu.h) fit too. */
 #define HD__VK_POOL_SETS_MAX HD_MAX_LIGHTS
 typedef char hd__vk_mg_sets_fit_a_pool[HD__GPU_MG_SETS <= HD__VK_POOL_SETS_MAX ? 1 : -1];
 
 /* Empties `pool` and allocates n (<= HD__VK_POOL_SETS_MAX) sets of the backend's set layout from
    it into sets[]; reset_name and alloc_name name the calls in a failure's log line. */
-static hd_result hd__vk_pool_sets(hd__ctx *ctx, VkDescriptorPool pool, int n, VkDescriptorSet *sets,
+static hd_result hd__vk_pool_sets(const hd__view *vw, VkDescriptorPool pool, int n, VkDescriptorSet *sets,
                                   const char *reset_name, const char *alloc_name)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkDescriptorSetLayout layouts[HD__VK_POOL_SETS_MAX];
     VkDescriptorSetAllocateInfo ai;
     int i;
-    HD__VK_TRY(ctx, be->fn.vkResetDescriptorPool(be->device, pool, 0), reset_name);
+    HD__VK_TRY(vw, be->fn.vkResetDescriptorPool(be->device, pool, 0), reset_name);
     for (i = 0; i < n; ++i) layouts[i] = be->set_layout;
     memset(&ai, 0, sizeof ai);
     ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
     ai.descriptorPool = pool;
     ai.descriptorSetCount = (uint32_t)n;
     ai.pSetLayouts = layouts;
-    HD__VK_TRY(ctx, be->fn.vkAllocateDescriptorSets(be->device, &ai, sets), alloc_name);
+    HD__VK_TRY(vw, be->fn.vkAllocateDescriptorSets(be->device, &ai, sets), alloc_name);
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_pipelines(hd__ctx *ctx)
+static hd_result hd__vk_pipelines(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     static const VkDescriptorType types[HD__VK_BINDINGS] = {
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
@@ -1100,23 +1098,23 @@ static hd_result hd__vk_pipelines(hd__ctx *ctx)
        projection's TF table) and storage images (volume, sigma_t, E, phi, phi2, two light volumes,
        the projection's E + phi): above Vulkan's guaranteed minimum of 4 per stage each */
     if (be->limits.maxPerStageDescriptorStorageBuffers < 6 || be->limits.maxPerStageDescriptorStorageImages < 8)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED,
                        "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 6 and 8 needed",
                        be->limits.maxPerStageDescriptorStorageBuffers, be->limits.maxPerStageDescriptorStorageImages);
-    if ((r = hd__vk_layouts(ctx, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
+    if ((r = hd__vk_layouts(vw, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
     for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i) /* the diffusion stage's on first use, per flags */
-        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(ctx, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
-    return hd__vk_pool(ctx, HD_MAX_LIGHTS, &be->dpool); /* a set per light */
+        if (i != HD__VK_DIFFUSE && (r = hd__vk_pipeline(vw, i, 0, 0, 0, &be->pipelines[i])) != HD_SUCCESS) return r;
+    return hd__vk_pool(vw, HD_MAX_LIGHTS, &be->dpool); /* a set per light */
 }
 
 /* Writes set `set`: binding 0 the parameter buffer `params` (dynamic offset, one block), the
    others im[i] / bu[i] (absent resources, NULL or not allocated, bind placeholders: at float16
    storage an r16f one for E / phi / phi2, a view's format must match the shader's). */
-static void hd__vk_write_set(hd__ctx *ctx, VkDescriptorSet set, const hd__vk_buffer *params, const hd__vk_image *const *im,
+static void hd__vk_write_set(const hd__view *vw, VkDescriptorSet set, const hd__vk_buffer *params, const hd__vk_image *const *im,
                              const hd__vk_buffer *const *bu)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkWriteDescriptorSet w[HD__VK_BINDINGS];
     VkDescriptorBufferInfo bi[HD__VK_BINDINGS];
     VkDescriptorImageInfo ii[HD__VK_BINDINGS];
@@ -1158,13 +1156,13 @@ static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, con
    spare) at bindings 9 and 10; set 0 serves every other stage (multigrid's passes have their own,
    hd__vk_mg_sets). Nothing may be in flight (the backend waits after each stage;
    hd_vulkan_record's contract). */
-static hd_result hd__vk_sets(hd__ctx *ctx)
+static hd_result hd__vk_sets(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
     int n = be->gg.nlv > 0 ? be->gg.nlv : 1, s;
     if (be->sets_valid) return HD_SUCCESS;
-    if ((r = hd__vk_pool_sets(ctx, be->dpool, n, be->sets, "vkResetDescriptorPool", "vkAllocateDescriptorSets")) != HD_SUCCESS)
+    if ((r = hd__vk_pool_sets(vw, be->dpool, n, be->sets, "vkResetDescriptorPool", "vkAllocateDescriptorSets")) != HD_SUCCESS)
         return r;
     for (s = 0; s < n; ++s) {
         const hd__vk_image *im[HD__VK_BINDINGS];
@@ -1176,27 +1174,27 @@ static hd_result hd__vk_sets(hd__ctx *ctx)
         im[9] = be->gg.nlv > 0 ? &be->lv[s] : &be->dummy;
         im[10] = be->gg.nlv > 0 ? &be->lv[be->gg.nlv] : &be->dummy;
         im[14] = &be->lsum;
-        hd__vk_write_set(ctx, be->sets[s], &be->params, im, bu);
+        hd__vk_write_set(vw, be->sets[s], &be->params, im, bu);
     }
     be->sets_valid = 1;
     be->sets_gen++;
     return HD_SUCCESS;
 }
 
-/* The parameter ring: ctx->kp in a slot of its own whenever it changed since the last one, so
+/* The parameter ring: vw->kp in a slot of its own whenever it changed since the last one, so
    every recorded iteration reads the parameters it was recorded with. */
-static hd_result hd__vk_ring(hd__ctx *ctx, uint32_t slots)
+static hd_result hd__vk_ring(const hd__view *vw, uint32_t slots)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
     if (be->params.buffer && be->slots >= slots) return HD_SUCCESS;
-    hd__vk_free_buffer(ctx, &be->params);
+    hd__vk_free_buffer(vw, &be->params);
     be->slots = 0;
     be->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
     if (slots > (1u << 20))
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "vulkan: %u parameter slots (recorded iterations) are too many; record at most 2^19 iterations at a time", slots);
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_PARAMETER, "vulkan: %u parameter slots (recorded iterations) are too many; record at most 2^19 iterations at a time", slots);
     {
-        hd_result r = hd__vk_buffer_create(ctx, &be->params, be->slot_bytes * slots, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1,
+        hd_result r = hd__vk_buffer_create(vw, &be->params, be->slot_bytes * slots, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1,
                                            "the parameter ring");
         if (r != HD_SUCCESS) return r;
     }
@@ -1206,15 +1204,15 @@ static hd_result hd__vk_ring(hd__ctx *ctx, uint32_t slots)
     return HD_SUCCESS;
 }
 
-static hd_result hd__vk_params(hd__ctx *ctx, uint32_t *offset)
+static hd_result hd__vk_params(const hd__view *vw, uint32_t *offset)
 {
-    hd__backend *be = ctx->be;
-    if (!be->have_slot || memcmp(&be->slot_kp, &ctx->kp, sizeof ctx->kp) != 0) {
+    hd__backend *be = vw->be;
+    if (!be->have_slot || memcmp(&be->slot_kp, &vw->kp, sizeof vw->kp) != 0) {
         if (be->next_slot >= be->slots)
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the parameter ring's %u slots are used up", be->slots);
+            return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the parameter ring's %u slots are used up", be->slots);
         be->slot = be->next_slot++;
-        memcpy((char *)be->params.map + be->slot * be->slot_bytes, &ctx->kp, sizeof ctx->kp);
-        be->slot_kp = ctx->kp;
+        memcpy((char *)be->params.map + be->slot * be->slot_bytes, &vw->kp, sizeof vw->kp);
+        be->slot_kp = vw->kp;
         be->have_slot = 1;
     }
     *offset = (uint32_t)(be->slot * be->slot_bytes);
@@ -1235,56 +1233,56 @@ static void hd__vk_record_dispatch(hd__backend *be, VkCommandBuffer cb, VkPipeli
 
 /* Records one dispatch of pipeline pipe over groups of 64 x 1 x 1 covering nx x ny x nz, with
    the given set (of be->sets) and push constants, after a barrier. */
-static hd_result hd__vk_dispatch(hd__ctx *ctx, VkCommandBuffer cb, VkPipeline pipe, int set, int nx, int ny, int nz,
+static hd_result hd__vk_dispatch(const hd__view *vw, VkCommandBuffer cb, VkPipeline pipe, int set, int nx, int ny, int nz,
                                  int pc0, int pc1, int pc2, int pc3)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int32_t pc[4];
     uint32_t offset;
     hd_result r;
     if (nx <= 0 || ny <= 0 || nz <= 0) return HD_SUCCESS;
-    if ((r = hd__vk_params(ctx, &offset)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_params(vw, &offset)) != HD_SUCCESS) return r;
     pc[0] = pc0; pc[1] = pc1; pc[2] = pc2; pc[3] = pc3;
     hd__vk_record_dispatch(be, cb, pipe, be->sets[set], offset, nx, ny, nz, pc);
     return HD_SUCCESS;
 }
 
 /* Everything a stage needs before recording: the sets and a command buffer. */
-static hd_result hd__vk_begin(hd__ctx *ctx, VkCommandBuffer *cb)
+static hd_result hd__vk_begin(const hd__view *vw, VkCommandBuffer *cb)
 {
     hd_result r;
-    if (!ctx->be->sets_valid) {
-        if (ctx->be->rec)
-            return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: resources changed while recording (internal error)");
-        if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-        if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
+    if (!vw->be->sets_valid) {
+        if (vw->be->rec)
+            return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: resources changed while recording (internal error)");
+        if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_sets(vw)) != HD_SUCCESS) return r;
     }
-    return hd__vk_cmd(ctx, cb);
+    return hd__vk_cmd(vw, cb);
 }
 
 /* ---- life cycle -------------------------------------------------------------------------------- */
 /* The bracket of a public call (src/hd_backend.h): a lost device refused; at the end, what is
    still recorded (a clear, a new grid's zeroing) submitted and waited for. */
-static hd_result hd__be_begin(hd__ctx *ctx)
+static hd_result hd__be_begin(const hd__view *vw)
 {
-    HD__VK_LOST_CHECK(ctx);
+    HD__VK_LOST_CHECK(vw);
     return HD_SUCCESS;
 }
-static hd_result hd__be_end(hd__ctx *ctx, hd_result r) { return r != HD_SUCCESS ? r : hd__vk_flush(ctx); }
+static hd_result hd__be_end(const hd__view *vw, hd_result r) { return r != HD_SUCCESS ? r : hd__vk_flush(vw); }
 
-static void hd__be_destroy(hd__ctx *ctx)
+static void hd__be_destroy(hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     int i;
     if (!be) return;
     if (be->device && be->fn.vkDeviceWaitIdle) {
-        if (be->open && !be->lost) hd__vk_flush(ctx);
+        if (be->open && !be->lost) hd__vk_flush(vw);
         be->fn.vkDeviceWaitIdle(be->device); /* also after a lost device: then it returns at once */
-        hd__gpu_free(ctx, &be->gg);
-        hd__vk_free_image(ctx, &be->vol); hd__vk_free_image(ctx, &be->dummy); hd__vk_free_image(ctx, &be->dummy16);
-        hd__vk_free_buffer(ctx, &be->params); hd__vk_free_buffer(ctx, &be->tf); hd__vk_free_buffer(ctx, &be->maj);
-        hd__vk_free_buffer(ctx, &be->img); hd__vk_free_buffer(ctx, &be->staging); hd__vk_free_buffer(ctx, &be->dummy_buffer);
-        hd__vk_free_buffer(ctx, &be->dl); hd__vk_free_buffer(ctx, &be->ptab);
+        hd__gpu_free(vw, &be->gg);
+        hd__vk_free_image(vw, &be->vol); hd__vk_free_image(vw, &be->dummy); hd__vk_free_image(vw, &be->dummy16);
+        hd__vk_free_buffer(vw, &be->params); hd__vk_free_buffer(vw, &be->tf); hd__vk_free_buffer(vw, &be->maj);
+        hd__vk_free_buffer(vw, &be->img); hd__vk_free_buffer(vw, &be->staging); hd__vk_free_buffer(vw, &be->dummy_buffer);
+        hd__vk_free_buffer(vw, &be->dl); hd__vk_free_buffer(vw, &be->ptab);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -1304,15 +1302,15 @@ static void hd__be_destroy(hd__ctx *ctx)
         if (be->messenger) be->fn.vkDestroyDebugUtilsMessengerEXT(be->instance, be->messenger, NULL);
         be->fn.vkDestroyInstance(be->instance, NULL);
     }
-    hd__free(ctx, be);
-    ctx->be = NULL;
+    hd__free(vw, be);
+    vw->be = NULL;
 }
 
 /* Whether the device has r16f storage images (float16 illumination): be->no_half says why not.
    A caller's device: the physical device's feature is checked; enabling it was the caller's job. */
-static void hd__vk_check_half(hd__ctx *ctx)
+static void hd__vk_check_half(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkPhysicalDeviceFeatures f;
     VkFormatProperties fp;
     const char *knob = getenv("HD_VK_NO_HALF");
@@ -1334,9 +1332,9 @@ static void hd__vk_check_half(hd__ctx *ctx)
    not. The own device enables it where the physical device has it; a caller's device must have
    enabled it (Vulkan cannot be asked which features a device was created with, so only the
    physical device's is checked, as for r16f). $HD_VK_NO_F64=1 plays a device without it. */
-static void hd__vk_check_f64(hd__ctx *ctx)
+static void hd__vk_check_f64(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkPhysicalDeviceFeatures f;
     be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
     be->no_f64 = NULL;
@@ -1347,14 +1345,14 @@ static void hd__vk_check_f64(hd__ctx *ctx)
 }
 
 /* HD_ERROR_UNSUPPORTED, logged, when float16 illumination is asked for and the device lacks it. */
-static hd_result hd__vk_half_ok(hd__ctx *ctx)
+static hd_result hd__vk_half_ok(const hd__view *vw)
 {
-    if (ctx->params.illumination_precision != HD_PRECISION_FLOAT16 || !ctx->be->no_half) return HD_SUCCESS;
-    return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: illumination_precision FLOAT16 is not available on %s: %s",
-                   ctx->be->device_name, ctx->be->no_half);
+    if (vw->params.illumination_precision != HD_PRECISION_FLOAT16 || !vw->be->no_half) return HD_SUCCESS;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: illumination_precision FLOAT16 is not available on %s: %s",
+                   vw->be->device_name, vw->be->no_half);
 }
 
-static hd_result hd__be_create(hd__ctx *ctx)
+static hd_result hd__be_create(hd__view *vw)
 {
     hd__backend *be;
     hd_result r;
@@ -1363,12 +1361,12 @@ static hd_result hd__be_create(hd__ctx *ctx)
     VkCommandBufferAllocateInfo cbai;
     VkFenceCreateInfo fci;
     const char *limit = getenv("HD_VK_MEMORY_LIMIT"), *lose = getenv("HD_VK_LOSE_DEVICE");
-    const hd_desc *d = &ctx->desc;
+    const hd_desc *d = &vw->desc;
     int caller = d->vulkan.instance || d->vulkan.physical_device || d->vulkan.device;
-    be = (hd__backend *)hd__calloc(ctx, 1, sizeof *be);
-    if (!be) return HD__ERR(&ctx->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the backend");
-    ctx->be = be;
-    be->ctx = ctx;
+    be = (hd__backend *)hd__calloc(vw, 1, sizeof *be);
+    if (!be) return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: cannot allocate the backend");
+    vw->be = be;
+    be->vw = vw;
     be->diffuse_zk = HD__VK_DIFFUSE_ZK;
     be->diffuse_yk = HD__VK_DIFFUSE_YK;
     if (limit && *limit) be->mem_limit = (VkDeviceSize)strtoull(limit, NULL, 10);
@@ -1379,22 +1377,22 @@ static hd_result hd__be_create(hd__ctx *ctx)
     if (!be->gipa) be->gipa = vkGetInstanceProcAddr;
 #endif
     if (!be->gipa)
-        return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "vulkan: built with HD_VK_NO_LOADER: desc.vulkan.get_instance_proc_addr is required");
+        return HD__ERR(&vw->log, HD_ERROR_NULL_POINTER, "vulkan: built with HD_VK_NO_LOADER: desc.vulkan.get_instance_proc_addr is required");
     if (caller) {
         if (!d->vulkan.instance || !d->vulkan.physical_device || !d->vulkan.device)
-            return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "vulkan: give desc.vulkan.instance, physical_device and device together, or none");
+            return HD__ERR(&vw->log, HD_ERROR_NULL_POINTER, "vulkan: give desc.vulkan.instance, physical_device and device together, or none");
         be->instance = (VkInstance)d->vulkan.instance;
         be->phys = (VkPhysicalDevice)d->vulkan.physical_device;
         be->device = (VkDevice)d->vulkan.device;
         be->queue_family = d->vulkan.queue_family;
-        if ((r = hd__vk_load_instance_fns(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_load_instance_fns(vw)) != HD_SUCCESS) return r;
     } else {
         be->own_device = 1;
-        if ((r = hd__vk_create_instance(ctx)) != HD_SUCCESS) return r;
-        if ((r = hd__vk_pick_device(ctx)) != HD_SUCCESS) return r;
-        if ((r = hd__vk_create_device(ctx)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_create_instance(vw)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_pick_device(vw)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_create_device(vw)) != HD_SUCCESS) return r;
     }
-    if ((r = hd__vk_load_device_fns(ctx)) != HD_SUCCESS) {
+    if ((r = hd__vk_load_device_fns(vw)) != HD_SUCCESS) {
         if (be->own_device) be->device = VK_NULL_HANDLE; /* cannot destroy it without its functions */
         return r;
     }
@@ -1407,126 +1405,126 @@ static hd_result hd__be_create(hd__ctx *ctx)
     be->spread_rows = props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     memcpy(be->device_name, props.deviceName, sizeof be->device_name);
     be->device_name[sizeof be->device_name - 1] = '\0';
-    HD__INFO(&ctx->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
+    HD__INFO(&vw->log, "vulkan: device %s (%s), queue family %u", be->device_name, caller ? "the caller's" : "own", be->queue_family);
     if (props.limits.maxUniformBufferRange < sizeof(hd__kparams))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: maxUniformBufferRange %u < the %zu-byte parameter block",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: maxUniformBufferRange %u < the %zu-byte parameter block",
                        props.limits.maxUniformBufferRange, sizeof(hd__kparams));
     memset(&cpci, 0, sizeof cpci);
     cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
     cpci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     cpci.queueFamilyIndex = be->queue_family;
-    HD__VK_TRY(ctx, be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &be->pool), "vkCreateCommandPool");
+    HD__VK_TRY(vw, be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &be->pool), "vkCreateCommandPool");
     memset(&cbai, 0, sizeof cbai);
     cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
     cbai.commandPool = be->pool;
     cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     cbai.commandBufferCount = 1;
-    HD__VK_TRY(ctx, be->fn.vkAllocateCommandBuffers(be->device, &cbai, &be->cmd), "vkAllocateCommandBuffers");
+    HD__VK_TRY(vw, be->fn.vkAllocateCommandBuffers(be->device, &cbai, &be->cmd), "vkAllocateCommandBuffers");
     memset(&fci, 0, sizeof fci);
     fci.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    HD__VK_TRY(ctx, be->fn.vkCreateFence(be->device, &fci, NULL, &be->fence), "vkCreateFence");
-    if ((r = hd__vk_pipelines(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_ring(ctx, 16)) != HD_SUCCESS) return r;
-    hd__vk_check_half(ctx);
-    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) return r;
-    hd__vk_check_f64(ctx);
-    if (ctx->params.solver == HD_SOLVER_MULTIGRID && be->no_f64)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name, be->no_f64);
-    if (!be->no_half && (r = hd__vk_image_new_as(ctx, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
+    HD__VK_TRY(vw, be->fn.vkCreateFence(be->device, &fci, NULL, &be->fence), "vkCreateFence");
+    if ((r = hd__vk_pipelines(vw)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_ring(vw, 16)) != HD_SUCCESS) return r;
+    hd__vk_check_half(vw);
+    if ((r = hd__vk_half_ok(vw)) != HD_SUCCESS) return r;
+    hd__vk_check_f64(vw);
+    if (vw->params.solver == HD_SOLVER_MULTIGRID && be->no_f64)
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name, be->no_f64);
+    if (!be->no_half && (r = hd__vk_image_new_as(vw, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
         return r;
-    if ((r = hd__vk_buffer_create(ctx, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_new(ctx, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_buffer_create(ctx, &be->maj, (VkDeviceSize)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2] * sizeof(float),
+    if ((r = hd__vk_buffer_create(vw, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_new(vw, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_buffer_create(vw, &be->maj, (VkDeviceSize)vw->mdims[0] * vw->mdims[1] * vw->mdims[2] * sizeof(float),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the majorant grid")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_create(ctx, &be->vol, ctx->dims[0], ctx->dims[1], ctx->dims[2], "the volume")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_init(ctx, &be->vol)) != HD_SUCCESS) return r;
-    return hd__vk_upload_image(ctx, &be->vol, ctx->vol);
+    if ((r = hd__vk_image_create(vw, &be->vol, vw->dims[0], vw->dims[1], vw->dims[2], "the volume")) != HD_SUCCESS) return r;
+    if ((r = hd__vk_image_init(vw, &be->vol)) != HD_SUCCESS) return r;
+    return hd__vk_upload_image(vw, &be->vol, vw->vol);
 }
 
 /* TF and majorants: small host-visible buffers written in place (nothing is in flight here). */
-static hd_result hd__be_upload_inputs(hd__ctx *ctx)
+static hd_result hd__be_upload_inputs(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
-    size_t tf_bytes = (size_t)ctx->tf_count * 4 * sizeof(float);
-    size_t ncell = (size_t)ctx->mdims[0] * ctx->mdims[1] * ctx->mdims[2];
+    hd__backend *be = vw->be;
+    size_t tf_bytes = (size_t)vw->tf_count * 4 * sizeof(float);
+    size_t ncell = (size_t)vw->mdims[0] * vw->mdims[1] * vw->mdims[2];
     hd_result r;
-    HD__VK_IDLE(ctx);
+    HD__VK_IDLE(vw);
     if (tf_bytes != be->tf_bytes) {
-        hd__vk_free_buffer(ctx, &be->tf);
+        hd__vk_free_buffer(vw, &be->tf);
         be->tf_bytes = 0;
-        if ((r = hd__vk_buffer_create(ctx, &be->tf, tf_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the transfer function")) != HD_SUCCESS)
+        if ((r = hd__vk_buffer_create(vw, &be->tf, tf_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the transfer function")) != HD_SUCCESS)
             return r;
         be->tf_bytes = tf_bytes;
     }
-    memcpy(be->tf.map, ctx->tf, tf_bytes);
-    memcpy(be->maj.map, ctx->majorant, ncell * sizeof(float));
+    memcpy(be->tf.map, vw->tf, tf_bytes);
+    memcpy(be->maj.map, vw->majorant, ncell * sizeof(float));
     /* the projection's TF table has as many entries as long as the TF has as many: sized here, while
        nothing is being recorded; written by hd__vk_project */
-    if (hd__project_table_n(ctx) != be->ptab_cap) {
-        hd__vk_free_buffer(ctx, &be->ptab);
+    if (hd__project_table_n(vw) != be->ptab_cap) {
+        hd__vk_free_buffer(vw, &be->ptab);
         be->ptab_n = be->ptab_cap = 0;
         be->ptab_key.valid = 0;
-        if ((r = hd__vk_buffer_create(ctx, &be->ptab, (size_t)hd__project_table_n(ctx) * 4 * sizeof(float),
+        if ((r = hd__vk_buffer_create(vw, &be->ptab, (size_t)hd__project_table_n(vw) * 4 * sizeof(float),
                                       VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the projection's TF table")) != HD_SUCCESS)
             return r;
-        be->ptab_cap = hd__project_table_n(ctx);
+        be->ptab_cap = hd__project_table_n(vw);
     }
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_alloc_illumination(hd__ctx *ctx, size_t illum_floats)
+static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    HD__VK_IDLE(ctx);
+    HD__VK_IDLE(vw);
     be->sets_valid = 0; /* the placeholders bound for absent E / phi / phi2 follow the precision */
-    if ((r = hd__vk_half_ok(ctx)) != HD_SUCCESS) { /* after hd_set_params */
-        hd__gpu_alloc_illumination(ctx, &be->gg, 0);
+    if ((r = hd__vk_half_ok(vw)) != HD_SUCCESS) { /* after hd_set_params */
+        hd__gpu_alloc_illumination(vw, &be->gg, 0);
         return r;
     }
-    return hd__gpu_alloc_illumination(ctx, &be->gg, illum_floats);
+    return hd__gpu_alloc_illumination(vw, &be->gg, illum_floats);
 }
 
-static hd_result hd__be_alloc_jacobi(hd__ctx *ctx, int enable)
+static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable)
 {
-    HD__VK_IDLE(ctx);
-    return hd__gpu_alloc_jacobi(ctx, &ctx->be->gg, enable);
+    HD__VK_IDLE(vw);
+    return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable);
 }
 
-static hd_result hd__be_alloc_image(hd__ctx *ctx, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     size_t floats = hd__image_floats(width, height, reduced);
     VkDeviceSize bytes = (VkDeviceSize)floats * sizeof(float);
     hd__vk_buffer img;
     hd_result r;
-    HD__VK_IDLE(ctx);
+    HD__VK_IDLE(vw);
     if (be->rec) /* a recorded command names the buffer: hd_vulkan_record makes it before recording */
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the image buffer changed while recording (internal error)");
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the image buffer changed while recording (internal error)");
     if (bytes > be->limits.maxStorageBufferRange)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image%s needs %llu bytes, above maxStorageBufferRange = %u",
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image%s needs %llu bytes, above maxStorageBufferRange = %u",
                        width, height, reduced ? " with room for reduced frames" : "", (unsigned long long)bytes,
                        be->limits.maxStorageBufferRange);
-    if ((r = hd__vk_buffer_create(ctx, &img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+    if ((r = hd__vk_buffer_create(vw, &img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                   VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, reduced ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
-        hd__vk_free_buffer(ctx, &img);
+        hd__vk_free_buffer(vw, &img);
         return r;
     }
-    hd__vk_free_buffer(ctx, &be->img);
+    hd__vk_free_buffer(vw, &be->img);
     be->img = img;
     be->img_floats = floats;
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
+static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    if ((r = hd__gpu_clear(ctx, &be->gg, what)) != HD_SUCCESS) return r;
+    if ((r = hd__gpu_clear(vw, &be->gg, what)) != HD_SUCCESS) return r;
     if ((what & HD__DIRTY_IMAGE) && be->img.buffer) {
-        if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
         hd__vk_barrier(be, cb);
         be->fn.vkCmdFillBuffer(cb, be->img.buffer, 0, VK_WHOLE_SIZE, 0u);
     }
@@ -1536,183 +1534,186 @@ static hd_result hd__be_clear(hd__ctx *ctx, unsigned what)
 /* ---- stages ------------------------------------------------------------------------------------ */
 /* Stage p (not the diffusion) as one dispatch of its pipeline (hd__vk_stage_pipeline) over
    nx x ny x nz with set 0 and push constants (pc0, 0, 0, 0), then submitted. */
-static hd_result hd__vk_stage(hd__ctx *ctx, int p, int nx, int ny, int nz, int pc0)
+static hd_result hd__vk_stage(const hd__view *vw, int p, int nx, int ny, int nz, int pc0)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     hd_result r;
-    if ((r = hd__vk_stage_pipeline(ctx, p, &pipe)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS ||
-        (r = hd__vk_dispatch(ctx, cb, pipe, 0, nx, ny, nz, pc0, 0, 0, 0)) != HD_SUCCESS)
+    if ((r = hd__vk_stage_pipeline(vw, p, &pipe)) != HD_SUCCESS || (r = hd__vk_begin(vw, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_dispatch(vw, cb, pipe, 0, nx, ny, nz, pc0, 0, 0, 0)) != HD_SUCCESS)
         return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
-static hd_result hd__be_classify(hd__ctx *ctx)
+static hd_result hd__be_classify(const hd__view *vw)
 {
-    return hd__vk_stage(ctx, HD__VK_CLASSIFY, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0);
+    return hd__vk_stage(vw, HD__VK_CLASSIFY, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0);
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t) into a host-visible buffer;
    the sets are rewritten (nothing is in flight here). */
-static hd_result hd__be_direct_list(hd__ctx *ctx)
+static hd_result hd__be_direct_list(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    HD__VK_IDLE(ctx);
-    hd__vk_free_buffer(ctx, &be->dl);
-    if ((r = hd__vk_buffer_create(ctx, &be->dl, ctx->dl_count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+    HD__VK_IDLE(vw);
+    hd__vk_free_buffer(vw, &be->dl);
+    if ((r = hd__vk_buffer_create(vw, &be->dl, vw->dl_count * sizeof(uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "the direct light's list")) != HD_SUCCESS)
         return r;
-    if (ctx->dl_count) memcpy(be->dl.map, ctx->dl_idx, ctx->dl_count * sizeof(uint32_t));
+    if (vw->dl_count) memcpy(be->dl.map, vw->dl_idx, vw->dl_count * sizeof(uint32_t));
     return HD_SUCCESS;
 }
 
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
    groups along x are limited to maxComputeWorkGroupCount, at least 65535). */
 #define HD__DIRECT_ROW ((int)HD__VK_LOCAL_X * 32768)
-static hd_result hd__be_direct(hd__ctx *ctx)
+static hd_result hd__be_direct(const hd__view *vw)
 {
-    int n = (int)ctx->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
-    ctx->be->gg.lsum_ok = 0;
-    return hd__vk_stage(ctx, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
+    int n = (int)vw->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    vw->be->gg.lsum_ok = 0;
+    return hd__vk_stage(vw, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one
    Jacobi pass, phi -> phi2, and a copy back (the descriptor sets stay fixed, which recorded
    command buffers need). */
-static hd_result hd__be_diffuse(hd__ctx *ctx, int jacobi)
+static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     /* invocations along y and z: blocks of diffuse_yk rows and diffuse_zk slices, nzb per channel
        (push constant z, hd_entry_glsl.h) */
-    int ny = (ctx->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (ctx->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
-    int nz = nzb * ctx->channels;
+    int ny = (vw->gdims[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (vw->gdims[2] + be->diffuse_zk - 1) / be->diffuse_zk;
+    int nz = nzb * vw->channels;
     VkPipeline pipe;
     be->gg.lsum_ok = 0;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_diffuse_pipeline(ctx, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_diffuse_pipeline(vw, jacobi ? 1 : 0, &pipe)) != HD_SUCCESS) return r;
     if (jacobi) {
-        if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, ctx->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
+        if ((r = hd__vk_dispatch(vw, cb, pipe, 0, vw->gdims[0], ny, nz, 0, 1, nzb, 0)) != HD_SUCCESS) return r;
         hd__vk_copy_image(be, cb, &be->phi2, &be->phi);
     } else {
         int parity;
         for (parity = 0; parity < 2; ++parity)
-            if ((r = hd__vk_dispatch(ctx, cb, pipe, 0, (ctx->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
+            if ((r = hd__vk_dispatch(vw, cb, pipe, 0, (vw->gdims[0] + 1) / 2, ny, nz, parity, 0, nzb, 0)) != HD_SUCCESS)
                 return r;
     }
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
 /* The projection, after its inputs: lsum rebuilt (the light-sum stage) when a pass changed E or
    phi since, and the TF table (hd__project_table) written when it differs from the one in the
    buffer. A recorded frame reads the table as it is when the command buffer runs, as the TF. */
-static hd_result hd__be_project(hd__ctx *ctx)
+static hd_result hd__be_project(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline sum, proj;
-    int n = hd__project_table_n(ctx), nb, p;
+    int n = hd__project_table_n(vw), nb, p;
     hd_result r;
     if (!be->ptab.map || be->ptab_cap != n)
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the projection's TF table has no room for %d entries (internal error)",
                        n);
-    if (!hd__project_table_key_same(ctx, &be->ptab_key)) {
-        hd__project_table(ctx, (float *)be->ptab.map, n); /* written in place: the table is only written */
-        be->ptab_key = hd__project_table_key(ctx);
+    if (!hd__project_table_key_same(vw, &be->ptab_key)) {
+        hd__project_table(vw, (float *)be->ptab.map, n); /* written in place: the table is only written */
+        be->ptab_key = hd__project_table_key(vw);
         be->ptab_n = n;
     }
-    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
-        (r = hd__vk_stage_pipeline(ctx, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS)
+    if ((r = hd__vk_stage_pipeline(vw, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
+        (r = hd__vk_stage_pipeline(vw, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(vw, &cb)) != HD_SUCCESS)
         return r;
     if (!be->gg.lsum_ok) {
-        r = hd__vk_dispatch(ctx, cb, sum, 0, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, 0, 0, 0, 0);
+        r = hd__vk_dispatch(vw, cb, sum, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0);
         if (r != HD_SUCCESS) return r;
         be->gg.lsum_ok = 1;
     }
-    nb = (ctx->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
+    nb = (vw->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
     p = be->spread_rows ? hd__gpu_row_stride(nb) : 1;
-    if ((r = hd__vk_dispatch(ctx, cb, proj, 0, ctx->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : ctx->kp.image.y, 1, n, p,
+    if ((r = hd__vk_dispatch(vw, cb, proj, 0, vw->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : vw->kp.image.y, 1, n, p,
                              HD__GPU_ROW_BLOCK, 0)) != HD_SUCCESS)
         return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
+/* The projection's pipeline runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_glsl.h). */
+static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+
 /* ---- read-back ------------------------------------------------------------------------------- */
-static hd_result hd__be_read_image(hd__ctx *ctx, float *dst)
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkBufferCopy bc;
-    size_t bytes = (size_t)ctx->kp.image.x * ctx->kp.image.y * 4 * sizeof(float);
+    size_t bytes = (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float);
     hd_result r;
-    HD__VK_IDLE(ctx);
-    if ((r = hd__vk_staging(ctx, bytes)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
+    HD__VK_IDLE(vw);
+    if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
     hd__vk_barrier(be, cb);
     memset(&bc, 0, sizeof bc);
     bc.size = bytes;
     be->fn.vkCmdCopyBuffer(cb, be->img.buffer, be->staging.buffer, 1, &bc);
     hd__vk_barrier(be, cb);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
     memcpy(dst, be->staging.map, bytes);
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_read_illumination(hd__ctx *ctx, hd_illumination which, const int *zz, int count, float *dst)
+static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
 {
-    return hd__vk_download_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, dst, zz, count);
+    return hd__vk_download_image(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, dst, zz, count);
 }
 
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
-HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(hd__ctx *ctx, hd_illumination which, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
-    ctx->be->gg.lsum_ok = 0;
-    return hd__vk_upload_image(ctx, which == HD_ILLUMINATION_DIRECT ? &ctx->be->E : &ctx->be->phi, src);
+    vw->be->gg.lsum_ok = 0;
+    return hd__vk_upload_image(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, src);
 }
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
-static hd_result hd__be_alloc_lights(hd__ctx *ctx, int count)
+static hd_result hd__be_alloc_lights(const hd__view *vw, int count)
 {
-    HD__VK_IDLE(ctx);
-    return hd__gpu_alloc_lights(ctx, &ctx->be->gg, count);
+    HD__VK_IDLE(vw);
+    return hd__gpu_alloc_lights(vw, &vw->be->gg, count);
 }
 
 /* One convection step of light `light`: its volume -> the spare, copied back (the CPU backend
    swaps the two instead; a copy keeps the descriptor sets fixed for recorded command buffers). */
-static hd_result hd__be_convect(hd__ctx *ctx, int light)
+static hd_result hd__be_convect(const hd__view *vw, int light)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_dispatch(ctx, cb, ctx->be->pipelines[HD__VK_CONVECT], light, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(vw, cb, vw->be->pipelines[HD__VK_CONVECT], light, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0, 0, light, 0)) != HD_SUCCESS)
         return r;
     hd__vk_copy_image(be, cb, &be->lv[be->gg.nlv], &be->lv[light]);
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
 /* E = sum over the lights of colour * falloff * light volume, the first pass overwriting E. */
-static hd_result hd__be_sum_lights(hd__ctx *ctx)
+static hd_result hd__be_sum_lights(const hd__view *vw)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     int l;
     VkPipeline pipe;
-    ctx->be->gg.lsum_ok = 0;
-    if ((r = hd__vk_stage_pipeline(ctx, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r;
-    for (l = 0; l < ctx->be->gg.nlv; ++l)
-        if ((r = hd__vk_dispatch(ctx, cb, pipe, l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
+    vw->be->gg.lsum_ok = 0;
+    if ((r = hd__vk_stage_pipeline(vw, HD__VK_SUM_LIGHT, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r;
+    for (l = 0; l < vw->be->gg.nlv; ++l)
+        if ((r = hd__vk_dispatch(vw, cb, pipe, l, vw->gdims[0], vw->gdims[1], vw->gdims[2], 0, 0, l, l == 0)) != HD_SUCCESS)
             return r;
-    return hd__vk_flush(ctx);
+    return hd__vk_flush(vw);
 }
 
 /* ---- PT_SS / PT_MS ------------------------------------------------------------------------------ */
-static hd_result hd__be_path(hd__ctx *ctx)
+static hd_result hd__be_path(const hd__view *vw)
 {
-    return hd__vk_stage(ctx, HD__VK_PATH, ctx->kp.image.x, ctx->kp.image.y, 1, 0);
+    return hd__vk_stage(vw, HD__VK_PATH, vw->kp.image.x, vw->kp.image.y, 1, 0);
 }
 
 /* ---- HD_SOLVER_MULTIGRID ------------------------------------------------------------------------
@@ -1727,52 +1728,52 @@ static hd_result hd__be_path(hd__ctx *ctx)
    images (a level's smoothing, a restriction, ...) is a set of the multigrid's own pool, written
    when the levels are made and again whenever the backend's sets are rebuilt (its sigma_t, E and
    phi may be new: be->sets_gen); the parameter blocks are slots of the multigrid's own uniform
-   buffer, one per level and one for the fine ctx->kp, bound with a dynamic offset.
+   buffer, one per level and one for the fine vw->kp, bound with a dynamic offset.
    The passes are recorded into the backend's command buffer (hd__vk_cmd) and submitted at each
    read-back of the row sums and at the end: three submissions a step, each waited for, so
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
-static size_t hd__be_solver_bytes(const hd__ctx *ctx) { return hd__gpu_solver_bytes(ctx, &ctx->be->gg); }
-static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx) { return &ctx->be->gg; }
+static size_t hd__be_solver_bytes(const hd__view *vw) { return hd__gpu_solver_bytes(vw, &vw->be->gg); }
+static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw) { return &vw->be->gg; }
 
 /* The row-sum buffers, the parameter slots and the set pool; nothing of theirs may be in flight
    when they are freed (each step ends waited for). */
-static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make)
+static hd_result hd__gpu_mg_extras(const hd__view *vw, int make)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__vk_mg *mg = &be->mg;
     VkDeviceSize align = be->limits.minUniformBufferOffsetAlignment ? be->limits.minUniformBufferOffsetAlignment : 256;
     size_t rows = hd__gpu_mg_rows(&be->gg);
     hd_result r;
-    hd__vk_free_buffer(ctx, &mg->dot_a); hd__vk_free_buffer(ctx, &mg->dot_b); hd__vk_free_buffer(ctx, &mg->params);
+    hd__vk_free_buffer(vw, &mg->dot_a); hd__vk_free_buffer(vw, &mg->dot_b); hd__vk_free_buffer(vw, &mg->params);
     if (mg->pool) be->fn.vkDestroyDescriptorPool(be->device, mg->pool, NULL);
     mg->pool = VK_NULL_HANDLE;
     mg->sets_valid = 0;
     if (!make) return HD_SUCCESS;
     mg->slot_bytes = (sizeof(hd__kparams) + align - 1) / align * align;
-    if ((r = hd__vk_buffer_create(ctx, &mg->dot_a, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+    if ((r = hd__vk_buffer_create(vw, &mg->dot_a, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__vk_buffer_create(ctx, &mg->dot_b, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+        (r = hd__vk_buffer_create(vw, &mg->dot_b, rows * sizeof(double), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
                                   "multigrid's row sums")) != HD_SUCCESS ||
-        (r = hd__vk_buffer_create(ctx, &mg->params, mg->slot_bytes * (VkDeviceSize)(be->gg.levels + 1),
+        (r = hd__vk_buffer_create(vw, &mg->params, mg->slot_bytes * (VkDeviceSize)(be->gg.levels + 1),
                                   VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, 1, "multigrid's parameter blocks")) != HD_SUCCESS)
         return r;
-    return hd__vk_pool(ctx, HD__GPU_MG_SETS, &mg->pool);
+    return hd__vk_pool(vw, HD__GPU_MG_SETS, &mg->pool);
 }
 
-/* Every pass's set (src/hd_gpu.h's hd__gpu_mg_set: sigma_t, E, phi, phi2 and the other grid at
+/* Every pass's set (backends/hd_gpu.h's hd__gpu_mg_set: sigma_t, E, phi, phi2 and the other grid at
    bindings 4..7 and 10, the row sums at 11), written when the levels are new or the backend's
    sets were rebuilt since (its grids may be new). Nothing is in flight. */
-static hd_result hd__vk_mg_sets(hd__ctx *ctx)
+static hd_result hd__vk_mg_sets(const hd__view *vw)
 {
     static const int binding[5] = {4, 5, 6, 7, 10};
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     struct hd__vk_mg *mg = &be->mg;
     hd_result r;
     int n = HD__GPU_MG_CG(&be->gg, HD__GPU_MG_CG_SETS), s, i;
     if (mg->sets_valid && mg->sets_gen == be->sets_gen) return HD_SUCCESS;
     mg->sets_valid = 0;
-    if ((r = hd__vk_pool_sets(ctx, mg->pool, n, mg->sets, "vkResetDescriptorPool (multigrid)",
+    if ((r = hd__vk_pool_sets(vw, mg->pool, n, mg->sets, "vkResetDescriptorPool (multigrid)",
                               "vkAllocateDescriptorSets (multigrid)")) != HD_SUCCESS)
         return r;
     for (s = 0; s < n; ++s) {
@@ -1785,7 +1786,7 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
         hd__vk_common_buffers(be, bu, b.dot == 1 ? &mg->dot_a : b.dot == 2 ? &mg->dot_b : NULL);
         im[1] = &be->vol;
         for (i = 0; i < 5; ++i) im[binding[i]] = b.grid[i] < 0 ? NULL : hd__vk_grid(be, b.grid[i]);
-        hd__vk_write_set(ctx, mg->sets[s], &mg->params, im, bu);
+        hd__vk_write_set(vw, mg->sets[s], &mg->params, im, bu);
     }
     mg->sets_gen = be->sets_gen;
     mg->sets_valid = 1;
@@ -1794,14 +1795,14 @@ static hd_result hd__vk_mg_sets(hd__ctx *ctx)
 
 /* Parameter block kp into slot l (level l's; slot `levels`: the fine one). Nothing is in flight:
    each step ends waited for. */
-static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp)
+static hd_result hd__gpu_mg_send(const hd__view *vw, int l, const hd__kparams *kp)
 {
-    memcpy((char *)ctx->be->mg.params.map + (size_t)l * ctx->be->mg.slot_bytes, kp, sizeof *kp);
+    memcpy((char *)vw->be->mg.params.map + (size_t)l * vw->be->mg.slot_bytes, kp, sizeof *kp);
     return HD_SUCCESS;
 }
 
 /* The pipeline of multigrid pass `stage` for the current flags, made on first use. */
-static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
+static hd_result hd__vk_mg_pipeline(const hd__view *vw, int stage, VkPipeline *out)
 {
     static const uint32_t *const code[HD__MG_STAGES] = {hd__spv_mg_sig, hd__spv_mg_residual, hd__spv_mg_restrict,
                                                            hd__spv_mg_prolong, hd__spv_mg_dir, hd__spv_mg_res_f64,
@@ -1810,13 +1811,13 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
                                                   sizeof hd__spv_mg_prolong, sizeof hd__spv_mg_dir, sizeof hd__spv_mg_res_f64,
                                                   sizeof hd__spv_mg_dot, sizeof hd__spv_mg_update,
                                                   sizeof hd__spv_mg_extrap};
-    hd__backend *be = ctx->be;
-    int f, variant = hd__gpu_mg_variant(stage, ctx->kp.counts.z, &f);
+    hd__backend *be = vw->be;
+    int f, variant = hd__gpu_mg_variant(stage, vw->kp.counts.z, &f);
     VkPipeline *slot = &be->mg_pipes[variant];
     int32_t flags = (int32_t)f;
     hd_result r;
-    if (!*slot && (r = hd__vk_pipeline_code(ctx, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
-        HD__INFO(&ctx->log, "vulkan: making the %s pipeline failed", hd__mg_stage_names[stage - 1]);
+    if (!*slot && (r = hd__vk_pipeline_code(vw, code[stage - 1], size[stage - 1], &flags, 0, slot)) != HD_SUCCESS) {
+        HD__INFO(&vw->log, "vulkan: making the %s pipeline failed", hd__mg_stage_names[stage - 1]);
         return r;
     }
     *out = *slot;
@@ -1826,15 +1827,15 @@ static hd_result hd__vk_mg_pipeline(hd__ctx *ctx, int stage, VkPipeline *out)
 /* Records pass p into the backend's command buffer with its set and parameter slot; the
    direction's beta (its bits) and the update's alpha (low and high words: packDouble2x32's x and
    y; the host's byte order is the device's) in hd_pc.x and .y. */
-static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
+static hd_result hd__gpu_mg_pass(const hd__view *vw, const hd__gpu_mg_run *p)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkPipeline pipe;
     int32_t pc[4];
     uint64_t u;
     hd_result r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(ctx, p->stage, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS || (r = hd__vk_mg_pipeline(vw, p->stage, &pipe)) != HD_SUCCESS) return r;
     memcpy(pc, p->pc, sizeof pc);
     if (p->stage == HD__MG_DIR) memcpy(&pc[0], &p->beta, sizeof p->beta);
     if (p->stage == HD__MG_UPDATE) {
@@ -1848,9 +1849,9 @@ static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p)
 }
 
 /* Level l's smoothing: the diffusion pipeline with HD_FLAG_DIFFUSE_RHS on its parameter slot. */
-static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
+static hd_result hd__be_mg_smooth(const hd__view *vw, int l, int sweeps, int first)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     const int *d = be->gg.lv[l].dims;
     int ny = (d[1] + be->diffuse_yk - 1) / be->diffuse_yk, nzb = (d[2] + be->diffuse_zk - 1) / be->diffuse_zk;
@@ -1859,7 +1860,7 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
     VkPipeline pipe;
     hd_result r;
     int s, h;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS || (r = hd__vk_diffuse_pipeline_for(ctx, flags, 0, &pipe)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS || (r = hd__vk_diffuse_pipeline_for(vw, flags, 0, &pipe)) != HD_SUCCESS) return r;
     for (s = 0; s < sweeps; ++s)
         for (h = 0; h < 2; ++h) {
             int32_t pc[4];
@@ -1873,66 +1874,59 @@ static hd_result hd__be_mg_smooth(hd__ctx *ctx, int l, int sweeps, int first)
 /* Submits what is pending, makes the levels, writes the parameter slots and the sets; the step's
    passes are recorded into one command buffer up to each read-back (hd__be_mg_row_sums), so a
    step is three submissions. */
-static hd_result hd__be_mg_begin(hd__ctx *ctx, int *fresh)
+static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     if (be->no_f64)
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name,
                        be->no_f64);
     if (be->rec) /* hd_vulkan_record refuses the solver before it starts */
-        return HD__ERR(&ctx->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS || (r = hd__gpu_mg_begin(ctx, &be->gg, fresh)) != HD_SUCCESS ||
-        (r = hd__gpu_mg_send(ctx, be->gg.levels, &ctx->kp)) != HD_SUCCESS)
+        return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: a multigrid step while recording (internal error)");
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS || (r = hd__gpu_mg_begin(vw, &be->gg, fresh)) != HD_SUCCESS ||
+        (r = hd__gpu_mg_send(vw, be->gg.levels, &vw->kp)) != HD_SUCCESS)
         return r;
-    if ((r = hd__vk_begin(ctx, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
-    return hd__vk_mg_sets(ctx);
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r; /* submits the new images' clears, rebuilds be->sets */
+    return hd__vk_mg_sets(vw);
 }
 
-static hd_result hd__be_mg_end(hd__ctx *ctx, hd_result r)
+static hd_result hd__be_mg_end(const hd__view *vw, hd_result r)
 {
     VkCommandBuffer cb = VK_NULL_HANDLE;
     if (r != HD_SUCCESS) return r;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    return hd__vk_flush(ctx);
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    return hd__vk_flush(vw);
 }
 
 /* Submits what was recorded, the row sums made visible to the host, and waits; the sums are read
    in the host-visible buffers themselves. */
-static hd_result hd__be_mg_row_sums(hd__ctx *ctx, int n, const double **a, const double **b)
+static hd_result hd__be_mg_row_sums(const hd__view *vw, int n, const double **a, const double **b)
 {
-    struct hd__vk_mg *mg = &ctx->be->mg;
+    struct hd__vk_mg *mg = &vw->be->mg;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
     (void)n;
-    if ((r = hd__vk_cmd(ctx, &cb)) != HD_SUCCESS) return r;
-    hd__vk_barrier(ctx->be, cb);
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    hd__vk_barrier(vw->be, cb);
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
     *a = (const double *)mg->dot_a.map;
     *b = (const double *)mg->dot_b.map;
     return HD_SUCCESS;
 }
 
 /* The single-level solver's sweeps: each its own submission. */
-static hd_result hd__be_diffuse_sweeps(hd__ctx *ctx, int jacobi, int sweeps) { return hd__be_diffuse_each(ctx, jacobi, sweeps); }
+static hd_result hd__be_diffuse_sweeps(const hd__view *vw, int jacobi, int sweeps) { return hd__be_diffuse_each(vw, jacobi, sweeps); }
 
-/* ---- recording into the caller's command buffer ------------------------------------------------ */
-static hd__ctx *hd__lookup(hd_context h, hd_logger *log_out);
-static hd_result hd__iterate_method(hd__ctx *ctx);
-static hd_result hd__light_iteration(hd__ctx *ctx);
-static hd_result hd__project_frame(hd__ctx *ctx);
-static hd_result hd__image_room(hd__ctx *ctx);
-static int hd__method_is_pt(hd_method m);
-static double hd__scale_pixels(const hd__ctx *ctx, int s);
-static void hd__frame_cost_add(hd__ctx *ctx, int s, double pixels, double seconds);
+/* ---- recording into the caller's command buffer (HD__BE_RECORD) ------------------------------- */
+static unsigned hd__be_features(void) { return HD__BE_RECORD; }
 
 /* The timestamp pool for recorded frames, made on the first recording; none (ts_state -1) where
    the queue family has no timestamps, and then HD_RENDER_SCALE_AUTO has no frame time to go on
    while recording (its first scale stays 4, or what an unrecorded frame measured). */
-static hd_result hd__vk_timestamps(hd__ctx *ctx)
+static hd_result hd__vk_timestamps(const hd__view *vw)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     VkQueueFamilyProperties q[32];
     VkQueryPoolCreateInfo qpci;
     uint32_t n = 32, bits;
@@ -1941,7 +1935,7 @@ static hd_result hd__vk_timestamps(hd__ctx *ctx)
     bits = be->queue_family < n && be->queue_family < 32 ? q[be->queue_family].timestampValidBits : 0;
     if (bits == 0) {
         be->ts_state = -1;
-        HD__INFO(&ctx->log, "vulkan: queue family %u has no timestamps: recorded frames are not timed for HD_RENDER_SCALE_AUTO",
+        HD__INFO(&vw->log, "vulkan: queue family %u has no timestamps: recorded frames are not timed for HD_RENDER_SCALE_AUTO",
                  be->queue_family);
         return HD_SUCCESS;
     }
@@ -1950,92 +1944,68 @@ static hd_result hd__vk_timestamps(hd__ctx *ctx)
     qpci.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
     qpci.queryType = VK_QUERY_TYPE_TIMESTAMP;
     qpci.queryCount = 2;
-    HD__VK_TRY(ctx, be->fn.vkCreateQueryPool(be->device, &qpci, NULL, &be->ts_pool), "vkCreateQueryPool");
+    HD__VK_TRY(vw, be->fn.vkCreateQueryPool(be->device, &qpci, NULL, &be->ts_pool), "vkCreateQueryPool");
     be->ts_state = 1;
     return HD_SUCCESS;
 }
 
-/* The last recorded frame's device time goes into the frame cost model HD_RENDER_SCALE_AUTO
-   predicts from (the caller has run the command buffer by now; a frame measured since by
-   hd_iterate or hd_render is newer and is kept). */
-static void hd__vk_read_frame_time(hd__ctx *ctx)
+/* The last recorded frame's device time (the caller has run the command buffer by now). */
+static int hd__be_record_seconds(const hd__view *vw, double *seconds)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     uint64_t t[2];
     VkResult e;
-    if (!be->ts_pending) return;
+    if (!be->ts_pending) return 0;
     be->ts_pending = 0;
     e = be->fn.vkGetQueryPoolResults(be->device, be->ts_pool, 0, 2, sizeof t, t, sizeof t[0], VK_QUERY_RESULT_64_BIT);
-    if (e == VK_SUCCESS && ctx->cost_gen == be->ts_cost_gen) {
-        double dt = (double)((t[1] - t[0]) & be->ts_mask) * (double)be->limits.timestampPeriod * 1e-9;
-        hd__frame_cost_add(ctx, be->ts_scale, be->ts_pixels, dt);
+    if (e != VK_SUCCESS) return 0;
+    *seconds = (double)((t[1] - t[0]) & be->ts_mask) * (double)be->limits.timestampPeriod * 1e-9;
+    return 1;
+}
+
+/* A timestamp before (end 0) and after (end 1) a recorded frame. */
+static void hd__be_record_mark(const hd__view *vw, int end)
+{
+    hd__backend *be = vw->be;
+    if (!be->ts_pool) return;
+    if (!end) {
+        be->fn.vkCmdResetQueryPool(be->rec, be->ts_pool, 0, 2);
+        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 0);
+    } else {
+        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 1);
+        be->ts_pending = 1;
     }
 }
 
-/* One recorded HD or CD iteration: the light, then the frame between two timestamps. */
-static hd_result hd__vk_record_iteration(hd__ctx *ctx)
+/* Recording into cb starts after the preparation's work is submitted and waited for: only
+   iterations are recorded, each with its own parameter slots. */
+static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = vw->be;
     hd_result r;
-    if ((r = hd__light_iteration(ctx)) != HD_SUCCESS) return r;
-    if (be->ts_pool) {
-        be->fn.vkCmdResetQueryPool(be->rec, be->ts_pool, 0, 2);
-        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 0);
-    }
-    if ((r = hd__project_frame(ctx)) != HD_SUCCESS) return r;
-    if (be->ts_pool) {
-        be->fn.vkCmdWriteTimestamp(be->rec, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, be->ts_pool, 1);
-        be->ts_pending = 1;
-        be->ts_scale = ctx->frame_scale;
-        be->ts_pixels = hd__scale_pixels(ctx, ctx->frame_scale);
-        be->ts_cost_gen = ctx->cost_gen;
-    }
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_timestamps(vw)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_ring(vw, (uint32_t)slots)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_sets(vw)) != HD_SUCCESS) return r;
+    be->next_slot = 0;
+    be->have_slot = 0;
+    be->rec = (VkCommandBuffer)target;
+    be->ts_pending = 0;
     return HD_SUCCESS;
 }
 
-/* n iterations recorded into cb after hd__prepare's work is submitted and waited for: only
-   iterations are recorded, each with its own parameter slots. */
-static hd_result hd__vk_record(hd__ctx *ctx, VkCommandBuffer cb, int n)
+static hd_result hd__be_record_end(const hd__view *vw, hd_result r)
 {
-    hd__backend *be = ctx->be;
-    hd_result r;
-    int i;
-    /* reduced frames need the image buffer's second region, which cannot be made mid-recording */
-    if (!hd__method_is_pt(ctx->params.method) && ctx->params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_flush(ctx)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_timestamps(ctx)) != HD_SUCCESS) return r;
-    /* light, frame and a reduced frame's upsample pass (params.render_scale) */
-    if ((r = hd__vk_ring(ctx, 3u * (uint32_t)n + 2u)) != HD_SUCCESS) return r;
-    if ((r = hd__vk_sets(ctx)) != HD_SUCCESS) return r;
-    be->next_slot = 0;
-    be->have_slot = 0;
-    be->rec = cb;
-    ctx->no_measure = 1;
-    for (i = 0; i < n && r == HD_SUCCESS; ++i)
-        r = ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD ? hd__vk_record_iteration(ctx)
-                                                                                     : hd__iterate_method(ctx);
-    ctx->no_measure = 0;
+    hd__backend *be = vw->be;
     if (r == HD_SUCCESS) hd__vk_barrier(be, be->rec); /* the caller's next commands see the results */
     else be->ts_pending = 0;                           /* a failed recording is not submitted */
     be->rec = VK_NULL_HANDLE;
     return r;
 }
 
-HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+/* No GL texture: the core never calls it. */
+static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
 {
-    hd_logger stale;
-    hd__ctx *ctx = hd__lookup(h, &stale);
-    hd_result r;
-    if (!ctx) return HD__ERR(&stale, HD_ERROR_INVALID_HANDLE, "context handle 0x%08x is invalid, stale or destroyed", (unsigned)h.id);
-    if (!command_buffer) return HD__ERR(&ctx->log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
-    if (n < 1) return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
-    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
-        return HD__ERR(&ctx->log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
-    if (ctx->params.solver == HD_SOLVER_MULTIGRID && !ctx->params.disable_diffusion &&
-        (ctx->params.method == HD_METHOD_HD || ctx->params.method == HD_METHOD_CD))
-        return HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED,
-                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
-    hd__vk_read_frame_time(ctx);
-    HD__BE_CALL(r, ctx, hd__vk_record(ctx, (VkCommandBuffer)command_buffer, n));
-    return r;
+    (void)texture;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no GL texture");
 }

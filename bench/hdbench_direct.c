@@ -71,7 +71,7 @@ static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int
     gvox = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2];
     tracked = hd__test_direct_count(h[0]);
     /* the mask alone, as a TF change rebuilds it (median of 3) */
-    ctx = hd__lookup(h[0], NULL);
+    ctx = hd__lookup(h[0]);
     {
         double b[3];
         for (rep = 0; rep < 3; ++rep) {
@@ -95,7 +95,7 @@ static int bench_tf(const hd_volume_file *vf, const char *preset, int iters, int
     }
     for (i = 0; i < n && nm == 2; ++i) {
         size_t k = i % gvox;
-        if ((ctx->dl_bits[k >> 3] >> (k & 7) & 1u) ? e[0][i] != e[1][i] : e[0][i] != 0.0f) ++mismatch;
+        if ((ctx->dl.bits[k >> 3] >> (k & 7) & 1u) ? e[0][i] != e[1][i] : e[0][i] != 0.0f) ++mismatch;
     }
     {
         double a = hdb_median(ms[0], reps), b = nm == 2 ? hdb_median(ms[1], reps) : 0.0;

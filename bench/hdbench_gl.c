@@ -36,16 +36,16 @@ static double rate(hd_context c, int sweeps_only)
    recompiled at each switch, in rate()'s warm-up), best of each. */
 static void sweep_ab(hd_context c, int zk)
 {
-    hd__ctx *ctx = hd__lookup(c, NULL);
+    const hd__view *ctx = (&hd__lookup(c)->vw);
     hd__backend *be = ctx->be;
     double best[2] = {0.0, 0.0};
     int k, i, own = be->diffuse_zk;
     for (k = 0; k < 8; ++k) {
         double v;
-        if (hd__gl_enter(ctx) != HD_SUCCESS) return;
+        if (hd__be_begin(ctx) != HD_SUCCESS) return;
         for (i = HD__GL_PROGRAM_COUNT; i < HD__GL_SLOTS; ++i)
             if (be->programs[i]) { be->gl.DeleteProgram(be->programs[i]); be->programs[i] = 0; }
-        hd__gl_leave(ctx, HD_SUCCESS);
+        hd__be_end(ctx, HD_SUCCESS);
         be->diffuse_zk = k & 1 ? zk : own;
         v = rate(c, 1);
         if (v > best[k & 1]) best[k & 1] = v;

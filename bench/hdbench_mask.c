@@ -45,16 +45,16 @@ int main(int argc, char **argv)
             d.params.illumination_downsample = g;
             if (hd_create(&d, &h) != HD_SUCCESS) return 1;
             if (hd__test_prepare(h) != HD_SUCCESS) { hd_destroy(h); return 1; }
-            ctx = hd__lookup(h, NULL);
+            ctx = hd__lookup(h);
             for (rep = 0; rep < 5; ++rep) {
                 t0 = hd__now();
                 if (hd__direct_mask(ctx) != HD_SUCCESS) { hd_destroy(h); return 1; }
                 b[rep] = (hd__now() - t0) * 1e3;
             }
-            gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
+            gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
             for (i = 0; i < gvox; ++i)
-                if (ctx->dl_bits[i >> 3] >> (i & 7) & 1u) sum = sum * 31u + (uint32_t)i;
-            printf("%s grid /%d: tracked %zu, set hash %08x, mask build %.1f ms (median of 5)\n", tfs[t], g, ctx->dl_count,
+                if (ctx->dl.bits[i >> 3] >> (i & 7) & 1u) sum = sum * 31u + (uint32_t)i;
+            printf("%s grid /%d: tracked %zu, set hash %08x, mask build %.1f ms (median of 5)\n", tfs[t], g, ctx->vw.dl_count,
                    (unsigned)sum, hdb_median(b, 5));
             hd_destroy(h);
         }

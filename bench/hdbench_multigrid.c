@@ -37,7 +37,7 @@ static double cpu_seconds(void) { return (double)clock() / CLOCKS_PER_SEC; }
    (hd_prelude_c.h's hd__split_slot) in x-fastest order; NULL if out of memory. */
 static float *x_fastest(const hd__ctx *ctx, const float *buf, int slices)
 {
-    int gx = ctx->gdims[0], gy = ctx->gdims[1], x, y, zz;
+    int gx = ctx->vw.gdims[0], gy = ctx->vw.gdims[1], x, y, zz;
     float *out = (float *)malloc((size_t)gx * gy * slices * sizeof(float)), *o = out;
     if (!out) return NULL;
     for (zz = 0; zz < slices; ++zz)
@@ -50,16 +50,16 @@ static float *x_fastest(const hd__ctx *ctx, const float *buf, int slices)
    x-fastest copies): below float32's rounding floor. -1 when it cannot be computed. */
 static double residual_f64(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__ctx *ctx = hd__lookup(h);
     size_t gvox;
     float *sig, *E, *phi;
     double r = -1.0;
-    if (!ctx || !ctx->be->sig || !ctx->be->E || !ctx->be->phi) return -1.0;
-    gvox = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2];
-    sig = x_fastest(ctx, ctx->be->sig, ctx->gdims[2] * ctx->sig_channels);
-    E = x_fastest(ctx, ctx->be->E, ctx->gdims[2] * ctx->channels);
-    phi = x_fastest(ctx, ctx->be->phi, ctx->gdims[2] * ctx->channels);
-    if (sig && E && phi) r = hdb_residual_f64(&ctx->kp, sig, gvox * (size_t)ctx->sig_channels, E, phi);
+    if (!ctx || !ctx->vw.be->sig || !ctx->vw.be->E || !ctx->vw.be->phi) return -1.0;
+    gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
+    sig = x_fastest(ctx, ctx->vw.be->sig, ctx->vw.gdims[2] * ctx->vw.sig_channels);
+    E = x_fastest(ctx, ctx->vw.be->E, ctx->vw.gdims[2] * ctx->vw.channels);
+    phi = x_fastest(ctx, ctx->vw.be->phi, ctx->vw.gdims[2] * ctx->vw.channels);
+    if (sig && E && phi) r = hdb_residual_f64(&ctx->vw.kp, sig, gvox * (size_t)ctx->vw.sig_channels, E, phi);
     free(sig); free(E); free(phi);
     return r;
 }
@@ -71,30 +71,30 @@ static double residual_f64(hd_context h)
    iterate phi + lo instead of phi. -1 when it cannot be computed. */
 static double residual_kernel_f64(hd_context h, int iterate)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__ctx *ctx = hd__lookup(h);
     hd__cpu_grid g;
     int rows, r, x, gx;
     float *row;
     double r2 = 0.0, b2 = 0.0;
-    if (!ctx || !ctx->be->phi) return -1.0;
-    gx = ctx->gdims[0];
-    rows = ctx->gdims[1] * ctx->gdims[2] * ctx->channels;
+    if (!ctx || !ctx->vw.be->phi) return -1.0;
+    gx = ctx->vw.gdims[0];
+    rows = ctx->vw.gdims[1] * ctx->vw.gdims[2] * ctx->vw.channels;
     if (!(row = (float *)malloc((size_t)gx * sizeof(float)))) return -1.0;
-    if (iterate && !ctx->be->mg) { free(row); return -1.0; }
-    g.k = &ctx->be->k;
+    if (iterate && !ctx->vw.be->mg) { free(row); return -1.0; }
+    g.k = &ctx->vw.be->k;
     g.res = NULL;
-    ctx->be->grid = iterate ? &ctx->be->mg->fineg : &g; /* the fine grid's residual reads phi + lo */
+    ctx->vw.be->grid = iterate ? &ctx->vw.be->mg->fineg : &g; /* the fine grid's residual reads phi + lo */
     for (r = 0; r < rows; ++r) {
-        int y = r % ctx->gdims[1], z = (r / ctx->gdims[1]) % ctx->gdims[2], c = r / (ctx->gdims[1] * ctx->gdims[2]);
-        hd__cpu_mg_residual_f64_into(ctx->be, r, row);
+        int y = r % ctx->vw.gdims[1], z = (r / ctx->vw.gdims[1]) % ctx->vw.gdims[2], c = r / (ctx->vw.gdims[1] * ctx->vw.gdims[2]);
+        hd__cpu_mg_residual_f64_into(ctx->vw.be, r, row);
         for (x = 0; x < gx; ++x) {
             float rhs;
-            (void)hd_diffuse_residual(&ctx->be->k, x, y, z, c, &rhs);
+            (void)hd_diffuse_residual(&ctx->vw.be->k, x, y, z, c, &rhs);
             r2 += (double)row[x] * row[x];
             b2 += (double)rhs * rhs;
         }
     }
-    ctx->be->grid = NULL;
+    ctx->vw.be->grid = NULL;
     free(row);
     return b2 > 0.0 ? sqrt(r2 / b2) : 0.0;
 }
@@ -117,10 +117,10 @@ static unsigned char *tissue_mask;
 /* The medium voxels of a context's grid (channel 0's sigma_t) into tissue_mask. */
 static void tissue_mask_of(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
-    size_t n = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], i;
-    float empty_below = 0.5f * ctx->kp.grid.w / (1.0f - ctx->kp.medium.y * ctx->kp.medium.z);
-    float *sig = x_fastest(ctx, ctx->be->sig, ctx->gdims[2]);
+    hd__ctx *ctx = hd__lookup(h);
+    size_t n = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2], i;
+    float empty_below = 0.5f * ctx->vw.kp.grid.w / (1.0f - ctx->vw.kp.medium.y * ctx->vw.kp.medium.z);
+    float *sig = x_fastest(ctx, ctx->vw.be->sig, ctx->vw.gdims[2]);
     tissue_mask = (unsigned char *)malloc(n);
     for (i = 0; i < n; ++i) tissue_mask[i] = sig[i] >= empty_below;
     free(sig);
@@ -129,13 +129,13 @@ static void tissue_mask_of(hd_context h)
 /* The relative L2 error of phi (channel 0) over the medium voxels against tissue_ref. */
 static double tissue_error(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
-    size_t n = (size_t)ctx->gdims[0] * ctx->gdims[1] * ctx->gdims[2], i;
+    hd__ctx *ctx = hd__lookup(h);
+    size_t n = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2], i;
     double e2 = 0.0, r2 = 0.0;
     for (i = 0; i < n; ++i)
         if (tissue_mask[i]) {
-            int gx = ctx->gdims[0], gy = ctx->gdims[1];
-            double d = (double)ctx->be->phi[hd__split_slot(gx, gy, (int)(i % gx), (int)(i / gx % gy), (int)(i / gx / gy))] -
+            int gx = ctx->vw.gdims[0], gy = ctx->vw.gdims[1];
+            double d = (double)ctx->vw.be->phi[hd__split_slot(gx, gy, (int)(i % gx), (int)(i / gx % gy), (int)(i / gx / gy))] -
                        tissue_ref[i];
             e2 += d * d;
             r2 += (double)tissue_ref[i] * tissue_ref[i];
@@ -157,11 +157,11 @@ static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threa
         hd__test_residual(ctx, &res);
         if (f64) res = residual_f64(ctx);
         if (tissue_ref ? ((r.steps / batch) & (r.steps / batch - 1)) == 0 : r.steps % (batch * print_every) == 0 || res < tol) {
-            hd__ctx *c = hd__lookup(ctx, NULL);
+            hd__ctx *c = hd__lookup(ctx);
             printf("  %s: %6d steps, %8.2f s wall, %8.2f s cpu/thread, ", name, r.steps, r.wall, r.cpu);
             if (tissue_ref) printf("tissue error %.3e, ", tissue_error(ctx));
             printf("residual %.3e (kernel coefficients %.3e", res, f64 ? residual_kernel_f64(ctx, 0) : res);
-            if (f64 && c && c->be->mg && c->params.solver == HD_SOLVER_MULTIGRID)
+            if (f64 && c && c->vw.be->mg && c->vw.params.solver == HD_SOLVER_MULTIGRID)
                 printf("; the solver's iterate phi + lo %.3e", residual_kernel_f64(ctx, 1));
             printf(")\n");
         }
@@ -176,13 +176,13 @@ static mg_run solve(hd_context ctx, int batch, double tol, double cap, int threa
    (rounding to nearest moves a voxel by up to half an ulp, about 0.29 ulp rms; this is 1 ulp). */
 static double residual_ulp_f64(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__ctx *ctx = hd__lookup(h);
     size_t n, i;
     float *phi, *keep;
     double res;
-    if (!ctx || !ctx->be->phi) return -1.0;
-    n = ctx->be->illum_slots; /* the padding slots too: residual_f64 reads only the voxels */
-    phi = ctx->be->phi;
+    if (!ctx || !ctx->vw.be->phi) return -1.0;
+    n = ctx->vw.be->illum_slots; /* the padding slots too: residual_f64 reads only the voxels */
+    phi = ctx->vw.be->phi;
     if (!(keep = (float *)malloc(n * sizeof(float)))) return -1.0;
     memcpy(keep, phi, n * sizeof(float));
     for (i = 0; i < n; ++i) {
@@ -242,11 +242,11 @@ int main(int argc, char **argv)
             if (hd_create(&d, &ref) != HD_SUCCESS || hd__test_direct(ref, 4) != HD_SUCCESS ||
                 hd__test_diffuse(ref, ref_steps) != HD_SUCCESS)
                 return 1;
-            rc = hd__lookup(ref, NULL);
-            n = (size_t)rc->gdims[0] * rc->gdims[1] * rc->gdims[2];
+            rc = hd__lookup(ref);
+            n = (size_t)rc->vw.gdims[0] * rc->vw.gdims[1] * rc->vw.gdims[2];
             free(tissue_ref);
             free(tissue_mask);
-            tissue_ref = x_fastest(rc, rc->be->phi, rc->gdims[2]); /* channel 0 */
+            tissue_ref = x_fastest(rc, rc->vw.be->phi, rc->vw.gdims[2]); /* channel 0 */
             tissue_mask_of(ref);
             if (ref_file) { /* --tissue-ref FILE.box / FILE.surface: one reference for two builds */
                 char fn[1024];
@@ -280,8 +280,8 @@ int main(int argc, char **argv)
         printf("| %s | red-black | %d sweeps | %.2f | %.2f | %.2e |\n", boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", a.steps, a.wall, a.cpu, a.res);
         printf("| %s | multigrid | %d PCG steps | %.2f | %.2f | %.2e |\n", boundary == HD_BOUNDARY_SURFACE ? "surface" : "box", b.steps, b.wall, b.cpu, b.res);
         {
-            hd__ctx *m = hd__lookup(mg, NULL);
-            double vc = m && m->be->mg ? m->mg.vcycle_seconds : 0.0;
+            hd__ctx *m = hd__lookup(mg);
+            double vc = m && m->vw.be->mg ? m->mg.vcycle_seconds : 0.0;
             printf("per step (wall): red-black sweep %.2f ms, PCG step %.2f ms, of which its V-cycle %.2f ms\n",
                    1e3 * a.wall / a.steps, 1e3 * b.wall / b.steps, 1e3 * vc / b.steps);
         }

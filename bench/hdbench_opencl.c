@@ -138,14 +138,14 @@ static void bind9(hd__backend *be, cl_kernel k)
 
 static void experiments(hd_context h, int quick)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
-    hd__backend *be = ctx->be;
+    hd__ctx *ctx = hd__lookup(h);
+    hd__backend *be = ctx->vw.be;
     cl_program pv, pi;
     cl_kernel kv, kp, kd;
     cl_int e;
-    int i, reps = quick ? 5 : 20, gx = ctx->gdims[0], gy = ctx->gdims[1], gz = ctx->gdims[2];
+    int i, reps = quick ? 5 : 20, gx = ctx->vw.gdims[0], gy = ctx->vw.gdims[1], gz = ctx->vw.gdims[2];
     double t0, t_row, t_vox, t_pb, t_pi, t_db, t_di;
-    size_t gv[3], gp[2], gd[3], npix = (size_t)ctx->kp.image.x * ctx->kp.image.y * 4, ngrid = ctx->nvox;
+    size_t gv[3], gp[2], gd[3], npix = (size_t)ctx->vw.kp.image.x * ctx->vw.kp.image.y * 4, ngrid = ctx->vw.nvox;
     float *img_b = (float *)malloc(npix * 4), *img_i = (float *)malloc(npix * 4);
     float *e_b = (float *)malloc(ngrid * 4), *e_i = (float *)malloc(ngrid * 4);
     cl_image_format fmt;
@@ -160,9 +160,9 @@ static void experiments(hd_context h, int quick)
     if (!pv) return;
     kv = clCreateKernel(pv, "hdx_diffuse_row", &e);
     bind9(be, kv);
-    hd__be_diffuse(ctx, 0); clFinish(be->queue);
+    hd__be_diffuse(&ctx->vw, 0); clFinish(be->queue);
     t0 = hd__now();
-    for (i = 0; i < reps; ++i) hd__be_diffuse(ctx, 0);
+    for (i = 0; i < reps; ++i) hd__be_diffuse(&ctx->vw, 0);
     clFinish(be->queue);
     t_vox = (hd__now() - t0) / reps;
     gv[0] = (size_t)gy; gv[1] = (size_t)gz; gv[2] = 1;
@@ -191,54 +191,54 @@ static void experiments(hd_context h, int quick)
     fmt.image_channel_data_type = CL_FLOAT;
     memset(&idesc, 0, sizeof idesc);
     idesc.image_type = CL_MEM_OBJECT_IMAGE3D;
-    idesc.image_width = (size_t)ctx->dims[0]; idesc.image_height = (size_t)ctx->dims[1]; idesc.image_depth = (size_t)ctx->dims[2];
-    vimg = clCreateImage(be->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, &fmt, &idesc, ctx->vol, &e);
+    idesc.image_width = (size_t)ctx->vw.dims[0]; idesc.image_height = (size_t)ctx->vw.dims[1]; idesc.image_depth = (size_t)ctx->vw.dims[2];
+    vimg = clCreateImage(be->context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, &fmt, &idesc, ctx->vw.vol, &e);
     if (e != CL_SUCCESS) { printf("3D image: %s\n", hd__cl_error_name(e)); return; }
     smp = clCreateSampler(be->context, CL_TRUE, CL_ADDRESS_CLAMP_TO_EDGE, CL_FILTER_LINEAR, &e);
-    gp[0] = (size_t)ctx->kp.image.x; gp[1] = (size_t)ctx->kp.image.y;
+    gp[0] = (size_t)ctx->vw.kp.image.x; gp[1] = (size_t)ctx->vw.kp.image.y;
     gd[0] = (size_t)gx; gd[1] = (size_t)gy; gd[2] = (size_t)gz;
     /* projection: same frame parameters, the image cleared before each variant */
     ctx->frames = 1; hd__fill_kparams(ctx);
-    hd__be_clear(ctx, HD__DIRTY_IMAGE);
-    hd__be_project(ctx);
+    hd__be_clear(&ctx->vw, HD__DIRTY_IMAGE);
+    hd__be_project(&ctx->vw);
     t0 = hd__now();
-    for (i = 0; i < reps; ++i) hd__be_project(ctx);
+    for (i = 0; i < reps; ++i) hd__be_project(&ctx->vw);
     t_pb = (hd__now() - t0) / reps;
-    hd__be_clear(ctx, HD__DIRTY_IMAGE);
-    hd__be_project(ctx);
-    hd__be_read_image(ctx, img_b);
+    hd__be_clear(&ctx->vw, HD__DIRTY_IMAGE);
+    hd__be_project(&ctx->vw);
+    hd__be_read_image(&ctx->vw, img_b);
     bind9(be, kp);
     clSetKernelArg(kp, 9, sizeof vimg, &vimg);
     clSetKernelArg(kp, 10, sizeof smp, &smp);
-    hd__be_clear(ctx, HD__DIRTY_IMAGE);
+    hd__be_clear(&ctx->vw, HD__DIRTY_IMAGE);
     clEnqueueNDRangeKernel(be->queue, kp, 2, NULL, gp, NULL, 0, NULL, NULL);
     clFinish(be->queue);
-    hd__be_read_image(ctx, img_i);
+    hd__be_read_image(&ctx->vw, img_i);
     t0 = hd__now();
     for (i = 0; i < reps; ++i) clEnqueueNDRangeKernel(be->queue, kp, 2, NULL, gp, NULL, 0, NULL, NULL);
     clFinish(be->queue);
     t_pi = (hd__now() - t0) / reps;
     /* direct light: one pass each from E = 0, iteration 1 */
     ctx->iterations = 1; hd__fill_kparams(ctx);
-    hd__cl_bind(ctx, HD__CL_DIRECT);
-    hd__be_clear(ctx, HD__DIRTY_DIRECT);
+    hd__cl_bind(&ctx->vw, HD__CL_DIRECT);
+    hd__be_clear(&ctx->vw, HD__DIRTY_DIRECT);
     t0 = hd__now();
-    hd__be_direct(ctx); clFinish(be->queue);
+    hd__be_direct(&ctx->vw); clFinish(be->queue);
     t_db = hd__now() - t0;
-    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, NULL, 0, e_b);
+    hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_DIRECT, NULL, 0, e_b);
     bind9(be, kd);
     clSetKernelArg(kd, 9, sizeof vimg, &vimg);
     clSetKernelArg(kd, 10, sizeof smp, &smp);
-    hd__be_clear(ctx, HD__DIRTY_DIRECT);
+    hd__be_clear(&ctx->vw, HD__DIRTY_DIRECT);
     t0 = hd__now();
     clEnqueueNDRangeKernel(be->queue, kd, 3, NULL, gd, NULL, 0, NULL, NULL);
     clFinish(be->queue);
     t_di = hd__now() - t0;
-    hd__be_read_illumination(ctx, HD_ILLUMINATION_DIRECT, NULL, 0, e_i);
+    hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_DIRECT, NULL, 0, e_i);
     for (i = 0; i < (int)npix; ++i) { d2 += (double)(img_i[i] - img_b[i]) * (img_i[i] - img_b[i]); r2 += (double)img_b[i] * img_b[i]; }
     for (i = 0; i < (int)ngrid; ++i) { de2 += (double)(e_i[i] - e_b[i]) * (e_i[i] - e_b[i]); re2 += (double)e_b[i] * e_b[i]; }
     printf("volume reads, projection %dx%d: buffer+software trilinear %.1f ms, 3D image+linear sampler %.1f ms (image/buffer time %.2fx), image vs buffer rel L2 %.1e\n",
-           ctx->kp.image.x, ctx->kp.image.y, t_pb * 1e3, t_pi * 1e3, t_pi / t_pb, sqrt(d2 / (r2 > 0 ? r2 : 1)));
+           ctx->vw.kp.image.x, ctx->vw.kp.image.y, t_pb * 1e3, t_pi * 1e3, t_pi / t_pb, sqrt(d2 / (r2 > 0 ? r2 : 1)));
     printf("volume reads, direct light pass: buffer %.1f ms, 3D image %.1f ms (image/buffer time %.2fx), rel L2 of E %.1e\n",
            t_db * 1e3, t_di * 1e3, t_di / t_db, sqrt(de2 / (re2 > 0 ? re2 : 1)));
     clReleaseKernel(kp); clReleaseKernel(kd); clReleaseProgram(pi);

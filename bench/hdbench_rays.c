@@ -73,7 +73,7 @@ int main(int argc, char **argv)
     if (!ok) return 1;
     hd_get_stats(h[0][0], &st);
     tracked = hd__test_direct_count(h[0][0]);
-    ctx = hd__lookup(h[0][0], NULL);
+    ctx = hd__lookup(h[0][0]);
     printf("hdbench_rays: cpu, %s, grid %dx%dx%d, %zu voxels tracked, HD_RR_THRESHOLD %g, %d x %d passes\n", path,
            st.illumination_dims[0], st.illumination_dims[1], st.illumination_dims[2], tracked, (double)HD_RR_THRESHOLD,
            reps, passes);
@@ -94,7 +94,7 @@ int main(int argc, char **argv)
             if (hd_read_illumination(h[k][s], HD_ILLUMINATION_DIRECT, e[s], n) != HD_SUCCESS) return 1;
         for (j = 0; j < n; ++j) {
             double a = e[0][j], b = e[1][j];
-            if (!(ctx->dl_bits[j >> 3] >> (j & 7) & 1u)) continue;
+            if (!(ctx->dl.bits[j >> 3] >> (j & 7) & 1u)) continue;
             dd += (a - b) * (a - b);
             ee += 0.25 * (a + b) * (a + b);
             sum += 0.5 * (a + b);

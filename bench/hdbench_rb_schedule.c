@@ -80,7 +80,7 @@ typedef void (*ab_run)(hd__backend *be, int variant, int sweeps);
    caller's) until the end. */
 static void interleave(hd__ctx *ctx, ab_run run, int reps, int sweeps, double best[2], int *same)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = ctx->vw.be;
     size_t n = be->illum_slots; /* phi in the colour layout, padding slots included */
     float *start = (float *)malloc(n * sizeof(float));
     unsigned long long hash[2] = {0, 0};
@@ -106,9 +106,9 @@ static void interleave(hd__ctx *ctx, ab_run run, int reps, int sweeps, double be
 /* Points the backend at the context's own grid (what hd__be_diffuse does for a sweep). */
 static void use_fine_grid(hd__ctx *ctx, hd__cpu_grid *g)
 {
-    g->k = &ctx->be->k;
+    g->k = &ctx->vw.be->k;
     g->res = NULL;
-    ctx->be->grid = g;
+    ctx->vw.be->grid = g;
     hd__fill_kparams(ctx);
 }
 
@@ -134,7 +134,7 @@ static void run_walks(hd__backend *be, int variant, int sweeps)
    per voxel update, on the context's grid from its current phi. */
 static void measure(hd__ctx *ctx, double best[2], double *l2_update, int *same)
 {
-    hd__backend *be = ctx->be;
+    hd__backend *be = ctx->vw.be;
     hd__cpu_grid g;
     int r, i, rep, y, z;
     use_fine_grid(ctx, &g);
@@ -160,10 +160,10 @@ static void measure_walks(hd__ctx *ctx, int N, int walk, double best[2], int *sa
 {
     hd__cpu_grid g;
     use_fine_grid(ctx, &g);
-    ctx->be->rb_walk_sweeps = walk;
+    ctx->vw.be->rb_walk_sweeps = walk;
     interleave(ctx, run_walks, 8 / N, N, best, same);
-    ctx->be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
-    ctx->be->grid = NULL;
+    ctx->vw.be->rb_walk_sweeps = HD__CPU_RB_WALK_SWEEPS;
+    ctx->vw.be->grid = NULL;
 }
 
 int main(int argc, char **argv)

@@ -71,7 +71,7 @@ typedef struct ab_sweep {
 static hd_result ab_step(void *user)
 {
     ab_sweep *a = (ab_sweep *)user;
-    hd__backend *be = hd__lookup(a->h, NULL)->be;
+    hd__backend *be = (&hd__lookup(a->h)->vw)->be;
     VkPipeline own = be->diffuse[0];
     int32_t own_zk = be->diffuse_zk, own_yk = be->diffuse_yk;
     hd_result r;
@@ -88,7 +88,7 @@ static hd_result ab_step(void *user)
 /* After one sweep made the library's pipeline: the alternative with the same specialization. */
 static hd_result ab_init(ab_sweep *a, hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    const hd__view *ctx = (&hd__lookup(h)->vw);
     hd_result r;
     a->h = h;
     a->alt = VK_NULL_HANDLE;
@@ -108,7 +108,7 @@ static hd_result ab_init(ab_sweep *a, hd_context h)
 
 static void ab_free(ab_sweep *a)
 {
-    hd__backend *be = hd__lookup(a->h, NULL)->be;
+    hd__backend *be = (&hd__lookup(a->h)->vw)->be;
     be->fn.vkDeviceWaitIdle(be->device);
     if (a->alt) be->fn.vkDestroyPipeline(be->device, a->alt, NULL);
 }
@@ -130,7 +130,7 @@ static hd_result iterate_step(void *h) { return hd_iterate(*(hd_context *)h, 1);
 
 /* ---- the plain stencil on the Vulkan device ------------------------------------------------- */
 typedef struct stencil {
-    hd__ctx *ctx;
+    const hd__view *ctx;
     int ssbo, cur, g[3]; /* ssbo: 0 r32f images, 1 float buffers, 2 the buffers as vec4 (x-packed) */
     VkDescriptorSetLayout set_layout;
     VkPipelineLayout layout;
@@ -157,7 +157,7 @@ static void stencil_free(stencil *s)
 /* Three grids of g: a and b zeroed, rhs = (i % 97) * 0.01 as in c_stencil. */
 static hd_result stencil_resources(stencil *s)
 {
-    hd__ctx *ctx = s->ctx;
+    const hd__view *ctx = s->ctx;
     size_t n = (size_t)s->g[0] * s->g[1] * s->g[2], i;
     VkDeviceSize bytes = n * sizeof(float);
     float *rhs = (float *)malloc(n * sizeof(float));
@@ -234,7 +234,7 @@ static hd_result stencil_sets(stencil *s)
     return HD_SUCCESS;
 }
 
-static hd_result stencil_init(stencil *s, hd__ctx *ctx, const int *g, int ssbo)
+static hd_result stencil_init(stencil *s, const hd__view *ctx, const int *g, int ssbo)
 {
     VkDescriptorType types[3];
     hd_result r;
@@ -277,7 +277,7 @@ static hd_result stencil_step(void *user)
 #define VAR_BINDINGS 14
 #define VAR_IMAGES 11
 typedef struct variants {
-    hd__ctx *ctx;
+    const hd__view *ctx;
     int g[3], cur;
     float prm[4], med[4]; /* push constants of RB / PACKED: the library's parameters (variants_params) */
     /* st, E, phi (r32f), packed (st, phi) (rg32f); st, E, phi, out x-packed by 4 (rgba32f); st, E,
@@ -391,7 +391,7 @@ static hd_result variants_pipelines(variants *v)
     return HD_SUCCESS;
 }
 
-static hd_result variants_init(variants *v, hd__ctx *ctx, const int *g, const float *lib_st, const float *lib_e)
+static hd_result variants_init(variants *v, const hd__view *ctx, const int *g, const float *lib_st, const float *lib_e)
 {
     hd__backend *be = ctx->be;
     VkDescriptorType types[VAR_BINDINGS];
@@ -519,9 +519,9 @@ static void sweep_figures(const hd_desc *base, const int *g, int rounds)
     if (hd_create(&d, &h[0]) != HD_SUCCESS) { printf("Vulkan unavailable\n"); return; }
     d.params.solver = HD_SOLVER_JACOBI;
     if (hd_create(&d, &h[1]) != HD_SUCCESS) { hd_destroy(h[0]); printf("Vulkan unavailable\n"); return; }
-    printf("device: %s\n", hd__lookup(h[0], NULL)->be->device_name);
+    printf("device: %s\n", (&hd__lookup(h[0])->vw)->be->device_name);
     for (k = 0; k < 2; ++k)
-        if (stencil_init(&st[k], hd__lookup(h[0], NULL), g, k) != HD_SUCCESS) ok = 0;
+        if (stencil_init(&st[k], (&hd__lookup(h[0])->vw), g, k) != HD_SUCCESS) ok = 0;
     memset(ab, 0, sizeof ab);
     for (k = 0; ab_code && k < 2; ++k)
         if (ab_init(&ab[k], h[k]) != HD_SUCCESS) ok = 0;
@@ -570,7 +570,7 @@ static int variant_wanted(int k)
 /* The library's parameters for RB / PACKED (hd_k_diffuse.h reads them from the parameter block):
    1 / h^2 per axis (the shader multiplies by 0.6666667 as hd_k_diffuse.h does), the sigma' floor,
    albedo and anisotropy. */
-static void variants_params(variants *v, const hd__ctx *ctx)
+static void variants_params(variants *v, const hd__view *ctx)
 {
     v->prm[0] = ctx->kp.grid.x;
     v->prm[1] = ctx->kp.grid.y;
@@ -610,7 +610,7 @@ static int variants_check(variants *v, const float *lib_phi, size_t n, int nswee
         if (hd__vk_upload_image(v->ctx, variant_phi(v, k), zero) != HD_SUCCESS) { ++bad; continue; }
         for (s = 0; s < nsweeps; ++s)
             if (variant_step(v) != HD_SUCCESS) break;
-        if (s < nsweeps || hd__vk_download_image(v->ctx, variant_phi(v, k), out) != HD_SUCCESS) { ++bad; continue; }
+        if (s < nsweeps || hd__vk_download_image(v->ctx, variant_phi(v, k), out, NULL, 0) != HD_SUCCESS) { ++bad; continue; }
         for (i = 0; i < n; ++i) {
             double d = fabs((double)out[i] - lib_phi[i]);
             if (out[i] != lib_phi[i]) ++ndiff;
@@ -638,24 +638,24 @@ static int variants_check(variants *v, const float *lib_phi, size_t n, int nswee
    from 0: the variants' data and the check's reference. */
 static hd_result library_state(hd_context h, float *st, float *e, float *phi, size_t n, int nsweeps)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    const hd__view *ctx = (&hd__lookup(h)->vw);
     hd__vk_image *sig = &ctx->be->sig;
     float *all = NULL;
     hd_result r = hd__test_direct(h, 1); /* allocates the images first */
     if (r == HD_SUCCESS && !(all = (float *)malloc((size_t)sig->extent[0] * sig->extent[1] * sig->extent[2] * sizeof(float))))
         r = HD_ERROR_OUT_OF_MEMORY;
-    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, sig, all);
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, sig, all, NULL, 0);
     if (r == HD_SUCCESS) memcpy(st, all, n * sizeof(float));
-    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->E, e);
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->E, e, NULL, 0);
     if (r == HD_SUCCESS) r = hd__test_diffuse(h, nsweeps);
-    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->phi, phi);
+    if (r == HD_SUCCESS) r = hd__vk_download_image(ctx, &ctx->be->phi, phi, NULL, 0);
     free(all);
     return r;
 }
 
 /* The device's subgroup properties (17 SGB and 18 SHUF need the basic and shuffle operations and
    SGB a subgroup of at least its block's rows; a smaller one shows as WRONG in the check). */
-static void subgroup_properties(hd__ctx *ctx)
+static void subgroup_properties(const hd__view *ctx)
 {
     hd__backend *be = ctx->be;
     PFN_vkGetPhysicalDeviceProperties2 gp2 = (PFN_vkGetPhysicalDeviceProperties2)be->gipa(be->instance, "vkGetPhysicalDeviceProperties2");
@@ -714,18 +714,18 @@ static void variant_figures(const hd_desc *base, const int *g, int rounds)
     d.params.anisotropy = 0.3f; /* 1 - albedo g != 1: the check covers sigma' */
     if (hd_create(&d, &h) != HD_SUCCESS) { printf("Vulkan unavailable\n"); return; }
     ok = lst && le && lphi && per;
-    subgroup_properties(hd__lookup(h, NULL));
+    subgroup_properties((&hd__lookup(h)->vw));
     if (ok) {
-        hd__ctx *ctx = hd__lookup(h, NULL);
+        const hd__view *ctx = (&hd__lookup(h)->vw);
         ok = library_state(h, lst, le, lphi, n, nsweeps) == HD_SUCCESS;
         ok = ok && ctx->gdims[0] == g[0] && ctx->gdims[1] == g[1] && ctx->gdims[2] == g[2] && ctx->sig_channels >= 1;
     }
-    ok = ok && stencil_init(&st, hd__lookup(h, NULL), g, 0) == HD_SUCCESS;
-    ok = ok && stencil_init(&sb[0], hd__lookup(h, NULL), g, 1) == HD_SUCCESS;
-    ok = ok && stencil_init(&sb[1], hd__lookup(h, NULL), g, 2) == HD_SUCCESS;
-    ok = ok && variants_init(&v, hd__lookup(h, NULL), g, lst, le) == HD_SUCCESS;
+    ok = ok && stencil_init(&st, (&hd__lookup(h)->vw), g, 0) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[0], (&hd__lookup(h)->vw), g, 1) == HD_SUCCESS;
+    ok = ok && stencil_init(&sb[1], (&hd__lookup(h)->vw), g, 2) == HD_SUCCESS;
+    ok = ok && variants_init(&v, (&hd__lookup(h)->vw), g, lst, le) == HD_SUCCESS;
     if (ok) {
-        variants_params(&v, hd__lookup(h, NULL));
+        variants_params(&v, (&hd__lookup(h)->vw));
         if (variants_check(&v, lphi, n, nsweeps) != 0) printf("check: some variants compute other values (above)\n");
     }
     for (k = 0; ok && k < rounds; ++k)

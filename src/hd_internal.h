@@ -1,5 +1,6 @@
-/* hd_internal.h - the context's private state, logging and allocation, shared by the core
-   (hd_context.h) and the backends. Private names are hd__ / HD__. */
+/* hd_internal.h - the low layer the core (src/) and the backends (backends/) share: limits, the
+   dirty bits, the view of a context a backend is handed (hd__view), logging and allocation.
+   Private names are hd__ / HD__. */
 #ifndef HD_INTERNAL_H
 #define HD_INTERNAL_H
 #include <stdarg.h>
@@ -41,92 +42,37 @@ enum {
 
 typedef struct hd__backend hd__backend; /* defined by the selected backend */
 
-/* HD_SOLVER_MULTIGRID's run state, the same on every backend (src/hd_multigrid.h). */
-typedef struct hd__mg_cg {
-    unsigned sig_gen;        /* ctx->sig_gen the coarse sigma_t were restricted from */
-    int sig_surface;         /* ... and the boundary they were restricted for */
-    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
-    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
-    int have_dir;            /* the backend's p holds a direction of the current CG run */
-    double rz;               /* <r, z> of the previous step (beta's denominator) */
-    unsigned light_gen;      /* the context's light_gen of the current CG run */
-    double vcycle_seconds;   /* wall time in V-cycles (bench/hdbench_multigrid.c: a step against a V-cycle) */
-} hd__mg_cg;
-
-typedef struct hd__ctx {
-    hd_desc desc;            /* with defaults filled in; pointers refer to the copies below */
-    hd_allocator alloc;
+/* What a backend sees of a context: the one struct the core hands every primitive of
+   src/hd_backend.h, read-only (const) except in hd__be_create and hd__be_destroy, which own be.
+   The core keeps these fields here and only here, and brings them up to date before each
+   primitive; everything else of the context (src/hd_core.h) is the core's alone. */
+typedef struct hd__view {
+    hd__backend *be;         /* the backend's own state, made by hd__be_create */
     hd_logger log;
-    /* volume */
+    hd_allocator alloc;
+    hd_desc desc;            /* the desc with defaults filled in: the backend's own sections
+                                (desc.opencl, .vulkan, .gl, .threads) */
+    hd_params params;        /* the current parameters (defaults filled in) */
+    hd_camera camera;        /* the current camera: the image is camera.width x height */
+    /* the volume: normalised voxel values in [0, 1], x fastest */
     int dims[3];
     size_t nvox;
-    float box[3];            /* world size of the volume box */
-    float *vol;              /* normalised voxel values in [0, 1] */
-    float *cell_range;       /* per majorant cell: min and max value incl. the filter halo */
-    int mdims[3];
-    float *majorant;         /* per cell: max sigma_t */
-    float max_sigma;         /* max over the whole grid */
-    /* inputs */
-    float *tf;               /* RGBA * tf_count */
+    float *vol;
+    int mdims[3];            /* the majorant grid (HD__MAJORANT_CELL voxels per cell edge) */
+    float *majorant;         /* per cell: max sigma_t (0 outside the crop box) */
+    float *tf;               /* the transfer function: RGBA * tf_count */
     int tf_count;
     unsigned tf_serial;      /* bumped by every TF change (the projection's table key, hd_backend.h) */
-    hd_light lights[HD_MAX_LIGHTS];
-    int light_count;
-    hd_camera camera;
-    hd_params params;
-    /* method state */
-    int gdims[3];            /* illumination grid */
+    /* the illumination grid */
+    int gdims[3];
     int channels;            /* 1 or 3 */
-    int lights_one_colour;   /* every light has the same colour */
     int sig_channels;        /* sigma_t grid channels: 1, or 4 with the TF colour (RGB scattering) */
-    float chan_color[3];
-    unsigned dirty;
-    uint64_t iterations;
-    uint64_t frames;
-    hd__kparams kp;
-    double seconds[3];       /* direct (or convection / paths), diffusion, projection */
-    /* light convergence (hd__light_measure): E and phi of the medium's voxels after the
-       previous light iteration, to estimate the error from their change */
-    uint32_t *conv_idx;      /* in-slice indices (y * gx + x) of the voxels measured, slice by slice */
-    size_t conv_count;
-    int *conv_zz;            /* the stacked slices read back: conv_nz per channel, channel-major */
-    size_t *conv_off;        /* conv_nz + 1 starts in conv_idx, one per measured slice */
-    int conv_nz;             /* measured slices per channel */
-    float *conv_prev;        /* conv_count * channels values of E, then the same of phi */
-    float *conv_tmp;         /* the measured slices of one illumination volume read back, all channels */
-    int conv_have_prev;      /* conv_prev holds the previous iteration */
-    int conv_below;          /* light iterations in a row with light_error below the tolerance */
-    double conv_dphi;        /* |phi_n - phi_n-1| of the previous iteration */
-    double conv_q;           /* the solver's observed contraction of that change */
-    double light_error;
-    uint64_t converged_frames; /* projection frames since the light converged */
-    int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
-                                was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
-    /* HD_RENDER_SCALE_AUTO's frame cost model (hd__frame_cost_add / _predict in hd_context.h):
-       per render scale 1, 2, 4, 8 (slot log2 s) the pixels its last frame marched (0: none yet),
-       its smoothed seconds and the measurement count when it was last measured; the newest
-       measurement's slot; measurements so far (0: none) */
-    double cost_pixels[4], cost_seconds[4];
-    unsigned cost_at[4];
-    int cost_last;
-    unsigned cost_gen;
-    int image_room;          /* the image buffer holds the reduced frames' region (made when a
-                                scale > 1 is first used, hd__image_room) */
-    int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
-    unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
-    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
-    hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
-    /* HD's direct light is tracked only at the illumination-grid voxels whose E is read (the
-       projection's and the diffusion's footprint of the medium, hd__direct_mask); rebuilt with
-       sigma_t, E elsewhere stays 0 */
-    uint32_t *dl_idx;        /* their grid indices in bricks (hd__direct_mask; every voxel, ascending, with dl_all) */
+    hd__kparams kp;          /* the kernels' parameter block for the next primitive */
+    /* HD's direct light: the grid voxels it tracks (src/hd_direct_mask.h) */
+    uint32_t *dl_idx;        /* their grid indices in bricks */
     size_t dl_count;
-    uint8_t *dl_bits;        /* the same voxels, one bit each (read by the convergence estimate) */
-    int dl_all;              /* track every voxel (a test hook: the reference for the mask) */
     unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
-    uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
-    hd__backend *be;
-} hd__ctx;
+} hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */
 static void hd__logf(const hd_logger *log, hd_log_level level, hd_result code, const char *file,
@@ -148,21 +94,21 @@ static void hd__logf(const hd_logger *log, hd_log_level level, hd_result code, c
 static void *hd__malloc_default(size_t size, void *user) { (void)user; return malloc(size); }
 static void hd__free_default(void *ptr, void *user) { (void)user; free(ptr); }
 
-static void *hd__alloc(hd__ctx *ctx, size_t size)
+static void *hd__alloc(const hd__view *vw, size_t size)
 {
-    return ctx->alloc.alloc(size ? size : 1, ctx->alloc.user_data);
+    return vw->alloc.alloc(size ? size : 1, vw->alloc.user_data);
 }
-static void *hd__calloc(hd__ctx *ctx, size_t count, size_t size)
+static void *hd__calloc(const hd__view *vw, size_t count, size_t size)
 {
     void *p;
     if (size && count > (size_t)-1 / size) return NULL;
-    p = hd__alloc(ctx, count * size);
+    p = hd__alloc(vw, count * size);
     if (p) memset(p, 0, count * size);
     return p;
 }
-static void hd__free(hd__ctx *ctx, void *ptr)
+static void hd__free(const hd__view *vw, void *ptr)
 {
-    if (ptr) ctx->alloc.free(ptr, ctx->alloc.user_data);
+    if (ptr) vw->alloc.free(ptr, vw->alloc.user_data);
 }
 
 /* Wall clock for the per-stage timers. */

@@ -1,61 +1,11 @@
 /* hd_multigrid_cg.h - HD_SOLVER_MULTIGRID's rules that the core's step (src/hd_multigrid.h) and
-   the backends' primitives share: when conjugate gradients restart, when the coarse levels'
-   sigma_t must be restricted again, beta, the row-order sum of the dot products' row sums, the
+   the backends' primitives share: the row-order sum of the dot products' row sums, the
    levels' count, grids and parameter blocks, the solver's bytes (OpenCL pads its rows: its own
    count) and whether a backend's buffers still fit the grid. Below the backends: it calls none
    of them. docs/DESIGN-MULTIGRID.md has the design. */
 #ifndef HD_MULTIGRID_CG_H
 #define HD_MULTIGRID_CG_H
 
-
-/* A new state for a backend whose sigma_t generation is sig_gen: the first step restricts. */
-HD__MAYBE_UNUSED static void hd__mg_cg_init(hd__mg_cg *cg, unsigned sig_gen)
-{
-    memset(cg, 0, sizeof *cg);
-    cg->sig_gen = sig_gen - 1u;
-}
-
-/* The start of a step, for a backend at sigma_t generation sig_gen. *restart: CG restarts (a new
-   HD iteration brought a new E, or A changed); *stale: besides, the iterate's low part belongs to
-   another phi (A changed, or E and phi were reset: ctx->light_gen moved on; it is at most half an
-   ulp of phi, so a stale one would only perturb the start) and the backend zeroes it. Returns
-   whether the coarse sigma_t must be restricted again (sigma_t or the boundary changed): the
-   backend does so, then calls hd__mg_cg_restricted. */
-HD__MAYBE_UNUSED static int hd__mg_cg_begin(hd__mg_cg *cg, const hd__ctx *ctx, unsigned sig_gen, int *restart, int *stale)
-{
-    hd__kparams key;
-    int resig = cg->sig_gen != sig_gen || cg->sig_surface != (ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY);
-    memset(&key, 0, sizeof key);
-    key.gdims = ctx->kp.gdims;
-    key.counts.z = ctx->kp.counts.z;
-    key.medium = ctx->kp.medium;
-    key.grid = ctx->kp.grid;
-    key.gridh = ctx->kp.gridh;
-    *stale = resig || memcmp(&key, &cg->akey, sizeof key) != 0 || ctx->iterations < cg->iteration ||
-             cg->light_gen != ctx->light_gen;
-    *restart = *stale || !cg->have_dir || cg->iteration != ctx->iterations;
-    cg->akey = key;
-    cg->iteration = ctx->iterations;
-    cg->light_gen = ctx->light_gen;
-    return resig;
-}
-
-/* The coarse sigma_t now match generation sig_gen and the context's boundary. */
-HD__MAYBE_UNUSED static void hd__mg_cg_restricted(hd__mg_cg *cg, const hd__ctx *ctx, unsigned sig_gen)
-{
-    cg->sig_gen = sig_gen;
-    cg->sig_surface = ctx->kp.counts.z & HD_FLAG_SURFACE_BOUNDARY;
-}
-
-/* beta = <r, z> / the previous <r, z>, 0 at a restart (or without a positive previous one, or
-   where the ratio is not a finite float: the run restarts rather than carry an overflow). */
-HD__MAYBE_UNUSED static float hd__mg_cg_beta(hd__mg_cg *cg, double rz, int restart)
-{
-    double q = restart || !(cg->rz > 0.0) ? 0.0 : rz / cg->rz;
-    float beta = q >= 0.0 && q <= 3.4e38 ? (float)q : 0.0f;
-    cg->rz = rz;
-    return beta;
-}
 
 /* The sum of the first `rows` row sums in row order: the same bits for any thread count and on
    any backend. */
@@ -121,10 +71,10 @@ HD__MAYBE_UNUSED static size_t hd__mg_bytes(const int *fine, int levels, int cha
 }
 
 /* Whether a backend's solver buffers, made for fine grid `fine` with channels and sig_channels
-   channels, no longer fit ctx's grid (hd__be_mg_begin then remakes them). */
-HD__MAYBE_UNUSED static int hd__mg_stale(const hd__ctx *ctx, const int *fine, int channels, int sig_channels)
+   channels, no longer fit the view's grid (hd__be_mg_begin then remakes them). */
+HD__MAYBE_UNUSED static int hd__mg_stale(const hd__view *vw, const int *fine, int channels, int sig_channels)
 {
-    return channels != ctx->channels || sig_channels != ctx->sig_channels || memcmp(fine, ctx->gdims, 3 * sizeof(int)) != 0;
+    return channels != vw->channels || sig_channels != vw->sig_channels || memcmp(fine, vw->gdims, 3 * sizeof(int)) != 0;
 }
 
 #endif

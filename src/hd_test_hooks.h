@@ -19,7 +19,7 @@ static hd_result hd__test_direct_once(hd__ctx *ctx)
 {
     ctx->iterations++;
     hd__fill_kparams(ctx);
-    return hd__be_direct(ctx);
+    return hd__be_direct(&ctx->vw);
 }
 HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
 {
@@ -35,7 +35,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
 HD__MAYBE_UNUSED static hd_result hd__test_direct_all(hd_context h, int on)
 {
     HD__GET_CTX(ctx, h);
-    ctx->dl_all = on != 0;
+    ctx->dl.all = on != 0;
     ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
@@ -43,8 +43,8 @@ HD__MAYBE_UNUSED static hd_result hd__test_direct_all(hd_context h, int on)
 /* The number of illumination-grid voxels the direct light tracks (after hd__test_prepare). */
 HD__MAYBE_UNUSED static size_t hd__test_direct_count(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
-    return ctx ? ctx->dl_count : 0;
+    hd__ctx *ctx = hd__lookup(h);
+    return ctx ? ctx->vw.dl_count : 0;
 }
 
 /* n diffusion sweeps of the selected solver (multigrid: CG steps) on the current E and phi. */
@@ -67,7 +67,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_residual(hd_context h, double *out)
 {
     HD__GET_CTX(ctx, h);
     hd__fill_kparams(ctx);
-    *out = hd__cpu_residual(ctx);
+    *out = hd__cpu_residual(&ctx->vw);
     return HD_SUCCESS;
 }
 #endif
@@ -77,7 +77,7 @@ static hd_result hd__test_project_once(hd__ctx *ctx)
 {
     ctx->frames++;
     hd__fill_kparams(ctx);
-    return hd__be_project(ctx);
+    return hd__be_project(&ctx->vw);
 }
 HD__MAYBE_UNUSED static hd_result hd__test_project(hd_context h, int n)
 {
@@ -94,16 +94,16 @@ HD__MAYBE_UNUSED static hd_result hd__test_write_illumination(hd_context h, hd_i
     hd_result r;
     HD__GET_CTX(ctx, h);
 #if defined(HYBRIDDIFF_BACKEND_CPU)
-    HD__BE_CALL(r, ctx, hd__cpu_write_illumination(ctx, which, src));
+    HD__BE_CALL(r, ctx, hd__cpu_write_illumination(&ctx->vw, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_OPENCL)
-    HD__BE_CALL(r, ctx, hd__cl_write_illumination(ctx, which, src));
+    HD__BE_CALL(r, ctx, hd__cl_write_illumination(&ctx->vw, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_VULKAN)
-    HD__BE_CALL(r, ctx, hd__vk_write_illumination(ctx, which, src));
+    HD__BE_CALL(r, ctx, hd__vk_write_illumination(&ctx->vw, which, src));
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-    HD__BE_CALL(r, ctx, hd__gl_write_illumination(ctx, which, src));
+    HD__BE_CALL(r, ctx, hd__gl_write_illumination(&ctx->vw, which, src));
 #else
     (void)which; (void)src;
-    r = HD__ERR(&ctx->log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
+    r = HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd__test_write_illumination: no hook for the %s backend", hd__be_name());
 #endif
     return r;
 }
@@ -113,9 +113,9 @@ HD__MAYBE_UNUSED static hd_result hd__test_finish(hd_context h)
 {
     HD__GET_CTX(ctx, h);
 #if defined(HYBRIDDIFF_BACKEND_OPENCL)
-    HD__CL_TRY(ctx, clFinish(ctx->be->queue), "clFinish");
+    HD__CL_TRY(&ctx->vw, clFinish(ctx->vw.be->queue), "clFinish");
 #elif defined(HYBRIDDIFF_BACKEND_GL)
-    return hd__gl_finish(ctx);
+    return hd__gl_finish(&ctx->vw);
 #endif
     (void)ctx;
     return HD_SUCCESS;
@@ -133,6 +133,6 @@ HD__MAYBE_UNUSED static hd_result hd__test_frame_cost(hd_context h, int s, doubl
 /* The scale HD_RENDER_SCALE_AUTO would give a new image's first frame now. */
 HD__MAYBE_UNUSED static int hd__test_first_scale(hd_context h)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
+    hd__ctx *ctx = hd__lookup(h);
     return ctx ? hd__first_scale(ctx) : 0;
 }

@@ -174,46 +174,7 @@ static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
     return HD_SUCCESS;
 }
 
-/* The crop box: a zero high corner is the volume's high face, per axis. */
-static void hd__crop_defaults(hd_params *p)
-{
-    int i;
-    for (i = 0; i < 3; ++i)
-        if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
-}
-
-static hd_result hd__check_crop(const hd_params *p, const hd_logger *log)
-{
-    int i;
-    for (i = 0; i < 3; ++i)
-        if (!hd__finite(p->crop_min[i]) || !hd__finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
-            !(p->crop_max[i] <= 1.0f) || !(p->crop_min[i] < p->crop_max[i]))
-            return HD__ERR(log, HD_ERROR_INVALID_PARAMETER,
-                           "params.crop_min[%d] = %g, crop_max[%d] = %g: need 0 <= min < max <= 1", i,
-                           (double)p->crop_min[i], i, (double)p->crop_max[i]);
-    return HD_SUCCESS;
-}
-
-static void hd__params_defaults(hd_params *p)
-{
-    if (p->method == HD_METHOD_DEFAULT) p->method = HD_METHOD_HD;
-    if (p->extinction == 0.0f) p->extinction = 100.0f;
-    if (p->albedo == 0.0f) p->albedo = 0.9f;
-    if (p->solver == HD_SOLVER_DEFAULT) p->solver = HD_SOLVER_RED_BLACK;
-    if (p->diffusion_sweeps == 0) p->diffusion_sweeps = p->solver == HD_SOLVER_MULTIGRID ? 1 : 4;
-    if (p->tracking == HD_TRACKING_DEFAULT) p->tracking = HD_TRACKING_RATIO;
-    if (p->step == 0.0f) p->step = 0.5f;
-    if (p->frame_window == 0) p->frame_window = 8;
-    if (p->exposure == 0.0f) p->exposure = 1.0f;
-    if (p->max_bounces == 0) p->max_bounces = 64;
-    if (p->illumination_downsample == 0) p->illumination_downsample = 2;
-    if (p->diffusion_boundary == HD_BOUNDARY_DEFAULT) p->diffusion_boundary = HD_BOUNDARY_SURFACE;
-    if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
-    if (p->render_scale == 0) p->render_scale = 1;
-    hd__crop_defaults(p);
-}
-
-/* The defaults above were chosen by measurement against PT_MS (docs/EVALUATION.md, "Defaults");
+/* The defaults (src/hd_params.h) were chosen by measurement against PT_MS (docs/EVALUATION.md, "Defaults");
    the paper's preset keeps its settings reachable. */
 HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_logger *log)
 {
@@ -232,58 +193,4 @@ HDDEF hd_result hd_params_preset(hd_preset preset, hd_params *params, const hd_l
         params->diffusion_sweeps = 0;
     }
     return HD_SUCCESS;
-}
-
-/* Checks parameters whose defaults are filled in. */
-static hd_result hd__check_params(const hd_params *p, const hd_logger *log)
-{
-    if ((int)p->method < 0 || p->method >= HD_METHOD_COUNT)
-        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.method %d is not a hd_method", (int)p->method);
-    if ((int)p->solver < 0 || p->solver >= HD_SOLVER_COUNT)
-        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.solver %d is not a hd_solver", (int)p->solver);
-    if ((int)p->tracking < 0 || p->tracking >= HD_TRACKING_COUNT)
-        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.tracking %d is not a hd_tracking", (int)p->tracking);
-    if (!hd__finite(p->extinction) || p->extinction < 0.0f || p->extinction > 1e6f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.extinction = %g is outside (0, 1e6]", (double)p->extinction);
-    if (!hd__finite(p->albedo) || p->albedo < 0.0f || p->albedo > 1.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.albedo = %g is outside (0, 1]", (double)p->albedo);
-    if (!hd__finite(p->anisotropy) || !(p->anisotropy > -1.0f && p->anisotropy < 1.0f))
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.anisotropy = %g is outside (-1, 1)", (double)p->anisotropy);
-    /* above the largest extinction a majorant only adds null collisions (1e6 per world unit) */
-    if (!hd__finite(p->majorant) || p->majorant < 0.0f || p->majorant > 1e6f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.majorant = %g is outside [0, 1e6]", (double)p->majorant);
-    if (p->diffusion_sweeps < 0 || p->diffusion_sweeps > 100000)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_sweeps = %d is outside 1..100000", p->diffusion_sweeps);
-    if (!hd__finite3(p->background) || p->background[0] < 0.0f || p->background[1] < 0.0f || p->background[2] < 0.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.background must be finite and >= 0");
-    if (!hd__finite(p->step) || !(p->step >= 0.01f && p->step <= 16.0f))
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.step = %g voxels is outside [0.01, 16]", (double)p->step);
-    if (p->frame_window < 0)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.frame_window = %d is negative", p->frame_window);
-    if (!hd__finite(p->exposure) || p->exposure < 0.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.exposure = %g must be >= 0 and finite", (double)p->exposure);
-    if (p->max_bounces < 0 || p->max_bounces > 100000)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.max_bounces = %d is outside 1..100000", p->max_bounces);
-    if (p->illumination_downsample < 1 || p->illumination_downsample > 8)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.illumination_downsample = %d is outside 1..8", p->illumination_downsample);
-    if (p->rgb_scattering != 0 && p->rgb_scattering != 1)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.rgb_scattering = %d must be 0 or 1", p->rgb_scattering);
-    if ((int)p->diffusion_boundary < 0 || (int)p->diffusion_boundary >= (int)HD_BOUNDARY_COUNT)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.diffusion_boundary = %d is not an hd_boundary", (int)p->diffusion_boundary);
-    if ((int)p->illumination_precision < 0 || (int)p->illumination_precision >= (int)HD_PRECISION_COUNT)
-        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "params.illumination_precision = %d is not an hd_precision",
-                       (int)p->illumination_precision);
-    if (!hd__finite(p->light_tolerance) || p->light_tolerance < 0.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.light_tolerance = %g must be >= 0 and finite", (double)p->light_tolerance);
-    if (!hd__finite(p->render_budget) || p->render_budget < 0.0f)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_budget = %g s must be >= 0 and finite", (double)p->render_budget);
-    if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > HD__MAX_RENDER_SCALE))
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.render_scale = %d must be 1..%d or HD_RENDER_SCALE_AUTO (-1)",
-                       p->render_scale, HD__MAX_RENDER_SCALE);
-    if (p->disable_diffusion != 0 && p->disable_diffusion != 1)
-        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "params.disable_diffusion = %d must be 0 or 1", p->disable_diffusion);
-    /* the multigrid levels (src/hd_multigrid.h) restrict and prolong float32 fine grids */
-    if (p->illumination_precision == HD_PRECISION_FLOAT16 && p->solver == HD_SOLVER_MULTIGRID)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "illumination_precision FLOAT16 with solver MULTIGRID is not available (float32 levels only)");
-    return hd__check_crop(p, log);
 }

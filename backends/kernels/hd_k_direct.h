@@ -32,7 +32,7 @@ HD_FN void hd_direct_voxel(HD_KARGS int x, int y, int z)
 }
 
 /* The same at illumination-grid index i (x fastest): the dispatch over the list of voxels whose
-   E is read (hd_context.h, hd__direct_mask). The random key stays the voxel's grid index, so a
+   E is read (src/hd_direct_mask.h, hd__direct_mask). The random key stays the voxel's grid index, so a
    tracked voxel's E is bit-identical to tracking every voxel. */
 HD_FN void hd_direct_index(HD_KARGS int i)
 {

@@ -1,6 +1,6 @@
 /* hd_k_params.h - the parameter block every kernel reads (shared source; no #include here).
    Only 16-byte vectors, so C, OpenCL and std140 GLSL agree on the layout. The host fills it in
-   src/hd_context.h (hd__fill_kparams). */
+   src/hd_kparams.h (hd__fill_kparams). */
 HD_PARAMS_BEGIN
 HD_PARAM_I4(dims)       /* volume dims x, y, z; w = TF entry count */
 HD_PARAM_I4(gdims)      /* illumination grid dims x, y, z; w = channels (1 or 3) */

@@ -164,7 +164,7 @@ HD_FN void hd_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(
    jitter), so the step advances however far the eye is; n stays below HD_MAX_MARCH_STEPS, and
    the march stops once T falls below march.z. Empty space is skipped through the majorant grid
    (cells of mdims.w voxels, each majorant bounding every trilinear sample inside the cell with a
-   one-voxel halo, hd_context.h), walked cell by cell (hd_cell_walk, the 3D DDA hd_track also
+   one-voxel halo, src/hd_volume.h), walked cell by cell (hd_cell_walk, the 3D DDA hd_track also
    walks): in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing. The walk
    visits each cell once and ends at the grid's far face or at len (the grid's last cell reaches
    to len). Two marches take the same samples, in the same order, to the same image; each

@@ -49,10 +49,10 @@ static hd_result vk_create(const hd_desc *desc, hd_context *out)
     r = hd_create(&d, out);
     if (r == HD_SUCCESS) {
         /* the context keeps user_data: point it at its own slot's copy */
-        hd__ctx *ctx = hd__lookup(*out, NULL);
+        hd__ctx *ctx = hd__lookup(*out);
         vk_loggers[out->id & 0xffu] = pending;
-        ctx->log.user_data = &vk_loggers[out->id & 0xffu];
-        ctx->desc.logger.user_data = ctx->log.user_data;
+        ctx->vw.log.user_data = &vk_loggers[out->id & 0xffu];
+        ctx->vw.desc.logger.user_data = ctx->vw.log.user_data;
     }
     return vk_checked(r, before);
 }

@@ -459,11 +459,11 @@ static void check_image_room(void)
     r = hd_create(&d, &c);
     CHECK(r == HD_SUCCESS, "image room: hd_create: %s", hd_result_string(r));
     if (r != HD_SUCCESS) return;
-    ctx = hd__lookup(c, NULL);
+    ctx = hd__lookup(c);
     CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_get_stats(c, &st) == HD_SUCCESS && st.image_bytes == full,
           "image room: %zu image bytes at scale 1, want %zu", st.image_bytes, full);
-    limit = ctx->be->max_ssbo_block;
-    ctx->be->max_ssbo_block = (GLint)full;
+    limit = ctx->vw.be->max_ssbo_block;
+    ctx->vw.be->max_ssbo_block = (GLint)full;
     p = d.params;
     p.render_scale = 2;
     CHECK(hd_set_params(c, &p) == HD_SUCCESS, "image room: render_scale 2");
@@ -473,7 +473,7 @@ static void check_image_room(void)
     CHECK(hd_get_stats(c, &st) == HD_SUCCESS && st.image_bytes == full, "image room: %zu bytes after the failure", st.image_bytes);
     p.render_scale = 1;
     CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_iterate(c, 1) == HD_SUCCESS && nc_errors == 1, "image room: scale 1 after it");
-    ctx->be->max_ssbo_block = limit;
+    ctx->vw.be->max_ssbo_block = limit;
     p.render_scale = 2;
     CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_iterate(c, 2) == HD_SUCCESS && hd_get_stats(c, &st) == HD_SUCCESS &&
               st.image_bytes == full + room && st.render_scale == 2 && nc_errors == 1,

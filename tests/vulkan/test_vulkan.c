@@ -125,14 +125,14 @@ static int test_messenger(void)
     r = hd_create(&d, &h);
     if (r != HD_SUCCESS) { printf("SKIPPED messenger: %s\n", hd_result_string(r)); return 0; }
     CHECK(messages == 0);
-    ctx = hd__lookup(h, NULL);
+    ctx = hd__lookup(h);
     memset(&bci, 0, sizeof bci);
     bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     bci.size = 16;
     bci.usage = 0; /* invalid: VUID-VkBufferCreateInfo-usage-requiredbitmask */
     before = messages;
-    if (ctx->be->fn.vkCreateBuffer(ctx->be->device, &bci, NULL, &buf) == VK_SUCCESS && buf)
-        ctx->be->fn.vkDestroyBuffer(ctx->be->device, buf, NULL);
+    if (ctx->vw.be->fn.vkCreateBuffer(ctx->vw.be->device, &bci, NULL, &buf) == VK_SUCCESS && buf)
+        ctx->vw.be->fn.vkDestroyBuffer(ctx->vw.be->device, buf, NULL);
     CHECK(messages > before);
     printf("%s messenger fires on a broken call (%lu message%s)\n", messages > before ? "PASS" : "FAIL",
            messages - before, messages - before == 1 ? "" : "s");
@@ -568,8 +568,8 @@ static void test_kept_instance(void)
    waits, as an application using hd_vulkan_record would. */
 static hd_result record_run(hd_context h, int n)
 {
-    hd__ctx *ctx = hd__lookup(h, NULL);
-    hd__backend *be = ctx->be;
+    hd__ctx *ctx = hd__lookup(h);
+    hd__backend *be = ctx->vw.be;
     VkCommandPoolCreateInfo cpci;
     VkCommandBufferAllocateInfo cbai;
     VkCommandBufferBeginInfo bi;
@@ -620,18 +620,18 @@ static void test_image_room(void)
     d.vulkan.enable_validation = 1;
     messages = 0;
     if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
-    ctx = hd__lookup(h, NULL);
+    ctx = hd__lookup(h);
     ok &= hd_iterate(h, 1) == HD_SUCCESS && hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
     p = d.params;
     p.render_scale = 2;
     ok &= hd_set_params(h, &p) == HD_SUCCESS;
-    ctx->be->mem_limit = ctx->be->mem_used + 4096; /* no room for a second image buffer */
+    ctx->vw.be->mem_limit = ctx->vw.be->mem_used + 4096; /* no room for a second image buffer */
     ok &= hd_iterate(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
     ok &= record_run(h, 1) == HD_ERROR_OUT_OF_DEVICE_MEMORY;
     ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full;
     p.render_scale = 1;
     ok &= hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && record_run(h, 1) == HD_SUCCESS;
-    ctx->be->mem_limit = 0;
+    ctx->vw.be->mem_limit = 0;
     p.render_scale = 2;
     ok &= hd_set_params(h, &p) == HD_SUCCESS && record_run(h, 2) == HD_SUCCESS;
     ok &= hd_get_stats(h, &s) == HD_SUCCESS && s.image_bytes == full + room && s.render_scale == 2 && s.frames == 2;

@@ -71,77 +71,77 @@ static size_t hd__gpu_mg_rows(const hd__gpu_grids *g) { return (size_t)g->fine[1
 /* ---- the primitives a GPU backend defines -------------------------------------------------- */
 /* Grid id as w x h x d values (channels stacked in d), zeroed (a device backend may record the
    zeroing for its next submission). A grid id already holds is freed first. */
-static hd_result hd__gpu_grid_new(hd__ctx *ctx, int id, int w, int h, int d, const char *what);
+static hd_result hd__gpu_grid_new(const hd__view *vw, int id, int w, int h, int d, const char *what);
 /* Frees grid id (first submitting what the backend recorded that may use it); nothing when it
    holds none. */
-static void hd__gpu_grid_free(hd__ctx *ctx, int id);
+static void hd__gpu_grid_free(const hd__view *vw, int id);
 /* Zeroes grid id; nothing when it holds none. */
-static hd_result hd__gpu_grid_zero(hd__ctx *ctx, int id);
+static hd_result hd__gpu_grid_zero(const hd__view *vw, int id);
 /* The backend's own multigrid objects for the levels its hd__gpu_grids describes: made (make =
    1; on failure hd__gpu_mg_free follows) or freed (make = 0, also when partly made). */
-static hd_result hd__gpu_mg_extras(hd__ctx *ctx, int make);
+static hd_result hd__gpu_mg_extras(const hd__view *vw, int make);
 /* Gives level l's parameter block kp to the device (level l's buffer or slot of the extras). */
-static hd_result hd__gpu_mg_send(hd__ctx *ctx, int l, const hd__kparams *kp);
+static hd_result hd__gpu_mg_send(const hd__view *vw, int l, const hd__kparams *kp);
 
 /* ---- the life cycle, for the backends' hd__be_alloc_* and hd__be_clear ---------------------- */
 /* Frees the multigrid's levels, vectors and extras. */
-static void hd__gpu_mg_free(hd__ctx *ctx, hd__gpu_grids *g)
+static void hd__gpu_mg_free(const hd__view *vw, hd__gpu_grids *g)
 {
     int l, k;
     if (!g->levels) return;
-    hd__gpu_mg_extras(ctx, 0);
+    hd__gpu_mg_extras(vw, 0);
     for (l = 0; l < g->levels; ++l)
-        for (k = 0; k < 4; ++k) hd__gpu_grid_free(ctx, HD__G_MG(l, k));
-    hd__gpu_grid_free(ctx, HD__G_MG_P);
-    hd__gpu_grid_free(ctx, HD__G_MG_LO);
+        for (k = 0; k < 4; ++k) hd__gpu_grid_free(vw, HD__G_MG(l, k));
+    hd__gpu_grid_free(vw, HD__G_MG_P);
+    hd__gpu_grid_free(vw, HD__G_MG_LO);
     g->levels = 0;
 }
 
-/* The multigrid's grids for ctx's grid and channels: kept when they fit (*fresh = 0), else made
+/* The multigrid's grids for vw's grid and channels: kept when they fit (*fresh = 0), else made
    anew, zeroed, with the backend's extras (*fresh = 1). */
-static hd_result hd__gpu_mg_ready(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
+static hd_result hd__gpu_mg_ready(const hd__view *vw, hd__gpu_grids *g, int *fresh)
 {
     int l, n;
     hd_result r;
-    if (g->levels && hd__mg_stale(ctx, g->fine, g->channels, g->sig_channels)) hd__gpu_mg_free(ctx, g);
+    if (g->levels && hd__mg_stale(vw, g->fine, g->channels, g->sig_channels)) hd__gpu_mg_free(vw, g);
     *fresh = !g->levels;
     if (g->levels) return HD_SUCCESS;
-    g->channels = ctx->channels;
-    g->sig_channels = ctx->sig_channels;
-    memcpy(g->fine, ctx->gdims, sizeof g->fine);
+    g->channels = vw->channels;
+    g->sig_channels = vw->sig_channels;
+    memcpy(g->fine, vw->gdims, sizeof g->fine);
     g->levels = 1; /* from here on hd__gpu_mg_free frees what was made */
-    r = hd__gpu_grid_new(ctx, HD__G_MG_P, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's p");
-    if (r == HD_SUCCESS) r = hd__gpu_grid_new(ctx, HD__G_MG_LO, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's lo");
+    r = hd__gpu_grid_new(vw, HD__G_MG_P, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's p");
+    if (r == HD_SUCCESS) r = hd__gpu_grid_new(vw, HD__G_MG_LO, g->fine[0], g->fine[1], g->fine[2] * g->channels, "multigrid's lo");
     for (l = 0, n = hd__mg_levels(g->fine); l < n && r == HD_SUCCESS; ++l) {
         const int *d = g->lv[l].dims;
         hd__mg_level_dims(g->fine, l, g->lv[l].dims);
         g->lv[l].kp_sent = 0;
         g->levels = l + 1;
-        if ((r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_RHS), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+        if ((r = hd__gpu_grid_new(vw, HD__G_MG(l, HD__G_MG_RHS), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
                 HD_SUCCESS &&
-            (r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_PHI), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+            (r = hd__gpu_grid_new(vw, HD__G_MG(l, HD__G_MG_PHI), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
                 HD_SUCCESS &&
-            (r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_RES), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
+            (r = hd__gpu_grid_new(vw, HD__G_MG(l, HD__G_MG_RES), d[0], d[1], d[2] * g->channels, "a multigrid level")) ==
                 HD_SUCCESS &&
             l > 0)
-            r = hd__gpu_grid_new(ctx, HD__G_MG(l, HD__G_MG_SIG), d[0], d[1], d[2] * g->sig_channels, "a multigrid level's sigma_t");
+            r = hd__gpu_grid_new(vw, HD__G_MG(l, HD__G_MG_SIG), d[0], d[1], d[2] * g->sig_channels, "a multigrid level's sigma_t");
     }
-    if (r == HD_SUCCESS) r = hd__gpu_mg_extras(ctx, 1);
-    if (r != HD_SUCCESS) hd__gpu_mg_free(ctx, g);
+    if (r == HD_SUCCESS) r = hd__gpu_mg_extras(vw, 1);
+    if (r != HD_SUCCESS) hd__gpu_mg_free(vw, g);
     return r;
 }
 
 /* hd__be_mg_begin's common part: the levels made or kept (hd__gpu_mg_ready), and each level's
-   parameter block for ctx->kp sent where it changed (hd__gpu_mg_send). */
-static hd_result hd__gpu_mg_begin(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
+   parameter block for vw->kp sent where it changed (hd__gpu_mg_send). */
+static hd_result hd__gpu_mg_begin(const hd__view *vw, hd__gpu_grids *g, int *fresh)
 {
-    hd_result r = hd__gpu_mg_ready(ctx, g, fresh);
+    hd_result r = hd__gpu_mg_ready(vw, g, fresh);
     int l;
     for (l = 0; l < g->levels && r == HD_SUCCESS; ++l) {
         hd__gpu_level *L = &g->lv[l];
-        hd__kparams kp = hd__mg_level_kp(&ctx->kp, l, L->dims);
+        hd__kparams kp = hd__mg_level_kp(&vw->kp, l, L->dims);
         if (L->kp_sent && memcmp(&kp, &L->kp, sizeof kp) == 0) continue;
-        if ((r = hd__gpu_mg_send(ctx, l, &kp)) != HD_SUCCESS) break;
+        if ((r = hd__gpu_mg_send(vw, l, &kp)) != HD_SUCCESS) break;
         L->kp = kp;
         L->kp_sent = 1;
     }
@@ -150,80 +150,80 @@ static hd_result hd__gpu_mg_begin(hd__ctx *ctx, hd__gpu_grids *g, int *fresh)
 
 /* Bytes of the multigrid's state on a backend whose grids are unpadded (hd__mg_bytes); 0 without
    it or with another solver. */
-HD__MAYBE_UNUSED static size_t hd__gpu_solver_bytes(const hd__ctx *ctx, const hd__gpu_grids *g)
+HD__MAYBE_UNUSED static size_t hd__gpu_solver_bytes(const hd__view *vw, const hd__gpu_grids *g)
 {
-    if (!g->levels || ctx->params.solver != HD_SOLVER_MULTIGRID) return 0;
+    if (!g->levels || vw->params.solver != HD_SOLVER_MULTIGRID) return 0;
     return hd__mg_bytes(g->fine, g->levels, g->channels, g->sig_channels);
 }
 
 /* hd__be_alloc_illumination: sigma_t, E, phi (at the precision the backend chose) and the
-   summed light anew for ctx's grid, or none (illum_floats 0); phi2 and the levels go with them. */
-static hd_result hd__gpu_alloc_illumination(hd__ctx *ctx, hd__gpu_grids *g, size_t illum_floats)
+   summed light anew for vw's grid, or none (illum_floats 0); phi2 and the levels go with them. */
+static hd_result hd__gpu_alloc_illumination(const hd__view *vw, hd__gpu_grids *g, size_t illum_floats)
 {
-    const int *gd = ctx->gdims;
+    const int *gd = vw->gdims;
     hd_result r;
     int id;
-    hd__gpu_mg_free(ctx, g); /* its fine grid is this one */
-    for (id = HD__G_SIG; id <= HD__G_LSUM; ++id) hd__gpu_grid_free(ctx, id);
+    hd__gpu_mg_free(vw, g); /* its fine grid is this one */
+    for (id = HD__G_SIG; id <= HD__G_LSUM; ++id) hd__gpu_grid_free(vw, id);
     g->illum_floats = 0;
     g->lsum_ok = 0;
-    g->f16 = ctx->params.illumination_precision == HD_PRECISION_FLOAT16;
+    g->f16 = vw->params.illumination_precision == HD_PRECISION_FLOAT16;
     if (illum_floats == 0) return HD_SUCCESS;
-    if ((r = hd__gpu_grid_new(ctx, HD__G_SIG, gd[0], gd[1], gd[2] * ctx->sig_channels, "sigma_t")) != HD_SUCCESS ||
-        (r = hd__gpu_grid_new(ctx, HD__G_E, gd[0], gd[1], gd[2] * ctx->channels, "E")) != HD_SUCCESS ||
-        (r = hd__gpu_grid_new(ctx, HD__G_PHI, gd[0], gd[1], gd[2] * ctx->channels, "phi")) != HD_SUCCESS ||
-        (r = hd__gpu_grid_new(ctx, HD__G_LSUM, gd[0], gd[1], gd[2] * ctx->channels, "the summed light")) != HD_SUCCESS)
+    if ((r = hd__gpu_grid_new(vw, HD__G_SIG, gd[0], gd[1], gd[2] * vw->sig_channels, "sigma_t")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(vw, HD__G_E, gd[0], gd[1], gd[2] * vw->channels, "E")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(vw, HD__G_PHI, gd[0], gd[1], gd[2] * vw->channels, "phi")) != HD_SUCCESS ||
+        (r = hd__gpu_grid_new(vw, HD__G_LSUM, gd[0], gd[1], gd[2] * vw->channels, "the summed light")) != HD_SUCCESS)
         return r;
     g->illum_floats = illum_floats;
     return HD_SUCCESS;
 }
 
 /* hd__be_alloc_jacobi: phi2 while enabled and the illumination grids exist. */
-static hd_result hd__gpu_alloc_jacobi(hd__ctx *ctx, const hd__gpu_grids *g, int enable)
+static hd_result hd__gpu_alloc_jacobi(const hd__view *vw, const hd__gpu_grids *g, int enable)
 {
-    hd__gpu_grid_free(ctx, HD__G_PHI2);
+    hd__gpu_grid_free(vw, HD__G_PHI2);
     if (!enable || g->illum_floats == 0) return HD_SUCCESS;
-    return hd__gpu_grid_new(ctx, HD__G_PHI2, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2] * ctx->channels, "Jacobi's buffer");
+    return hd__gpu_grid_new(vw, HD__G_PHI2, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, "Jacobi's buffer");
 }
 
 /* CD's light volumes freed. */
-static void hd__gpu_free_lights(hd__ctx *ctx, hd__gpu_grids *g)
+static void hd__gpu_free_lights(const hd__view *vw, hd__gpu_grids *g)
 {
     int l;
-    for (l = 0; g->nlv > 0 && l <= g->nlv; ++l) hd__gpu_grid_free(ctx, HD__G_LIGHT + l);
+    for (l = 0; g->nlv > 0 && l <= g->nlv; ++l) hd__gpu_grid_free(vw, HD__G_LIGHT + l);
     g->nlv = 0;
 }
 
 /* hd__be_alloc_lights: count + 1 dark light volumes (the lights and the convection's spare), as
    the CPU backend; count 0 frees them. */
-static hd_result hd__gpu_alloc_lights(hd__ctx *ctx, hd__gpu_grids *g, int count)
+static hd_result hd__gpu_alloc_lights(const hd__view *vw, hd__gpu_grids *g, int count)
 {
     hd_result r = HD_SUCCESS;
     int l;
-    hd__gpu_free_lights(ctx, g);
+    hd__gpu_free_lights(vw, g);
     for (l = 0; l <= count && count > 0 && r == HD_SUCCESS; ++l) {
         g->nlv = count;
-        r = hd__gpu_grid_new(ctx, HD__G_LIGHT + l, ctx->gdims[0], ctx->gdims[1], ctx->gdims[2], "a CD light volume");
+        r = hd__gpu_grid_new(vw, HD__G_LIGHT + l, vw->gdims[0], vw->gdims[1], vw->gdims[2], "a CD light volume");
     }
-    if (r != HD_SUCCESS) hd__gpu_free_lights(ctx, g);
+    if (r != HD_SUCCESS) hd__gpu_free_lights(vw, g);
     return r;
 }
 
 /* Every grid freed (hd__be_destroy). */
-static void hd__gpu_free(hd__ctx *ctx, hd__gpu_grids *g)
+static void hd__gpu_free(const hd__view *vw, hd__gpu_grids *g)
 {
-    hd__gpu_alloc_illumination(ctx, g, 0);
-    hd__gpu_free_lights(ctx, g);
+    hd__gpu_alloc_illumination(vw, g, 0);
+    hd__gpu_free_lights(vw, g);
 }
 
 /* hd__be_clear's grids: E (HD__DIRTY_DIRECT), phi and phi2 (HD__DIRTY_PHI) zeroed. */
-static hd_result hd__gpu_clear(hd__ctx *ctx, hd__gpu_grids *g, unsigned what)
+static hd_result hd__gpu_clear(const hd__view *vw, hd__gpu_grids *g, unsigned what)
 {
     hd_result r = HD_SUCCESS;
     if (what & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) g->lsum_ok = 0;
-    if (what & HD__DIRTY_DIRECT) r = hd__gpu_grid_zero(ctx, HD__G_E);
-    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI);
-    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(ctx, HD__G_PHI2);
+    if (what & HD__DIRTY_DIRECT) r = hd__gpu_grid_zero(vw, HD__G_E);
+    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(vw, HD__G_PHI);
+    if ((what & HD__DIRTY_PHI) && r == HD_SUCCESS) r = hd__gpu_grid_zero(vw, HD__G_PHI2);
     return r;
 }
 
@@ -231,7 +231,7 @@ static hd_result hd__gpu_clear(hd__ctx *ctx, hd__gpu_grids *g, unsigned what)
 /* ---- HD_SOLVER_MULTIGRID's passes --------------------------------------------------------------
    The primitives of src/hd_backend.h that are single passes are written here, once, over one
    primitive: hd__gpu_mg_pass. Each pass reads one parameter block (slot l: level l's; slot
-   `levels`: the fine ctx->kp) and one set of grids: sigma_t, E, phi, phi2 and the other grid
+   `levels`: the fine vw->kp) and one set of grids: sigma_t, E, phi, phi2 and the other grid
    (hd_entry_glsl_multigrid.h's names; GL image unit 6, Vulkan binding 10) and a row-sum buffer.
    The sets are numbered per level (HD__GPU_MG_SET), then CG's (HD__GPU_MG_CG), and
    hd__gpu_mg_set says what each binds: GL binds a set per pass, Vulkan writes each into a
@@ -312,14 +312,14 @@ typedef struct hd__gpu_mg_run {
 
 /* The backend's: its grids, and one pass run (GL) or recorded (Vulkan) in order after the
    earlier ones. */
-static hd__gpu_grids *hd__gpu_grids_of(hd__ctx *ctx);
-static hd_result hd__gpu_mg_pass(hd__ctx *ctx, const hd__gpu_mg_run *p);
+static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw);
+static hd_result hd__gpu_mg_pass(const hd__view *vw, const hd__gpu_mg_run *p);
 
 /* Pass `stage` over level l's grid of `channels` channels stacked in z; hd_pc: the level's dims
    (dims_pc; else zeros) and channels. */
-static hd_result hd__gpu_mg_level_pass(hd__ctx *ctx, int stage, int set, int slot, int l, int channels, int dims_pc)
+static hd_result hd__gpu_mg_level_pass(const hd__view *vw, int stage, int set, int slot, int l, int channels, int dims_pc)
 {
-    const int *d = hd__gpu_grids_of(ctx)->lv[l].dims;
+    const int *d = hd__gpu_grids_of(vw)->lv[l].dims;
     hd__gpu_mg_run p;
     int i;
     memset(&p, 0, sizeof p);
@@ -332,14 +332,14 @@ static hd_result hd__gpu_mg_level_pass(hd__ctx *ctx, int stage, int set, int slo
         p.pc[i] = dims_pc ? d[i] : 0;
     }
     p.pc[3] = channels;
-    return hd__gpu_mg_pass(ctx, &p);
+    return hd__gpu_mg_pass(vw, &p);
 }
 
 /* Pass `stage` with CG's set cg over the fine grid, hd_pc (pc0, pc1, 0, channels); the dot
    products over the fine rows instead (y, then z and channels). */
-static hd_result hd__gpu_mg_fine_pass(hd__ctx *ctx, int stage, int cg, int slot, int pc0, int pc1, float beta, double alpha)
+static hd_result hd__gpu_mg_fine_pass(const hd__view *vw, int stage, int cg, int slot, int pc0, int pc1, float beta, double alpha)
 {
-    const hd__gpu_grids *g = hd__gpu_grids_of(ctx);
+    const hd__gpu_grids *g = hd__gpu_grids_of(vw);
     hd__gpu_mg_run p;
     memset(&p, 0, sizeof p);
     p.stage = stage;
@@ -353,73 +353,73 @@ static hd_result hd__gpu_mg_fine_pass(hd__ctx *ctx, int stage, int cg, int slot,
     p.pc[3] = g->channels;
     p.beta = beta;
     p.alpha = alpha;
-    return hd__gpu_mg_pass(ctx, &p);
+    return hd__gpu_mg_pass(vw, &p);
 }
 
-static hd_result hd__be_mg_coarsen(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_coarsen(const hd__view *vw, int l)
 {
-    return hd__gpu_mg_level_pass(ctx, HD__MG_SIG, HD__GPU_MG_SET(l, HD__GPU_MG_COARSEN), l - 1, l,
-                                 hd__gpu_grids_of(ctx)->sig_channels, 1);
+    return hd__gpu_mg_level_pass(vw, HD__MG_SIG, HD__GPU_MG_SET(l, HD__GPU_MG_COARSEN), l - 1, l,
+                                 hd__gpu_grids_of(vw)->sig_channels, 1);
 }
 
-static hd_result hd__be_mg_residual(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_residual(const hd__view *vw, int l)
 {
-    return hd__gpu_mg_level_pass(ctx, HD__MG_RESIDUAL, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, l, hd__gpu_grids_of(ctx)->channels, 0);
+    return hd__gpu_mg_level_pass(vw, HD__MG_RESIDUAL, HD__GPU_MG_SET(l, HD__GPU_MG_SMOOTH), l, l, hd__gpu_grids_of(vw)->channels, 0);
 }
 
 /* With level l's parameters over level l + 1's grid. */
-static hd_result hd__be_mg_restrict(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_restrict(const hd__view *vw, int l)
 {
-    return hd__gpu_mg_level_pass(ctx, HD__MG_RESTRICT, HD__GPU_MG_SET(l, HD__GPU_MG_RESTRICT_TO), l, l + 1,
-                                 hd__gpu_grids_of(ctx)->channels, 1);
+    return hd__gpu_mg_level_pass(vw, HD__MG_RESTRICT, HD__GPU_MG_SET(l, HD__GPU_MG_RESTRICT_TO), l, l + 1,
+                                 hd__gpu_grids_of(vw)->channels, 1);
 }
 
 /* With level l + 1's parameters over level l's grid. */
-static hd_result hd__be_mg_prolong(hd__ctx *ctx, int l)
+static hd_result hd__be_mg_prolong(const hd__view *vw, int l)
 {
-    return hd__gpu_mg_level_pass(ctx, HD__MG_PROLONG, HD__GPU_MG_SET(l, HD__GPU_MG_PROLONG_FROM), l + 1, l,
-                                 hd__gpu_grids_of(ctx)->channels, 1);
+    return hd__gpu_mg_level_pass(vw, HD__MG_PROLONG, HD__GPU_MG_SET(l, HD__GPU_MG_PROLONG_FROM), l + 1, l,
+                                 hd__gpu_grids_of(vw)->channels, 1);
 }
 
 /* f - A (phi + lo) in double with the fine parameters (hd_pc.x: use lo). */
-static hd_result hd__be_mg_residual_f64(hd__ctx *ctx)
+static hd_result hd__be_mg_residual_f64(const hd__view *vw)
 {
-    return hd__gpu_mg_fine_pass(ctx, HD__MG_RES_F64, HD__GPU_MG_RES_R, hd__gpu_grids_of(ctx)->levels, 1, 0, 0.0f, 0.0);
+    return hd__gpu_mg_fine_pass(vw, HD__MG_RES_F64, HD__GPU_MG_RES_R, hd__gpu_grids_of(vw)->levels, 1, 0, 0.0f, 0.0);
 }
 
-static hd_result hd__be_mg_dot_rz(hd__ctx *ctx) { return hd__gpu_mg_fine_pass(ctx, HD__MG_DOT, HD__GPU_MG_DOT_RZ, 0, 0, 0, 0.0f, 0.0); }
+static hd_result hd__be_mg_dot_rz(const hd__view *vw) { return hd__gpu_mg_fine_pass(vw, HD__MG_DOT, HD__GPU_MG_DOT_RZ, 0, 0, 0, 0.0f, 0.0); }
 
-static hd_result hd__be_mg_direction(hd__ctx *ctx, float beta)
+static hd_result hd__be_mg_direction(const hd__view *vw, float beta)
 {
-    return hd__gpu_mg_fine_pass(ctx, HD__MG_DIR, HD__GPU_MG_DIR, 0, 0, 0, beta, 0.0);
+    return hd__gpu_mg_fine_pass(vw, HD__MG_DIR, HD__GPU_MG_DIR, 0, 0, 0, beta, 0.0);
 }
 
 /* q = A p: the double residual negated (hd_pc.y) on level 0's parameters, E = z = 0, phi = p. */
-static hd_result hd__be_mg_apply(hd__ctx *ctx)
+static hd_result hd__be_mg_apply(const hd__view *vw)
 {
     hd_result r;
-    if ((r = hd__gpu_mg_fine_pass(ctx, HD__MG_RES_F64, HD__GPU_MG_RES_Q, 0, 0, 1, 0.0f, 0.0)) != HD_SUCCESS ||
-        (r = hd__gpu_mg_fine_pass(ctx, HD__MG_DOT, HD__GPU_MG_DOT_PQ, 0, 0, 0, 0.0f, 0.0)) != HD_SUCCESS)
+    if ((r = hd__gpu_mg_fine_pass(vw, HD__MG_RES_F64, HD__GPU_MG_RES_Q, 0, 0, 1, 0.0f, 0.0)) != HD_SUCCESS ||
+        (r = hd__gpu_mg_fine_pass(vw, HD__MG_DOT, HD__GPU_MG_DOT_PQ, 0, 0, 0, 0.0f, 0.0)) != HD_SUCCESS)
         return r;
-    return hd__gpu_mg_fine_pass(ctx, HD__MG_DOT, HD__GPU_MG_DOT_RP, 0, 0, 0, 0.0f, 0.0);
+    return hd__gpu_mg_fine_pass(vw, HD__MG_DOT, HD__GPU_MG_DOT_RP, 0, 0, 0, 0.0f, 0.0);
 }
 
-static hd_result hd__be_mg_update(hd__ctx *ctx, double alpha)
+static hd_result hd__be_mg_update(const hd__view *vw, double alpha)
 {
-    hd__gpu_grids_of(ctx)->lsum_ok = 0;
-    return hd__gpu_mg_fine_pass(ctx, HD__MG_UPDATE, HD__GPU_MG_UPDATE, 0, 0, 0, 0.0f, alpha);
+    hd__gpu_grids_of(vw)->lsum_ok = 0;
+    return hd__gpu_mg_fine_pass(vw, HD__MG_UPDATE, HD__GPU_MG_UPDATE, 0, 0, 0, 0.0f, alpha);
 }
 
 /* The fine parameters (no right-hand-side flag); hd_pc.x the colour. */
-static hd_result hd__be_mg_extrapolate(hd__ctx *ctx, int colour)
+static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour)
 {
-    hd__gpu_grids *g = hd__gpu_grids_of(ctx);
+    hd__gpu_grids *g = hd__gpu_grids_of(vw);
     g->lsum_ok = 0;
-    return hd__gpu_mg_fine_pass(ctx, HD__MG_EXTRAP, HD__GPU_MG_EXTRAP, g->levels, colour, 0, 0.0f, 0.0);
+    return hd__gpu_mg_fine_pass(vw, HD__MG_EXTRAP, HD__GPU_MG_EXTRAP, g->levels, colour, 0, 0.0f, 0.0);
 }
 
 /* lo = 0. */
-static hd_result hd__be_mg_zero_lo(hd__ctx *ctx) { return hd__gpu_grid_zero(ctx, HD__G_MG_LO); }
+static hd_result hd__be_mg_zero_lo(const hd__view *vw) { return hd__gpu_grid_zero(vw, HD__G_MG_LO); }
 
 /* The projection's dispatch on CPU devices: llvmpipe and lavapipe hand each of their threads one
    contiguous run of a dispatch's work groups, so with the rows in order one thread marches the top

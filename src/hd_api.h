@@ -1,0 +1,265 @@
+/* hd_api.h - the public calls: names, the context's life cycle and the setters. Part of the core
+   (src/hd_core.h). */
+/* ---- names ----------------------------------------------------------------------------------- */
+HDDEF const char *hd_result_string(hd_result result)
+{
+    switch (result) {
+#define HD__X(name, text) case name: return #name ": " text;
+        HD__RESULT_LIST(HD__X)
+#undef HD__X
+    default: return "HD_ERROR_UNKNOWN: not a hd_result value";
+    }
+}
+
+HDDEF const char *hd_method_name(hd_method method)
+{
+    switch (method) {
+    case HD_METHOD_DEFAULT: return "default";
+    case HD_METHOD_HD: return "HD";
+    case HD_METHOD_CD: return "CD";
+    case HD_METHOD_PT_SS: return "PT_SS";
+    case HD_METHOD_PT_MS: return "PT_MS";
+    default: return "unknown";
+    }
+}
+
+HDDEF const char *hd_backend_name(void) { return hd__be_name(); }
+
+HDDEF void hd_log_stderr(void *user_data, hd_log_level level, hd_result code, const char *message,
+                         const char *file, int line)
+{
+    static const char *names[] = {"error", "warning", "info"};
+    (void)user_data; (void)file; (void)line;
+    fprintf(stderr, "hybriddiff %s: %s%s%s\n", names[level <= HD_LOG_INFO ? level : 0], message,
+            code != HD_SUCCESS ? " -- " : "", code != HD_SUCCESS ? hd_result_string(code) : "");
+}
+
+/* ---- life cycle ---------------------------------------------------------------------------- */
+static void hd__conv_free(hd__ctx *ctx);
+
+static void hd__direct_mask_free(hd__ctx *ctx);
+
+static void hd__ctx_free(hd__ctx *ctx)
+{
+    hd__conv_free(ctx);
+    hd__direct_mask_free(ctx);
+    if (ctx->vw.be) hd__be_destroy(&ctx->vw);
+    hd__free(&ctx->vw, ctx->vw.vol);
+    hd__free(&ctx->vw, ctx->cell_range);
+    hd__free(&ctx->vw, ctx->vw.majorant);
+    hd__free(&ctx->vw, ctx->vw.tf);
+    hd__free(&ctx->vw, ctx->srgb);
+    hd__free(&ctx->vw, ctx);
+}
+
+HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
+{
+    hd_desc d;
+    const hd_logger *log;
+    hd__ctx *ctx;
+    hd_result r;
+    hd_light default_light;
+    if (!desc) return HD_ERROR_NULL_POINTER; /* no logger to tell */
+    log = &desc->logger;
+    if (!out_ctx) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_create: out_ctx is NULL");
+    out_ctx->id = 0;
+    d = *desc;
+    if ((d.allocator.alloc == NULL) != (d.allocator.free == NULL))
+        return HD__ERR(log, HD_ERROR_NULL_POINTER, "allocator: give both alloc and free, or neither");
+    /* validate everything first: nothing is allocated for a bad desc */
+    if ((r = hd__check_volume(&d.volume, log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_tf(&d.transfer_function, log)) != HD_SUCCESS) return r;
+    memset(&default_light, 0, sizeof default_light);
+    default_light.direction[2] = -1.0f;
+    if (!d.lights && d.light_count == 0) { d.lights = &default_light; d.light_count = 1; }
+    if ((r = hd__check_lights(d.lights, d.light_count, log)) != HD_SUCCESS) return r;
+    hd__camera_defaults(&d.camera);
+    if ((r = hd__check_camera(&d.camera, log)) != HD_SUCCESS) return r;
+    hd__params_defaults(&d.params);
+    if ((r = hd__check_params(&d.params, log)) != HD_SUCCESS) return r;
+    if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
+    if (d.volume.spacing[0] == 0.0f && d.volume.spacing[1] == 0.0f && d.volume.spacing[2] == 0.0f)
+        d.volume.spacing[0] = d.volume.spacing[1] = d.volume.spacing[2] = 1.0f;
+    if (d.volume.value_range[0] == 0.0f && d.volume.value_range[1] == 0.0f)
+        d.volume.value_range[1] = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f : 1.0f;
+    if (!d.allocator.alloc) { d.allocator.alloc = hd__malloc_default; d.allocator.free = hd__free_default; }
+
+    ctx = (hd__ctx *)d.allocator.alloc(sizeof *ctx, d.allocator.user_data);
+    if (!ctx) return HD__ERR(log, HD_ERROR_OUT_OF_MEMORY, "cannot allocate the context");
+    memset(ctx, 0, sizeof *ctx);
+    ctx->vw.desc = d;
+    ctx->vw.alloc = d.allocator;
+    ctx->vw.log = d.logger;
+    ctx->vw.camera = d.camera;
+    ctx->vw.params = d.params;
+    ctx->vw.desc.volume.data = NULL; /* the caller's buffer is not kept */
+    hd__set_lights(ctx, d.lights, d.light_count);
+    if ((r = hd__set_tf(ctx, &d.transfer_function)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    if ((r = hd__prepare_volume(ctx, &d.volume)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    hd__build_majorants(ctx);
+    if ((r = hd__check_majorant(ctx, &ctx->vw.params)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    hd__set_grid(ctx);
+    ctx->dirty = HD__DIRTY_ALL;
+    if ((r = hd__be_create(&ctx->vw)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+
+    *out_ctx = hd__slot_take(ctx);
+    if (out_ctx->id == 0) {
+        hd__ctx_free(ctx);
+        return HD__ERR(log, HD_ERROR_TOO_MANY_CONTEXTS, "no free context slot: %d contexts are alive, or the slots' handles are used up",
+                       HD_MAX_CONTEXTS);
+    }
+    HD__INFO(&ctx->vw.log, "created: %s backend, volume %dx%dx%d, %d lights", hd__be_name(),
+             ctx->vw.dims[0], ctx->vw.dims[1], ctx->vw.dims[2], ctx->light_count);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_destroy(hd_context h)
+{
+    HD__GET_CTX(ctx, h);
+    hd__slot_release(h);
+    hd__ctx_free(ctx);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_query_desc(hd_context h, hd_desc *out)
+{
+    HD__GET_CTX(ctx, h);
+    if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_query_desc: out_desc is NULL");
+    *out = ctx->vw.desc;
+    out->camera = ctx->vw.camera;
+    out->params = ctx->vw.params;
+    return HD_SUCCESS;
+}
+
+/* ---- setters ----------------------------------------------------------------------------------- */
+HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_function *tf)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!tf) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_transfer_function: tf is NULL");
+    if ((r = hd__check_tf(tf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
+    hd__build_majorants(ctx);
+    if (ctx->vw.params.majorant > 0.0f &&
+        (ctx->vw.params.majorant < ctx->max_sigma / (1.0f + 1e-5f) || ctx->vw.params.majorant > hd__majorant_cap(ctx->max_sigma))) {
+        HD__INFO(&ctx->vw.log, "params.majorant %g is outside 1..16x the new TF's largest extinction %g: using the majorant grid",
+                 (double)ctx->vw.params.majorant, (double)ctx->max_sigma);
+        ctx->vw.params.majorant = 0.0f;
+    }
+    ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
+{
+    hd_result r;
+    int channels_before;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__check_lights(lights, count, &ctx->vw.log)) != HD_SUCCESS) return r;
+    channels_before = ctx->vw.channels;
+    hd__set_lights(ctx, lights, count);
+    ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    if (ctx->vw.channels != channels_before) ctx->dirty |= HD__DIRTY_ALLOC;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
+{
+    hd_camera c;
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!camera) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_camera: camera is NULL");
+    c = *camera;
+    hd__camera_defaults(&c);
+    if ((r = hd__check_camera(&c, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if (c.width != ctx->vw.camera.width || c.height != ctx->vw.camera.height) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
+    ctx->vw.camera = c;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
+{
+    hd_params p;
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!params) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_params: params is NULL");
+    p = *params;
+    hd__params_defaults(&p);
+    if ((r = hd__check_params(&p, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
+    ctx->dirty |= hd__params_dirty(&ctx->vw.params, &p);
+    ctx->vw.params = p;
+    hd__set_channels(ctx);
+    if (ctx->dirty & HD__DIRTY_ALLOC) hd__set_grid(ctx);
+    if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
+    return HD_SUCCESS;
+}
+
+/* ---- iterations and frames ---------------------------------------------------------------- */
+HDDEF hd_result hd_iterate(hd_context h, int n)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: n = %d, must be >= 1", n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: more than 2^31 iterations; reset with a new seed");
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__iterate_method));
+    return r;
+}
+
+
+HDDEF hd_result hd_refine(hd_context h, int n)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_refine: n = %d, must be >= 1", n);
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_refine: method %s has no light volume to refine; use hd_iterate or hd_render",
+                       hd_method_name(ctx->vw.params.method));
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_refine: more than 2^31 iterations; reset with a new seed");
+    HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__refine_once));
+    return r;
+}
+
+
+HDDEF hd_result hd_render(hd_context h)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    HD__BE_CALL(r, ctx, hd__render(ctx));
+    return r;
+}
+
+/* The optional features' entry points, for every backend (hd__be_features). */
+HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+{
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if (!(hd__be_features() & HD__BE_TEXTURE))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture: this is the %s backend", hd__be_name());
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
+    HD__BE_CALL(r, ctx, hd__be_render_to_texture(&ctx->vw, texture));
+    return r;
+}
+
+HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+{
+    hd_result r;
+    const hd_params *p;
+    HD__GET_CTX(ctx, h);
+    p = &ctx->vw.params;
+    if (!(hd__be_features() & HD__BE_RECORD))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_vulkan_record: this is the %s backend", hd__be_name());
+    if (!command_buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
+    if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
+    if (p->solver == HD_SOLVER_MULTIGRID && !p->disable_diffusion && (p->method == HD_METHOD_HD || p->method == HD_METHOD_CD))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED,
+                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
+    hd__record_cost(ctx);
+    HD__BE_CALL(r, ctx, hd__record(ctx, command_buffer, n));
+    return r;
+}

@@ -1,0 +1,130 @@
+/* hd_core.h - the core: the context (hd__ctx) and, in dependency order, the parts that own its
+   state. Included after the selected backend, which sees only the context's view (hd__view,
+   src/hd_internal.h) through the primitives of src/hd_backend.h: a backend that named hd__ctx
+   would not compile.
+     hd_handles.h      handles and their slots
+     hd_validate.h     checks of the volume, TF, lights and camera, and their defaults
+     hd_params.h       hd_params as one table: defaults, checks, what each field invalidates
+     hd_volume.h       the volume, majorants, TF and lights (the inputs the backend uploads)
+     hd_kparams.h      the kernels' parameter block packed from the context
+     hd_multigrid.h    HD_SOLVER_MULTIGRID's driver over the backend's level primitives
+     hd_direct_mask.h  where the direct light is tracked
+     hd_convergence.h  the light's error estimate
+     hd_frame_cost.h   HD_RENDER_SCALE_AUTO's frame-cost model and scale choice
+     hd_schedule.h     the methods' stages, hd_render's loop, recording
+     hd_readback.h     the image, illumination and statistics read back
+     hd_api.h          the public calls */
+#ifndef HD_CORE_H
+#define HD_CORE_H
+
+/* HD_SOLVER_MULTIGRID's run state, the same on every backend (src/hd_multigrid.h). */
+typedef struct hd__mg_cg {
+    unsigned sig_gen;        /* ctx->sig_gen the coarse sigma_t were restricted from */
+    int sig_surface;         /* ... and the boundary they were restricted for */
+    uint64_t iteration;      /* the HD iteration (ctx->iterations) the CG run belongs to */
+    hd__kparams akey;        /* the parameters A depends on, at the last step (restart on change) */
+    int have_dir;            /* the backend's p holds a direction of the current CG run */
+    double rz;               /* <r, z> of the previous step (beta's denominator) */
+    unsigned light_gen;      /* the context's light_gen of the current CG run */
+    double vcycle_seconds;   /* wall time in V-cycles (bench/hdbench_multigrid.c: a step against a V-cycle) */
+} hd__mg_cg;
+
+/* The light's convergence estimate (src/hd_convergence.h): E and phi of the medium's voxels
+   after the previous light iteration, to estimate the error from their change. */
+typedef struct hd__conv {
+    uint32_t *idx;           /* in-slice indices (y * gx + x) of the voxels measured, slice by slice */
+    size_t count;
+    int *zz;                 /* the stacked slices read back: nz per channel, channel-major */
+    size_t *off;             /* nz + 1 starts in idx, one per measured slice */
+    int nz;                  /* measured slices per channel */
+    float *prev;             /* count * channels values of E, then the same of phi */
+    float *tmp;              /* the measured slices of one illumination volume read back, all channels */
+    int have_prev;           /* prev holds the previous iteration */
+    int below;               /* light iterations in a row with light_error below the tolerance */
+    double dphi;             /* |phi_n - phi_n-1| of the previous iteration */
+    double q;                /* the solver's observed contraction of that change */
+} hd__conv;
+
+/* HD_RENDER_SCALE_AUTO's frame cost model (src/hd_frame_cost.h): per render scale 1, 2, 4, 8
+   (slot log2 s) the pixels its last frame marched (0: none yet), its smoothed seconds and the
+   measurement count when it was last measured; the newest measurement's slot; measurements so
+   far (0: none). */
+typedef struct hd__cost {
+    double pixels[4], seconds[4];
+    unsigned at[4];
+    int last;
+    unsigned gen;
+    /* a frame recorded into a caller's command buffer (hd_vulkan_record), timed on the device and
+       read by the next call: its scale, pixels and the measurement count when it was recorded */
+    int rec_pending, rec_scale;
+    double rec_pixels;
+    unsigned rec_gen;
+} hd__cost;
+
+/* The direct light's voxels besides what the backend reads (vw.dl_idx, src/hd_direct_mask.h). */
+typedef struct hd__dl {
+    uint8_t *bits;           /* the tracked voxels, one bit each (read by the convergence estimate) */
+    int all;                 /* track every voxel (a test hook: the reference for the mask) */
+} hd__dl;
+
+typedef struct hd__ctx {
+    hd__view vw;             /* what the backend sees (src/hd_internal.h) */
+    /* volume */
+    float box[3];            /* world size of the volume box */
+    float *cell_range;       /* per majorant cell: min and max value incl. the filter halo */
+    float max_sigma;         /* max over the whole grid */
+    /* inputs */
+    hd_light lights[HD_MAX_LIGHTS];
+    int light_count;
+    int lights_one_colour;   /* every light has the same colour */
+    float chan_color[3];
+    /* method state */
+    unsigned dirty;
+    uint64_t iterations;
+    uint64_t frames;
+    double seconds[3];       /* direct (or convection / paths), diffusion, projection */
+    hd__conv conv;
+    double light_error;
+    uint64_t converged_frames; /* projection frames since the light converged */
+    int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
+                                was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
+    hd__cost cost;
+    int image_room;          /* the image buffer holds the reduced frames' region (made when a
+                                scale > 1 is first used, hd__image_room) */
+    int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
+    unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
+    unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
+    hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
+    hd__dl dl;
+    uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
+} hd__ctx;
+
+/* The path tracers keep no illumination grid: the image is their whole state. */
+static int hd__method_is_pt(hd_method m) { return m == HD_METHOD_PT_SS || m == HD_METHOD_PT_MS; }
+
+/* Brings the device state up to date with what the setters changed (src/hd_schedule.h). */
+static hd_result hd__prepare(hd__ctx *ctx);
+/* r = the result of hd__prepare and then of expr, both in one bracket of the backend's
+   (hd__be_begin / hd__be_end); expr is not evaluated when an earlier step failed. */
+#define HD__BE_CALL(r, ctx, expr) \
+    do { \
+        if (((r) = hd__be_begin(&(ctx)->vw)) == HD_SUCCESS) { \
+            if (((r) = hd__prepare(ctx)) == HD_SUCCESS) (r) = (expr); \
+            (r) = hd__be_end(&(ctx)->vw, (r)); \
+        } \
+    } while (0)
+
+#include "hd_handles.h"
+#include "hd_validate.h"
+#include "hd_params.h"
+#include "hd_volume.h"
+#include "hd_kparams.h"
+#include "hd_multigrid.h"
+#include "hd_direct_mask.h"
+#include "hd_convergence.h"
+#include "hd_frame_cost.h"
+#include "hd_schedule.h"
+#include "hd_readback.h"
+#include "hd_api.h"
+
+#endif

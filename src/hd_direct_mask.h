@@ -1,0 +1,217 @@
+/* hd_direct_mask.h - where HD's direct light is tracked: the illumination-grid voxels whose E
+   the projection or the diffusion reads. Part of the core (src/hd_core.h). */
+/* ---- where the direct light is read ------------------------------------------------------------
+   E is read by the projection, trilinearly at samples whose sigma_t > 0, and by the diffusion as
+   sigma_s E at voxels whose sigma_t > 0 (the surface boundary reads sigma_t only); a grid voxel
+   no such read reaches keeps E = 0 with no effect on phi or the image. The mask is exact at the
+   level of the volume's dual cells (the 8 voxels a trilinear sample interpolates): a cell is
+   empty when its 8 values lie in one run of TF entries whose alpha is 0, widened by
+   HD__DL_VALUE_EPS for the kernels' rounding of the interpolation, or when they are 8 equal
+   values (interpolated exactly) where alpha is 0, or when no sample it holds lies in the crop
+   box (with HD__DL_COORD_EPS); a grid voxel is tracked when
+   an interpolation that reads it (weight 0 included) can sample a non-empty cell. */
+#define HD__DL_VALUE_EPS 1e-5f
+#define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
+#define HD__DL_BRICK 8 /* voxels per edge of the list's bricks (a multiple of the light's runs of 8) */
+
+/* The run of zero-alpha TF entries (numbered from 1) that every value within HD__DL_VALUE_EPS of
+   [t0, t1] lies in, 0 when some of them may have sigma_t > 0. A value's entries lie within those
+   of the range (both ends are monotone in the value), so a range in one run puts each of its
+   values there. */
+static int32_t hd__dl_run_range(const int32_t *entry_run, int n, float t0, float t1)
+{
+    float lo = t0 - HD__DL_VALUE_EPS, hi = t1 + HD__DL_VALUE_EPS, n1 = (float)(n - 1);
+    int i, i0, i1;
+    lo = lo < 0.0f ? 0.0f : lo;
+    hi = hi > 1.0f ? 1.0f : hi;
+    i0 = (int)(lo * n1);
+    i1 = (int)(hi * n1) + 1;
+    if (i0 > n - 2) i0 = n - 2;
+    if (i1 > n - 1) i1 = n - 1;
+    for (i = i0; i <= i1; ++i)
+        if (entry_run[i] == 0) return 0;
+    return entry_run[i0]; /* consecutive zero entries share their run */
+}
+
+/* The same for one value. */
+static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
+{
+    return hd__dl_run_range(entry_run, n, t, t);
+}
+
+/* Dual cells [lo, hi] along one axis (volume size n) that an interpolation reading grid voxel x
+   (grid size g) can sample: the grid's lerp reads x for s = u g in [x - 0.5, x + 1.5), and its
+   clamps make voxels 0 and 1 read from s = 0 on and voxels g - 2 and g - 1 up to s = g; the
+   volume's lerp samples cell min(floor(u n - 0.5), n - 2), clamped to [0, n - 2]. */
+static void hd__dl_axis(int x, int g, int n, int *lo, int *hi)
+{
+    int last = n - 2 > 0 ? n - 2 : 0;
+    float eps = g == n ? 0.0f : HD__DL_COORD_EPS; /* same grid: the same float expression */
+    float plo = ((float)x - 0.5f) / (float)g * (float)n - 0.5f - eps;
+    float phi = ((float)x + 1.5f) / (float)g * (float)n - 0.5f + eps;
+    int a = plo <= 0.0f ? 0 : (int)floorf(plo), b = phi <= 0.0f ? 0 : (int)ceilf(phi) - 1; /* s < x + 1.5 */
+    if (x <= 1) a = 0;
+    if (x >= g - 2) b = last;
+    *lo = a > last ? last : a;
+    *hi = b > last ? last : b;
+}
+
+static void hd__direct_mask_free(hd__ctx *ctx)
+{
+    hd__free(&ctx->vw, ctx->vw.dl_idx);
+    hd__free(&ctx->vw, ctx->dl.bits);
+    ctx->vw.dl_idx = NULL;
+    ctx->dl.bits = NULL;
+    ctx->vw.dl_count = 0;
+}
+
+/* Builds dl_bits and dl_idx for the current TF, extinction, crop box and grid. */
+static hd_result hd__direct_mask(hd__ctx *ctx)
+{
+    const int *n = ctx->vw.dims, *g = ctx->vw.gdims;
+    int dn[3], d, x, y, z, j;
+    size_t gvox = (size_t)g[0] * g[1] * g[2], ncell = (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2], ndual, i, k;
+    int32_t *entry_run = NULL;
+    uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL;
+    int (*span)[2] = NULL;
+    hd_result r = HD_SUCCESS;
+    hd__direct_mask_free(ctx);
+    for (d = 0; d < 3; ++d) dn[d] = n[d] > 1 ? n[d] - 1 : 1;
+    ndual = (size_t)dn[0] * dn[1] * dn[2];
+    ctx->dl.bits = (uint8_t *)hd__calloc(&ctx->vw, (gvox + 7) / 8, 1);
+    entry_run = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
+    cell = (uint8_t *)hd__alloc(&ctx->vw, ndual);
+    ax = (uint8_t *)hd__alloc(&ctx->vw, (size_t)g[0] * dn[1] * dn[2]);
+    ay = (uint8_t *)hd__alloc(&ctx->vw, (size_t)g[0] * g[1] * dn[2]);
+    span = (int (*)[2])hd__alloc(&ctx->vw, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
+    crop = (uint8_t *)hd__alloc(&ctx->vw, (size_t)(dn[0] + dn[1] + dn[2]));
+    if (!ctx->dl.bits || !entry_run || !cell || !ax || !ay || !span || !crop) {
+        r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
+        goto done;
+    }
+    /* runs of zero-alpha entries; with no extinction nothing is medium */
+    for (j = 0, k = 0; j < ctx->vw.tf_count; ++j) {
+        int zero = !(ctx->vw.tf[4 * j + 3] > 0.0f) || !(ctx->vw.params.extinction > 0.0f);
+        if (zero && (j == 0 || entry_run[j - 1] == 0)) ++k;
+        entry_run[j] = zero ? (int32_t)k : 0;
+    }
+    /* dual cells per axis that meet the crop box: cell j holds the samples at u n - 0.5 in
+       [j, j + 1], the first and last also those the clamp folds onto them */
+    for (d = 0, k = 0; d < 3; ++d)
+        for (j = 0; j < dn[d]; ++j, ++k)
+            crop[k] = (uint8_t)hd__crop_meets(ctx, d, j == 0 ? -1.0 : ((double)j + 0.5) / n[d],
+                                              j == dn[d] - 1 ? 2.0 : ((double)j + 1.5) / n[d], HD__DL_COORD_EPS);
+    /* a dual cell is empty when its 8 voxels share one zero run. Dual cells are taken per
+       majorant cell (those whose lower corner it holds): the cell's value range, filter halo
+       included, covers their 8 voxels, so when it lies in one zero run they are all empty and no
+       voxel's run is needed; elsewhere the runs of the cell's block of voxels are computed once */
+    memset(cell, 0, ndual);
+    for (i = 0; i < ncell; ++i) {
+        enum { M = HD__MAJORANT_CELL, B = HD__MAJORANT_CELL + 1 };
+        int32_t blk[B * B * B];
+        int c[3], lo[3], hi[3], bx, by, bz;
+        const float *vol = ctx->vw.vol;
+        if (hd__dl_run_range(entry_run, ctx->vw.tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
+        c[0] = (int)(i % (size_t)ctx->vw.mdims[0]);
+        c[1] = (int)(i / (size_t)ctx->vw.mdims[0] % (size_t)ctx->vw.mdims[1]);
+        c[2] = (int)(i / ((size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1]));
+        for (d = 0; d < 3; ++d) {
+            lo[d] = c[d] * M;                                       /* first dual cell and voxel */
+            hi[d] = lo[d] + M < dn[d] ? lo[d] + M : dn[d];          /* dual cells end (exclusive) */
+        }
+        if (lo[0] >= hi[0] || lo[1] >= hi[1] || lo[2] >= hi[2]) continue;
+        /* runs of voxels lo .. min(hi, n - 1) */
+        bx = (hi[0] < n[0] - 1 ? hi[0] : n[0] - 1) - lo[0] + 1;
+        by = (hi[1] < n[1] - 1 ? hi[1] : n[1] - 1) - lo[1] + 1;
+        bz = (hi[2] < n[2] - 1 ? hi[2] : n[2] - 1) - lo[2] + 1;
+        for (z = 0; z < bz; ++z)
+            for (y = 0; y < by; ++y)
+                for (x = 0; x < bx; ++x)
+                    blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
+                                                          vol[((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x]);
+        for (z = lo[2]; z < hi[2]; ++z)
+            for (y = lo[1]; y < hi[1]; ++y)
+                for (x = lo[0]; x < hi[0]; ++x) {
+                    int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
+                    size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
+                    size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
+                    /* the block's rows of the 4 voxel rows, at x and x1 */
+                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
+                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
+                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
+                    int xa = x - lo[0], xb = x1 - lo[0];
+                    int32_t a = b0[xa];
+                    float v = vol[r00 + x];
+                    uint8_t full = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
+                                     b3[xa] == a && b3[xb] == a);
+                    /* 8 equal values interpolate to that value exactly, whatever the weights */
+                    if (full && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
+                        vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
+                        !(hd__tf_alpha(ctx, v) * ctx->vw.params.extinction > 0.0f))
+                        full = 0;
+                    if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full = 0;
+                    cell[((size_t)z * dn[1] + y) * dn[0] + x] = full;
+                }
+    }
+    /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
+    for (d = 0, k = 0; d < 3; ++d)
+        for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
+    for (z = 0; z < dn[2]; ++z)
+        for (y = 0; y < dn[1]; ++y)
+            for (x = 0; x < g[0]; ++x) {
+                const uint8_t *c = cell + ((size_t)z * dn[1] + y) * dn[0];
+                uint8_t v = 0;
+                for (j = span[x][0]; j <= span[x][1]; ++j) v |= c[j];
+                ax[((size_t)z * dn[1] + y) * g[0] + x] = v;
+            }
+    for (z = 0; z < dn[2]; ++z)
+        for (y = 0; y < g[1]; ++y)
+            for (x = 0; x < g[0]; ++x) {
+                uint8_t v = 0;
+                for (j = span[g[0] + y][0]; j <= span[g[0] + y][1]; ++j) v |= ax[((size_t)z * dn[1] + j) * g[0] + x];
+                ay[((size_t)z * g[1] + y) * g[0] + x] = v;
+            }
+    ctx->vw.dl_count = 0;
+    for (z = 0, k = 0; z < g[2]; ++z)
+        for (y = 0; y < g[1]; ++y)
+            for (x = 0; x < g[0]; ++x, ++k) {
+                uint8_t v = 0;
+                for (j = span[g[0] + g[1] + z][0]; j <= span[g[0] + g[1] + z][1]; ++j)
+                    v |= ay[((size_t)j * g[1] + y) * g[0] + x];
+                if (v) {
+                    ctx->dl.bits[k >> 3] |= (uint8_t)(1u << (k & 7));
+                    ++ctx->vw.dl_count;
+                }
+            }
+    if (ctx->dl.all) ctx->vw.dl_count = gvox;
+    ctx->vw.dl_idx = (uint32_t *)hd__alloc(&ctx->vw, (ctx->vw.dl_count ? ctx->vw.dl_count : 1) * sizeof(uint32_t));
+    if (!ctx->vw.dl_idx) {
+        r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's list (%zu voxels)", ctx->vw.dl_count);
+        goto done;
+    }
+    if (ctx->dl.all) {
+        for (k = 0; k < gvox; ++k) ctx->vw.dl_idx[k] = (uint32_t)k;
+    } else {
+        /* brick by brick (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries,
+           one work item's, start side by side, so their rays read the same part of the volume */
+        int bx, by, bz, b = HD__DL_BRICK;
+        for (bz = 0, i = 0; bz < g[2]; bz += b)
+            for (by = 0; by < g[1]; by += b)
+                for (bx = 0; bx < g[0]; bx += b)
+                    for (z = bz; z < bz + b && z < g[2]; ++z)
+                        for (y = by; y < by + b && y < g[1]; ++y)
+                            for (x = bx, k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx; x < bx + b && x < g[0]; ++x, ++k)
+                                if (ctx->dl.bits[k >> 3] >> (k & 7) & 1u) ctx->vw.dl_idx[i++] = (uint32_t)k;
+    }
+done:
+    hd__free(&ctx->vw, entry_run);
+    hd__free(&ctx->vw, cell);
+    hd__free(&ctx->vw, ax);
+    hd__free(&ctx->vw, ay);
+    hd__free(&ctx->vw, span);
+    hd__free(&ctx->vw, crop);
+    if (r != HD_SUCCESS) hd__direct_mask_free(ctx);
+    ctx->vw.dl_gen++;
+    return r;
+}

@@ -1,0 +1,153 @@
+/* hd_readback.h - the image and illumination read back, the sRGB encoding and the statistics.
+   Part of the core (src/hd_core.h). */
+/* ---- read-back --------------------------------------------------------------------------------- */
+HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
+{
+    hd_result r;
+    size_t need;
+    HD__GET_CTX(ctx, h);
+    if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_f32: dst is NULL");
+    need = (size_t)ctx->vw.camera.width * ctx->vw.camera.height * 4;
+    if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_f32: %zu floats given, %zu needed", dst_floats, need);
+    HD__BE_CALL(r, ctx, hd__be_read_image(&ctx->vw, dst));
+    return r;
+}
+
+static uint8_t hd__srgb8(float v)
+{
+    float s;
+    if (!(v > 0.0f)) return 0;
+    if (v >= 1.0f) return 255;
+    s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)(s * 255.0f + 0.5f);
+}
+
+/* hd__srgb8 of the floats in [2^-9, 1), the range where it calls powf, by table: the floats there
+   in groups of 2^12 consecutive ones (their top 20 bits); entry k is the code every float of
+   group k maps to, or 0x100 where the group's first and last floats map to different codes (a
+   code boundary inside: those floats take hd__srgb8 itself). hd__srgb8 is non-decreasing, so a
+   group whose ends agree maps to that code throughout, and the table gives its bytes exactly at
+   a table lookup per value. NULL when there is no memory for it (hd__srgb8 then does it all). */
+#define HD__SRGB_LO 0x3B000000u /* 2^-9 */
+#define HD__SRGB_HI 0x3F800000u /* 1.0f */
+#define HD__SRGB_SHIFT 12
+static const uint16_t *hd__srgb_table(hd__ctx *ctx)
+{
+    uint32_t k, n = (HD__SRGB_HI - HD__SRGB_LO) >> HD__SRGB_SHIFT;
+    if (ctx->srgb || !(ctx->srgb = (uint16_t *)hd__alloc(&ctx->vw, n * sizeof(uint16_t)))) return ctx->srgb;
+    for (k = 0; k < n; ++k) {
+        uint32_t a = HD__SRGB_LO + (k << HD__SRGB_SHIFT), b = a + (1u << HD__SRGB_SHIFT) - 1u;
+        float fa, fb;
+        uint8_t ca, cb;
+        memcpy(&fa, &a, sizeof fa);
+        memcpy(&fb, &b, sizeof fb);
+        ca = hd__srgb8(fa);
+        cb = hd__srgb8(fb);
+        ctx->srgb[k] = ca == cb ? ca : 0x100;
+    }
+    return ctx->srgb;
+}
+
+/* hd__srgb8(v), through table t (hd__srgb_table) where it holds v's code. */
+static uint8_t hd__srgb8_by(const uint16_t *t, float v)
+{
+    uint32_t u;
+    memcpy(&u, &v, sizeof u);
+    if (t && u - HD__SRGB_LO < HD__SRGB_HI - HD__SRGB_LO) {
+        uint16_t c = t[(u - HD__SRGB_LO) >> HD__SRGB_SHIFT];
+        if (c < 0x100) return (uint8_t)c;
+    }
+    return hd__srgb8(v);
+}
+
+HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes)
+{
+    hd_result r;
+    size_t need, i, n;
+    float *tmp;
+    const uint16_t *t;
+    HD__GET_CTX(ctx, h);
+    if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_rgba8: dst is NULL");
+    n = (size_t)ctx->vw.camera.width * ctx->vw.camera.height;
+    need = n * 4;
+    if (dst_bytes < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_rgba8: %zu bytes given, %zu needed", dst_bytes, need);
+    tmp = (float *)hd__alloc(&ctx->vw, need * sizeof(float));
+    if (!tmp) return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_read_image_rgba8: no memory for the conversion");
+    HD__BE_CALL(r, ctx, hd__be_read_image(&ctx->vw, tmp));
+    if (r == HD_SUCCESS) {
+        float e = ctx->vw.params.exposure;
+        t = hd__srgb_table(ctx);
+        for (i = 0; i < n; ++i) {
+            float a = tmp[4 * i + 3];
+            dst[4 * i] = hd__srgb8_by(t, tmp[4 * i] * e);
+            dst[4 * i + 1] = hd__srgb8_by(t, tmp[4 * i + 1] * e);
+            dst[4 * i + 2] = hd__srgb8_by(t, tmp[4 * i + 2] * e);
+            dst[4 * i + 3] = (uint8_t)(a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)(a * 255.0f + 0.5f));
+        }
+    }
+    hd__free(&ctx->vw, tmp);
+    return r;
+}
+
+HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float *dst, size_t dst_floats)
+{
+    hd_result r;
+    size_t need;
+    HD__GET_CTX(ctx, h);
+    if ((int)which < 0 || which >= HD_ILLUMINATION_COUNT)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_ENUM, "hd_read_illumination: which = %d is not a hd_illumination", (int)which);
+    if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_illumination: dst is NULL");
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_read_illumination: method %s keeps no illumination volume",
+                       hd_method_name(ctx->vw.params.method));
+    need = hd__illum_floats(ctx);
+    if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
+    HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, which, NULL, 0, dst));
+    return r;
+}
+
+HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
+{
+    size_t gvox;
+    HD__GET_CTX(ctx, h);
+    if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_get_stats: out_stats is NULL");
+    memset(out, 0, sizeof *out);
+    gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
+    out->method = ctx->vw.params.method;
+    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations;
+    if (hd__method_is_pt(ctx->vw.params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
+    out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
+    out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;
+    /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
+       plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
+#ifdef HD__BE_SPLIT_LAYOUT /* the colour layout: one padding slot per row when gx is odd */
+    out->method_bytes = hd__split_slots(ctx->vw.gdims[0], ctx->vw.gdims[1], (size_t)ctx->vw.gdims[2] * (size_t)ctx->vw.sig_channels) * sizeof(float) +
+                        hd__split_slots(ctx->vw.gdims[0], ctx->vw.gdims[1], (size_t)ctx->vw.gdims[2] * (size_t)ctx->vw.channels) *
+                            hd__illum_elem_bytes(ctx) * (ctx->vw.params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+#else
+    out->method_bytes = gvox * sizeof(float) * (size_t)ctx->vw.sig_channels +
+                        hd__illum_floats(ctx) * hd__illum_elem_bytes(ctx) * (ctx->vw.params.solver == HD_SOLVER_JACOBI ? 3 : 2);
+#endif
+    if (ctx->vw.params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
+    out->method_bytes += hd__be_solver_bytes(&ctx->vw); /* the solver's own state (multigrid levels) */
+    out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
+    if (hd__method_is_pt(ctx->vw.params.method)) out->method_bytes = 0;
+    /* the buffer held, or the one the next call makes for a new camera size */
+    out->image_bytes = hd__image_floats(ctx->vw.camera.width, ctx->vw.camera.height,
+                                        (ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) *
+                       sizeof(float);
+    /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */
+    out->volume_bytes = ctx->vw.nvox * sizeof(float) + (size_t)ctx->vw.tf_count * 16 +
+                        (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2] * sizeof(float);
+    memcpy(out->illumination_dims, ctx->vw.gdims, sizeof ctx->vw.gdims);
+    out->illumination_channels = ctx->vw.channels;
+    out->seconds_direct = ctx->seconds[0];
+    out->seconds_diffusion = ctx->seconds[1];
+    out->seconds_projection = ctx->seconds[2];
+    if (!hd__method_is_pt(ctx->vw.params.method)) {
+        int fresh = (ctx->dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) != 0;
+        out->light_error = fresh ? 1.0 : ctx->light_error;
+        out->light_converged = !fresh && hd__light_converged(ctx);
+    }
+    return HD_SUCCESS;
+}

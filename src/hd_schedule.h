@@ -1,0 +1,304 @@
+/* hd_schedule.h - the schedule of each method's stages over the backend's primitives: bringing
+   the device up to date (hd__prepare), light iterations, projection frames, hd_render's loop and
+   recording. Part of the core (src/hd_core.h). */
+/* ---- the schedule ---------------------------------------------------------------------------- */
+/* Bytes per stored element of E, phi and Jacobi's buffer: binary16 or float32. */
+static size_t hd__illum_elem_bytes(const hd__ctx *ctx)
+{
+    return ctx->vw.params.illumination_precision == HD_PRECISION_FLOAT16 ? 2 : sizeof(float);
+}
+
+static size_t hd__illum_floats(const hd__ctx *ctx)
+{
+    return (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2] * (size_t)ctx->vw.channels;
+}
+
+/* Whether a new image buffer (a new camera size) keeps the reduced frames' region: the old one
+   had it and the parameters may still ask for reduced frames. */
+static int hd__image_room_kept(const hd__ctx *ctx)
+{
+    return ctx->image_room && ctx->vw.params.render_scale != 1 && !hd__method_is_pt(ctx->vw.params.method);
+}
+
+/* Brings the device state up to date with what the setters changed, in dependency order. */
+static hd_result hd__prepare(hd__ctx *ctx)
+{
+    hd_result r;
+    unsigned dirty = ctx->dirty;
+    int pt = hd__method_is_pt(ctx->vw.params.method);
+    if (dirty & HD__DIRTY_ALLOC) {
+        if ((r = hd__be_alloc_illumination(&ctx->vw, pt ? 0 : hd__illum_floats(ctx))) != HD_SUCCESS) return r;
+        dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE | HD__DIRTY_JACOBI;
+    }
+    if (dirty & HD__DIRTY_JACOBI) {
+        if ((r = hd__be_alloc_jacobi(&ctx->vw, !pt && ctx->vw.params.solver == HD_SOLVER_JACOBI)) != HD_SUCCESS) return r;
+    }
+    /* CD's light volumes follow the lights: reallocated (dark) when they change; freed for the
+       other methods (a method change sets every dirty bit) */
+    if (dirty & HD__DIRTY_DIRECT) {
+        if ((r = hd__be_alloc_lights(&ctx->vw, ctx->vw.params.method == HD_METHOD_CD ? ctx->light_count : 0)) != HD_SUCCESS)
+            return r;
+    }
+    /* the path tracers' state is their image: whatever resets it restarts them */
+    if (pt && (dirty & HD__DIRTY_IMAGE)) dirty |= HD__DIRTY_DIRECT;
+    if (dirty & HD__DIRTY_IMAGE_ALLOC) {
+        int room = hd__image_room_kept(ctx);
+        if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height, room)) != HD_SUCCESS) return r;
+        ctx->image_room = room;
+        dirty |= HD__DIRTY_IMAGE;
+    }
+    ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
+    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
+    if (dirty & HD__DIRTY_IMAGE) {
+        ctx->frames = ctx->converged_frames = 0;
+        ctx->frame_scale = 0;
+    }
+    /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
+    if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) {
+        hd__conv_reset(ctx);
+        ctx->light_gen++;
+    }
+    hd__fill_kparams(ctx);
+    if (dirty & HD__DIRTY_SIGMA) {
+        if ((r = hd__be_upload_inputs(&ctx->vw)) != HD_SUCCESS) return r;
+        if (!pt) {
+            ++ctx->sig_gen;
+            if ((r = hd__be_classify(&ctx->vw)) != HD_SUCCESS) return r;
+        }
+        hd__direct_mask_free(ctx);
+        if (ctx->vw.params.method == HD_METHOD_HD) {
+            if ((r = hd__direct_mask(ctx)) != HD_SUCCESS) return r;
+            if ((r = hd__be_direct_list(&ctx->vw)) != HD_SUCCESS) return r;
+        }
+    }
+    if ((r = hd__be_clear(&ctx->vw, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
+    ctx->dirty = 0;
+    return HD_SUCCESS;
+}
+
+/* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a
+   V-cycle; docs/DESIGN-MULTIGRID.md has its cost in red-black sweeps). */
+static hd_result hd__diffuse_once(hd__ctx *ctx)
+{
+    if (ctx->vw.params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step(ctx);
+    return hd__be_diffuse(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI);
+}
+
+/* The diffusion sweeps of HD and CD (none with disable_diffusion). */
+static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
+{
+    hd_result r;
+    int s;
+    if (ctx->vw.params.disable_diffusion) return HD_SUCCESS;
+    /* all of them in one call: the CPU backend walks memory once for several red-black sweeps */
+    if (ctx->vw.params.solver != HD_SOLVER_MULTIGRID)
+        return hd__be_diffuse_sweeps(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI, ctx->vw.params.diffusion_sweeps);
+    for (s = 0; s < ctx->vw.params.diffusion_sweeps; ++s)
+        if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
+    return HD_SUCCESS;
+}
+
+/* One light iteration, no projection. HD: a direct-light sample per voxel and the diffusion
+   sweeps; CD: one convection step per light, their sum into E, and the sweeps (convection and
+   sum count as the direct stage). Then the convergence estimate, counted with the diffusion. */
+static hd_result hd__light_iteration(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now(), t1, t2;
+    ctx->iterations++;
+    hd__fill_kparams(ctx);
+    if (ctx->vw.params.method == HD_METHOD_CD) {
+        int l;
+        for (l = 0; l < ctx->light_count; ++l)
+            if ((r = hd__be_convect(&ctx->vw, l)) != HD_SUCCESS) return r;
+        if ((r = hd__be_sum_lights(&ctx->vw)) != HD_SUCCESS) return r;
+    } else if ((r = hd__be_direct(&ctx->vw)) != HD_SUCCESS) return r;
+    t1 = hd__now();
+    if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
+    /* iterations recorded into a caller's command buffer have not run yet: nothing to measure */
+    if (ctx->no_measure) hd__conv_reset(ctx);
+    else r = hd__light_measure(ctx);
+    t2 = hd__now();
+    ctx->seconds[0] += t1 - t0;
+    ctx->seconds[1] += t2 - t1;
+    if (!hd__light_converged(ctx)) ctx->converged_frames = 0;
+    return r;
+}
+
+/* One projection frame from the current E and phi into the image's running mean. At render
+   scale s > 1 the march covers the reduced size into the image buffer's second region, then the
+   upsample pass (hd__be_upsample, hd_k_upsample.h) fills the full
+   image from it; the parameter block is left describing the full image. */
+static hd_result hd__project_frame(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now(), t1, t2;
+    int s;
+    if ((r = hd__use_scale(ctx, hd__next_scale(ctx))) != HD_SUCCESS) return r;
+    t1 = hd__now(); /* the frame cost starts after a first reduced frame's allocation */
+    s = ctx->frame_scale;
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    if (s > 1) {
+        int w = ctx->vw.kp.image.x, h = ctx->vw.kp.image.y;
+        ctx->vw.kp.image.x = (w + s - 1) / s;
+        ctx->vw.kp.image.y = (h + s - 1) / s;
+        ctx->vw.kp.image.w = w * h;
+        r = hd__be_project(&ctx->vw);
+        if (r == HD_SUCCESS) {
+            ctx->vw.kp.image.x = w;
+            ctx->vw.kp.image.y = h;
+            ctx->vw.kp.image.w = s;
+            ctx->vw.kp.counts.z |= HD_FLAG_UPSAMPLE;
+            r = hd__be_upsample(&ctx->vw);
+        }
+        hd__fill_kparams(ctx);
+    } else {
+        r = hd__be_project(&ctx->vw);
+    }
+    t2 = hd__now();
+    ctx->seconds[2] += t2 - t0;
+    /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
+    if (r == HD_SUCCESS && !ctx->no_measure) hd__frame_cost_add(ctx, s, hd__scale_pixels(ctx, s), t2 - t1);
+    return r;
+}
+
+/* One HD or CD iteration: a light iteration and one frame. */
+static hd_result hd__iterate_light(hd__ctx *ctx)
+{
+    hd_result r;
+    if ((r = hd__light_iteration(ctx)) != HD_SUCCESS) return r;
+    return hd__project_frame(ctx);
+}
+
+/* One PT_SS / PT_MS iteration: one full path per pixel into the image's plain running mean.
+   Its time counts as the direct stage (paths), none as diffusion or projection. */
+static hd_result hd__iterate_pt(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now();
+    ctx->iterations++;
+    ctx->frames++;
+    hd__fill_kparams(ctx);
+    if ((r = hd__be_path(&ctx->vw)) != HD_SUCCESS) return r;
+    ctx->seconds[0] += hd__now() - t0;
+    return HD_SUCCESS;
+}
+
+/* One iteration of the current method (docs/METHOD.md: what an iteration is, per method). */
+static hd_result hd__iterate_method(hd__ctx *ctx)
+{
+    switch (ctx->vw.params.method) {
+    case HD_METHOD_CD: return hd__iterate_light(ctx);
+    case HD_METHOD_PT_SS:
+    case HD_METHOD_PT_MS: return hd__iterate_pt(ctx);
+    case HD_METHOD_HD: return hd__iterate_light(ctx);
+    default:
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "method %s is not available on the %s backend",
+                       hd_method_name(ctx->vw.params.method), hd__be_name());
+    }
+}
+
+/* n iterations of step (one iteration of hd_iterate or hd_refine), stopping at the first error. */
+static hd_result hd__iterate_n(hd__ctx *ctx, int n, hd_result (*step)(hd__ctx *))
+{
+    hd_result r = HD_SUCCESS;
+    int i;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = step(ctx);
+    return r;
+}
+
+/* A light iteration of hd_refine or hd_render. When the light converges, the frames in the
+   image saw light that was still changing: the image starts afresh. */
+static hd_result hd__refine_once(hd__ctx *ctx)
+{
+    int before = hd__light_converged(ctx);
+    hd_result r = hd__light_iteration(ctx);
+    if (r == HD_SUCCESS && !before && hd__light_converged(ctx)) {
+        ctx->frames = 0;
+        ctx->converged_frames = 0;
+        HD__INFO(&ctx->vw.log, "light converged after %llu iterations (estimated error %.3g)",
+                 (unsigned long long)ctx->iterations, ctx->light_error);
+    }
+    return r;
+}
+
+/* hd_render's work after hd__prepare. */
+static hd_result hd__render(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now(), last = 0.0, budget;
+    budget = (double)ctx->vw.params.render_budget;
+    if (hd__method_is_pt(ctx->vw.params.method)) {
+        /* the image is the path tracers' state: each call adds at least one path per pixel */
+        do {
+            double ti = hd__now();
+            if (ctx->iterations >= 0x7fffffffu) break;
+            if ((r = hd__iterate_method(ctx)) != HD_SUCCESS) return r;
+            last = hd__now() - ti;
+        } while (hd__now() - t0 + last <= budget);
+        return HD_SUCCESS;
+    }
+    /* refine while not converged: at least once, then while the budget has room for another */
+    while (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu) {
+        double ti = hd__now();
+        if ((r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
+        last = hd__now() - ti;
+        if (hd__now() - t0 + last > budget) break;
+    }
+    if (hd__light_converged(ctx)) {
+        /* the image is done once frame_window frames at its final scale are in */
+        int s = hd__next_scale(ctx);
+        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) return HD_SUCCESS;
+        if ((r = hd__use_scale(ctx, s)) != HD_SUCCESS) return r;
+        ctx->converged_frames++;
+    }
+    return hd__project_frame(ctx);
+}
+
+/* hd_vulkan_record's work after hd__prepare: n iterations whose primitives the backend records
+   into the caller's command buffer (HD__BE_RECORD). Recorded iterations have not run when this
+   returns: the light's convergence is not measured, and each HD or CD frame is timed on the
+   device between two marks, read by the next call (hd__record_cost). */
+static hd_result hd__record(hd__ctx *ctx, void *target, int n)
+{
+    hd_result r;
+    int i, light = ctx->vw.params.method == HD_METHOD_HD || ctx->vw.params.method == HD_METHOD_CD;
+    /* reduced frames need the image buffer's second region, which cannot be made mid-recording */
+    if (!hd__method_is_pt(ctx->vw.params.method) && ctx->vw.params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS)
+        return r;
+    /* per iteration: light, frame and a reduced frame's upsample pass */
+    if ((r = hd__be_record_begin(&ctx->vw, target, 3 * n + 2)) != HD_SUCCESS) return r;
+    ctx->no_measure = 1;
+    ctx->cost.rec_pending = 0;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) {
+        if (!light) {
+            r = hd__iterate_method(ctx);
+            continue;
+        }
+        if ((r = hd__light_iteration(ctx)) != HD_SUCCESS) break;
+        hd__be_record_mark(&ctx->vw, 0);
+        if ((r = hd__project_frame(ctx)) != HD_SUCCESS) break;
+        hd__be_record_mark(&ctx->vw, 1);
+        ctx->cost.rec_pending = 1;
+        ctx->cost.rec_scale = ctx->frame_scale;
+        ctx->cost.rec_pixels = hd__scale_pixels(ctx, ctx->frame_scale);
+        ctx->cost.rec_gen = ctx->cost.gen;
+    }
+    ctx->no_measure = 0;
+    if (r != HD_SUCCESS) ctx->cost.rec_pending = 0; /* a failed recording is not submitted */
+    return hd__be_record_end(&ctx->vw, r);
+}
+
+/* The last recorded frame's device time into the frame cost model HD_RENDER_SCALE_AUTO predicts
+   from, once the caller has run it; a frame measured since by hd_iterate or hd_render is newer
+   and is kept. */
+static void hd__record_cost(hd__ctx *ctx)
+{
+    double dt = 0.0;
+    if (!ctx->cost.rec_pending) return;
+    ctx->cost.rec_pending = 0;
+    if (hd__be_record_seconds(&ctx->vw, &dt) && ctx->cost.gen == ctx->cost.rec_gen)
+        hd__frame_cost_add(ctx, ctx->cost.rec_scale, ctx->cost.rec_pixels, dt);
+}

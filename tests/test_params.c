@@ -1,0 +1,297 @@
+/* test_params.c - hd_params' table (src/hd_params.h) against what the library does: every field
+   changed alone invalidates what its row says and nothing else, and a field the state depends on
+   (measured from fresh contexts) is invalidated by its row. Handles: a slot's generation runs out
+   into retirement, never into a reused handle. */
+#include "hybriddiff.h"
+#include "hd_test.h"
+#include <float.h>
+#include <stddef.h>
+
+int hdt_param_rows(void);
+const char *hdt_param_row(int i, size_t *offset, size_t *size, unsigned *invalidates);
+int hdt_param_bits(unsigned *direct, unsigned *phi, unsigned *image, unsigned *paths);
+unsigned hdt_slot_generation(int slot, unsigned generation);
+int hdt_slots(void);
+
+/* Another valid value for each field: a row without one here fails the walk, so a new field must
+   say how it is changed. */
+static int param_change(const char *name, hd_params *p)
+{
+#define F(n, stmt) if (strcmp(name, #n) == 0) { stmt; return 1; }
+    F(method, p->method = p->method == HD_METHOD_HD ? HD_METHOD_CD : HD_METHOD_HD)
+    F(extinction, p->extinction *= 0.5f)
+    F(albedo, p->albedo = 0.6f)
+    F(anisotropy, p->anisotropy = 0.4f)
+    F(majorant, p->majorant = 0.0f) /* set on the walk's contexts, changed back to the grid */
+    F(solver, p->solver = HD_SOLVER_JACOBI)
+    F(diffusion_sweeps, p->diffusion_sweeps += 3)
+    F(disable_diffusion, p->disable_diffusion = !p->disable_diffusion)
+    F(tracking, p->tracking = HD_TRACKING_DELTA)
+    F(seed, p->seed += 11)
+    F(background, p->background[1] = 0.25f)
+    F(step, p->step = 0.8f)
+    F(frame_window, p->frame_window = 3)
+    F(exposure, p->exposure = 2.0f)
+    F(max_bounces, p->max_bounces = 1)
+    F(illumination_downsample, p->illumination_downsample = 1)
+    F(rgb_scattering, p->rgb_scattering = 1)
+    F(diffusion_boundary, p->diffusion_boundary = HD_BOUNDARY_BOX)
+    F(illumination_precision, p->illumination_precision = HD_PRECISION_FLOAT16)
+    F(light_tolerance, p->light_tolerance = 0.02f)
+    F(render_budget, p->render_budget = 0.001f)
+    F(crop_min, p->crop_min[0] = 0.3f)
+    F(crop_max, p->crop_max[2] = 0.7f)
+    F(render_scale, p->render_scale = 2)
+#undef F
+    return 0;
+}
+
+/* The fields whose change leaves every limit as it is: the solver's path to the same solution
+   (solver, sweeps), an estimator of the same expectation (tracking), what only the 8-bit encoding
+   or hd_render's loop reads (exposure, light_tolerance, render_budget). Their rows invalidate
+   nothing, though a run of a few iterations can differ. */
+static int same_limit(const char *name)
+{
+    static const char *names[] = {"solver", "diffusion_sweeps", "tracking", "exposure", "light_tolerance", "render_budget"};
+    size_t i;
+    for (i = 0; i < sizeof names / sizeof names[0]; ++i)
+        if (strcmp(name, names[i]) == 0) return 1;
+    return 0;
+}
+
+enum { PN = 12, PW = 12 };
+static unsigned char pvox[PN * PN * PN];
+
+static void param_desc(hd_desc *d, hd_method m)
+{
+    int x, y, z;
+    for (z = 0; z < PN; ++z)
+        for (y = 0; y < PN; ++y)
+            for (x = 0; x < PN; ++x) pvox[(z * PN + y) * PN + x] = (unsigned char)((x * 37 + y * 11 + z * 5) % 200 + 40);
+    memset(d, 0, sizeof *d);
+    d->volume.type = HD_VOXEL_U8;
+    d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = PN;
+    d->volume.data = pvox;
+    d->camera.width = d->camera.height = PW;
+    d->params.method = m;
+    d->params.extinction = 30.0f;
+    d->params.max_bounces = 8;
+    d->threads = 1;
+}
+
+/* E, phi and the image after n iterations of a fresh context with params p (method p->method). */
+typedef struct param_state {
+    float img[PW * PW * 4];
+    float e[PN * PN * PN * 3], phi[PN * PN * PN * 3];
+    int ok;
+} param_state;
+static void param_run(const hd_params *p, int n, param_state *st)
+{
+    hd_desc d;
+    hd_context c;
+    param_desc(&d, p->method);
+    d.params = *p;
+    memset(st, 0, sizeof *st);
+    if (hd_create(&d, &c) != HD_SUCCESS) return;
+    st->ok = hd_iterate(c, n) == HD_SUCCESS && hd_read_image_f32(c, st->img, PW * PW * 4) == HD_SUCCESS;
+    if (p->method == HD_METHOD_HD)
+        st->ok = st->ok && hd_read_illumination(c, HD_ILLUMINATION_DIRECT, st->e, sizeof st->e / sizeof st->e[0]) == HD_SUCCESS &&
+                 hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, st->phi, sizeof st->phi / sizeof st->phi[0]) == HD_SUCCESS;
+    hd_destroy(c);
+}
+
+/* Every field changed alone, on an HD and a PT_MS context after two iterations: what the next
+   call would reset (hd_get_stats: iterations 0 when E restarts, frames 0 when the image restarts,
+   light_error 1 when E or phi restarts) is exactly the row's invalidation. */
+static void test_param_table_invalidation(void)
+{
+    unsigned bd, bp, bi, bpaths;
+    int i, k, rows = hdt_param_rows();
+    static const hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_PT_MS};
+    hdt_param_bits(&bd, &bp, &bi, &bpaths);
+    CHECK(rows >= 24);
+    for (i = 0; i < rows; ++i) {
+        size_t off, size;
+        unsigned row_inv;
+        const char *name = hdt_param_row(i, &off, &size, &row_inv);
+        for (k = 0; k < 2; ++k) {
+            unsigned inv = row_inv;
+            hd_desc d;
+            hd_context c;
+            hd_params p;
+            hd_stats s;
+            int want_d, want_i, want_fresh, pt = methods[k] == HD_METHOD_PT_MS;
+            param_desc(&d, methods[k]);
+            if (strcmp(name, "majorant") == 0) d.params.majorant = 100.0f;
+            CHECK(hd_create(&d, &c) == HD_SUCCESS);
+            CHECK(hd_iterate(c, 2) == HD_SUCCESS);
+            CHECK(hd_query_desc(c, &d) == HD_SUCCESS);
+            p = d.params;
+            CHECK_MSG(param_change(name, &p), "params.%s has no change in test_params.c", name);
+            CHECK_MSG(memcmp((const char *)&p + off, (const char *)&d.params + off, size) != 0, "params.%s did not change", name);
+            CHECK_MSG(hd_set_params(c, &p) == HD_SUCCESS, "params.%s", name);
+            CHECK(hd_get_stats(c, &s) == HD_SUCCESS);
+            if (inv & bpaths) inv = (inv & ~bpaths) | (pt ? bi : 0u);
+            if (pt && (inv & bi)) inv |= bd; /* a path tracer's image is its whole state */
+            if (strcmp(name, "method") == 0) inv = bd | bp | bi;
+            want_d = (inv & bd) != 0;
+            want_i = (inv & bi) != 0;
+            want_fresh = !pt && (inv & (bd | bp)) != 0;
+            CHECK_MSG((s.iterations == 0) == want_d && (s.frames == 0) == want_i && (!pt && s.light_error == 1.0) == want_fresh,
+                      "params.%s on %s: iterations %llu, frames %llu, light_error %g; the row invalidates E %d, image %d, light %d",
+                      name, pt ? "PT_MS" : "HD", (unsigned long long)s.iterations, (unsigned long long)s.frames, s.light_error,
+                      want_d, want_i, want_fresh);
+            hd_destroy(c);
+        }
+    }
+}
+
+/* Every field the state depends on is invalidated by its row: fresh contexts with the old and the
+   new value, 3 iterations each; where E, phi or the image differ, the row must reset it (a
+   field of same_limit() excepted). Fails on a row that forgets a dependence, as max_bounces did
+   for PT_MS's running mean. */
+static void test_param_table_dependence(void)
+{
+    static param_state a, b;
+    unsigned bd, bp, bi, bpaths;
+    int i, k, rows = hdt_param_rows();
+    static const hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_PT_MS};
+    hdt_param_bits(&bd, &bp, &bi, &bpaths);
+    for (i = 0; i < rows; ++i) {
+        size_t off, size;
+        unsigned inv;
+        const char *name = hdt_param_row(i, &off, &size, &inv);
+        if (strcmp(name, "method") == 0 || same_limit(name)) continue;
+        for (k = 0; k < 2; ++k) {
+            hd_desc d;
+            hd_params p;
+            int pt = methods[k] == HD_METHOD_PT_MS, de, dphi, dimg;
+            unsigned eff = inv;
+            param_desc(&d, methods[k]);
+            if (strcmp(name, "majorant") == 0) d.params.majorant = 100.0f;
+            p = d.params;
+            param_run(&p, 3, &a);
+            CHECK(param_change(name, &p));
+            param_run(&p, 3, &b);
+            CHECK_MSG(a.ok && b.ok, "params.%s: runs failed", name);
+            if (eff & bpaths) eff = (eff & ~bpaths) | (pt ? bi : 0u);
+            de = memcmp(a.e, b.e, sizeof a.e) != 0;
+            dphi = memcmp(a.phi, b.phi, sizeof a.phi) != 0;
+            dimg = memcmp(a.img, b.img, sizeof a.img) != 0;
+            CHECK_MSG(!de || (eff & bd), "params.%s: E depends on it, its row does not reset E", name);
+            CHECK_MSG(!dphi || (eff & bp), "params.%s: phi depends on it, its row does not reset phi", name);
+            CHECK_MSG(!dimg || (eff & bi), "params.%s on %s: the image depends on it, its row does not reset the image", name,
+                      pt ? "PT_MS" : "HD");
+        }
+    }
+}
+
+/* PT_MS after a max_bounces change: the running mean restarts (hd_stats.frames 1 after a call). */
+static void test_param_max_bounces_restarts(void)
+{
+    hd_desc d;
+    hd_context c;
+    hd_stats s;
+    param_desc(&d, HD_METHOD_PT_MS);
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_iterate(c, 3) == HD_SUCCESS);
+    d.params.max_bounces = 2;
+    CHECK(hd_set_params(c, &d.params) == HD_SUCCESS);
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(c, &s) == HD_SUCCESS);
+    CHECK_MSG(s.frames == 1 && s.iterations == 1, "frames %llu, iterations %llu", (unsigned long long)s.frames,
+              (unsigned long long)s.iterations);
+    hd_destroy(c);
+}
+
+/* Every enum field out of range is HD_ERROR_INVALID_ENUM, logged; render_budget above its bound
+   and a background that could overflow the image's sums are rejected. */
+static void test_param_codes(void)
+{
+    hd_desc d;
+    hd_context c;
+    hd_test_log log;
+    hd_params p;
+    param_desc(&d, HD_METHOD_HD);
+    d.logger = hd_test_logger(&log);
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_query_desc(c, &d) == HD_SUCCESS);
+#define BAD(stmt, code) do { p = d.params; stmt; log.errors = 0; \
+        CHECK_MSG(hd_set_params(c, &p) == (code) && log.errors == 1, "%s", #stmt); } while (0)
+    BAD(p.method = (hd_method)9, HD_ERROR_INVALID_ENUM);
+    BAD(p.solver = (hd_solver)-2, HD_ERROR_INVALID_ENUM);
+    BAD(p.tracking = (hd_tracking)3, HD_ERROR_INVALID_ENUM);
+    BAD(p.diffusion_boundary = (hd_boundary)3, HD_ERROR_INVALID_ENUM);
+    BAD(p.diffusion_boundary = (hd_boundary)-1, HD_ERROR_INVALID_ENUM);
+    BAD(p.illumination_precision = (hd_precision)1000, HD_ERROR_INVALID_ENUM);
+    BAD(p.render_budget = 10.5f, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.render_budget = 1e30f, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.background[0] = FLT_MAX, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.background[2] = 2e6f, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.exposure = NAN, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.render_scale = 0 - 2, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.frame_window = -1, HD_ERROR_INVALID_PARAMETER);
+    BAD(p.crop_min[1] = 0.9f; p.crop_max[1] = 0.5f, HD_ERROR_INVALID_PARAMETER);
+#undef BAD
+    p = d.params;
+    p.render_budget = 10.0f;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS);
+    hd_destroy(c);
+}
+
+/* Every slot at the end of its generations: the last handle of a slot works, and once destroyed
+   the slot is retired (its handles never come back); the next context takes another slot. The
+   slots' generations are restored after. */
+static void test_handle_retirement(void)
+{
+    hd_desc d;
+    hd_context a, b;
+    unsigned saved[256];
+    int i, n = hdt_slots();
+    param_desc(&d, HD_METHOD_HD);
+    for (i = 0; i < n; ++i) saved[i] = hdt_slot_generation(i, 0xfffffeu);
+    CHECK(hd_create(&d, &a) == HD_SUCCESS);
+    CHECK_MSG((a.id >> 8) == 0xffffffu, "handle 0x%08x", (unsigned)a.id);
+    CHECK(hd_get_stats(a, NULL) == HD_ERROR_NULL_POINTER); /* valid */
+    CHECK(hd_destroy(a) == HD_SUCCESS);
+    CHECK(hd_get_stats(a, NULL) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_destroy(a) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_create(&d, &b) == HD_SUCCESS);
+    CHECK_MSG((b.id & 0xffu) != (a.id & 0xffu) && b.id != a.id, "a retired slot was reused: 0x%08x after 0x%08x", (unsigned)b.id,
+              (unsigned)a.id);
+    CHECK(hd_get_stats(a, NULL) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_destroy(b) == HD_SUCCESS);
+    for (i = 0; i < n; ++i) hdt_slot_generation(i, saved[i]);
+}
+
+/* After hd_destroy the context's logger is never called, also for the stale handle's use. */
+static int destroyed_logger_calls;
+static void count_log(void *user, hd_log_level level, hd_result code, const char *message, const char *file, int line)
+{
+    (void)user; (void)level; (void)code; (void)message; (void)file; (void)line;
+    ++destroyed_logger_calls;
+}
+static void test_logger_after_destroy(void)
+{
+    hd_desc d;
+    hd_context c;
+    param_desc(&d, HD_METHOD_HD);
+    d.logger.func = count_log;
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_destroy(c) == HD_SUCCESS);
+    destroyed_logger_calls = 0;
+    CHECK(hd_render(c) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_set_params(c, &d.params) == HD_ERROR_INVALID_HANDLE);
+    CHECK(hd_destroy(c) == HD_ERROR_INVALID_HANDLE);
+    CHECK(destroyed_logger_calls == 0);
+}
+
+const hd_test_case hd_tests_params[] = {
+    {"param_table_invalidation", test_param_table_invalidation},
+    {"param_table_dependence", test_param_table_dependence},
+    {"param_max_bounces_restarts", test_param_max_bounces_restarts},
+    {"param_codes", test_param_codes},
+    {"handle_retirement", test_handle_retirement},
+    {"logger_after_destroy", test_logger_after_destroy},
+};
+const int hd_tests_params_count = sizeof hd_tests_params / sizeof hd_tests_params[0];
