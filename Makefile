@@ -35,6 +35,7 @@ help:
 	@echo "  make compile-vulkan-cxx             T the Vulkan implementation as C++17, warnings as errors"
 	@echo "  make compile-gl-cxx                 T the GL implementation as C++17, warnings as errors"
 	@echo "  make test-gl                        T GL host state restored, render to texture, caller's context checks"
+	@echo "  make test-null                      T the public API over the null backend (computes nothing, counts primitives)"
 	@echo "  make test-vulkan                    T caller's device and hd_vulkan_record, device memory and device-lost paths"
 	@echo "  make test-hdview                    T the viewer under Xvfb against hdrender's image"
 	@echo "  make alloc-fail-opencl              T every k-th host allocation failed on the OpenCL backend"

@@ -35,6 +35,9 @@
       HYBRIDDIFF_BACKEND_OPENCL  OpenCL 1.2+ (link -lOpenCL)
       HYBRIDDIFF_BACKEND_VULKAN  Vulkan 1.1+  (link -lvulkan)
       HYBRIDDIFF_BACKEND_GL      OpenGL 4.3+ compute (link -lEGL -lOpenGL)
+      HYBRIDDIFF_BACKEND_NULL    computes nothing (images and illumination stay zero): the
+                                 public API's checks and schedule alone, for tests, and the
+                                 template of a new backend (docs/BACKENDS.md)
       HYBRIDDIFF_STATIC          make every function static (private to one translation unit)
       HYBRIDDIFF_NO_ZLIB         build the file loaders without zlib (gzip-encoded files are then
                                  rejected with HD_ERROR_UNSUPPORTED_ENCODING); otherwise link -lz
@@ -646,11 +649,11 @@ HDDEF void hd_volume_free(hd_volume_file *vol);
 #define HYBRIDDIFF_IMPLEMENTATION_DONE
 
 #if (defined(HYBRIDDIFF_BACKEND_CPU) + defined(HYBRIDDIFF_BACKEND_OPENCL) + \
-     defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL)) == 0
-#error "hybriddiff: define exactly one backend: HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN or HYBRIDDIFF_BACKEND_GL"
+     defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL) + defined(HYBRIDDIFF_BACKEND_NULL)) == 0
+#error "hybriddiff: define exactly one backend: HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN, HYBRIDDIFF_BACKEND_GL or HYBRIDDIFF_BACKEND_NULL"
 #elif (defined(HYBRIDDIFF_BACKEND_CPU) + defined(HYBRIDDIFF_BACKEND_OPENCL) + \
-       defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL)) > 1
-#error "hybriddiff: more than one backend defined; define exactly one of HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN, HYBRIDDIFF_BACKEND_GL"
+       defined(HYBRIDDIFF_BACKEND_VULKAN) + defined(HYBRIDDIFF_BACKEND_GL) + defined(HYBRIDDIFF_BACKEND_NULL)) > 1
+#error "hybriddiff: more than one backend defined; define exactly one of HYBRIDDIFF_BACKEND_CPU, HYBRIDDIFF_BACKEND_OPENCL, HYBRIDDIFF_BACKEND_VULKAN, HYBRIDDIFF_BACKEND_GL, HYBRIDDIFF_BACKEND_NULL"
 #else /* exactly one backend: the implementation (skipped after an #error, so that is all the
          compiler reports) */
 
@@ -704,6 +707,8 @@ extern char *realpath(const char *path, char *resolved);
 #elif defined(HYBRIDDIFF_BACKEND_GL)
 #include "backends/hd_gpu.h"
 #include "backends/hd_gl.h"
+#elif defined(HYBRIDDIFF_BACKEND_NULL)
+#include "backends/hd_null.h"
 #endif
 #include "src/hd_core.h"
 #include "src/hd_io.h"

@@ -1,0 +1,209 @@
+/* test_null.c - the public API over the null backend (backends/hd_null.h), which computes
+   nothing and counts the primitives it is called with: every call the header documents works
+   through the contract of src/hd_backend.h alone, each primitive runs inside a bracket, and each
+   setter reaches exactly the stages its invalidation names (hybriddiff.h, above
+   hd_set_transfer_function). `make test-null` runs it (part of make test). */
+#define HYBRIDDIFF_IMPLEMENTATION
+#define HYBRIDDIFF_BACKEND_NULL
+#include "hybriddiff.h"
+#include "tests/hd_test.h"
+
+int hd_test_failures;
+
+static const hd__backend *be_of(hd_context h)
+{
+    const hd__ctx *c = hd__lookup(h);
+    return c ? c->vw.be : NULL;
+}
+
+/* The counters' change over one call (after - before), per primitive. */
+typedef struct calls {
+    unsigned long n[HD__NULL_COUNT];
+    unsigned cleared;
+} calls;
+static calls snap(hd_context h)
+{
+    calls c;
+    const hd__backend *be = be_of(h);
+    memcpy(c.n, be->calls, sizeof c.n);
+    c.cleared = be->cleared;
+    return c;
+}
+static unsigned long delta(hd_context h, const calls *before, int which) { return be_of(h)->calls[which] - before->n[which]; }
+
+enum { N = 8, W = 16 };
+static unsigned char vox[N * N * N];
+
+static void make_desc(hd_desc *d)
+{
+    int i;
+    for (i = 0; i < N * N * N; ++i) vox[i] = (unsigned char)(i * 7 % 251);
+    memset(d, 0, sizeof *d);
+    d->volume.type = HD_VOXEL_U8;
+    d->volume.dims[0] = d->volume.dims[1] = d->volume.dims[2] = N;
+    d->volume.data = vox;
+    d->camera.width = d->camera.height = W;
+}
+
+/* Every public call succeeds (or is refused as documented) over the null backend. */
+static void test_null_api(void)
+{
+    static float img[W * W * 4], ill[N * N * N * 3];
+    static uint8_t px[W * W * 4];
+    hd_desc d;
+    hd_context h;
+    hd_stats s;
+    hd_params p;
+    hd_camera cam;
+    hd_light l[2];
+    float tf[8] = {0, 0, 0, 0, 1, 1, 1, 1};
+    hd_transfer_function t;
+    int m;
+    make_desc(&d);
+    CHECK(strcmp(hd_backend_name(), "null") == 0);
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    CHECK(hd_iterate(h, 2) == HD_SUCCESS);
+    CHECK(hd_refine(h, 1) == HD_SUCCESS);
+    CHECK(hd_render(h) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(h, img, sizeof img / sizeof img[0]) == HD_SUCCESS && img[0] == 0.0f);
+    CHECK(hd_read_image_rgba8(h, px, sizeof px) == HD_SUCCESS && px[3] == 0);
+    CHECK(hd_read_illumination(h, HD_ILLUMINATION_DIRECT, ill, sizeof ill / sizeof ill[0]) == HD_SUCCESS);
+    CHECK(hd_read_illumination(h, HD_ILLUMINATION_SCATTERED, ill, sizeof ill / sizeof ill[0]) == HD_SUCCESS);
+    CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 3 && s.method == HD_METHOD_HD);
+    CHECK(hd_vulkan_record(h, (void *)px, 1) == HD_ERROR_UNSUPPORTED);
+    CHECK(hd_gl_render_to_texture(h, 1) == HD_ERROR_UNSUPPORTED);
+    t.rgba = tf;
+    t.count = 2;
+    CHECK(hd_set_transfer_function(h, &t) == HD_SUCCESS);
+    memset(l, 0, sizeof l);
+    l[0].direction[1] = -1.0f;
+    l[1].type = HD_LIGHT_POINT;
+    l[1].position[0] = 2.0f;
+    l[1].color[0] = 1.0f;
+    CHECK(hd_set_lights(h, l, 2) == HD_SUCCESS);
+    CHECK(hd_query_desc(h, &d) == HD_SUCCESS);
+    cam = d.camera;
+    cam.width = 9;
+    CHECK(hd_set_camera(h, &cam) == HD_SUCCESS);
+    for (m = HD_METHOD_HD; m < HD_METHOD_COUNT; ++m) {
+        p = d.params;
+        p.method = (hd_method)m;
+        p.render_scale = m == HD_METHOD_HD ? HD_RENDER_SCALE_AUTO : 2;
+        CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+        CHECK_MSG(hd_iterate(h, 2) == HD_SUCCESS && hd_render(h) == HD_SUCCESS, "method %s", hd_method_name((hd_method)m));
+        CHECK(hd_read_image_f32(h, img, sizeof img / sizeof img[0]) == HD_SUCCESS);
+    }
+    p = d.params;
+    p.solver = HD_SOLVER_MULTIGRID;
+    p.diffusion_sweeps = 2;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    CHECK(hd_iterate(h, 2) == HD_SUCCESS);
+    CHECK(be_of(h)->calls[HD__NULL_mg_begin] > 0 && be_of(h)->calls[HD__NULL_mg_row_sums] > 0);
+    p.solver = HD_SOLVER_JACOBI;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS && be_of(h)->jacobi == 1);
+    CHECK(!be_of(h)->misuse);
+    CHECK(be_of(h)->calls[HD__NULL_begin] == be_of(h)->calls[HD__NULL_end]);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    CHECK(hd_destroy(h) == HD_ERROR_INVALID_HANDLE);
+}
+
+/* Each setter, then one hd_iterate: the stages it reaches are what its invalidation names. */
+static void test_null_invalidation(void)
+{
+    hd_desc d;
+    hd_context h;
+    hd_params p;
+    hd_camera cam;
+    calls c;
+    make_desc(&d);
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS); /* the first: everything */
+    CHECK(delta(h, &c, HD__NULL_upload_inputs) == 1 && delta(h, &c, HD__NULL_classify) == 1 && delta(h, &c, HD__NULL_direct_list) == 1);
+    CHECK(delta(h, &c, HD__NULL_alloc_illumination) == 1 && delta(h, &c, HD__NULL_alloc_image) == 1);
+    CHECK(delta(h, &c, HD__NULL_direct) == 1 && delta(h, &c, HD__NULL_diffuse_sweeps) == 1 && delta(h, &c, HD__NULL_project) == 1);
+    CHECK(hd_query_desc(h, &d) == HD_SUCCESS);
+    /* the camera: the image only, no light work beyond the iteration's own */
+    cam = d.camera;
+    cam.eye[0] = 1.0f;
+    CHECK(hd_set_camera(h, &cam) == HD_SUCCESS);
+    c = snap(h);
+    ((hd__backend *)be_of(h))->cleared = 0;
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_classify) == 0 && delta(h, &c, HD__NULL_upload_inputs) == 0 && delta(h, &c, HD__NULL_alloc_image) == 0);
+    CHECK_MSG(be_of(h)->cleared == HD__DIRTY_IMAGE, "cleared 0x%x", be_of(h)->cleared);
+    /* a new image size: a new image buffer */
+    cam.width = 12;
+    CHECK(hd_set_camera(h, &cam) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS && delta(h, &c, HD__NULL_alloc_image) == 1);
+    /* albedo: phi and the image, not sigma_t or E */
+    p = d.params;
+    p.albedo = 0.5f;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    c = snap(h);
+    ((hd__backend *)be_of(h))->cleared = 0;
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_classify) == 0);
+    CHECK_MSG(be_of(h)->cleared == (HD__DIRTY_PHI | HD__DIRTY_IMAGE), "cleared 0x%x", be_of(h)->cleared);
+    /* extinction: sigma_t again, and E, phi, image */
+    p.extinction = 50.0f;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    c = snap(h);
+    ((hd__backend *)be_of(h))->cleared = 0;
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_upload_inputs) == 1 && delta(h, &c, HD__NULL_classify) == 1 && delta(h, &c, HD__NULL_direct_list) == 1);
+    CHECK(be_of(h)->cleared == (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE));
+    /* exposure, tracking, sweeps: nothing */
+    p.exposure = 3.0f;
+    p.tracking = HD_TRACKING_DELTA;
+    p.diffusion_sweeps = 2;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    c = snap(h);
+    ((hd__backend *)be_of(h))->cleared = 0;
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(be_of(h)->cleared == 0 && delta(h, &c, HD__NULL_classify) == 0);
+    /* the grid: new illumination grids */
+    p.illumination_downsample = 1;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS && delta(h, &c, HD__NULL_alloc_illumination) == 1 && delta(h, &c, HD__NULL_classify) == 1);
+    CHECK(be_of(h)->illum_floats == (size_t)N * N * N);
+    /* a reduced frame: projection then upsample */
+    p.render_scale = 2;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS && delta(h, &c, HD__NULL_project) == 1 && delta(h, &c, HD__NULL_upsample) == 1);
+    CHECK(be_of(h)->reduced == 1);
+    /* converged light: hd_render projects without light work, then stops once the image is done */
+    p.light_tolerance = 1e30f;
+    p.render_scale = 1;
+    p.frame_window = 2;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    CHECK(hd_render(h) == HD_SUCCESS && hd_render(h) == HD_SUCCESS && hd_render(h) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_render(h) == HD_SUCCESS && hd_render(h) == HD_SUCCESS);
+    CHECK_MSG(delta(h, &c, HD__NULL_direct) == 0 && delta(h, &c, HD__NULL_project) == 0, "direct %lu, project %lu",
+              delta(h, &c, HD__NULL_direct), delta(h, &c, HD__NULL_project));
+    CHECK(!be_of(h)->misuse);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+}
+
+static const hd_test_case cases[] = {
+    {"null_api", test_null_api},
+    {"null_invalidation", test_null_invalidation},
+};
+
+int main(void)
+{
+    int i, passed = 0, failed = 0;
+    for (i = 0; i < (int)(sizeof cases / sizeof cases[0]); ++i) {
+        hd_test_failures = 0;
+        fprintf(stderr, "[ RUN  ] %s\n", cases[i].name);
+        cases[i].fn();
+        if (hd_test_failures) { ++failed; fprintf(stderr, "[ FAIL ] %s\n", cases[i].name); }
+        else { ++passed; fprintf(stderr, "[  OK  ] %s\n", cases[i].name); }
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
