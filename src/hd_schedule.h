@@ -144,12 +144,13 @@ static hd_result hd__project_frame(hd__ctx *ctx)
         int w = ctx->vw.kp.image.x, h = ctx->vw.kp.image.y;
         ctx->vw.kp.image.x = (w + s - 1) / s;
         ctx->vw.kp.image.y = (h + s - 1) / s;
-        ctx->vw.kp.image.w = w * h;
+        ctx->vw.kp.region.x = w * h;
         r = hd__be_project(&ctx->vw);
         if (r == HD_SUCCESS) {
             ctx->vw.kp.image.x = w;
             ctx->vw.kp.image.y = h;
-            ctx->vw.kp.image.w = s;
+            ctx->vw.kp.region.x = 0;
+            ctx->vw.kp.region.y = s;
             ctx->vw.kp.counts.z |= HD_FLAG_UPSAMPLE;
             r = hd__be_upsample(&ctx->vw);
         }

@@ -68,11 +68,11 @@ HD_FN hd_v3 hd_camera_dir(HD_KARGS float fx, float fy)
 }
 
 /* Folds one frame value into the running mean of pixel i (RGBA) of the image region that
-   starts at pixel image.w (0; a reduced frame's region: hd_k_upsample.h). */
+   starts at pixel region.x (0; a reduced frame's region: hd_k_upsample.h). */
 HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
 {
     float w = HD_PRM(march).y;
-    int b = (i + HD_PRM(image).w) * 4;
+    int b = (i + HD_PRM(region).x) * 4;
     HD_SET1(img, b, HD_GET1(img, b) + (v.x - HD_GET1(img, b)) * w);
     HD_SET1(img, b + 1, HD_GET1(img, b + 1) + (v.y - HD_GET1(img, b + 1)) * w);
     HD_SET1(img, b + 2, HD_GET1(img, b + 2) + (v.z - HD_GET1(img, b + 2)) * w);

@@ -1,17 +1,17 @@
 /* hd_k_upsample.h - the reduced-resolution frame's upsample pass (shared source). A frame at
    render scale s marches ceil(w / s) x ceil(h / s) rays (hd_project_pixel with image.x, y the
    reduced size) into the image buffer's second region, which starts after the w x h image
-   (image.w = w h, the pixel offset hd_accumulate_pixel adds), as a running mean of its own. This
+   (region.x = w h, the pixel offset hd_accumulate_pixel adds), as a running mean of its own. This
    pass then fills the full image from that region by bilinear interpolation, so the image read
    back is always w x h. The backends run it through the projection's entry point when
-   counts.z has HD_FLAG_UPSAMPLE (image.x, y = w, h; image.w = s). */
+   counts.z has HD_FLAG_UPSAMPLE (image.x, y = w, h; region.y = s). */
 #define HD_FLAG_UPSAMPLE 32
 
 /* Full-image pixel (px, py) from the reduced region: pixel centres map onto the reduced grid's
    extent (the reduced frame covers the same field of view), clamped at its edges. */
 HD_FN void hd_upsample_pixel(HD_KARGS int px, int py)
 {
-    int w = HD_PRM(image).x, h = HD_PRM(image).y, s = HD_PRM(image).w;
+    int w = HD_PRM(image).x, h = HD_PRM(image).y, s = HD_PRM(region).y;
     int lw = (w + s - 1) / s, lh = (h + s - 1) / s;
     float fx = hd_clampf((HD_F(px) + 0.5f) * HD_F(lw) / HD_F(w) - 0.5f, 0.0f, HD_F(lw - 1));
     float fy = hd_clampf((HD_F(py) + 0.5f) * HD_F(lh) / HD_F(h) - 0.5f, 0.0f, HD_F(lh - 1));
