@@ -27,6 +27,7 @@ help:
 	@echo "  make check-glsl                     T every shared kernel compiles as GLSL 4.30 and 4.50"
 	@echo "  make compile-matrix                 T dist/hybriddiff.h as C99/C++17, gcc/clang, every backend, #error cases"
 	@echo "  make dist-builds                    T examples and conformance suites built from dist/hybriddiff.h, run --quick"
+	@echo "  make check-release                  T a release build from dist/ keeps no test hook or fault-injection knob"
 	@echo "  make conformance-opencl             T the OpenCL backend against the CPU reference (PoCL)"
 	@echo "  make conformance-vulkan             T the Vulkan backend against the CPU reference (lavapipe)"
 	@echo "  make conformance-vulkan-validation  T the same under the validation layer; fails on any message"

@@ -1090,6 +1090,7 @@ static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination wh
     return HD_SUCCESS;
 }
 
+#ifdef HYBRIDDIFF_TESTING
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
@@ -1097,6 +1098,7 @@ HD__MAYBE_UNUSED static hd_result hd__cpu_write_illumination(const hd__view *vw,
     hd__cpu_copy_illumination(vw, which, src, NULL, NULL, 0);
     return HD_SUCCESS;
 }
+#endif
 
 /* Relative residual |r| / |sigma_s E| of the diffusion equation for the current E and phi: the
    solver's convergence measure, for tests and benchmarks. Summed row by row in a fixed order. */

@@ -1000,6 +1000,7 @@ static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination wh
     return hd__gl_read_tex(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, zz, count, dst);
 }
 
+#ifdef HYBRIDDIFF_TESTING
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
 /* A GL_R16F grid gets the floats rounded to nearest even on the host (hd_f2h, the CPU backend's
    halves): the GL's own conversion may truncate, as llvmpipe's image stores do. */
@@ -1023,6 +1024,7 @@ HD__MAYBE_UNUSED static hd_result hd__gl_write_illumination(const hd__view *vw, 
     vw->be->gg.lsum_ok = 0;
     return hd__gl_write_tex(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, src);
 }
+#endif
 /* For src/hd_test_hooks.h: waits until the GL has done everything queued. */
 HD__MAYBE_UNUSED static hd_result hd__gl_finish(const hd__view *vw)
 {

@@ -788,12 +788,14 @@ static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination wh
     return hd__cl_copy_illumination(vw, which, NULL, dst, zz, count);
 }
 
+#ifdef HYBRIDDIFF_TESTING
 /* The inverse, for the test hooks (src/hd_test_hooks.h). */
 HD__MAYBE_UNUSED static hd_result hd__cl_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
     vw->be->gg.lsum_ok = 0;
     return hd__cl_copy_illumination(vw, which, src, NULL, NULL, 0);
 }
+#endif
 
 /* ---- CD: light volumes, convection, their sum into E ----------------------------------------- */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count) { return hd__gpu_alloc_lights(vw, &vw->be->gg, count); }

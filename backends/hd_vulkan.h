@@ -41,6 +41,7 @@
    (logged) at hd_create and at the next render after hd_set_params. The grids as images are not
    bound by maxStorageBufferRange (128 MiB on lavapipe), only by maxImageDimension3D per axis
    (channels stack along z).
+   With HYBRIDDIFF_TESTING defined (tests only; a release build reads none of these):
    $HD_VK_MEMORY_LIMIT=bytes caps the device memory the backend allocates; an allocation above it
    fails as VK_ERROR_OUT_OF_DEVICE_MEMORY would (a test knob: tests/vulkan/test_vulkan.c).
    $HD_VK_LOSE_DEVICE=n makes the n-th queue submission since hd_create fail as
@@ -493,7 +494,7 @@ static hd_result hd__vk_allocate(const hd__view *vw, const VkMemoryRequirements 
     if (type < 0) return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no memory type for %s", what);
     if (be->mem_limit && be->mem_used + req->size > be->mem_limit) {
         hd__logf(&vw->log, HD_LOG_ERROR, HD_ERROR_OUT_OF_DEVICE_MEMORY, __FILE__, __LINE__,
-                 "vulkan: vkAllocateMemory(%s, %llu bytes) failed: VK_ERROR_OUT_OF_DEVICE_MEMORY (HD_VK_MEMORY_LIMIT %llu, %llu in use)",
+                 "vulkan: vkAllocateMemory(%s, %llu bytes) failed: VK_ERROR_OUT_OF_DEVICE_MEMORY (the test limit %llu, %llu in use)",
                  what, (unsigned long long)req->size, (unsigned long long)be->mem_limit, (unsigned long long)be->mem_used);
         return HD_ERROR_OUT_OF_DEVICE_MEMORY;
     }
@@ -646,7 +647,7 @@ static hd_result hd__vk_flush(const hd__view *vw)
     si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
     si.commandBufferCount = 1;
     si.pCommandBuffers = &be->cmd;
-    if (++be->submits == be->lose_at) return hd__vk_fail(vw, VK_ERROR_DEVICE_LOST, "vkQueueSubmit (HD_VK_LOSE_DEVICE)", __LINE__);
+    if (++be->submits == be->lose_at) return hd__vk_fail(vw, VK_ERROR_DEVICE_LOST, "vkQueueSubmit (a lost device played by the test knob)", __LINE__);
     HD__VK_TRY(vw, be->fn.vkQueueSubmit(be->queue, 1, &si, be->fence), "vkQueueSubmit");
     e = be->fn.vkWaitForFences(be->device, 1, &be->fence, VK_TRUE, UINT64_MAX);
     if (e != VK_SUCCESS) return hd__vk_fail(vw, e < 0 ? e : VK_ERROR_DEVICE_LOST, "vkWaitForFences", __LINE__);
@@ -1313,12 +1314,16 @@ static void hd__vk_check_half(const hd__view *vw)
     hd__backend *be = vw->be;
     VkPhysicalDeviceFeatures f;
     VkFormatProperties fp;
+#ifdef HYBRIDDIFF_TESTING /* plays a device without r16f storage */
     const char *knob = getenv("HD_VK_NO_HALF");
+#else
+    const char *knob = NULL;
+#endif
     be->fn.vkGetPhysicalDeviceFeatures(be->phys, &f);
     be->fn.vkGetPhysicalDeviceFormatProperties(be->phys, VK_FORMAT_R16_SFLOAT, &fp);
     be->no_half = NULL;
     if (knob && *knob && strcmp(knob, "0") != 0)
-        be->no_half = "$HD_VK_NO_HALF is set (the test knob that plays a device without them)";
+        be->no_half = "the test knob plays a device without them";
     else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
         be->no_half = "VK_FORMAT_R16_SFLOAT has no VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT";
     else if (!(fp.optimalTilingFeatures & VK_FORMAT_FEATURE_TRANSFER_SRC_BIT) ||
@@ -1360,7 +1365,11 @@ static hd_result hd__be_create(hd__view *vw)
     VkCommandPoolCreateInfo cpci;
     VkCommandBufferAllocateInfo cbai;
     VkFenceCreateInfo fci;
+#ifdef HYBRIDDIFF_TESTING /* fault injection: a device memory limit, a lost device at the n-th submission */
     const char *limit = getenv("HD_VK_MEMORY_LIMIT"), *lose = getenv("HD_VK_LOSE_DEVICE");
+#else
+    const char *limit = NULL, *lose = NULL;
+#endif
     const hd_desc *d = &vw->desc;
     int caller = d->vulkan.instance || d->vulkan.physical_device || d->vulkan.device;
     be = (hd__backend *)hd__calloc(vw, 1, sizeof *be);
@@ -1666,12 +1675,14 @@ static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination wh
     return hd__vk_download_image(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, dst, zz, count);
 }
 
+#ifdef HYBRIDDIFF_TESTING
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
 HD__MAYBE_UNUSED static hd_result hd__vk_write_illumination(const hd__view *vw, hd_illumination which, const float *src)
 {
     vw->be->gg.lsum_ok = 0;
     return hd__vk_upload_image(vw, which == HD_ILLUMINATION_DIRECT ? &vw->be->E : &vw->be->phi, src);
 }
+#endif
 
 /* ---- CD: light volumes, convection, their sum into E ---------------------------------------- */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count)

@@ -10,6 +10,7 @@
    --dump PREFIX writes the tracked run's E (float32, as hd_read_illumination gives it) to
    PREFIX-<tf>.f32, for comparing two builds' E byte for byte (cmp).
    Usage: hdbench_direct [--iters N] [--reps R] [--grid N] [--tracked-only] [--dump PREFIX] [data/head.nrrd] */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_GL) && \
     !defined(HYBRIDDIFF_BACKEND_VULKAN)

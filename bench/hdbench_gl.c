@@ -3,6 +3,7 @@
    hd_iterate over at least 2 iterations and ~2 s after one warm-up iteration (shader compile,
    uploads), with glFinish before the clock stops. Also one diffusion sweep (red-black) alone.
    Usage: hdbench_gl [file.nrrd [N]]; N: also the sweep's A/B against N voxels per invocation. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_GL
 #include "hybriddiff.h"

@@ -4,6 +4,7 @@
    indices in ascending order), so that builds of two versions of the library can be run one
    after the other and checked to make the same mask. Figures, not a test.
    Usage: hdbench_mask [data/head.nrrd] */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"

@@ -15,6 +15,7 @@
                             [--print-every STEPS] [--surface-only] [--f64]
                             [--tissue-error REF_STEPS [--tissue-ref FILE]]
    Figures, not a test: nothing here passes or fails. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"

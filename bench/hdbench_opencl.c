@@ -11,6 +11,7 @@
    and its projection of a 256x256 image, best of 5 rounds of 2 frames)
    Figures, not a test. The experiments' extra kernels are built here from the same embedded
    sources plus a few bench-only entry points; the library uses rows and buffers. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_STATIC
 #define HYBRIDDIFF_BACKEND_OPENCL

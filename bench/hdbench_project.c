@@ -18,6 +18,7 @@
                           [--png PNG] [--tag WORD] [data/head.nrrd]
    --size N is an N x N frame; --size 1920x1080 (or --width / --height) any other.
    Figures, not a test: nothing here passes or fails. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #if !defined(HYBRIDDIFF_BACKEND_CPU) && !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_GL) && \
     !defined(HYBRIDDIFF_BACKEND_VULKAN)

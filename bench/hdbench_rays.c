@@ -12,6 +12,7 @@
    the shared kernels; other thresholds are measured by building this program with it changed
    (docs/DESIGN-DIRECT.md). Figures, not a test.
    Usage: hdbench_rays [--passes N] [--reps R] [data/head.nrrd] */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"

@@ -19,6 +19,7 @@
        rows per invocation, default 1 x 1), interleaved with the library's own.
    Usage: hdbench_vulkan [file.nrrd] [seconds per figure, default 2] [--sweeps] [--rounds n]
                          [--variants[=name,name...]] [--ab FILE.spv [--ab-zk n] [--ab-yk n]] */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_VULKAN
 #include "hybriddiff.h"

@@ -38,3 +38,20 @@ dist-builds: check-generated
 	@set -e; for p in $(DIST_CONFORMANCE); do echo "$$p $(DIST_CONFORMANCE_ARGS)"; $$p $(DIST_CONFORMANCE_ARGS); done
 
 test: compile-matrix dist-builds
+
+# A release build from dist/hybriddiff.h (no HYBRIDDIFF_TESTING) keeps no test-only function and
+# no fault-injection knob: each backend's implementation at -O0 (unused static functions are
+# still emitted there), checked by nm and by the binary's strings (part of `make test`).
+.PHONY: check-release
+RELEASE_B := $(B)/release
+check-release: check-generated
+	@mkdir -p $(RELEASE_B); set -e; \
+	for b in CPU OPENCL VULKAN GL; do \
+	  printf '#define HYBRIDDIFF_IMPLEMENTATION\n#define HYBRIDDIFF_BACKEND_%s\n#include "hybriddiff.h"\n' $$b > $(RELEASE_B)/impl_$$b.c; \
+	  $(CC) -Idist $(CPPFLAGS) $(WARN) -O0 -c $(RELEASE_B)/impl_$$b.c -o $(RELEASE_B)/impl_$$b.o; \
+	  if nm $(RELEASE_B)/impl_$$b.o | grep -q write_illumination; then echo "check-release: $$b keeps a test hook"; exit 1; fi; \
+	  if grep -q -a 'HD_VK_LOSE_DEVICE\|HD_VK_MEMORY_LIMIT\|HD_VK_NO_HALF' $(RELEASE_B)/impl_$$b.o; then \
+	    echo "check-release: $$b keeps a fault-injection knob"; exit 1; fi; \
+	  echo "check-release: $$b: no test hook, no fault injection"; \
+	done
+test: check-release

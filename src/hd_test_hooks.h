@@ -3,7 +3,12 @@
    library's implementation, in the same translation unit, to compare stages across backends:
    one diffusion sweep, a solve, the projection of illumination they wrote themselves.
    Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does, in one
-   bracket of the backend's (HD__BE_CALL). */
+   bracket of the backend's (HD__BE_CALL). A translation unit that includes it defines
+   HYBRIDDIFF_TESTING before the implementation, which then keeps the backends' test-only
+   functions and fault injection (without it a release build has neither). */
+#ifndef HYBRIDDIFF_TESTING
+#error "hybriddiff: src/hd_test_hooks.h needs HYBRIDDIFF_TESTING defined before the implementation"
+#endif
 
 /* The state a hook starts from: allocations, sigma_t, cleared accumulations. */
 HD__MAYBE_UNUSED static hd_result hd__test_prepare(hd_context h)

@@ -1,4 +1,5 @@
 /* The library's implementation for the test program, on the CPU backend. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"

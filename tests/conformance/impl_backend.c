@@ -1,5 +1,6 @@
 /* impl_backend.c - the backend under test as the table hd_api_backend (see hd_api.h). Build it
    with exactly one of -DHYBRIDDIFF_BACKEND_OPENCL, _VULKAN, _GL (or _CPU, to test the suite). */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_STATIC
 #include "hybriddiff.h"

@@ -4,6 +4,7 @@
    debug messenger logs each message as an error ("vulkan validation ..."). This table wraps the
    logger: a call during which a validation message arrived returns HD_ERROR_BACKEND, so the case
    FAILS, and messages outside any checked call (hd_destroy) make the program exit 1. */
+#define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_STATIC
 #define HYBRIDDIFF_BACKEND_VULKAN
