@@ -7,7 +7,7 @@
 #   make valgrind-opencl      the quick conformance subset under valgrind (PoCL suppressed)
 CL_LDLIBS := -lOpenCL
 CONF_DIR := tests/conformance
-CONF_DEPS := $(CONF_DIR)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
+CONF_DEPS := $(CONF_DIR)/hd_api.h $(CONF_DIR)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
 CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
 .PHONY: conformance-opencl compile-opencl-cxx check-generated bench-opencl valgrind-opencl

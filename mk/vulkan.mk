@@ -19,7 +19,7 @@
 # Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 VK_LDLIBS := -lvulkan
 VK_CONF := tests/conformance
-VK_DEPS := $(VK_CONF)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
+VK_DEPS := $(VK_CONF)/hd_api.h $(VK_CONF)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
 VK_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
 .PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan bench-vulkan-multigrid

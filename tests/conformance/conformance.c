@@ -11,9 +11,10 @@
    rest, the relative L2 without the largest 0.5 % of the differences, is <= 1e-4; an error in a
    kernel moves most elements and fails both. Relative L2 = |b - a| / |a|, relative Linf =
    max|b - a| / max|a|, a = reference. Every call is checked to leave the caller's buffers unchanged.
-   Output: one line per case with its errors, then "N passed, N failed". A backend whose runtime
-   or device is missing is reported SKIPPED with the reason (exit 0, or 1 when the environment
-   sets HD_CONFORMANCE_REQUIRE=1, as CI does). `conformance-opencl --quick`: one case per stage
+   Output: one line per case with its errors, then "N passed, N failed". A backend whose
+   hd_create fails is SKIPPED (exit 0) only when its runtime offers no device
+   (hd_backend_runtime_present, probed without the library); with a device there the failure
+   is the library's and fails; HD_CONFORMANCE_REQUIRE=1 (CI) makes a skip fail too. `conformance-opencl --quick`: one case per stage
    (what `make valgrind-opencl` runs); `--crop`: the crop box cases only. */
 #include "hd_api.h"
 #include <math.h>
@@ -723,7 +724,6 @@ static void crop_cases(const int *odd, const int *other)
 }
 
 /* ---- main ----------------------------------------------------------------------------------- */
-/* Creates one backend context: if the runtime or a device is missing, the backend is skipped. */
 /* A volume that is mostly empty: a thin spherical shell and a small off-centre blob in air
    (exact zeros, which the TF maps to sigma_t = 0), so the direct light is tracked only near them
    (hd__direct_mask). On each implementation, HD with the mask against the same run tracking
@@ -833,19 +833,26 @@ static void render_cases(const int *odd, const int *other)
     case_render_at(HD_METHOD_HD, HD_VOXEL_U8, other, 3, 8, 6);
 }
 
-static int backend_available(void)
+/* 1 when the backend creates a context. Else the reason is printed: SKIPPED when its runtime
+   offers no device (hd_backend_runtime_present: the machine lacks it), FAIL when it does (the
+   library failed where it should run); *hard says which. */
+static int backend_available(int *hard)
 {
     scene s;
     hd_desc d;
     hd_context c;
     hd_result r;
+    char why[512] = "";
     scene_init(&s, HD_VOXEL_U8, 8, 8, 8, 1, 0, 0);
     d = scene_desc(&s);
     r = hd_api_backend.create(&d, &c);
     scene_free(&s);
+    *hard = 0;
     if (r == HD_SUCCESS) { hd_api_backend.destroy(c); return 1; }
-    printf("SKIPPED backend %s: %s%s%s\n", hd_api_backend.backend_name(), hd_api_backend.result_string(r),
-           last_log[0] ? " -- " : "", last_log);
+    *hard = hd_backend_runtime_present(why, sizeof why);
+    printf("%s backend %s: hd_create: %s%s%s (%s%s)\n", *hard ? "FAIL" : "SKIPPED", hd_api_backend.backend_name(),
+           hd_api_backend.result_string(r), last_log[0] ? " -- " : "", last_log, why,
+           *hard ? ": the runtime has a device, so the library failed" : "");
     return 0;
 }
 
@@ -855,11 +862,15 @@ int main(int argc, char **argv)
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     int render = argc > 1 && strcmp(argv[1], "--render") == 0;
+    int hard = 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
-    if (!backend_available()) {
+    if (!backend_available(&hard)) {
         const char *req = getenv("HD_CONFORMANCE_REQUIRE");
-        printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed)\n", hd_api_backend.backend_name());
-        return req && req[0] == '1' ? 1 : 0;
+        int require = req && req[0] == '1';
+        if (hard) printf("0 passed, 1 failed\n");
+        else printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed%s)\n", hd_api_backend.backend_name(),
+                    require ? "; HD_CONFORMANCE_REQUIRE=1: a skip fails" : "");
+        return hard || require ? 1 : 0;
     }
     if (quick || crop || render) { /* quick: one case per stage, for valgrind; crop: the crop box
                                       cases; render: the per-frame API's */
