@@ -4,6 +4,7 @@
 #   make conformance-gl     tests/conformance on GL (part of `make test`)
 #   make test-gl            tests/gl/test_gl.c (part of `make test`)
 #   make compile-gl-cxx     the GL implementation as C++17, warnings as errors (part of `make test`)
+#   make physics-gl         tests/physics on GL (part of `make test`; mk/physics.mk)
 #   make hdview             build/hdview, the interactive viewer (examples/hdview.c, GLFW)
 #   make test-hdview        hdview under xvfb-run for a fixed number of frames: screenshot checks
 #   make bench-gl           build/hdbench_gl on the head CT (make data)
@@ -13,7 +14,7 @@ GL_CONF := tests/conformance
 GL_DEPS := $(GL_CONF)/hd_api.h $(GL_CONF)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
 GL_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
-.PHONY: conformance-gl test-gl compile-gl-cxx hdview test-hdview bench-gl
+.PHONY: conformance-gl test-gl compile-gl-cxx hdview test-hdview bench-gl physics-gl
 
 $(B)/conf_impl_gl.o: $(GL_CONF)/impl_backend.c $(GL_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) -c $< -o $@
@@ -24,6 +25,12 @@ $(B)/conformance-gl: $(B)/conformance.o $(B)/conf_impl_cpu.o $(B)/conf_impl_gl.o
 conformance-gl: $(B)/conformance-gl
 	$(B)/conformance-gl
 
+$(B)/physics-gl: $(B)/physics.o $(B)/conf_impl_gl.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(GL_LDLIBS)
+
+physics-gl: $(B)/physics-gl
+	$(B)/physics-gl
+
 $(B)/test_gl: tests/gl/test_gl.c $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(GL_LDLIBS) -lOpenGL
 
@@ -33,8 +40,8 @@ test-gl: $(B)/test_gl
 compile-gl-cxx: | $(B)
 	$(CXX) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(GL_CXXWARN) -O1 -x c++ -c $(GL_CONF)/impl_backend.c -o $(B)/conf_impl_gl_cxx.o
 
-TEST_PROGRAMS += $(B)/conformance-gl $(B)/test_gl
-test: conformance-gl test-gl compile-gl-cxx
+TEST_PROGRAMS += $(B)/conformance-gl $(B)/test_gl $(B)/physics-gl
+test: conformance-gl test-gl compile-gl-cxx physics-gl
 
 # ---- the viewer -------------------------------------------------------------------------------
 VIEW_LDLIBS := -lglfw -lOpenGL -lEGL
