@@ -5,12 +5,13 @@
 #   make check-generated      backends/hd_kernels_embedded.h is up to date with its sources
 #   make bench-opencl         build/hdbench_opencl: OpenCL vs CPU figures in one run
 #   make valgrind-opencl      the quick conformance subset under valgrind (PoCL suppressed)
+#   make physics-opencl       tests/physics on OpenCL (part of `make test`; mk/physics.mk)
 CL_LDLIBS := -lOpenCL
 CONF_DIR := tests/conformance
-CONF_DEPS := $(CONF_DIR)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
+CONF_DEPS := $(CONF_DIR)/hd_api.h $(CONF_DIR)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
 CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
-.PHONY: conformance-opencl compile-opencl-cxx check-generated bench-opencl valgrind-opencl
+.PHONY: conformance-opencl compile-opencl-cxx check-generated bench-opencl valgrind-opencl physics-opencl
 
 $(B)/conf_impl_cpu.o: $(CONF_DIR)/impl_cpu.c $(CONF_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
@@ -23,6 +24,12 @@ $(B)/conformance-opencl: $(B)/conformance.o $(B)/conf_impl_cpu.o $(B)/conf_impl_
 
 conformance-opencl: $(B)/conformance-opencl check-generated
 	$(B)/conformance-opencl
+
+$(B)/physics-opencl: $(B)/physics.o $(B)/conf_impl_opencl.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(CL_LDLIBS)
+
+physics-opencl: $(B)/physics-opencl
+	$(B)/physics-opencl
 
 # The backend, the test hooks and the conformance tables as C++17 (stb-style headers must be).
 compile-opencl-cxx: | $(B)
@@ -44,5 +51,5 @@ valgrind-opencl: $(B)/conformance-opencl
 bench-opencl: $(B)/hdbench_opencl
 	$(B)/hdbench_opencl
 
-TEST_PROGRAMS += $(B)/conformance-opencl
-test: conformance-opencl compile-opencl-cxx
+TEST_PROGRAMS += $(B)/conformance-opencl $(B)/physics-opencl
+test: conformance-opencl compile-opencl-cxx physics-opencl

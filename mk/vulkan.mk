@@ -7,6 +7,7 @@
 #   make test-vulkan                    tests/vulkan: messenger fires, caller-owned device and
 #                                       recording, out-of-device-memory and destroy
 #   make compile-vulkan-cxx             the Vulkan implementation as C++17, warnings as errors
+#   make physics-vulkan                 tests/physics on Vulkan (part of `make test`; mk/physics.mk)
 #   make bench-vulkan                   build/hdbench_vulkan on the head CT (make data): the
 #                                       sweep against a plain stencil (image3D, SSBO, C), then
 #                                       it/s per method; BENCH_ARGS=--sweeps for the first part,
@@ -19,10 +20,10 @@
 # Lavapipe on a machine with a GPU: VK_DRIVER_FILES=/usr/share/vulkan/icd.d/lvp_icd.x86_64.json
 VK_LDLIBS := -lvulkan
 VK_CONF := tests/conformance
-VK_DEPS := $(VK_CONF)/hd_api.h src/hd_test_hooks.h $(LIB_SRC)
+VK_DEPS := $(VK_CONF)/hd_api.h $(VK_CONF)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
 VK_CXXWARN := -std=c++17 -Wall -Wextra -Werror -Wpedantic
 
-.PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan bench-vulkan-multigrid
+.PHONY: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx bench-vulkan bench-vulkan-multigrid physics-vulkan
 
 $(B)/conf_impl_vk.o: $(VK_CONF)/impl_vk.c $(VK_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
@@ -35,6 +36,12 @@ conformance-vulkan: $(B)/conformance-vulkan
 
 conformance-vulkan-validation: $(B)/conformance-vulkan
 	HD_VK_VALIDATION=1 $(B)/conformance-vulkan
+
+$(B)/physics-vulkan: $(B)/physics.o $(B)/conf_impl_vk.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(VK_LDLIBS)
+
+physics-vulkan: $(B)/physics-vulkan
+	$(B)/physics-vulkan
 
 $(B)/test_vulkan: tests/vulkan/test_vulkan.c $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
@@ -63,5 +70,5 @@ $(B)/hdbench_mg_vulkan: $(B)/hdbench_mg_vulkan.o $(B)/conf_impl_cpu.o $(B)/conf_
 bench-vulkan-multigrid: $(B)/hdbench_mg_vulkan data
 	$(B)/hdbench_mg_vulkan data/head.nrrd $(BENCH_ARGS)
 
-TEST_PROGRAMS += $(B)/conformance-vulkan $(B)/test_vulkan
-test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx
+TEST_PROGRAMS += $(B)/conformance-vulkan $(B)/test_vulkan $(B)/physics-vulkan
+test: conformance-vulkan conformance-vulkan-validation test-vulkan compile-vulkan-cxx physics-vulkan

@@ -1,6 +1,8 @@
 /* hd_test.h - the tiny test runner every test program shares.
    A test is a function; CHECK records a failure with file and line and carries on, so one run
-   shows every broken assertion. The runner's last line is "N passed, N failed". */
+   shows every broken assertion. HD_TEST_SKIP marks the running test skipped (it reports
+   "[ SKIP ]", counted apart, never as passed). The runner's last line is "N passed, N failed"
+   (", N skipped" when some were). */
 #ifndef HD_TEST_H
 #define HD_TEST_H
 #include <stdio.h>
@@ -14,6 +16,15 @@ typedef struct hd_test_case {
 } hd_test_case;
 
 extern int hd_test_failures; /* failures in the running test */
+extern int hd_test_skipped;  /* the running test skipped (part of) what it checks */
+
+#define HD_TEST_SKIP(...) \
+    do { \
+        hd_test_skipped = 1; \
+        fprintf(stderr, "  skipped: "); \
+        fprintf(stderr, __VA_ARGS__); \
+        fputc('\n', stderr); \
+    } while (0)
 
 #define CHECK(cond) \
     do { \
@@ -105,6 +116,6 @@ static inline void hd_test_allocator(hd_desc *d, hd_test_alloc *s)
 #endif
 
 /* Runs every case whose name contains filter (NULL: all); returns the number of failed cases. */
-int hd_test_run(const hd_test_case *cases, int count, const char *filter, int *passed, int *failed);
+int hd_test_run(const hd_test_case *cases, int count, const char *filter, int *passed, int *failed, int *skipped);
 
 #endif

@@ -42,6 +42,20 @@ typedef struct hd_api {
 extern const hd_api hd_api_cpu;
 extern const hd_api hd_api_backend;
 
+/* 1 when the backend's runtime offers a device, found without the library (OpenCL: a platform
+   with a device; Vulkan: a physical device; GL: an EGL display with an OpenGL 4.3 core
+   context), 0 when it does not; why gets what was found. A suite whose hd_create fails asks it:
+   with a device there the failure is the library's (FAIL), without one the machine lacks the
+   runtime (SKIPPED, or FAIL under HD_CONFORMANCE_REQUIRE=1). Defined beside hd_api_backend
+   (impl_backend.c, impl_vk.c). */
+#ifdef __cplusplus
+extern "C" {
+#endif
+int hd_backend_runtime_present(char *why, size_t why_size);
+#ifdef __cplusplus
+}
+#endif
+
 /* Defines the table of the implementation included above it in the same translation unit. */
 #define HD_API_TABLE(var) \
     const hd_api var = {hd_backend_name, hd_result_string, hd_method_name, hd_log_stderr, hd_create, \

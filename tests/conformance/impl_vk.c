@@ -11,6 +11,7 @@
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"
 #include "hd_api.h"
+#include "hd_probe_vk.h"
 #include <unistd.h>
 
 static unsigned long vk_messages;      /* validation messages seen, all contexts */
