@@ -5,6 +5,9 @@
 // files, which would take the tool down with them.
 #include "hd_dicom.h"
 
+#include <gdcmDict.h>
+#include <gdcmDicts.h>
+#include <gdcmGlobal.h>
 #include <gdcmImage.h>
 #include <gdcmImageReader.h>
 #include <gdcmTrace.h>
@@ -62,16 +65,32 @@ std::string fmt(const char *f, ...)
     return buf;
 }
 
+// A message on one line: control characters (a newline in a file name) become '?'.
+std::string one_line(std::string s)
+{
+    for (char &ch : s)
+        if ((unsigned char)ch < 32 || ch == 127) ch = '?';
+    return s;
+}
+
 bool fail(char *err, size_t size, const std::string &msg)
 {
-    if (size) std::snprintf(err, size, "%s", msg.c_str());
+    if (size) std::snprintf(err, size, "%s", one_line(msg).c_str());
     return false;
 }
 
 // One line on stderr for each file that is not read: "PROGRAM: DICOM: PATH: skipped: WHY".
 void skipped(const std::string &path, const std::string &why)
 {
-    std::fprintf(stderr, "%s: DICOM: %s: skipped: %s\n", program_invocation_short_name, path.c_str(), why.c_str());
+    std::fprintf(stderr, "%s: DICOM: %s\n", program_invocation_short_name, one_line(path + ": skipped: " + why).c_str());
+}
+
+// Text from a file as a message shows it: at most 64 characters, '?' for what is not printable.
+std::string printable(const std::string &s)
+{
+    std::string o;
+    for (char ch : s.substr(0, 64)) o += ch >= 32 && ch < 127 ? ch : '?';
+    return o;
 }
 
 std::string tag_name(uint16_t g, uint16_t e) { return fmt("(%04X,%04X)", g, e); }
@@ -235,6 +254,41 @@ bool wanted(uint32_t tag)
     return tags.count(tag) != 0;
 }
 
+// Bytes per value of a binary VR (0: text or bytes).
+unsigned value_size(gdcm::VR::VRType t)
+{
+    switch (t) {
+    case gdcm::VR::US: case gdcm::VR::SS: case gdcm::VR::OW: return 2;
+    case gdcm::VR::UL: case gdcm::VR::SL: case gdcm::VR::FL: case gdcm::VR::AT: case gdcm::VR::OF: case gdcm::VR::OL: return 4;
+    case gdcm::VR::FD: case gdcm::VR::OD: case gdcm::VR::SV: case gdcm::VR::UV: case gdcm::VR::OV: return 8;
+    default: return 0;
+    }
+}
+
+// "" if an element of a public tag has a VR that GDCM's dictionary allows for it and a length
+// that is whole values of it; GDCM asserts on either when it turns the element into an attribute.
+std::string check_vr(uint16_t g, uint16_t e, const char *file_vr, uint32_t length)
+{
+    if (g & 1 || g == 0xfffe) return ""; // private tags, items
+    const gdcm::Dict &dict = gdcm::Global::GetInstance().GetDicts().GetPublicDict();
+    const gdcm::VR known = dict.GetDictEntry(gdcm::Tag(g, e)).GetVR();
+    const bool in_dict = known != gdcm::VR::INVALID && known != gdcm::VR::UN;
+    gdcm::VR::VRType t = known;
+    if (file_vr[0]) {
+        t = gdcm::VR::GetVRTypeFromFile(file_vr);
+        if (in_dict && t != gdcm::VR::UN && !known.Compatible(gdcm::VR(t)))
+            return fmt("element %s has VR %s; the DICOM dictionary gives it %s", tag_name(g, e).c_str(), file_vr,
+                       gdcm::VR::GetVRString(known));
+    } else if (!in_dict || known.IsDual()) {
+        return "";
+    }
+    const unsigned size = value_size(t);
+    if (size && length != 0xffffffffu && length % size)
+        return fmt("element %s of VR %s has %u bytes, not whole %u-byte values", tag_name(g, e).c_str(),
+                   gdcm::VR::GetVRString(t), length, size);
+    return "";
+}
+
 // Walks the elements of a file, each length checked against the end of what holds it: the file,
 // a sequence item or a sequence. Nothing is allocated from a length.
 class walker {
@@ -300,6 +354,8 @@ public:
             }
             if (have_prev && e.tag() <= prev) return order(e, at, prev);
             prev = e.tag(), have_prev = true;
+            const std::string vr_err = check_vr(e.g, e.e, e.vr, e.length);
+            if (!vr_err.empty()) return bad(vr_err + fmt(" (at byte %zu)", at));
             const bool sq = !implicit && e.vr[0] == 'S' && e.vr[1] == 'Q';
             if (e.undefined) {
                 if (e.tag() == 0x7fe00010 && c_.encapsulated && !implicit &&
@@ -366,12 +422,6 @@ private:
         return bad(fmt("element %s at byte %zu comes after %s (out of order or repeated)", tag_name(e.g, e.e).c_str(), at,
                        tag_name((uint16_t)(prev >> 16), (uint16_t)prev).c_str()));
     }
-    static std::string printable(const std::string &s)
-    {
-        std::string o;
-        for (char ch : s.substr(0, 64)) o += ch >= 32 && ch < 127 ? ch : '?';
-        return o;
-    }
 
     // One element's tag, VR and length at pos; its value must end by end.
     bool header(size_t pos, size_t end, bool explicit_vr, element &e)
@@ -390,12 +440,15 @@ private:
                 e.length = u16(pos + 6);
             } else {
                 return bad(fmt("element %s at byte %zu has VR '%s', none DICOM defines", tag_name(e.g, e.e).c_str(), pos,
-                               printable(e.vr).c_str()));
+                               printable(std::string(e.vr, 2)).c_str()));
             }
         } else {
             e.length = u32(len_at);
         }
         e.undefined = e.length == 0xffffffffu;
+        if (!e.undefined && e.length > end - e.value && e.g == 0x7fe0 && e.e == 0x0010 && end == n_)
+            return bad(fmt("its pixel data is cut short: Pixel Data (7FE0,0010) at byte %zu claims %u bytes, the file "
+                           "has %zu after it (a truncated file?)", pos, e.length, end - e.value));
         if (!e.undefined && e.length > end - e.value)
             return bad(fmt("element %s at byte %zu claims %u bytes, past the end of %s (%zu bytes)", tag_name(e.g, e.e).c_str(),
                            pos, e.length, end == n_ ? "the file" : "what holds it", end == n_ ? n_ : end - e.value));
@@ -516,12 +569,12 @@ std::string check_image(const walker &w, file_check &c)
     if (samples != 1) return fmt("a colour image (Samples per Pixel %u); only greyscale series are read", samples);
     const std::string photometric = get(0x00280004).present ? w.text(get(0x00280004)) : "MONOCHROME2";
     if (photometric != "MONOCHROME1" && photometric != "MONOCHROME2")
-        return "a colour image (Photometric Interpretation '" + photometric.substr(0, 32) + "'); only greyscale series are read";
+        return "a colour image (Photometric Interpretation '" + printable(photometric) + "'); only greyscale series are read";
     if (get(0x00280008).present) {
         std::vector<double> f;
         const std::string s = w.text(get(0x00280008));
         if (!numbers(s, f) || f.size() != 1 || f[0] != std::floor(f[0]) || f[0] < 1)
-            return "Number of Frames '" + s.substr(0, 32) + "' is not a count";
+            return "Number of Frames '" + printable(s) + "' is not a count";
         if (f[0] != 1) return fmt("a multi-frame image (%g frames); only single-frame series are read", f[0]);
     }
     if (c.rows < 1 || c.cols < 1 || c.rows > (unsigned)HD_MAX_DIM || c.cols > (unsigned)HD_MAX_DIM)
@@ -558,7 +611,7 @@ std::string check_image(const walker &w, file_check &c)
         bool ok = numbers(s, v) && (n.count == 0 || v.size() == n.count);
         for (double d : v) ok = ok && std::fabs(d) <= kMaxCoordinate && (!n.positive || d > 0);
         if (!ok)
-            return fmt("%s '%s' is not %s finite number%s %s", n.name, s.substr(0, 48).c_str(),
+            return fmt("%s '%s' is not %s finite number%s %s", n.name, printable(s).c_str(),
                        n.count == 1 ? "a" : n.count == 2 ? "two" : n.count == 3 ? "three" : "six", n.count == 1 ? "" : "s",
                        n.positive ? "> 0" : "within +-1e9");
     }
@@ -915,8 +968,8 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
             pixel_spacing[1] = r.spacing[1];
         } else {
             if (c.series != series)
-                return fail_free(dir + ": more than one series (" + first + " is in " + series + ", " + f.path + " in " +
-                                 c.series + "); give a folder of one series");
+                return fail_free(dir + ": more than one series (" + first + " is in " + printable(series) + ", " + f.path + " in " +
+                                 printable(c.series) + "); give a folder of one series");
             for (int k = 0; k < 6; ++k)
                 if (std::fabs(dc[k] - cosines[k]) > 1e-3)
                     return fail_free(dir + ": slices of different orientations (" + first + ", " + f.path + ")");

@@ -10,23 +10,32 @@
 #                               (part of `make test`)
 .PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom
 
-HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC) $(B)/hd_dicom.o
+HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC)
 HDR_BACKENDS := $(B)/hdrender $(B)/hdrender-opencl $(B)/hdrender-vulkan $(B)/hdrender-gl
 # DICOM series (a directory as input) through GDCM, in a C++ file of the tools (libgdcm-dev)
 DICOM_CXXFLAGS := -std=c++17 -Wall -Wextra -Werror -Wpedantic -I/usr/include/gdcm-3.0
-DICOM_LDLIBS := -lgdcmMSFF -lgdcmDSED -lgdcmCommon -lstdc++
+DICOM_LDLIBS := -lgdcmMSFF -lgdcmDICT -lgdcmDSED -lgdcmCommon -lstdc++
 
 $(B)/hd_dicom.o: examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
 	$(CXX) $(CPPFLAGS) $(DICOM_CXXFLAGS) $(CFLAGS) -c $< -o $@
 
-$(B)/hdrender: $(HDR_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) $(DICOM_LDLIBS)
-$(B)/hdrender-opencl: $(HDR_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_OPENCL $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) -lOpenCL $(DICOM_LDLIBS)
-$(B)/hdrender-vulkan: $(HDR_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_VULKAN $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) -lvulkan $(DICOM_LDLIBS)
-$(B)/hdrender-gl: $(HDR_DEPS) | $(B)
-	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) -lEGL $(DICOM_LDLIBS)
+# each backend's object (the library's implementation is most of the compile), then the link
+$(B)/hdrender.o: $(HDR_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/hdrender-opencl.o: $(HDR_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_OPENCL $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/hdrender-vulkan.o: $(HDR_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_VULKAN $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/hdrender-gl.o: $(HDR_DEPS) | $(B)
+	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) -c $< -o $@
+$(B)/hdrender: $(B)/hdrender.o $(B)/hd_dicom.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(DICOM_LDLIBS)
+$(B)/hdrender-opencl: $(B)/hdrender-opencl.o $(B)/hd_dicom.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lOpenCL $(DICOM_LDLIBS)
+$(B)/hdrender-vulkan: $(B)/hdrender-vulkan.o $(B)/hd_dicom.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lvulkan $(DICOM_LDLIBS)
+$(B)/hdrender-gl: $(B)/hdrender-gl.o $(B)/hd_dicom.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lEGL $(DICOM_LDLIBS)
 
 hdrender-backends: $(HDR_BACKENDS)
 TEST_PROGRAMS += $(HDR_BACKENDS)
