@@ -85,11 +85,11 @@ void skipped(const std::string &path, const std::string &why)
     std::fprintf(stderr, "%s: DICOM: %s\n", program_invocation_short_name, one_line(path + ": skipped: " + why).c_str());
 }
 
-// Text from a file as a message shows it: at most 64 characters, '?' for what is not printable.
-std::string printable(const std::string &s)
+// Text from a file as a message shows it: at most max characters, '?' for what is not printable.
+std::string printable(const std::string &s, size_t max = 64)
 {
     std::string o;
-    for (char ch : s.substr(0, 64)) o += ch >= 32 && ch < 127 ? ch : '?';
+    for (char ch : s.substr(0, max)) o += ch >= 32 && ch < 127 ? ch : '?';
     return o;
 }
 
@@ -99,6 +99,7 @@ std::string tag_name(uint16_t g, uint16_t e) { return fmt("(%04X,%04X)", g, e); 
 struct candidate {
     std::string path; // as listed (the messages)
     std::string open; // what is opened: path, or the target of a link inside the folder
+    size_t size;      // bytes when listed (the time it may take)
 };
 
 const char *kind_of(mode_t m)
@@ -151,7 +152,7 @@ bool list_folder(const std::string &dir, std::vector<candidate> &out, size_t &sk
         } else {
             auto it = seen.emplace(std::make_pair(st.st_dev, st.st_ino), path);
             if (!it.second) skipped(path, "the same file as " + it.first->second), ++skips;
-            else out.push_back({path, path});
+            else out.push_back({path, path, (size_t)std::min<unsigned long long>((unsigned long long)st.st_size, kMaxFileBytes)});
         }
     }
     for (const std::string &n : links) {
@@ -176,7 +177,7 @@ bool list_folder(const std::string &dir, std::vector<candidate> &out, size_t &sk
         } else {
             auto it = seen.emplace(std::make_pair(st.st_dev, st.st_ino), path);
             if (!it.second) skipped(path, "the same file as " + it.first->second), ++skips;
-            else out.push_back({path, target});
+            else out.push_back({path, target, (size_t)std::min<unsigned long long>((unsigned long long)st.st_size, kMaxFileBytes)});
         }
     }
     closedir(d);
@@ -354,8 +355,12 @@ public:
             }
             if (have_prev && e.tag() <= prev) return order(e, at, prev);
             prev = e.tag(), have_prev = true;
+#ifdef HDX_DICOM_TEST_NO_VR_CHECK // tests/dicom: without it GDCM's asserts reach the worker
+            (void)&check_vr;
+#else
             const std::string vr_err = check_vr(e.g, e.e, e.vr, e.length);
             if (!vr_err.empty()) return bad(vr_err + fmt(" (at byte %zu)", at));
+#endif
             const bool sq = !implicit && e.vr[0] == 'S' && e.vr[1] == 'Q';
             if (e.undefined) {
                 if (e.tag() == 0x7fe00010 && c_.encapsulated && !implicit &&
@@ -616,6 +621,7 @@ std::string check_image(const walker &w, file_check &c)
                        n.positive ? "> 0" : "within +-1e9");
     }
     if (get(0x0020000e).present) c.series = w.text(get(0x0020000e));
+    if (c.series.size() > 64) return "Series Instance UID '" + printable(c.series) + "...' is longer than 64 characters";
     return "";
 }
 
@@ -631,7 +637,12 @@ std::string check_file(const std::vector<unsigned char> &b, file_check &c)
     return check_image(w, c);
 }
 
-// ---- GDCM, in a child ------------------------------------------------------------------------------
+// ---- the worker: checks and GDCM in a child process ----------------------------------------------
+// One child reads, checks and parses the files one by one (a fork per file costs milliseconds in
+// page tables and copy-on-write faults); before GDCM sees a file its address space and CPU time
+// are limited to that file's budget. A worker that dies takes only its file with it: the next
+// file goes to a new one.
+
 // A read-only stream over bytes in memory (GDCM parses exactly what was checked, not the file again).
 class memory_buf : public std::streambuf {
 public:
@@ -657,12 +668,13 @@ protected:
     }
 };
 
-// What the child sends back before the voxels.
-struct parsed {
-    uint32_t magic;
-    int32_t ok;
+// What the worker sends for each file, before the voxels of an image.
+struct reply {
+    uint32_t magic, index;
+    int32_t ok; // 1: an image; cols * rows floats follow
     uint32_t cols, rows;
-    double origin[3], cosines[6], spacing[2], slope, intercept;
+    double origin[3], cosines[6], spacing[2];
+    char series[72];
     char message[400];
 };
 const uint32_t kMagic = 0x4d434448;
@@ -679,75 +691,150 @@ bool write_all(int fd, const void *p, size_t n)
     return true;
 }
 
-// In the child: GDCM reads the image, its voxels become floats after the rescale, all to fd.
-void child_parse(const std::vector<unsigned char> &bytes, const file_check &c, int fd)
+bool read_all(int fd, void *p, size_t n)
 {
-    parsed r;
-    std::memset(&r, 0, sizeof r);
-    r.magic = kMagic;
-    std::vector<float> voxels;
+    char *c = (char *)p;
+    while (n) {
+        const ssize_t r = read(fd, c, n);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) return false;
+        c += r, n -= (size_t)r;
+    }
+    return true;
+}
+
+// One file's budget: CPU seconds, wall seconds (the machine may be busy), address space beyond
+// what the worker holds (GDCM keeps the file, the decoded pixels and the floats, plus its own).
+unsigned cpu_budget_s(size_t file_bytes) { return 1 + (unsigned)(file_bytes >> 24); }
+double wall_budget_s(size_t file_bytes) { return 4.0 * cpu_budget_s(file_bytes) + 2.0; }
+unsigned long long memory_budget(size_t file_bytes, const file_check &c)
+{
+    return (64ull << 20) + 3ull * file_bytes + (unsigned long long)c.rows * c.cols * (c.bits / 8 + 8);
+}
+
+void set_soft_limit(int resource, rlim_t soft)
+{
+    struct rlimit l;
+    if (getrlimit(resource, &l) != 0) return;
+    l.rlim_cur = l.rlim_max == RLIM_INFINITY || soft < l.rlim_max ? soft : l.rlim_max;
+    setrlimit(resource, &l);
+}
+
+void relax_soft_limit(int resource)
+{
+    struct rlimit l;
+    if (getrlimit(resource, &l) != 0) return;
+    l.rlim_cur = l.rlim_max;
+    setrlimit(resource, &l);
+}
+
+unsigned long long address_space_bytes()
+{
+    unsigned long long pages = 0;
+    if (std::FILE *f = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(f, "%llu", &pages) != 1) pages = 0;
+        std::fclose(f);
+    }
+    return pages * (unsigned long long)sysconf(_SC_PAGESIZE);
+}
+
+double cpu_seconds()
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_utime.tv_sec + (double)u.ru_stime.tv_sec + 1e-6 * (double)(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// In the worker: GDCM reads the checked bytes into r's geometry and voxels (after the rescale).
+// "" or why not.
+std::string gdcm_parse(const std::vector<unsigned char> &bytes, const file_check &c, reply &r, std::vector<float> &voxels)
+{
     try {
         memory_buf buf(bytes.data(), bytes.size());
         std::istream is(&buf);
         gdcm::ImageReader reader;
         reader.SetStream(is);
-        if (!reader.Read()) {
-            std::snprintf(r.message, sizeof r.message, "GDCM cannot read it");
-        } else {
-            const gdcm::Image &image = reader.GetImage();
-            const gdcm::PixelFormat &pf = image.GetPixelFormat();
-            const size_t count = (size_t)c.rows * c.cols;
-            if ((image.GetNumberOfDimensions() != 2 && image.GetDimension(2) > 1) || image.GetDimension(0) != c.cols ||
-                image.GetDimension(1) != c.rows || pf.GetSamplesPerPixel() != 1) {
-                std::snprintf(r.message, sizeof r.message, "GDCM reads it as %ux%ux%u pixels of %u samples; the header says %ux%u of 1",
-                              image.GetDimension(0), image.GetDimension(1),
-                              image.GetNumberOfDimensions() > 2 ? image.GetDimension(2) : 1, pf.GetSamplesPerPixel(), c.cols,
-                              c.rows);
-            } else if (image.GetBufferLength() != count * (c.bits / 8) || pf.GetBitsAllocated() != c.bits) {
-                std::snprintf(r.message, sizeof r.message, "GDCM decodes it to %lu bytes of %u bits; %zu pixels of %u bits expected",
-                              image.GetBufferLength(), pf.GetBitsAllocated(), count, c.bits);
-            } else {
-                std::vector<char> raw(image.GetBufferLength());
-                if (!image.GetBuffer(raw.data())) {
-                    std::snprintf(r.message, sizeof r.message, "cannot decode its pixel data (transfer syntax %s)", c.ts_uid.c_str());
-                } else {
-                    voxels.resize(count);
-                    const double slope = image.GetSlope(), intercept = image.GetIntercept();
-                    const char *type = NULL;
-                    for (size_t i = 0; i < count && !type; ++i) {
-                        double v;
-                        switch (pf.GetScalarType()) {
-                        case gdcm::PixelFormat::UINT8: v = (double)((const uint8_t *)raw.data())[i]; break;
-                        case gdcm::PixelFormat::INT8: v = (double)((const int8_t *)raw.data())[i]; break;
-                        case gdcm::PixelFormat::UINT16: v = (double)((const uint16_t *)raw.data())[i]; break;
-                        case gdcm::PixelFormat::INT16: v = (double)((const int16_t *)raw.data())[i]; break;
-                        case gdcm::PixelFormat::UINT32: v = (double)((const uint32_t *)raw.data())[i]; break;
-                        case gdcm::PixelFormat::INT32: v = (double)((const int32_t *)raw.data())[i]; break;
-                        default: type = pf.GetScalarTypeAsString(); v = 0; break;
-                        }
-                        voxels[i] = (float)(v * slope + intercept);
-                    }
-                    if (type) {
-                        std::snprintf(r.message, sizeof r.message, "pixel type %s is not supported", type);
-                    } else {
-                        r.ok = 1;
-                        r.cols = c.cols, r.rows = c.rows;
-                        for (int k = 0; k < 3; ++k) r.origin[k] = image.GetOrigin()[k];
-                        for (int k = 0; k < 6; ++k) r.cosines[k] = image.GetDirectionCosines()[k];
-                        r.spacing[0] = image.GetSpacing(0), r.spacing[1] = image.GetSpacing(1);
-                        r.slope = slope, r.intercept = intercept;
-                    }
-                }
+        if (!reader.Read()) return "GDCM cannot read it";
+        const gdcm::Image &image = reader.GetImage();
+        const gdcm::PixelFormat &pf = image.GetPixelFormat();
+        const size_t count = (size_t)c.rows * c.cols;
+        if ((image.GetNumberOfDimensions() != 2 && image.GetDimension(2) > 1) || image.GetDimension(0) != c.cols ||
+            image.GetDimension(1) != c.rows || pf.GetSamplesPerPixel() != 1)
+            return fmt("GDCM reads it as %ux%ux%u pixels of %u samples; the header says %ux%u of 1", image.GetDimension(0),
+                       image.GetDimension(1), image.GetNumberOfDimensions() > 2 ? image.GetDimension(2) : 1,
+                       pf.GetSamplesPerPixel(), c.cols, c.rows);
+        if (image.GetBufferLength() != count * (c.bits / 8) || pf.GetBitsAllocated() != c.bits)
+            return fmt("GDCM decodes it to %lu bytes of %u bits; %zu pixels of %u bits expected", image.GetBufferLength(),
+                       pf.GetBitsAllocated(), count, c.bits);
+        std::vector<char> raw(image.GetBufferLength());
+        if (!image.GetBuffer(raw.data())) return "cannot decode its pixel data (transfer syntax " + c.ts_uid + ")";
+        voxels.resize(count);
+        const double slope = image.GetSlope(), intercept = image.GetIntercept();
+        for (size_t i = 0; i < count; ++i) {
+            double v;
+            switch (pf.GetScalarType()) {
+            case gdcm::PixelFormat::UINT8: v = (double)((const uint8_t *)raw.data())[i]; break;
+            case gdcm::PixelFormat::INT8: v = (double)((const int8_t *)raw.data())[i]; break;
+            case gdcm::PixelFormat::UINT16: v = (double)((const uint16_t *)raw.data())[i]; break;
+            case gdcm::PixelFormat::INT16: v = (double)((const int16_t *)raw.data())[i]; break;
+            case gdcm::PixelFormat::UINT32: v = (double)((const uint32_t *)raw.data())[i]; break;
+            case gdcm::PixelFormat::INT32: v = (double)((const int32_t *)raw.data())[i]; break;
+            default: return std::string("pixel type ") + pf.GetScalarTypeAsString() + " is not supported";
             }
+            voxels[i] = (float)(v * slope + intercept);
         }
+        for (int k = 0; k < 3; ++k) r.origin[k] = image.GetOrigin()[k];
+        for (int k = 0; k < 6; ++k) r.cosines[k] = image.GetDirectionCosines()[k];
+        r.spacing[0] = image.GetSpacing(0), r.spacing[1] = image.GetSpacing(1);
+        return "";
     } catch (const std::bad_alloc &) {
-        r.ok = 0;
-        std::snprintf(r.message, sizeof r.message, "GDCM ran out of the memory a file of its size may take");
+        return "GDCM ran out of the memory a file of its size may take";
     } catch (const std::exception &e) {
-        r.ok = 0;
-        std::snprintf(r.message, sizeof r.message, "GDCM failed on it (%.200s)", e.what());
+        return fmt("GDCM failed on it (%.200s)", e.what());
     }
-    if (write_all(fd, &r, sizeof r) && r.ok) write_all(fd, voxels.data(), voxels.size() * sizeof(float));
+}
+
+// In the worker: one file read, checked and, if it passes, parsed under its budget.
+void work_one(const candidate &f, std::vector<unsigned char> &bytes, reply &r, std::vector<float> &voxels)
+{
+    std::string why = read_file(f.open, bytes);
+    file_check c;
+    if (why.empty()) why = check_file(bytes, c);
+    if (why.empty()) {
+        const unsigned long long now = address_space_bytes();
+        if (now) set_soft_limit(RLIMIT_AS, (rlim_t)(now + memory_budget(bytes.size(), c)));
+        set_soft_limit(RLIMIT_CPU, (rlim_t)std::ceil(cpu_seconds()) + cpu_budget_s(bytes.size()));
+        why = gdcm_parse(bytes, c, r, voxels);
+        relax_soft_limit(RLIMIT_AS);
+        relax_soft_limit(RLIMIT_CPU);
+    }
+    if (!why.empty()) {
+        std::snprintf(r.message, sizeof r.message, "%s", why.c_str());
+        return;
+    }
+    r.ok = 1;
+    r.cols = c.cols, r.rows = c.rows;
+    std::snprintf(r.series, sizeof r.series, "%s", c.series.c_str());
+}
+
+[[noreturn]] void worker_main(const std::vector<candidate> &files, int requests, int replies)
+{
+    signal(SIGPIPE, SIG_DFL);
+    struct rlimit none = {0, 0};
+    setrlimit(RLIMIT_CORE, &none);  // an abort leaves no core file in the user's folder
+    setrlimit(RLIMIT_FSIZE, &none); // nor writes one
+    std::vector<unsigned char> bytes;
+    std::vector<float> voxels;
+    reply r;
+    for (uint32_t i; read_all(requests, &i, sizeof i);) {
+        if (i >= files.size()) _exit(3);
+        std::memset(&r, 0, sizeof r);
+        r.magic = kMagic, r.index = i;
+        work_one(files[i], bytes, r, voxels);
+        if (!write_all(replies, &r, sizeof r) || (r.ok && !write_all(replies, voxels.data(), voxels.size() * sizeof(float))))
+            _exit(4);
+    }
+    _exit(0); // no destructors, no atexit handlers, no flush of the parent's stdio buffers
 }
 
 double now_s()
@@ -757,126 +844,170 @@ double now_s()
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-// The last line GDCM wrote to stderr (an assertion, its error), for the message.
+// The last line the worker wrote to stderr (GDCM's assertion or error) for a message: an
+// assertion as FILE:LINE and its condition.
 std::string last_line(const std::string &s)
 {
-    size_t end = s.find_last_not_of("\r\n ");
+    const size_t end = s.find_last_not_of("\r\n ");
     if (end == std::string::npos) return "";
-    size_t begin = s.find_last_of('\n', end);
-    std::string line = s.substr(begin == std::string::npos ? 0 : begin + 1, end + 1 - (begin == std::string::npos ? 0 : begin + 1));
-    for (char &ch : line)
-        if (ch < 32 || ch > 126) ch = '?';
-    return line.size() > 160 ? line.substr(0, 157) + "..." : line;
+    const size_t nl = s.find_last_of('\n', end), begin = nl == std::string::npos ? 0 : nl + 1;
+    std::string line = s.substr(begin, end + 1 - begin);
+    const size_t a = line.find("Assertion `");
+    if (a != std::string::npos) {
+        const size_t p = line.find(": ");                  // "PROGRAM: SOURCE:LINE: FUNCTION: Assertion ..."
+        const size_t q = p == std::string::npos ? p : line.find(": ", p + 2);
+        std::string where = q == std::string::npos ? "" : line.substr(p + 2, q - p - 2);
+        if (where.find('/') != std::string::npos) where = where.substr(where.rfind('/') + 1);
+        line = (where.empty() ? "" : where + ": ") + line.substr(a);
+    }
+    return printable(line, 200);
 }
 
-// GDCM parses bytes in a child limited to a budget of address space and CPU time; the header
-// and count voxels come back in r and dst. "" or why the file is not read.
-std::string parse_contained(const std::vector<unsigned char> &bytes, const file_check &c, parsed &r, float *dst)
-{
-    const size_t count = (size_t)c.rows * c.cols;
-    // GDCM holds the file, the decoded pixels and the floats: a few times the file, plus its own
-    const unsigned long long budget = (64ull << 20) + 3ull * bytes.size() + (unsigned long long)count * (c.bits / 8 + 8);
-    const unsigned cpu_s = 1 + (unsigned)(bytes.size() >> 24);
-    const double wall_s = 4.0 * cpu_s + 2.0;
-    int data[2], errs[2];
-    if (pipe(data) != 0) return std::string("cannot make a pipe: ") + std::strerror(errno);
-    if (pipe(errs) != 0) {
-        close(data[0]), close(data[1]);
-        return std::string("cannot make a pipe: ") + std::strerror(errno);
-    }
-    std::fflush(NULL);
-    const pid_t pid = fork();
-    if (pid < 0) {
-        close(data[0]), close(data[1]), close(errs[0]), close(errs[1]);
-        return std::string("cannot fork: ") + std::strerror(errno);
-    }
-    if (pid == 0) {
-        close(data[0]), close(errs[0]);
-        dup2(errs[1], 1);
-        dup2(errs[1], 2);
-        close(errs[1]);
-        signal(SIGPIPE, SIG_DFL);
-        struct rlimit l;
-        unsigned long long vm_pages = 0;
-        if (std::FILE *f = std::fopen("/proc/self/statm", "r")) {
-            if (std::fscanf(f, "%llu", &vm_pages) != 1) vm_pages = 0;
-            std::fclose(f);
-        }
-        if (vm_pages && getrlimit(RLIMIT_AS, &l) == 0) {
-            const rlim_t want = (rlim_t)(vm_pages * (unsigned long long)sysconf(_SC_PAGESIZE) + budget);
-            if (l.rlim_max == RLIM_INFINITY || want < l.rlim_max) l.rlim_max = want;
-            l.rlim_cur = l.rlim_max;
-            setrlimit(RLIMIT_AS, &l);
-        }
-        l.rlim_cur = cpu_s, l.rlim_max = cpu_s + 1;
-        setrlimit(RLIMIT_CPU, &l);
-        l.rlim_cur = l.rlim_max = 0;
-        setrlimit(RLIMIT_CORE, &l);
-        setrlimit(RLIMIT_FSIZE, &l);
-        child_parse(bytes, c, data[1]);
-        _exit(0); // no destructors, no atexit handlers, no stdio flush of the parent's buffers
-    }
-    close(data[1]), close(errs[1]);
-    const size_t want = sizeof r + count * sizeof(float);
-    size_t got = 0;
-    std::string errtext;
-    bool timed_out = false;
-    const double deadline = now_s() + wall_s;
-    struct pollfd fds[2] = {{data[0], POLLIN, 0}, {errs[0], POLLIN, 0}};
-    int open_fds = 2;
-    while (open_fds) {
-        const double left = deadline - now_s();
-        if (left <= 0) {
-            timed_out = true;
-            break;
-        }
-        const int n = poll(fds, 2, (int)(left * 1000) + 1);
-        if (n < 0 && errno == EINTR) continue;
-        if (n < 0) break;
-        for (int k = 0; k < 2; ++k) {
-            if (fds[k].fd < 0 || !(fds[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
-            char scratch[4096];
-            char *to = scratch;
-            size_t room = sizeof scratch;
-            if (k == 0 && got < sizeof r) to = (char *)&r + got, room = sizeof r - got;
-            else if (k == 0 && got < want) to = (char *)dst + (got - sizeof r), room = want - got;
-            const ssize_t m = read(fds[k].fd, to, room);
+// The parent's end of the worker.
+class worker {
+public:
+    explicit worker(const std::vector<candidate> &files) : files_(files) {}
+    ~worker() { stop(); }
+
+    // File i read by the worker: "" with r and, for an image, its voxels in plane; or why it was not.
+    std::string ask(uint32_t i, reply &r, std::vector<float> &plane)
+    {
+        std::string why;
+        if (pid_ < 0 && !start(why)) return why;
+        errtext_.clear();
+        const double wall_s = wall_budget_s(files_[i].size);
+        if (!write_all(requests_, &i, sizeof i)) return died(false, i);
+        size_t got = 0, want = sizeof r;
+        const double deadline = now_s() + wall_s;
+        while (got < want) {
+            const double left = deadline - now_s();
+            if (left <= 0) return died(true, i);
+            struct pollfd fds[2] = {{replies_, POLLIN, 0}, {errors_, POLLIN, 0}};
+            const int n = poll(fds, errors_ >= 0 ? 2 : 1, (int)(left * 1000) + 1);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) return died(false, i);
+            if (errors_ >= 0 && (fds[1].revents & (POLLIN | POLLHUP | POLLERR))) drain_errors();
+            if (!(fds[0].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+            char *to = got < sizeof r ? (char *)&r + got : (char *)plane.data() + (got - sizeof r);
+            const ssize_t m = read(replies_, to, (got < sizeof r ? sizeof r : want) - got);
             if (m < 0 && errno == EINTR) continue;
-            if (m <= 0) {
-                close(fds[k].fd);
-                fds[k].fd = -1;
-                --open_fds;
-            } else if (k == 0) {
-                if (got < want) got += (size_t)m;
-                else got = want + 1; // more than was asked for
-            } else if (errtext.size() < 4096) {
-                errtext.append(scratch, (size_t)m);
+            if (m <= 0) return died(false, i);
+            got += (size_t)m;
+            if (got == sizeof r && want == sizeof r) { // the header: is there an image?
+                if (r.magic != kMagic || r.index != i) {
+                    stop();
+                    return "the reader's worker answered out of turn";
+                }
+                r.message[sizeof r.message - 1] = r.series[sizeof r.series - 1] = 0;
+                if (!r.ok) break;
+                if (r.cols < 1 || r.rows < 1 || r.cols > (unsigned)HD_MAX_DIM || r.rows > (unsigned)HD_MAX_DIM) {
+                    stop();
+                    return fmt("the reader's worker sent a %ux%u image", r.cols, r.rows);
+                }
+                try {
+                    plane.resize((size_t)r.cols * r.rows);
+                } catch (const std::bad_alloc &) {
+                    stop();
+                    return "out of memory for a slice";
+                }
+                want = sizeof r + plane.size() * sizeof(float);
             }
         }
+        if (r.ok) return "";
+        drain_errors();
+        const std::string said = last_line(errtext_);
+        return std::strncmp(r.message, "GDCM cannot", 11) == 0 && !said.empty() ? std::string(r.message) + " (" + said + ")"
+                                                                               : std::string(r.message);
     }
-    for (int k = 0; k < 2; ++k)
-        if (fds[k].fd >= 0) close(fds[k].fd);
-    if (timed_out) kill(pid, SIGKILL);
-    int st = 0;
-    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {}
-    const std::string said = last_line(errtext);
-    if (timed_out) return fmt("GDCM took over %.0f s on it (stopped)", wall_s);
-    if (WIFSIGNALED(st)) {
-        const int sig = WTERMSIG(st);
-        if (sig == SIGXCPU || sig == SIGKILL) return fmt("GDCM ran over %u s of CPU time on it (stopped)", cpu_s);
-        return fmt("GDCM %s on it (signal %d%s%s)", sig == SIGABRT ? "aborted" : "crashed", sig, said.empty() ? "" : ": ",
-                   said.c_str());
+
+private:
+    const std::vector<candidate> &files_;
+    pid_t pid_ = -1;
+    int requests_ = -1, replies_ = -1, errors_ = -1;
+    std::string errtext_;
+
+    bool start(std::string &why)
+    {
+        int req[2], rep[2], err[2];
+        if (pipe(req) != 0) return why = std::string("cannot make a pipe: ") + std::strerror(errno), false;
+        if (pipe(rep) != 0) {
+            close(req[0]), close(req[1]);
+            return why = std::string("cannot make a pipe: ") + std::strerror(errno), false;
+        }
+        if (pipe(err) != 0) {
+            close(req[0]), close(req[1]), close(rep[0]), close(rep[1]);
+            return why = std::string("cannot make a pipe: ") + std::strerror(errno), false;
+        }
+        std::fflush(NULL);
+        const pid_t pid = fork();
+        if (pid < 0) {
+            for (int fd : {req[0], req[1], rep[0], rep[1], err[0], err[1]}) close(fd);
+            return why = std::string("cannot start the reader's worker: ") + std::strerror(errno), false;
+        }
+        if (pid == 0) {
+            close(req[1]), close(rep[0]), close(err[0]);
+            dup2(err[1], 1), dup2(err[1], 2);
+            close(err[1]);
+            worker_main(files_, req[0], rep[1]);
+        }
+        close(req[0]), close(rep[1]), close(err[1]);
+        pid_ = pid, requests_ = req[1], replies_ = rep[0], errors_ = err[0];
+        return true;
     }
-    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0) return fmt("GDCM's reader exited with status %d", WEXITSTATUS(st));
-    if (got < sizeof r || r.magic != kMagic) return "GDCM's reader returned nothing";
-    r.message[sizeof r.message - 1] = 0;
-    if (!r.ok) return said.empty() || std::strstr(r.message, "decode") ? std::string(r.message) : std::string(r.message) + " (" + said + ")";
-    if (got != want) return "GDCM's reader returned a short image";
-    return "";
-}
+
+    void drain_errors()
+    {
+        char buf[4096];
+        struct pollfd p = {errors_, POLLIN, 0};
+        while (errors_ >= 0 && poll(&p, 1, 0) > 0) {
+            const ssize_t m = read(errors_, buf, sizeof buf);
+            if (m < 0 && errno == EINTR) continue;
+            if (m <= 0) {
+                close(errors_);
+                errors_ = -1;
+                break;
+            }
+            errtext_.append(buf, (size_t)m);
+            if (errtext_.size() > 8192) errtext_.erase(0, errtext_.size() - 4096);
+        }
+    }
+
+    // Ends the worker; returns its exit status (-1 if there was none).
+    int stop(bool kill_it = true)
+    {
+        if (pid_ < 0) return -1;
+        if (kill_it) kill(pid_, SIGKILL);
+        if (requests_ >= 0) close(requests_);
+        if (replies_ >= 0) close(replies_);
+        int st = 0;
+        while (waitpid(pid_, &st, 0) < 0 && errno == EINTR) {}
+        drain_errors();
+        if (errors_ >= 0) close(errors_);
+        pid_ = -1, requests_ = replies_ = errors_ = -1;
+        return st;
+    }
+
+    // Why file i was not read when the worker stopped answering: killed at the deadline, over its
+    // CPU time, aborted, crashed.
+    std::string died(bool timed_out, uint32_t i)
+    {
+        if (timed_out) kill(pid_, SIGKILL);
+        const int st = stop(false);
+        const std::string said = last_line(errtext_);
+        const std::string tail = said.empty() ? "" : ": " + said;
+        if (timed_out) return fmt("reading it took over %.0f s (stopped)", wall_budget_s(files_[i].size));
+        if (WIFSIGNALED(st)) {
+            const int sig = WTERMSIG(st);
+            if (sig == SIGXCPU || sig == SIGKILL)
+                return fmt("reading it took over %u s of CPU time (stopped)", cpu_budget_s(files_[i].size));
+            return fmt("GDCM %s on it (signal %d%s)", sig == SIGABRT ? "aborted" : "crashed", sig, tail.c_str());
+        }
+        return fmt("the reader's worker stopped on it (exit status %d%s)", WIFEXITED(st) ? WEXITSTATUS(st) : -1, tail.c_str());
+    }
+};
 
 // GDCM's geometry of a slice: finite, unit direction cosines at right angles, spacing > 0.
-std::string check_geometry(const parsed &r)
+std::string check_geometry(const reply &r)
 {
     for (double v : r.origin)
         if (!std::isfinite(v) || std::fabs(v) > kMaxCoordinate) return "its origin is not finite";
@@ -889,7 +1020,6 @@ std::string check_geometry(const parsed &r)
         return fmt("Image Orientation %g,%g,%g,%g,%g,%g is not two perpendicular unit vectors", a[0], a[1], a[2], b[0], b[1], b[2]);
     for (double v : r.spacing)
         if (!(v > 0) || v > kMaxCoordinate) return fmt("its pixel spacing %g,%g is not > 0", r.spacing[0], r.spacing[1]);
-    if (!std::isfinite(r.slope) || !std::isfinite(r.intercept)) return "its rescale is not finite";
     return "";
 }
 
@@ -911,7 +1041,7 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
 {
     std::memset(out, 0, sizeof *out);
     if (err_size) err[0] = 0;
-    // GDCM's messages go to the child's captured stderr; the warnings are not wanted at all
+    // GDCM's messages go to the worker's captured stderr; its warnings are not wanted at all
     gdcm::Trace::WarningOff();
     const std::string dir = dir_c;
     std::vector<candidate> files;
@@ -928,37 +1058,30 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
         std::free(data);
         return fail(err, err_size, m);
     };
-    std::vector<unsigned char> bytes;
-    for (const candidate &f : files) {
-        std::string why = read_file(f.open, bytes);
-        file_check c;
-        if (why.empty()) why = check_file(bytes, c);
-        if (why.empty() && !slices.empty() && (c.cols != cols || c.rows != rows))
+    worker w(files);
+    std::vector<float> voxels;
+    for (uint32_t i = 0; i < (uint32_t)files.size(); ++i) {
+        const candidate &f = files[i];
+        reply r;
+        std::string why = w.ask(i, r, voxels);
+        if (why.empty() && !slices.empty() && (r.cols != cols || r.rows != rows))
             return fail_free(dir + ": slices of different sizes (" + first + " " + std::to_string(cols) + "x" +
-                             std::to_string(rows) + ", " + f.path + " " + std::to_string(c.cols) + "x" + std::to_string(c.rows) + ")");
-        if (why.empty() && slices.size() == (size_t)HD_MAX_DIM)
-            return fail_free(dir + fmt(": more than %d slices, the library's limit per axis", HD_MAX_DIM));
-        parsed r;
-        if (why.empty()) {
-            const size_t n = (size_t)c.rows * c.cols;
-            float *grown = (float *)std::realloc(data, (slices.size() + 1) * n * sizeof(float));
-            if (!grown) return fail_free(dir + ": out of memory for the volume");
-            data = grown;
-            why = parse_contained(bytes, c, r, data + slices.size() * n);
-        }
+                             std::to_string(rows) + ", " + f.path + " " + std::to_string(r.cols) + "x" + std::to_string(r.rows) + ")");
         if (why.empty()) why = check_geometry(r);
-        for (size_t i = 0, n = (size_t)c.rows * c.cols; why.empty() && i < n; ++i)
-            if (!std::isfinite(data[slices.size() * n + i])) why = "a voxel is not finite after the rescale";
+        for (size_t k = 0; why.empty() && k < voxels.size(); ++k)
+            if (!std::isfinite(voxels[k])) why = "a voxel is not finite after the rescale";
         if (!why.empty()) {
             skipped(f.path, why), ++skips;
             continue;
         }
+        if (slices.size() == (size_t)HD_MAX_DIM)
+            return fail_free(dir + fmt(": more than %d slices, the library's limit per axis", HD_MAX_DIM));
         const double *dc = r.cosines;
         if (slices.empty()) {
             first = f.path;
-            series = c.series;
-            cols = c.cols;
-            rows = c.rows;
+            series = r.series;
+            cols = r.cols;
+            rows = r.rows;
             plane = (size_t)rows * cols;
             for (int k = 0; k < 6; ++k) cosines[k] = dc[k];
             normal[0] = dc[1] * dc[5] - dc[2] * dc[4];
@@ -967,18 +1090,21 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
             pixel_spacing[0] = r.spacing[0];
             pixel_spacing[1] = r.spacing[1];
         } else {
-            if (c.series != series)
-                return fail_free(dir + ": more than one series (" + first + " is in " + printable(series) + ", " + f.path + " in " +
-                                 printable(c.series) + "); give a folder of one series");
+            if (r.series != series)
+                return fail_free(dir + ": more than one series (" + first + " is in " + printable(series) + ", " + f.path +
+                                 " in " + printable(r.series) + "); give a folder of one series");
             for (int k = 0; k < 6; ++k)
                 if (std::fabs(dc[k] - cosines[k]) > 1e-3)
                     return fail_free(dir + ": slices of different orientations (" + first + ", " + f.path + ")");
         }
+        float *grown = (float *)std::realloc(data, (slices.size() + 1) * plane * sizeof(float));
+        if (!grown) return fail_free(dir + ": out of memory for the volume");
+        data = grown;
+        std::memcpy(data + slices.size() * plane, voxels.data(), plane * sizeof(float));
         const double *o = r.origin;
         slices.push_back({f.path, o[0] * normal[0] + o[1] * normal[1] + o[2] * normal[2], slices.size()});
     }
-    bytes.clear();
-    bytes.shrink_to_fit();
+    voxels = std::vector<float>();
     if (slices.empty())
         return fail_free(dir + (skips ? fmt(": no DICOM images it can read (%zu entr%s skipped, each named above)", skips,
                                             skips == 1 ? "y" : "ies")

@@ -8,7 +8,16 @@
 #   make test-dicom             a DICOM series written from the head CT renders as the NRRD in
 #                               hdrender and hdview; malformed series give their own errors
 #                               (part of `make test`)
-.PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom
+#   make test-dicom-hostile     hostile DICOM folders (scripts/dicom-corpus): each case's exit and
+#                               message, 60 junk files and 30 mutated slices beside a series, the
+#                               files that abort GDCM contained; 5 s and 256 MiB per run (part of
+#                               `make test`, ~10 s)
+#   make dicom-hostile-long     the same with 1000 junk files and 1000 mutated slices, then GDCM
+#                               alone on them (build/gdcm_probe: aborts, time, memory)
+#   make test-hdrender-cli      FIFOs, /dev/full, numbers out of range, TF files at 1 MiB, NUL
+#                               bytes (part of `make test`)
+.PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom test-dicom-hostile \
+        dicom-hostile-long test-hdrender-cli
 
 HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC)
 HDR_BACKENDS := $(B)/hdrender $(B)/hdrender-opencl $(B)/hdrender-vulkan $(B)/hdrender-gl
@@ -37,8 +46,17 @@ $(B)/hdrender-vulkan: $(B)/hdrender-vulkan.o $(B)/hd_dicom.o
 $(B)/hdrender-gl: $(B)/hdrender-gl.o $(B)/hd_dicom.o
 	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lEGL $(DICOM_LDLIBS)
 
+# the DICOM reader's tests: hdrender with the VR check off, so that GDCM's asserts on the files
+# of tests/dicom/gdcm-aborts reach the worker; gdcm_probe, GDCM alone on a corpus
+$(B)/hd_dicom_novrcheck.o: examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
+	$(CXX) $(CPPFLAGS) -DHDX_DICOM_TEST_NO_VR_CHECK $(DICOM_CXXFLAGS) $(CFLAGS) -c $< -o $@
+$(B)/hdrender_novrcheck: $(B)/hdrender.o $(B)/hd_dicom_novrcheck.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(DICOM_LDLIBS)
+$(B)/gdcm_probe: tests/dicom/gdcm_probe.cpp examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
+	$(CXX) $(CPPFLAGS) $(DICOM_CXXFLAGS) $(CFLAGS) $< -o $@ $(DICOM_LDLIBS)
+
 hdrender-backends: $(HDR_BACKENDS)
-TEST_PROGRAMS += $(HDR_BACKENDS)
+TEST_PROGRAMS += $(HDR_BACKENDS) $(B)/hdrender_novrcheck
 all: hdrender-backends
 
 test-hdrender-backends: $(HDR_BACKENDS) $(B)/pngcmp data
@@ -50,4 +68,14 @@ test-hdrender-defaults: $(B)/hdrender $(B)/pngcmp data
 test-dicom: $(B)/hdrender $(B)/hdview $(B)/pngcmp data
 	scripts/test-dicom $(B)
 
-test: test-hdrender-backends test-hdrender-defaults test-dicom
+test-dicom-hostile: $(B)/hdrender $(B)/hdrender_novrcheck
+	scripts/test-dicom-hostile $(B)
+
+dicom-hostile-long: $(B)/hdrender $(B)/hdrender_novrcheck $(B)/gdcm_probe
+	scripts/test-dicom-hostile $(B) 1000 1000
+	$(B)/gdcm_probe $(B)/dicom-hostile/corpus/junk/j* $(B)/dicom-hostile/corpus/mutated/*/m.dcm
+
+test-hdrender-cli: $(B)/hdrender
+	scripts/test-hdrender-cli $(B)
+
+test: test-hdrender-backends test-hdrender-defaults test-dicom test-dicom-hostile test-hdrender-cli
