@@ -14,10 +14,11 @@
 #                               `make test`, ~10 s)
 #   make dicom-hostile-long     the same with 1000 junk files and 1000 mutated slices, then GDCM
 #                               alone on them (build/gdcm_probe: aborts, time, memory)
+#   make dicom-dcmtk-probe      DCMTK alone on that corpus (needs libdcmtk-dev; docs/DICOM.md)
 #   make test-hdrender-cli      FIFOs, /dev/full, numbers out of range, TF files at 1 MiB, NUL
 #                               bytes (part of `make test`)
 .PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom test-dicom-hostile \
-        dicom-hostile-long test-hdrender-cli
+        dicom-hostile-long dicom-dcmtk-probe test-hdrender-cli
 
 HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC)
 HDR_BACKENDS := $(B)/hdrender $(B)/hdrender-opencl $(B)/hdrender-vulkan $(B)/hdrender-gl
@@ -74,6 +75,14 @@ test-dicom-hostile: $(B)/hdrender $(B)/hdrender_novrcheck
 dicom-hostile-long: $(B)/hdrender $(B)/hdrender_novrcheck $(B)/gdcm_probe
 	scripts/test-dicom-hostile $(B) 1000 1000
 	$(B)/gdcm_probe $(B)/dicom-hostile/corpus/junk/j* $(B)/dicom-hostile/corpus/mutated/*/m.dcm
+
+# DCMTK alone on the same corpus, for docs/DICOM.md (after dicom-hostile-long; needs Debian's
+# libdcmtk-dev, which the tools do not use)
+DCMTK_LDLIBS := -ldcmjpls -ldcmjpeg -ldcmimgle -ldcmdata -lijg8 -lijg12 -lijg16 -ldcmtkcharls -loflog -lofstd
+$(B)/dcmtk_probe: tests/dicom/dcmtk_probe.cpp | $(B)
+	$(CXX) -std=c++17 -Wall -Wextra -Werror $(CFLAGS) $< -o $@ $(DCMTK_LDLIBS)
+dicom-dcmtk-probe: $(B)/dcmtk_probe
+	$(B)/dcmtk_probe $(B)/dicom-hostile/corpus/junk/j* $(B)/dicom-hostile/corpus/mutated/*/m.dcm
 
 test-hdrender-cli: $(B)/hdrender
 	scripts/test-hdrender-cli $(B)
