@@ -280,6 +280,7 @@ std::string check_vr(uint16_t g, uint16_t e, const char *file_vr, uint32_t lengt
         if (in_dict && t != gdcm::VR::UN && !known.Compatible(gdcm::VR(t)))
             return fmt("element %s has VR %s; the DICOM dictionary gives it %s", tag_name(g, e).c_str(), file_vr,
                        gdcm::VR::GetVRString(known));
+        if (t == gdcm::VR::UN && in_dict && !known.IsDual()) t = known; // GDCM reads UN as the dictionary's VR
     } else if (!in_dict || known.IsDual()) {
         return "";
     }
@@ -313,6 +314,10 @@ public:
             if (e.undefined || (e.vr[0] == 'S' && e.vr[1] == 'Q'))
                 return bad(fmt("meta element %s at byte %zu: a sequence or undefined length", tag_name(e.g, e.e).c_str(), pos));
             if (have_prev && e.tag() <= prev) return order(e, pos, prev);
+#ifndef HDX_DICOM_TEST_NO_VR_CHECK
+            const std::string vr_err = check_vr(e.g, e.e, e.vr, e.length);
+            if (!vr_err.empty()) return bad(vr_err + fmt(" (at byte %zu)", pos));
+#endif
             if (e.e == 0x0000) {
                 if (e.length != 4) return bad(fmt("meta group length at byte %zu has %u bytes, not 4", pos, e.length));
                 group_end = e.value + 4 + u32(e.value);
@@ -374,7 +379,8 @@ public:
                     return bad(fmt("Pixel Data at byte %zu has an undefined length in transfer syntax %s", at, c_.ts_uid.c_str()));
                 const bool un = !implicit && e.vr[0] == 'U' && e.vr[1] == 'N';
                 if (!implicit && !sq && !un)
-                    return bad(fmt("element %s at byte %zu: an undefined length on VR %s", tag_name(e.g, e.e).c_str(), at, e.vr));
+                    return bad(fmt("element %s at byte %zu: an undefined length on VR %s", tag_name(e.g, e.e).c_str(), at,
+                                   printable(std::string(e.vr, 2)).c_str()));
                 pos = e.value;
                 if (!sequence(pos, end, true, implicit || un, depth + 1)) return false; // UN: implicit VR inside
                 continue;
@@ -555,7 +561,8 @@ std::string check_image(const walker &w, file_check &c)
         const value_ref &r = get(tag);
         if (!r.present) return required ? std::string("no ") + name : std::string();
         if (r.length != 2 || (r.vr[0] && (r.vr[0] != 'U' || r.vr[1] != 'S')))
-            return fmt("%s has %zu bytes of VR %s, not one US value", name, r.length, r.vr[0] ? r.vr : "(implicit)");
+            return fmt("%s has %zu bytes of VR %s, not one US value", name, r.length,
+                       r.vr[0] ? printable(std::string(r.vr, 2)).c_str() : "(implicit)");
         v = w.u16(r.offset);
         return "";
     };
@@ -599,7 +606,7 @@ std::string check_image(const walker &w, file_check &c)
     static const struct {
         uint32_t tag;
         const char *name;
-        size_t count; // 0: one or more
+        size_t count;
         bool positive;
     } nums[] = {
         {0x00280030, "Pixel Spacing", 2, true},           {0x00200032, "Image Position (Patient)", 3, false},
@@ -613,7 +620,7 @@ std::string check_image(const walker &w, file_check &c)
         if (!r.present || r.length == 0) continue;
         const std::string s = w.text(r);
         std::vector<double> v;
-        bool ok = numbers(s, v) && (n.count == 0 || v.size() == n.count);
+        bool ok = numbers(s, v) && v.size() == n.count;
         for (double d : v) ok = ok && std::fabs(d) <= kMaxCoordinate && (!n.positive || d > 0);
         if (!ok)
             return fmt("%s '%s' is not %s finite number%s %s", n.name, printable(s).c_str(),
@@ -1023,6 +1030,21 @@ std::string check_geometry(const reply &r)
     return "";
 }
 
+// SIGPIPE ignored while it lives: a request to a worker that has just died is an error to
+// handle, not the end of the program.
+struct sigpipe_ignored {
+    struct sigaction old;
+    sigpipe_ignored()
+    {
+        struct sigaction ign;
+        std::memset(&ign, 0, sizeof ign);
+        ign.sa_handler = SIG_IGN;
+        sigemptyset(&ign.sa_mask);
+        sigaction(SIGPIPE, &ign, &old);
+    }
+    ~sigpipe_ignored() { sigaction(SIGPIPE, &old, NULL); }
+};
+
 struct slice {
     std::string path;
     double position; // along the slice normal, mm
@@ -1058,6 +1080,7 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
         std::free(data);
         return fail(err, err_size, m);
     };
+    sigpipe_ignored no_sigpipe;
     worker w(files);
     std::vector<float> voxels;
     for (uint32_t i = 0; i < (uint32_t)files.size(); ++i) {
