@@ -26,15 +26,24 @@
                            (two points at one value make a step); R G B A in 0..1
    Entry i sits at value lo + (hi - lo) * i / (N - 1) and is the linear interpolation of the two
    control points around it; below the first point it is the first point, above the last the
-   last. Numbers are C decimal numbers ('.' as the decimal point, any locale). */
+   last. Numbers are C decimal numbers ('.' as the decimal point, any locale). A file is a regular
+   file of at most 1 MiB (hdx_tf_load: a FIFO or device is refused, not waited on); a NUL byte on
+   a line is an error, as is a line over 511 characters. */
 #ifndef HD_TF_H
 #define HD_TF_H
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
 #include "hybriddiff.h"
+#if defined(__unix__) || defined(__APPLE__)
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#define HDX_TF_POSIX 1
+#endif
 
 #if defined(__GNUC__) || defined(__clang__)
 #define HDX_TF_FN static __attribute__((unused))
@@ -45,6 +54,7 @@
 #define HDX_TF_MAX_ENTRIES 4096
 #define HDX_TF_MAX_POINTS 256
 #define HDX_TF_DEFAULT_ENTRIES 256
+#define HDX_TF_MAX_FILE_BYTES (1 << 20)
 
 typedef struct hdx_tf_point {
     float value;   /* data units */
@@ -248,6 +258,10 @@ HDX_TF_FN int hdx_tf_parse(const char *text, size_t len, const char *name, hdx_t
         char *s, *hash;
         ++line;
         while (pos < len && text[pos] != '\n') {
+            if (text[pos] == 0) {
+                snprintf(err, err_size, "%s:%d: a NUL byte (not a text file?)", name, line);
+                return 0;
+            }
             if (n + 1 < sizeof buf) buf[n++] = text[pos];
             else {
                 snprintf(err, err_size, "%s:%d: line is too long", name, line);
@@ -334,31 +348,61 @@ HDX_TF_FN int hdx_tf_parse(const char *text, size_t len, const char *name, hdx_t
     return 1;
 }
 
-/* Reads a TF file. Returns 1, or 0 with a one-line message in err. */
+/* Reads a TF file of at most 1 MiB. Returns 1, or 0 with a one-line message in err. Only a
+   regular file is read (a FIFO or a device is refused, never waited on). */
 HDX_TF_FN int hdx_tf_load(const char *path, hdx_tf *tf, char *err, size_t err_size)
 {
-    FILE *f = fopen(path, "rb");
     char *buf;
-    size_t n;
-    int ok;
+    size_t n = 0;
+    int ok, failed = 0;
+#ifdef HDX_TF_POSIX
+    struct stat st;
+    int fd = open(path, O_RDONLY | O_NONBLOCK);
+    if (fd < 0) {
+        snprintf(err, err_size, "%s: cannot open the transfer function file: %s", path, strerror(errno));
+        return 0;
+    }
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        snprintf(err, err_size, "%s: not a regular file (a FIFO, device or folder is not read)", path);
+        return 0;
+    }
+#else
+    FILE *f = fopen(path, "rb");
     if (!f) {
         snprintf(err, err_size, "%s: cannot open the transfer function file", path);
         return 0;
     }
-    buf = (char *)malloc(1 << 20);
-    if (!buf) {
+#endif
+    buf = (char *)malloc(HDX_TF_MAX_FILE_BYTES + 1);
+    if (buf) {
+#ifdef HDX_TF_POSIX
+        for (;;) { /* one byte more than the limit tells a file over it */
+            ssize_t r = read(fd, buf + n, HDX_TF_MAX_FILE_BYTES + 1 - n);
+            if (r < 0 && errno == EINTR) continue;
+            if (r < 0) failed = 1;
+            if (r <= 0) break;
+            n += (size_t)r;
+            if (n == HDX_TF_MAX_FILE_BYTES + 1) break;
+        }
+        close(fd);
+#else
+        n = fread(buf, 1, HDX_TF_MAX_FILE_BYTES + 1, f);
+        failed = ferror(f);
         fclose(f);
-        snprintf(err, err_size, "%s: out of memory", path);
-        return 0;
+#endif
+    } else {
+#ifdef HDX_TF_POSIX
+        close(fd);
+#else
+        fclose(f);
+#endif
     }
-    n = fread(buf, 1, 1 << 20, f);
-    if (ferror(f) || n == (1 << 20)) {
-        snprintf(err, err_size, "%s: %s", path, ferror(f) ? "read error" : "larger than 1 MiB");
-        fclose(f);
+    if (!buf || failed || n > HDX_TF_MAX_FILE_BYTES) {
+        snprintf(err, err_size, "%s: %s", path, !buf ? "out of memory" : failed ? "read error" : "larger than 1 MiB");
         free(buf);
         return 0;
     }
-    fclose(f);
     ok = hdx_tf_parse(buf, n, path, tf, err, err_size);
     free(buf);
     return ok;

@@ -31,6 +31,7 @@
 #include "hd_frames.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -251,8 +252,9 @@ static long parse_int(const char *flag, const char *s, long lo, long hi)
     return v;
 }
 
-/* "X,Y,Z" -> v; count numbers exactly. */
-static void parse_floats(const char *flag, const char *s, float *v, int count)
+
+/* "X,Y,Z" -> v; count numbers exactly, each within +-max_abs. */
+static void parse_floats_in(const char *flag, const char *s, float *v, int count, double max_abs)
 {
     const char *p = s;
     int i;
@@ -261,12 +263,19 @@ static void parse_floats(const char *flag, const char *s, float *v, int count)
         double d;
         errno = 0;
         d = strtod(p, &end);
-        if (end == p || errno == ERANGE || !isfinite(d) ||
+        if (end == p || (errno == ERANGE && d != 0.0) || !isfinite(d) ||
             (i + 1 < count ? *end != ',' : *end != 0))
             fail(2, "%s: '%s' is not %d comma-separated numbers", flag, s, count);
+        if (fabs(d) > max_abs) fail(2, "%s: '%s': %g is outside +-%g", flag, s, d, max_abs);
         v[i] = (float)d;
         p = end + 1;
     }
+}
+
+/* The same within float range (1e30: sums and products of a few stay finite). */
+static void parse_floats(const char *flag, const char *s, float *v, int count)
+{
+    parse_floats_in(flag, s, v, count, 1e30);
 }
 
 static void parse_dims(const char *flag, const char *s, int dims[3])
@@ -283,16 +292,20 @@ static void parse_dims(const char *flag, const char *s, int dims[3])
 
 static void parse_size(const char *flag, const char *s, int *w, int *h)
 {
+    const char *p = s;
     char *end;
     long a, b;
     errno = 0;
-    a = strtol(s, &end, 10);
-    if (end == s || (*end != 'x' && *end != 'X')) fail(2, "%s: '%s' is not WxH", flag, s);
-    s = end + 1;
-    b = strtol(s, &end, 10);
-    if (end == s || *end || errno == ERANGE) fail(2, "%s: '%s' is not WxH", flag, s);
+    a = strtol(p, &end, 10);
+    if (end == p || (*end != 'x' && *end != 'X')) fail(2, "%s: '%s' is not WxH", flag, s);
+    if (errno == ERANGE) a = HD_MAX_IMAGE_DIM + 1L; /* outside, reported below */
+    p = end + 1;
+    errno = 0;
+    b = strtol(p, &end, 10);
+    if (end == p || *end) fail(2, "%s: '%s' is not WxH", flag, s);
+    if (errno == ERANGE) b = HD_MAX_IMAGE_DIM + 1L;
     if (a < 1 || b < 1 || a > HD_MAX_IMAGE_DIM || b > HD_MAX_IMAGE_DIM)
-        fail(2, "%s: %ldx%ld is outside 1..%d per side", flag, a, b, HD_MAX_IMAGE_DIM);
+        fail(2, "%s: '%s' is outside 1..%d per side", flag, s, HD_MAX_IMAGE_DIM);
     *w = (int)a;
     *h = (int)b;
 }
@@ -322,7 +335,8 @@ static hd_light parse_light(const char *s)
         fail(2, "--light: '%s' must start with dir: or point:", s);
     if (n < 2) fail(2, "--light: '%s' needs a %s X,Y,Z", s,
                     l.type == HD_LIGHT_POINT ? "position" : "direction");
-    parse_floats("--light", parts[1], l.type == HD_LIGHT_POINT ? l.position : l.direction, 3);
+    /* the library's limit for positions; a direction's squares stay finite in float as well */
+    parse_floats_in("--light", parts[1], l.type == HD_LIGHT_POINT ? l.position : l.direction, 3, HD_MAX_LIGHT_DISTANCE);
     if (l.type == HD_LIGHT_DIRECTIONAL &&
         l.direction[0] == 0.0f && l.direction[1] == 0.0f && l.direction[2] == 0.0f)
         fail(2, "--light: '%s': the direction is zero", s);
@@ -414,15 +428,16 @@ static void make_parent_dirs(const char *path)
     }
 }
 
-/* Fails now, not after the render, if path cannot be written. Leaves an existing file alone. */
+/* Fails now, not after the render, if path cannot be written. Leaves an existing file alone; a
+   FIFO without a reader is refused instead of waited on. */
 static void check_writable(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    int existed = f != NULL;
-    if (f) fclose(f);
-    f = fopen(path, "ab");
-    if (!f) fail(2, "--out: cannot write %s: %s", path, strerror(errno));
-    fclose(f);
+    struct stat st;
+    int existed = stat(path, &st) == 0, fd;
+    fd = open(path, O_WRONLY | O_APPEND | O_CREAT | O_NONBLOCK, 0666);
+    if (fd < 0 && errno == ENXIO) fail(2, "--out: %s is a FIFO with no reader", path);
+    if (fd < 0) fail(2, "--out: cannot write %s: %s", path, strerror(errno));
+    close(fd);
     if (!existed) remove(path);
 }
 
@@ -690,7 +705,7 @@ int main(int argc, char **argv)
     static hdx_tf tf;
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
-    int print_tf = 0, i, k, have_spacing = 0, status, camera_given = 0, min_light = 0, crop_given = 0, window_given = 0;
+    int print_tf = 0, i, k, have_spacing = 0, camera_given = 0, min_light = 0, crop_given = 0, window_given = 0;
     double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -801,13 +816,15 @@ int main(int argc, char **argv)
         } else if (IS("--lights")) {
             lights_n = (int)parse_int(a, VAL(), 1, HD_MAX_LIGHTS);
         } else if (IS("--eye")) {
-            parse_floats(a, VAL(), desc.camera.eye, 3);
+            parse_floats_in(a, VAL(), desc.camera.eye, 3, HD_MAX_CAMERA_DISTANCE);
             camera_given = 1;
         } else if (IS("--target")) {
-            parse_floats(a, VAL(), desc.camera.target, 3);
+            parse_floats_in(a, VAL(), desc.camera.target, 3, HD_MAX_CAMERA_DISTANCE);
             camera_given = 1;
         } else if (IS("--up")) {
-            parse_floats(a, VAL(), desc.camera.up, 3);
+            parse_floats_in(a, VAL(), desc.camera.up, 3, 1e15);
+            if (desc.camera.up[0] == 0.0f && desc.camera.up[1] == 0.0f && desc.camera.up[2] == 0.0f)
+                fail(2, "--up: '%s' is the zero vector", v);
             camera_given = 1;
         } else if (IS("--fov")) {
             desc.camera.fov_y = parse_float(a, VAL(), 0.0f, 180.0f, 1, 1);
@@ -923,10 +940,10 @@ int main(int argc, char **argv)
     /* ---- transfer function ---- */
     if (tf_arg) {
         if (!hdx_tf_preset(tf_arg, &tf)) {
-            FILE *f = fopen(tf_arg, "rb");
-            if (!f) fail(2, "--tf: '%s' is neither a preset (ct-skin, ct-bone, ct-tissue, ct-flesh, ramp) "
-                            "nor a readable file", tf_arg);
-            fclose(f);
+            struct stat st;
+            if (stat(tf_arg, &st) != 0)
+                fail(2, "--tf: '%s' is neither a preset (ct-skin, ct-bone, ct-tissue, ct-flesh, ramp) "
+                        "nor a file (%s)", tf_arg, strerror(errno));
             if (!hdx_tf_load(tf_arg, &tf, err, sizeof err)) fail(2, "--tf: %s", err);
         }
         if (print_tf) {
@@ -960,6 +977,10 @@ int main(int argc, char **argv)
         else histogram_tf(&vol, &tf);
     }
     if (!camera_given && !raw) known_volume_camera(input, &vol, &desc.camera);
+    if (desc.camera.eye[0] == desc.camera.target[0] && desc.camera.eye[1] == desc.camera.target[1] &&
+        desc.camera.eye[2] == desc.camera.target[2])
+        fail(2, "--eye and --target are the same point (%g,%g,%g): the camera has no view direction",
+             (double)desc.camera.eye[0], (double)desc.camera.eye[1], (double)desc.camera.eye[2]);
     if (!crop_given && !raw) hdx_known_crop(input, vol.desc.dims, &desc.params);
     if (tf.data_domain) {
         float lo = vol.value_min, hi = vol.value_max;
@@ -1060,9 +1081,9 @@ int main(int argc, char **argv)
                 "the pixels above 8/255): raise --exposure or --iterations%s, or check --tf and the "
                 "camera (--eye, --target)\n", mean, 100.0 * lit,
                 desc.params.method == HD_METHOD_CD ? " (CD needs about 200)" : "");
-    status = stbi_write_png(out_path, desc.camera.width, desc.camera.height, 3, rgb,
-                            desc.camera.width * 3);
-    if (!status) fail(1, "cannot write %s", out_path);
+    if (!hdx_png_write(out_path, desc.camera.width, desc.camera.height, 3, rgb, desc.camera.width * 3, err,
+                       sizeof err))
+        fail(1, "cannot write %s: %s", out_path, err);
     if (!g_quiet && hd_get_stats(ctx, &stats) == HD_SUCCESS)
         fprintf(stderr, "hdrender: %d iteration%s, %d frame%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
                 "%.2f s, projection %.2f s) -> %s\n", iterations, iterations == 1 ? "" : "s",
