@@ -23,7 +23,7 @@ help:
 	@echo "  make clean                          remove build/"
 	@echo "  make help                           this list"
 	@echo "tests (T: part of make test):"
-	@echo "  make check-generated                T embedded kernels, SPIR-V and dist/hybriddiff.h are up to date"
+	@echo "  make check-generated                T embedded kernels, SPIR-V, hd_undef.h, dist/hybriddiff.h up to date; no macro leaks"
 	@echo "  make check-glsl                     T every shared kernel compiles as GLSL 4.30 and 4.50"
 	@echo "  make compile-matrix                 T dist/hybriddiff.h as C99/C++17, gcc/clang, every backend, #error cases"
 	@echo "  make dist-builds                    T examples and conformance suites built from dist/hybriddiff.h, run --quick"

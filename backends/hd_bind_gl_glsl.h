@@ -17,7 +17,7 @@
 #define HD_GLSL_CUSTOM_BUFFERS 1
 #ifdef HD_ILLUM_R16F
 #define HD_ILLUM_FMT r16f
-#define HD_ILLUM_ROUND(v) hd_f16_round(min((v), 65504.0)) /* nearest even (hd_prelude_glsl.h), saturated as hd_f2h_sat */
+#define HD_ILLUM_ROUND(v) hdk_f16_round(min((v), 65504.0)) /* nearest even (hd_prelude_glsl.h), saturated as hdk_f2h_sat */
 #else
 #define HD_ILLUM_FMT r32f
 #define HD_ILLUM_ROUND(v) (v)

@@ -30,7 +30,7 @@
 #define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
 #ifdef HD_ILLUM_R16F
 #define HD_ILLUM_FMT r16f
-#define HD_ILLUM_ROUND(v) hd_f16_round(min((v), 65504.0)) /* nearest even (hd_prelude_glsl.h), saturated as hd_f2h_sat */
+#define HD_ILLUM_ROUND(v) hdk_f16_round(min((v), 65504.0)) /* nearest even (hd_prelude_glsl.h), saturated as hdk_f2h_sat */
 #else
 #define HD_ILLUM_FMT r32f
 #define HD_ILLUM_ROUND(v) (v)

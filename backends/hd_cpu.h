@@ -356,7 +356,7 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 static void hd__cpu_classify_row(hd__backend *be, int r)
 {
     int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
-    for (x = 0; x < gx; ++x) hd_classify_voxel(&be->k, x, r % gy, r / gy);
+    for (x = 0; x < gx; ++x) hdk_classify_voxel(&be->k, x, r % gy, r / gy);
 }
 /* Direct light: items of HD__CPU_DIRECT_CHUNK consecutive entries of the tracked voxels' list. */
 #define HD__CPU_DIRECT_CHUNK 64
@@ -365,7 +365,7 @@ static void hd__cpu_direct_chunk(hd__backend *be, int item)
     const hd__view *vw = be->vw;
     size_t j = (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
     if (end > vw->dl_count) end = vw->dl_count;
-    for (; j < end; ++j) hd_direct_index(&be->k, (int)vw->dl_idx[j]);
+    for (; j < end; ++j) hdk_direct_index(&be->k, (int)vw->dl_idx[j]);
 }
 /* ---- diffusion -------------------------------------------------------------------------------
    A pass works on be->grid: the illumination grid itself, or a multigrid level
@@ -378,17 +378,17 @@ static void hd__cpu_direct_chunk(hd__backend *be, int item)
    colour's half of the row at id - 1 + cp and id + cp, the y +- 1 and z +- 1 neighbours at id in
    the neighbouring rows' halves of the other colour: unit-stride loads, no permutes. The loop
    loads the values itself and hands them to the shared pure functions of hd_k_diffuse.h
-   (hd_diffuse_own_of, hd_diffuse_box_of / _surface_rhs_of) with rgb, rhs and the boundary as
+   (hdk_diffuse_own_of, hdk_diffuse_box_of / _surface_rhs_of) with rgb, rhs and the boundary as
    literals and every in-grid flag 1, so each variant is a branch-free loop the compiler
-   vectorises; the same operations in the same order as hd_diffuse_terms_loaded, so the same
-   bits as the per-voxel path (hd_diffuse_row). Rows on the grid's faces in y or z (y = 0 or
+   vectorises; the same operations in the same order as hdk_diffuse_terms_loaded, so the same
+   bits as the per-voxel path (hdk_diffuse_row). Rows on the grid's faces in y or z (y = 0 or
    gy - 1, z = 0 or gz - 1) take the same loop with their four y/z in-grid flags as run-time
    values (a second copy of each variant; an outside neighbour's loads read the row's own other
    colour instead, and the kernels ignore the values of an outside neighbour), because the
    per-voxel path made those few rows a large share of a sweep; the colour layout spares the
    permutes a stride-2 loop over an x-fastest layout needs for every load (docs/DESIGN-CPU.md
    has both measurements, bench/hdbench_rb_schedule.c reproduces them). The two end
-   voxels go through hd_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
+   voxels go through hdk_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
    neighbour lies outside the row). */
 #define HD__CPU_ROW_MAX 8192
 
@@ -517,13 +517,13 @@ static int hd__cpu_edge_row(const hd__kparams *p, int y, int z)
 }
 
 /* E, phi or phi2 at slot o in K's storage precision (K->f16 a literal in the row loops). */
-#define HD__CPU_LD(buf, o) (K->f16 != 0 ? hd_h2f(K->buf##h[(o)]) : K->buf[(o)])
+#define HD__CPU_LD(buf, o) (K->f16 != 0 ? hdk_h2f(K->buf##h[(o)]) : K->buf[(o)])
 
-/* sigma' of a neighbour with sigma_t st and RGB albedo channel sc: hd_diffuse_sigp on loaded
+/* sigma' of a neighbour with sigma_t st and RGB albedo channel sc: hdk_diffuse_sigp on loaded
    values (ag: 1 - albedo g of the grey albedo, used without RGB scattering). */
 HD__CPU_INLINE float hd__cpu_nb_sigp(const hd__kctx *K, float st, float sc, int rgb, float ag)
 {
-    return rgb != 0 ? hd_diffuse_sigp_of(K, st, hd_diffuse_albedo_of(K, sc, rgb)) : ag * st;
+    return rgb != 0 ? hdk_diffuse_sigp_of(K, st, hdk_diffuse_albedo_of(K, sc, rgb)) : ag * st;
 }
 
 /* The interior voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into
@@ -540,19 +540,19 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
     for (id = lo; id <= hi; ++id) {
         int xm = id - 1 + cp, xq = id + cp;
         float sp, dn, den, num;
-        float st = sg[s[0] + id], al = hd_diffuse_albedo_of(K, rgb != 0 ? sg[a[0] + id] : 0.0f, rgb);
-        float ag = hd_diffuse_ag(K, al);
-        num = hd_diffuse_own_of(K, st, al, HD__CPU_LD(E, p[0] + id), rhs, &sp, &dn);
+        float st = sg[s[0] + id], al = hdk_diffuse_albedo_of(K, rgb != 0 ? sg[a[0] + id] : 0.0f, rgb);
+        float ag = hdk_diffuse_ag(K, al);
+        num = hdk_diffuse_own_of(K, st, al, HD__CPU_LD(E, p[0] + id), rhs, &sp, &dn);
 #define HD__CPU_NB(j, i) hd__cpu_nb_sigp(K, sg[s[j] + (i)], rgb != 0 ? sg[a[j] + (i)] : 0.0f, rgb, ag)
         if (surface)
-            num = hd_diffuse_surface_rhs_of(K, rhs, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq),
+            num = hdk_diffuse_surface_rhs_of(K, rhs, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq),
                                             HD__CPU_NB(2, id), HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                             HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                             HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
                                             HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, iym, iyp,
                                             izm, izp, &den);
         else
-            num = hd_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
+            num = hdk_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
                                     HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                     HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                     HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
@@ -565,7 +565,7 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
 
 /* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) of the colour with x parity x0
    into out[x >> 1], through `terms` with literal in-grid flags, so they take no branch either
-   (through hd_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep); the y/z
+   (through hdk_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep); the y/z
    flags iym .. izp as the loop's. */
 #define HD__CPU_ROW_ENDS(terms, rgb, rhs, residual, iym, iyp, izm, izp)                               \
     do {                                                                                            \
@@ -586,8 +586,8 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
     do {                                                                                            \
         hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual, ym, yp, \
                             zm, zp);                                                                \
-        if (surface) HD__CPU_ROW_ENDS(hd_diffuse_terms_surface, rgb, rhs, residual, ym, yp, zm, zp);  \
-        else HD__CPU_ROW_ENDS(hd_diffuse_terms_box, rgb, rhs, residual, ym, yp, zm, zp);              \
+        if (surface) HD__CPU_ROW_ENDS(hdk_diffuse_terms_surface, rgb, rhs, residual, ym, yp, zm, zp);  \
+        else HD__CPU_ROW_ENDS(hdk_diffuse_terms_box, rgb, rhs, residual, ym, yp, zm, zp);              \
     } while (0)
 #define HD__CPU_COLOUR_SWITCH(residual, ym, yp, zm, zp)                                              \
     switch (hd__cpu_row_variant(K)) {                                                               \
@@ -616,7 +616,7 @@ HD__CPU_INLINE void hd__cpu_relax_colour(const hd__kctx *K, int y, int z, int c,
     HD__CPU_COLOUR_SWITCH(0, iym, iyp, izm, izp)
     if (K->f16) {
         uint16_t *dst = (jacobi ? K->phi2h : K->phih) + o.p[0];
-        for (i = 0; i < n; ++i) dst[i] = hd_f2h_sat(out[i]);
+        for (i = 0; i < n; ++i) dst[i] = hdk_f2h_sat(out[i]);
     } else {
         memcpy((jacobi ? K->phi2 : K->phi) + o.p[0], out, (size_t)n * sizeof(float));
     }
@@ -656,7 +656,7 @@ static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z
 {
     const hd__kparams *p = be->grid->k->p;
     if (p->gdims.x < 3) {
-        hd_diffuse_row(be->grid->k, y, z, c, parity, be->jacobi);
+        hdk_diffuse_row(be->grid->k, y, z, c, parity, be->jacobi);
         return;
     }
     if (hd__cpu_edge_row(p, y, z)) {
@@ -896,9 +896,9 @@ static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_residual_edge_row(hd__backe
     hd__cpu_residual_halves(be, y, z, c, y > 0, y < gy - 1, z > 0, z < gz - 1);
 }
 
-/* Row r = (c * gz + z) * gy + y. The per-voxel path (hd_diffuse_residual) where the loop does not
+/* Row r = (c * gz + z) * gy + y. The per-voxel path (hdk_diffuse_residual) where the loop does not
    apply: rows under 3 voxels, and edge rows under the surface boundary without rhs, whose empty
-   voxels hd_diffuse_residual gives residual 0 (the V-cycle's grids all solve with rhs). */
+   voxels hdk_diffuse_residual gives residual 0 (the V-cycle's grids all solve with rhs). */
 static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
 {
     const hd__kctx *K = be->grid->k;
@@ -909,7 +909,7 @@ static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
     if (gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
         float rhs;
         for (x = 0; x < gx; ++x)
-            be->grid->res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hd_diffuse_residual(K, x, y, z, c, &rhs);
+            be->grid->res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hdk_diffuse_residual(K, x, y, z, c, &rhs);
     } else if (edge) {
         hd__cpu_residual_edge_row(be, y, z, c);
     } else {
@@ -928,10 +928,10 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
     k.ptab_n = be->ptab_n;
     if (k.f16) {
         k.f16 = 1;
-        for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
+        for (px = 0; px < w; ++px) hdk_project_pixel(&k, px, py);
     } else {
         k.f16 = 0;
-        for (px = 0; px < w; ++px) hd_project_pixel(&k, px, py);
+        for (px = 0; px < w; ++px) hdk_project_pixel(&k, px, py);
     }
 }
 
@@ -939,7 +939,7 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 static void hd__cpu_upsample_row(hd__backend *be, int py)
 {
     int px, w = be->vw->kp.image.x;
-    for (px = 0; px < w; ++px) hd_upsample_pixel(&be->k, px, py);
+    for (px = 0; px < w; ++px) hdk_upsample_pixel(&be->k, px, py);
 }
 
 static hd_result hd__be_classify(const hd__view *vw)
@@ -995,7 +995,7 @@ static void hd__cpu_lsum_row(hd__backend *be, int r)
     int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     hd__kctx k = be->k;
     k.lsum = be->lsum;
-    for (x = 0; x < gx; ++x) hd_light_sum_voxel(&k, x, r % gy, r / gy);
+    for (x = 0; x < gx; ++x) hdk_light_sum_voxel(&k, x, r % gy, r / gy);
 }
 
 /* The projection's inputs: lsum (after any pass that changed E or phi) and the TF table for the
@@ -1075,8 +1075,8 @@ static void hd__cpu_copy_illumination(const hd__view *vw, hd_illumination which,
             for (x = 0; x < gx; ++x) {
                 size_t s = hd__split_slot(gx, gy, x, y, zz);
                 if (h) {
-                    if (src) h[s] = hd_f2h(*src++);
-                    else *dst++ = hd_h2f(h[s]);
+                    if (src) h[s] = hdk_f2h(*src++);
+                    else *dst++ = hdk_h2f(h[s]);
                 } else {
                     if (src) f[s] = *src++;
                     else *dst++ = f[s];
@@ -1112,7 +1112,7 @@ HD__MAYBE_UNUSED static double hd__cpu_residual(const hd__view *vw)
             for (y = 0; y < gy; ++y)
                 for (x = 0; x < gx; ++x) {
                     float rhs;
-                    float r = hd_diffuse_residual(&be->k, x, y, z, c, &rhs);
+                    float r = hdk_diffuse_residual(&be->k, x, y, z, c, &rhs);
                     r2 += (double)r * r;
                     b2 += (double)rhs * rhs;
                 }
@@ -1148,20 +1148,20 @@ static hd_result hd__be_alloc_lights(const hd__view *vw, int count)
 static void hd__cpu_convect_row(hd__backend *be, int r)
 {
     int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
-    for (x = 0; x < gx; ++x) hd_convect_voxel(&be->k, x, r % gy, r / gy, be->light);
+    for (x = 0; x < gx; ++x) hdk_convect_voxel(&be->k, x, r % gy, r / gy, be->light);
 }
 static void hd__cpu_sum_light_row(hd__backend *be, int r)
 {
     int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
-    for (x = 0; x < gx; ++x) hd_sum_light_voxel(&be->k, x, r % gy, r / gy, be->light, be->light == 0);
+    for (x = 0; x < gx; ++x) hdk_sum_light_voxel(&be->k, x, r % gy, r / gy, be->light, be->light == 0);
 }
 static void hd__cpu_path_row(hd__backend *be, int py)
 {
     int px, w = be->vw->kp.image.x;
-    for (px = 0; px < w; ++px) hd_path_pixel(&be->k, px, py);
+    for (px = 0; px < w; ++px) hdk_path_pixel(&be->k, px, py);
 }
 
-/* One convection step of light `light` (hd_convect_voxel on every voxel of the illumination
+/* One convection step of light `light` (hdk_convect_voxel on every voxel of the illumination
    grid): reads its volume, writes the spare, and the two swap roles. Needs sigma_t (classify). */
 static hd_result hd__be_convect(const hd__view *vw, int light)
 {
@@ -1175,7 +1175,7 @@ static hd_result hd__be_convect(const hd__view *vw, int light)
     return HD_SUCCESS;
 }
 
-/* E = sum over the lights of colour * falloff * light volume (hd_sum_light_voxel, one pass per
+/* E = sum over the lights of colour * falloff * light volume (hdk_sum_light_voxel, one pass per
    light, the first overwriting E), so the diffusion and projection of HD run on it unchanged. */
 static hd_result hd__be_sum_lights(const hd__view *vw)
 {
@@ -1190,7 +1190,7 @@ static hd_result hd__be_sum_lights(const hd__view *vw)
     return HD_SUCCESS;
 }
 
-/* One path per pixel (hd_path_pixel), folded into the image with weight march.y. */
+/* One path per pixel (hdk_path_pixel), folded into the image with weight march.y. */
 static hd_result hd__be_path(const hd__view *vw)
 {
     hd__cpu_parallel(vw->be, hd__cpu_path_row, vw->kp.image.y);

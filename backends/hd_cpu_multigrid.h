@@ -107,7 +107,7 @@ static hd_result hd__cpu_mg_alloc(const hd__view *vw)
    levels are float32: no per-load precision test, hd_prelude_c.h's HD_GET) and whose phi is the
    grid the function reads. */
 
-/* sigma_t (all its channels) of level mg->cur from the level above (hd_mg_coarse_sig). */
+/* sigma_t (all its channels) of level mg->cur from the level above (hdk_mg_coarse_sig). */
 static HD__CPU_FLATTEN void hd__cpu_mg_sig_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
@@ -116,7 +116,7 @@ static HD__CPU_FLATTEN void hd__cpu_mg_sig_row(hd__backend *be, int r)
     int Y = r % C->dims[1], Z = (r / C->dims[1]) % C->dims[2], ch = r / (C->dims[1] * C->dims[2]), X;
     k.f16 = 0;
     for (X = 0; X < C->dims[0]; ++X)
-        C->sig[hd__split_slot(C->dims[0], C->dims[1], X, Y, Z + ch * C->dims[2])] = hd_mg_coarse_sig(&k, X, Y, Z, ch);
+        C->sig[hd__split_slot(C->dims[0], C->dims[1], X, Y, Z + ch * C->dims[2])] = hdk_mg_coarse_sig(&k, X, Y, Z, ch);
 }
 
 /* Row (y, zz) of a grid of dims gx, gy in the colour layout into out[] in x order: its two
@@ -132,9 +132,9 @@ static void hd__cpu_mg_load_row(const float *buf, int gx, int gy, int y, int zz,
 }
 
 /* The right-hand side of level mg->cur: R = P^T / 8 of the residual of the level above
-   (hd_k_multigrid.h), each fine column's share of the row computed once (hd_mg_restrict_line's
-   terms, hd_mg_restrict_term, on each of the up to 16 fine rows loaded once, in its a, b order)
-   and four of them combined per coarse voxel (hd_mg_restrict_x); its phi (the correction)
+   (hd_k_multigrid.h), each fine column's share of the row computed once (hdk_mg_restrict_line's
+   terms, hdk_mg_restrict_term, on each of the up to 16 fine rows loaded once, in its a, b order)
+   and four of them combined per coarse voxel (hdk_mg_restrict_x); its phi (the correction)
    starts at 0. */
 static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
 {
@@ -154,14 +154,14 @@ static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
             if (y < 0 || y >= gy) continue;
             hd__cpu_mg_load_row(F->res, gx, gy, y, z + ch * gz, res);
             hd__cpu_mg_load_row(k.sig, gx, gy, y, z, m);
-            for (x = 0; x < gx; ++x) line[x] = hd_mg_restrict_term(line[x], a, b, res[x], hd_mg_medium_of(&k, m[x]));
+            for (x = 0; x < gx; ++x) line[x] = hdk_mg_restrict_term(line[x], a, b, res[x], hdk_mg_medium_of(&k, m[x]));
         }
     }
     for (X = 0; X < C->dims[0]; ++X) {
         float s = 0.0f;
         for (t = 0; t < 4; ++t) {
             x = 2 * X - 1 + t;
-            if (x >= 0 && x < gx) s = hd_mg_restrict_x(s, t, line[x]);
+            if (x >= 0 && x < gx) s = hdk_mg_restrict_x(s, t, line[x]);
         }
         size_t o = hd__split_slot(C->dims[0], C->dims[1], X, Y, Z + ch * C->dims[2]);
         C->rhs[o] = s;
@@ -169,8 +169,8 @@ static HD__CPU_FLATTEN void hd__cpu_mg_restrict_row(hd__backend *be, int r)
     }
 }
 
-/* Adds the prolonged correction of level mg->cur (hd_mg_prolong's terms, hd_mg_prolong_term, on
-   the up to 4 coarse rows loaded once), masked to the medium (hd_mg_medium_of the level above's
+/* Adds the prolonged correction of level mg->cur (hdk_mg_prolong's terms, hdk_mg_prolong_term, on
+   the up to 4 coarse rows loaded once), masked to the medium (hdk_mg_medium_of the level above's
    sigma_t), to row r of the level above. */
 static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
 {
@@ -183,9 +183,9 @@ static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
     float e[HD__CPU_ROW_MAX], m[HD__CPU_ROW_MAX], u[2][2][HD__CPU_ROW_MAX / 2 + 1];
     kf.f16 = 0;
     zc[0] = z >> 1;
-    zc[1] = hd_mg_far(z);
+    zc[1] = hdk_mg_far(z);
     yc[0] = y >> 1;
-    yc[1] = hd_mg_far(y);
+    yc[1] = hdk_mg_far(y);
     for (a = 0; a < 2; ++a)
         for (b = 0; b < 2; ++b)
             if (zc[a] >= 0 && zc[a] < GZ && yc[b] >= 0 && yc[b] < GY)
@@ -195,16 +195,16 @@ static HD__CPU_FLATTEN void hd__cpu_mg_prolong_row(hd__backend *be, int r)
         int xc[2];
         float v = 0.0f;
         xc[0] = x >> 1;
-        xc[1] = hd_mg_far(x);
+        xc[1] = hdk_mg_far(x);
         for (a = 0; a < 2; ++a) {
             if (zc[a] < 0 || zc[a] >= GZ) continue;
             for (b = 0; b < 2; ++b) {
                 if (yc[b] < 0 || yc[b] >= GY) continue;
                 for (t = 0; t < 2; ++t)
-                    if (xc[t] >= 0 && xc[t] < GX) v = hd_mg_prolong_term(v, a, b, t, u[a][b][xc[t]]);
+                    if (xc[t] >= 0 && xc[t] < GX) v = hdk_mg_prolong_term(v, a, b, t, u[a][b][xc[t]]);
             }
         }
-        e[x] = v * hd_mg_medium_of(&kf, m[x]);
+        e[x] = v * hdk_mg_medium_of(&kf, m[x]);
     }
     for (h = 0; h < 2; ++h) {
         float *dst = F->phi + hd__split_slot(gx, gy, h, y, z + c * gz);
@@ -217,7 +217,7 @@ static int hd__mg_rows(const hd__cpu_level *L, int channels) { return L->dims[1]
 
 /* ---- the fine residual in double ------------------------------------------------------------------ */
 /* f - A (phi + lo) of row r (= (c * gz + z) * gy + y) of be->grid into out[], evaluated in double
-   by the shared hd_mg_res_f64 (hd_k_multigrid.h says why), stored as float; lo (the iterate's low
+   by the shared hdk_mg_res_f64 (hd_k_multigrid.h says why), stored as float; lo (the iterate's low
    part) only on the fine grid of the iterate (mg->fineg). Literal in-grid flags, boundary and RGB
    for the interior voxels, so each variant's loop has no test. */
 static HD__CPU_FLATTEN void hd__cpu_mg_residual_f64_into(const hd__backend *be, int r, float *out)
@@ -234,17 +234,17 @@ static HD__CPU_FLATTEN void hd__cpu_mg_residual_f64_into(const hd__backend *be, 
     for (x = 0; x < gx; ++x) {
         int ix = x > 0 && x < gx - 1;
         if (edge || !ix)
-            out[x] = (float)hd_mg_res_f64(K, x, y, z, c, surface, rgb, lo, x > 0, x < gx - 1, y > 0, y < gy - 1, z > 0, z < gz - 1);
+            out[x] = (float)hdk_mg_res_f64(K, x, y, z, c, surface, rgb, lo, x > 0, x < gx - 1, y > 0, y < gy - 1, z > 0, z < gz - 1);
         else if (lo)
-            out[x] = (float)(surface ? (rgb ? hd_mg_res_f64(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, 1, 1)
-                                            : hd_mg_res_f64(K, x, y, z, c, 1, 0, 1, 1, 1, 1, 1, 1, 1))
-                                     : (rgb ? hd_mg_res_f64(K, x, y, z, c, 0, 1, 1, 1, 1, 1, 1, 1, 1)
-                                            : hd_mg_res_f64(K, x, y, z, c, 0, 0, 1, 1, 1, 1, 1, 1, 1)));
+            out[x] = (float)(surface ? (rgb ? hdk_mg_res_f64(K, x, y, z, c, 1, 1, 1, 1, 1, 1, 1, 1, 1)
+                                            : hdk_mg_res_f64(K, x, y, z, c, 1, 0, 1, 1, 1, 1, 1, 1, 1))
+                                     : (rgb ? hdk_mg_res_f64(K, x, y, z, c, 0, 1, 1, 1, 1, 1, 1, 1, 1)
+                                            : hdk_mg_res_f64(K, x, y, z, c, 0, 0, 1, 1, 1, 1, 1, 1, 1)));
         else
-            out[x] = (float)(surface ? (rgb ? hd_mg_res_f64(K, x, y, z, c, 1, 1, 0, 1, 1, 1, 1, 1, 1)
-                                            : hd_mg_res_f64(K, x, y, z, c, 1, 0, 0, 1, 1, 1, 1, 1, 1))
-                                     : (rgb ? hd_mg_res_f64(K, x, y, z, c, 0, 1, 0, 1, 1, 1, 1, 1, 1)
-                                            : hd_mg_res_f64(K, x, y, z, c, 0, 0, 0, 1, 1, 1, 1, 1, 1)));
+            out[x] = (float)(surface ? (rgb ? hdk_mg_res_f64(K, x, y, z, c, 1, 1, 0, 1, 1, 1, 1, 1, 1)
+                                            : hdk_mg_res_f64(K, x, y, z, c, 1, 0, 0, 1, 1, 1, 1, 1, 1))
+                                     : (rgb ? hdk_mg_res_f64(K, x, y, z, c, 0, 1, 0, 1, 1, 1, 1, 1, 1)
+                                            : hdk_mg_res_f64(K, x, y, z, c, 0, 0, 0, 1, 1, 1, 1, 1, 1)));
     }
 }
 
@@ -269,7 +269,7 @@ static void hd__cpu_mg_residual_f64_row(hd__backend *be, int r)
 }
 
 /* ---- conjugate gradients' passes over the fine rows --------------------------------------------- */
-/* <a, b> of row r of level 0 (hd_mg_dot_row's terms, hd_mg_dot_term: in double, x in order) on
+/* <a, b> of row r of level 0 (hdk_mg_dot_row's terms, hdk_mg_dot_term: in double, x in order) on
    the two rows loaded once (loads by coordinates are gathers in the colour layout). */
 static double hd__cpu_mg_dot(const hd__backend *be, int r, const float *a, const float *b)
 {
@@ -279,7 +279,7 @@ static double hd__cpu_mg_dot(const hd__backend *be, int r, const float *a, const
     int x;
     hd__cpu_mg_load_row(a, d[0], d[1], r % d[1], r / d[1], ra);
     hd__cpu_mg_load_row(b, d[0], d[1], r % d[1], r / d[1], rb);
-    for (x = 0; x < d[0]; ++x) s = hd_mg_dot_term(s, ra[x], rb[x]);
+    for (x = 0; x < d[0]; ++x) s = hdk_mg_dot_term(s, ra[x], rb[x]);
     return s;
 }
 
@@ -310,7 +310,7 @@ static void hd__cpu_mg_dir_row(hd__backend *be, int r)
         size_t o = hd__cpu_mg_half(be, r, h, &n);
         float *z = mg->lv[0].phi + o, *p = mg->p + o;
         for (i = 0; i < n; ++i) {
-            p[i] = hd_mg_dir_of(z[i], p[i], beta);
+            p[i] = hdk_mg_dir_of(z[i], p[i], beta);
             z[i] = 0.0f;
         }
     }
@@ -332,7 +332,7 @@ static void hd__cpu_mg_op_row(hd__backend *be, int r)
     mg->dot_b[r] = hd__cpu_mg_dot(be, r, mg->lv[0].rhs, mg->p);
 }
 
-/* phi + lo += alpha p in double (hd_mg_update_of): phi is the sum rounded to float, lo the rest. */
+/* phi + lo += alpha p in double (hdk_mg_update_of): phi is the sum rounded to float, lo the rest. */
 static void hd__cpu_mg_update_row(hd__backend *be, int r)
 {
     struct hd__cpu_mg *mg = be->mg;
@@ -342,13 +342,13 @@ static void hd__cpu_mg_update_row(hd__backend *be, int r)
         size_t o = hd__cpu_mg_half(be, r, h, &n);
         float *phi = be->phi + o, *lo = mg->lo + o;
         const float *p = mg->p + o;
-        for (i = 0; i < n; ++i) phi[i] = hd_mg_update_of(phi[i], &lo[i], p[i], alpha);
+        for (i = 0; i < n; ++i) phi[i] = hdk_mg_update_of(phi[i], &lo[i], p[i], alpha);
     }
 }
 
 /* Empty voxels of the surface boundary, colour mg->colour, of row r: phi = the extrapolation the
-   sweeps store there (hd_diffuse_extrapolate, read by the projection), lo = -phi, so CG's iterate
-   phi + lo stays exactly 0 on those identity rows (hd_mg_res_f64's -(phi + lo); z and so p are 0
+   sweeps store there (hdk_diffuse_extrapolate, read by the projection), lo = -phi, so CG's iterate
+   phi + lo stays exactly 0 on those identity rows (hdk_mg_res_f64's -(phi + lo); z and so p are 0
    there, the V-cycle's rows being identity rows too). */
 static HD__CPU_FLATTEN void hd__cpu_mg_extrap_row(hd__backend *be, int r)
 {
@@ -357,7 +357,7 @@ static HD__CPU_FLATTEN void hd__cpu_mg_extrap_row(hd__backend *be, int r)
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
     float v = 0.0f;
     for (x = (y + z + mg->colour) & 1; x < gx; x += 2)
-        if (hd_diffuse_extrapolate(&be->k, x, y, z, c, &v)) {
+        if (hdk_diffuse_extrapolate(&be->k, x, y, z, c, &v)) {
             size_t s = hd__split_slot(gx, gy, x, y, z + c * gz);
             be->phi[s] = v;
             mg->lo[s] = -v;

@@ -20,7 +20,7 @@
 __kernel void hd_k_classify(HD__CL_BUFFERS)
 {
     HD__CL_KCTX;
-    hd_classify_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2));
+    hdk_classify_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2));
 }
 
 /* One work-item per entry of the list of voxels whose E is read (hd__direct_mask), count
@@ -32,7 +32,7 @@ __kernel void hd_k_classify(HD__CL_BUFFERS)
     { \
         HD__CL_KCTX; \
         k.f16 = (is16); \
-        if ((int)get_global_id(0) < count) hd_direct_index(&k, (int)list[get_global_id(0)]); \
+        if ((int)get_global_id(0) < count) hdk_direct_index(&k, (int)list[get_global_id(0)]); \
     }
 HD__CL_DIRECT(hd_k_direct, 0)
 HD__CL_DIRECT(hd_k_direct_half, 1)
@@ -71,7 +71,7 @@ HD__CL_DIRECT(hd_k_direct_half, 1)
         k.cp = cp; \
         k.cid = get_global_id(0); \
         k.f16 = (is16); \
-        num = hd_diffuse_terms(&k, x, y, z, c, &den); \
+        num = hdk_diffuse_terms(&k, x, y, z, c, &den); \
         if (jacobi) HD_SET(phi2, 0, x, y, z + c * gz, num / den); \
         else HD_SET(phi, 0, x, y, z + c * gz, num / den); \
     }
@@ -94,7 +94,7 @@ HD__CL_DIFFUSE_SET(_half, 1)
         HD__CL_KCTX; \
         k.f16 = (is16); \
         k.lsum = lsum; \
-        hd_light_sum_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); \
+        hdk_light_sum_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); \
     }
 HD__CL_LIGHT_SUM(hd_k_light_sum, 0)
 HD__CL_LIGHT_SUM(hd_k_light_sum_half, 1)
@@ -106,7 +106,7 @@ __kernel void hd_k_convect(HD__CL_BUFFERS, __global const float *lv, __global fl
     HD__CL_KCTX;
     k.lv = lv;
     k.lv2 = lv2;
-    hd_convect_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l);
+    hdk_convect_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l);
 }
 
 /* CD: adds light l's volume into E (first != 0: overwrites); one work-item per voxel. */
@@ -116,7 +116,7 @@ __kernel void hd_k_convect(HD__CL_BUFFERS, __global const float *lv, __global fl
         HD__CL_KCTX; \
         k.lv = lv; \
         k.f16 = (is16); \
-        hd_sum_light_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l, first); \
+        hdk_sum_light_voxel(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), l, first); \
     }
 HD__CL_SUM_LIGHT(hd_k_sum_light, 0)
 HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
@@ -125,7 +125,7 @@ HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
 __kernel void hd_k_path(HD__CL_BUFFERS)
 {
     HD__CL_KCTX;
-    hd_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
+    hdk_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
 
 /* ---- HD_SOLVER_MULTIGRID: the per-voxel passes of hd_opencl.h's hd__be_mg_* -------------------
@@ -163,13 +163,13 @@ __kernel void hd_k_mg_sig(__constant hd__kparams *pf, __constant hd__kparams *pc
     int X = (int)get_global_id(0), Y = (int)get_global_id(1), zz = (int)get_global_id(2), gz = pc->gdims.z;
     kf.sig = fsig;
     kc.sig = csig;
-    hd__cl_mg_set_sig(&kc, X, Y, zz, hd_mg_coarse_sig(&kf, X, Y, zz % gz, zz / gz));
+    hd__cl_mg_set_sig(&kc, X, Y, zz, hdk_mg_coarse_sig(&kf, X, Y, zz % gz, zz / gz));
 }
 
 /* A level's float residual f - A phi into phi2 (the level's residual buffer; sig, E = the
    right-hand side, phi = the correction: the smoothing's bindings): the diffusion kernels' own
    work-item mapping, colour `parity` per pass (so loads are contiguous and the loop vectorises),
-   and hd_diffuse_terms' num - den phi, hd_diffuse_residual's and the CPU's hd__cpu_residual_row's
+   and hdk_diffuse_terms' num - den phi, hdk_diffuse_residual's and the CPU's hd__cpu_residual_row's
    expression. Padding slots get a finite, unused value, as in the sweep. */
 #define HD__CL_MG_RESIDUAL(name, bits) \
     __kernel void name(HD__CL_BUFFERS, int parity) \
@@ -184,7 +184,7 @@ __kernel void hd_k_mg_sig(__constant hd__kparams *pf, __constant hd__kparams *pc
         k.cx = x; \
         k.cp = cp; \
         k.cid = get_global_id(0); \
-        num = hd_diffuse_terms(&k, x, y, z, c, &den); \
+        num = hdk_diffuse_terms(&k, x, y, z, c, &den); \
         HD_SET(phi2, 0, x, y, z + c * gz, num - den * HD_GET(phi, 0, x, y, z + c * gz)); \
     }
 HD__CL_MG_RESIDUAL(hd_k_mg_residual, 0)
@@ -192,7 +192,7 @@ HD__CL_MG_RESIDUAL(hd_k_mg_residual_rgb, HD_FLAG_RGB_SCATTERING)
 HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface, HD_FLAG_SURFACE_BOUNDARY)
 HD__CL_MG_RESIDUAL(hd_k_mg_residual_surface_rgb, HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_RGB_SCATTERING)
 
-/* The restriction's first half, as the CPU's row: the share hd_mg_restrict_line of every fine
+/* The restriction's first half, as the CPU's row: the share hdk_mg_restrict_line of every fine
    column x of coarse row (Y, Z), channel c, into the row buffer `line` (x-fastest, rows of
    2 * hx, the fine grid's padded row), the columns of one parity per pass: the fine loads then
    use the diffusion's addressing (K->cx = x) and are contiguous. An odd grid's last item reads
@@ -204,13 +204,13 @@ __kernel void hd_k_mg_restrict_line(__constant hd__kparams *restrict pf, __const
     hd__kctx kf = hd__cl_mg_ctx(pf);
     int gz = pc->gdims.z, Y = (int)get_global_id(1), zz = (int)get_global_id(2), x = 2 * (int)get_global_id(0) + parity;
     kf.phi = fres;
-    kf.sig = fsig; /* the mask hd_mg_medium */
+    kf.sig = fsig; /* the mask hdk_mg_medium */
     kf.cx = x; kf.cp = parity; kf.cid = get_global_id(0);
-    line[((size_t)zz * pc->gdims.y + Y) * (size_t)(2 * kf.hx) + (size_t)x] = hd_mg_restrict_line(&kf, x, Y, zz % gz, zz / gz);
+    line[((size_t)zz * pc->gdims.y + Y) * (size_t)(2 * kf.hx) + (size_t)x] = hdk_mg_restrict_line(&kf, x, Y, zz % gz, zz / gz);
 }
 
 /* Its second half: a coarse level's right-hand side, the shares of fine columns 2 X - 1 .. 2 X + 2
-   combined in order (hd_mg_restrict_x); its correction cphi starts at 0. */
+   combined in order (hdk_mg_restrict_x); its correction cphi starts at 0. */
 __kernel void hd_k_mg_restrict(__constant hd__kparams *restrict pf, __constant hd__kparams *restrict pc,
                                __global float *restrict line, __global float *restrict crhs, __global float *restrict cphi)
 {
@@ -220,7 +220,7 @@ __kernel void hd_k_mg_restrict(__constant hd__kparams *restrict pf, __constant h
     float s = 0.0f;
     for (int t = 0; t < 4; ++t) {
         int x = 2 * X - 1 + t;
-        if (x >= 0 && x < gx) s = hd_mg_restrict_x(s, t, row[x]);
+        if (x >= 0 && x < gx) s = hdk_mg_restrict_x(s, t, row[x]);
     }
     kc.E = crhs; kc.phi = cphi;
     hd__cl_mg_set_E(&kc, X, Y, zz, s);
@@ -237,14 +237,14 @@ __kernel void hd_k_mg_prolong(__constant hd__kparams *restrict pf, __constant hd
 {
     hd__kctx kf = hd__cl_mg_ctx(pf), kc = hd__cl_mg_ctx(pc);
     int gz = pf->gdims.z, y = (int)get_global_id(1), z = (int)get_global_id(2) % gz, c = (int)get_global_id(2) / gz;
-    int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp, xk = hd_mini(x, pf->gdims.x - 1);
+    int cp = (y + z + parity) & 1, x = 2 * (int)get_global_id(0) + cp, xk = hdk_mini(x, pf->gdims.x - 1);
     kc.phi = cphi;
     kf.phi = fphi;
-    kf.sig = fsig; /* the mask hd_mg_medium */
+    kf.sig = fsig; /* the mask hdk_mg_medium */
     kf.cx = x; kf.cp = cp; kf.cid = get_global_id(0);
     hd__cl_mg_set_phi(&kf, x, y, z + c * gz,
                       hd__cl_mg_get_phi(&kf, x, y, z + c * gz) +
-                          hd_mg_prolong(&kc, xk, y, z, c) * hd_mg_medium(&kf, 0, xk, y, z));
+                          hdk_mg_prolong(&kc, xk, y, z, c) * hdk_mg_medium(&kf, 0, xk, y, z));
 }
 
 /* p = z + beta p, then z = 0. */
@@ -253,12 +253,12 @@ __kernel void hd_k_mg_dir(__constant hd__kparams *p, __global float *z, __global
     hd__kctx k = hd__cl_mg_ctx(p);
     int x = (int)get_global_id(0), y = (int)get_global_id(1), zz = (int)get_global_id(2);
     k.E = z; k.phi = dir;
-    hd__cl_mg_set_phi(&k, x, y, zz, hd_mg_dir_of(hd__cl_mg_get_E(&k, x, y, zz), hd__cl_mg_get_phi(&k, x, y, zz), beta));
+    hd__cl_mg_set_phi(&k, x, y, zz, hdk_mg_dir_of(hd__cl_mg_get_E(&k, x, y, zz), hd__cl_mg_get_phi(&k, x, y, zz), beta));
     hd__cl_mg_set_E(&k, x, y, zz, 0.0f);
 }
 
 #ifdef HD_MG_F64
-/* The fine grid's residual in double (hd_mg_res_f64): f - A (phi + lo) with use_lo, into out
+/* The fine grid's residual in double (hdk_mg_res_f64): f - A (phi + lo) with use_lo, into out
    (negate: -(f - A phi), conjugate gradients' q = A p with E = 0). The diffusion's work-item
    mapping (colour `parity` per pass) and literal boundary and RGB flags, as the residual above. */
 #define HD__CL_MG_RES_F64(name, surface, rgb) \
@@ -275,7 +275,7 @@ __kernel void hd_k_mg_dir(__constant hd__kparams *p, __global float *z, __global
         k.cx = x; k.cp = cp; k.cid = get_global_id(0); \
         ko = k; \
         ko.phi = out; \
-        v = (float)hd_mg_res_f64(&k, x, y, z, c, surface, rgb, use_lo, x > 0 ? 1 : 0, x < gx - 1 ? 1 : 0, y > 0 ? 1 : 0, \
+        v = (float)hdk_mg_res_f64(&k, x, y, z, c, surface, rgb, use_lo, x > 0 ? 1 : 0, x < gx - 1 ? 1 : 0, y > 0 ? 1 : 0, \
                                  y < gy - 1 ? 1 : 0, z > 0 ? 1 : 0, z < gz - 1 ? 1 : 0); \
         hd__cl_mg_set_phi(&ko, x, y, z + c * gz, negate != 0 ? -v : v); \
     }
@@ -284,16 +284,16 @@ HD__CL_MG_RES_F64(hd_k_mg_res_f64_rgb, 0, 1)
 HD__CL_MG_RES_F64(hd_k_mg_res_f64_surface, 1, 0)
 HD__CL_MG_RES_F64(hd_k_mg_res_f64_surface_rgb, 1, 1)
 
-/* dot[r] = <a, b> of row r = zz * gy + y (hd_mg_dot_row); the host sums the rows in order. */
+/* dot[r] = <a, b> of row r = zz * gy + y (hdk_mg_dot_row); the host sums the rows in order. */
 __kernel void hd_k_mg_dot(__constant hd__kparams *p, __global float *a, __global float *b, __global double *dot)
 {
     hd__kctx k = hd__cl_mg_ctx(p);
     int y = (int)get_global_id(0), zz = (int)get_global_id(1);
     k.E = a; k.phi = b;
-    dot[(size_t)zz * p->gdims.y + y] = hd_mg_dot_row(&k, y, zz);
+    dot[(size_t)zz * p->gdims.y + y] = hdk_mg_dot_row(&k, y, zz);
 }
 
-/* phi + lo += alpha p in double (hd_mg_update_of). */
+/* phi + lo += alpha p in double (hdk_mg_update_of). */
 __kernel void hd_k_mg_update(__constant hd__kparams *p, __global float *phi, __global float *lo, __global float *dir,
                              double alpha)
 {
@@ -302,13 +302,13 @@ __kernel void hd_k_mg_update(__constant hd__kparams *p, __global float *phi, __g
     float l, f;
     k.phi = phi; k.phi2 = lo; k.E = dir;
     l = hd__cl_mg_get_phi2(&k, x, y, zz);
-    f = hd_mg_update_of(hd__cl_mg_get_phi(&k, x, y, zz), &l, hd__cl_mg_get_E(&k, x, y, zz), alpha);
+    f = hdk_mg_update_of(hd__cl_mg_get_phi(&k, x, y, zz), &l, hd__cl_mg_get_E(&k, x, y, zz), alpha);
     hd__cl_mg_set_phi(&k, x, y, zz, f);
     hd__cl_mg_set_phi2(&k, x, y, zz, l);
 }
 
 /* Surface boundary: the empty voxels of colour `colour` ((x + y + z) & 1) get phi = the sweeps'
-   extrapolation, lo = -phi (hd_diffuse_extrapolate; p the fine parameters, without the
+   extrapolation, lo = -phi (hdk_diffuse_extrapolate; p the fine parameters, without the
    right-hand-side flag). */
 __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __global float *E, __global float *phi,
                              __global float *lo, int colour)
@@ -318,7 +318,7 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
     float v = 0.0f;
     k.sig = sig; k.E = E; k.phi = phi; k.phi2 = lo;
     if (((x + y + zz % gz + colour) & 1) != 0) return;
-    if (hd_diffuse_extrapolate(&k, x, y, zz % gz, zz / gz, &v) != 0) {
+    if (hdk_diffuse_extrapolate(&k, x, y, zz % gz, zz / gz, &v) != 0) {
         hd__cl_mg_set_phi(&k, x, y, zz, v);
         hd__cl_mg_set_phi2(&k, x, y, zz, -v);
     }
@@ -340,9 +340,9 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
         k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
         if (px >= p->image.x || py >= p->image.y) return; \
         if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
-            hd_upsample_pixel(&k, px, py); \
+            hdk_upsample_pixel(&k, px, py); \
         else \
-            hd_project_pixel(&k, px, py); \
+            hdk_project_pixel(&k, px, py); \
     }
 HD__CL_PROJECT(hd_k_project, 0)
 HD__CL_PROJECT(hd_k_project_half, 1)

@@ -17,7 +17,7 @@
 #define HD_MG_SIG 1      /* K fine; hd_pc = coarse dims, sigma_t channels; coarse sigma_t -> unit 6 */
 #define HD_MG_RESIDUAL 2 /* K the level (sig, E = rhs, phi); f - A phi in float -> phi2 */
 #define HD_MG_RESTRICT 3 /* K fine (phi = its residual, sig); hd_pc = coarse dims, channels; rhs -> unit 6, phi2 = 0 */
-#define HD_MG_PROLONG 4  /* K coarse (phi = its correction; sig = the FINE sigma_t, for hd_mg_medium);
+#define HD_MG_PROLONG 4  /* K coarse (phi = its correction; sig = the FINE sigma_t, for hdk_mg_medium);
                             hd_pc = fine dims, channels; unit 6 += P */
 #define HD_MG_DIR 5      /* E = z, phi = p: p = z + beta p, z = 0 */
 #define HD_MG_RES_F64 6  /* K fine (sig, E, phi, phi2 = lo); hd_pc.x use_lo, .y negate; -> unit 6 */
@@ -34,11 +34,11 @@ layout(location = 1) uniform float hd_mg_beta;
 layout(location = 2) uniform double hd_mg_alpha;
 #endif
 
-float hd_mg_other(int x, int y, int zz)
+float hdk_mg_other(int x, int y, int zz)
 {
     return imageLoad(hd_i_lv2, ivec3(x, y, zz)).r;
 }
-void hd_mg_set_other(int x, int y, int zz, float v)
+void hdk_mg_set_other(int x, int y, int zz, float v)
 {
     imageStore(hd_i_lv2, ivec3(x, y, zz), vec4(v, 0.0f, 0.0f, 0.0f));
 }
@@ -49,9 +49,9 @@ void main()
     ivec4 g = HD_PRM(gdims);
 #if HD_MG_STAGE == HD_MG_SIG
     if (x < hd_pc.x && y < hd_pc.y && zz < hd_pc.z * hd_pc.w)
-        hd_mg_set_other(x, y, zz, hd_mg_coarse_sig(x, y, zz % hd_pc.z, zz / hd_pc.z));
+        hdk_mg_set_other(x, y, zz, hdk_mg_coarse_sig(x, y, zz % hd_pc.z, zz / hd_pc.z));
 #elif HD_MG_STAGE == HD_MG_RESTRICT
-    /* the CPU's row form combines each fine column's share (hd_mg_restrict_line) of the coarse
+    /* the CPU's row form combines each fine column's share (hdk_mg_restrict_line) of the coarse
        row in t order; here each coarse voxel computes its 4 columns' shares itself: the same
        operations in the same order, so the same bits */
     if (x < hd_pc.x && y < hd_pc.y && zz < hd_pc.z * hd_pc.w) {
@@ -59,22 +59,22 @@ void main()
         float s = 0.0f;
         for (int t = 0; t < 4; ++t) {
             int xf = 2 * x - 1 + t;
-            if (xf >= 0 && xf < g.x) s = hd_mg_restrict_x(s, t, hd_mg_restrict_line(xf, y, Z, c));
+            if (xf >= 0 && xf < g.x) s = hdk_mg_restrict_x(s, t, hdk_mg_restrict_line(xf, y, Z, c));
         }
-        hd_mg_set_other(x, y, zz, s);
+        hdk_mg_set_other(x, y, zz, s);
         HD_SET(phi2, 0, x, y, zz, 0.0f);
     }
 #elif HD_MG_STAGE == HD_MG_PROLONG
     if (x < hd_pc.x && y < hd_pc.y && zz < hd_pc.z * hd_pc.w) {
         int z = zz % hd_pc.z, c = zz / hd_pc.z;
-        hd_mg_set_other(x, y, zz, hd_mg_other(x, y, zz) +
-                                      hd_mg_prolong(x, y, z, c) * hd_mg_medium((z * hd_pc.y + y) * hd_pc.x + x, x, y, z));
+        hdk_mg_set_other(x, y, zz, hdk_mg_other(x, y, zz) +
+                                      hdk_mg_prolong(x, y, z, c) * hdk_mg_medium((z * hd_pc.y + y) * hd_pc.x + x, x, y, z));
     }
 #elif HD_MG_STAGE == HD_MG_RESIDUAL
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w) {
         int z = zz % g.z, c = zz / g.z;
         float den = 0.0f;
-        float num = hd_diffuse_terms(x, y, z, c, den);
+        float num = hdk_diffuse_terms(x, y, z, c, den);
         HD_SET(phi2, 0, x, y, zz, num - den * HD_GET(phi, 0, x, y, zz));
     }
 #elif HD_MG_STAGE == HD_MG_RES_F64
@@ -82,31 +82,31 @@ void main()
         int z = zz % g.z, c = zz / g.z;
         int surface = (HD_DIFFUSE_FLAGS & HD_FLAG_SURFACE_BOUNDARY) != 0 ? 1 : 0;
         int rgb = (HD_DIFFUSE_FLAGS & HD_FLAG_RGB_SCATTERING) != 0 ? 1 : 0;
-        float v = float(hd_mg_res_f64(x, y, z, c, surface, rgb, hd_pc.x, x > 0 ? 1 : 0, x < g.x - 1 ? 1 : 0,
+        float v = float(hdk_mg_res_f64(x, y, z, c, surface, rgb, hd_pc.x, x > 0 ? 1 : 0, x < g.x - 1 ? 1 : 0,
                                       y > 0 ? 1 : 0, y < g.y - 1 ? 1 : 0, z > 0 ? 1 : 0, z < g.z - 1 ? 1 : 0));
-        hd_mg_set_other(x, y, zz, hd_pc.y != 0 ? -v : v);
+        hdk_mg_set_other(x, y, zz, hd_pc.y != 0 ? -v : v);
     }
 #elif HD_MG_STAGE == HD_MG_DOT
     /* x: the row's y, y: its zz (z + c gz) */
-    if (x < g.y && y < g.z * hd_pc.w) hd_mg_row_sums[y * g.y + x] = hd_mg_dot_row(x, y);
+    if (x < g.y && y < g.z * hd_pc.w) hd_mg_row_sums[y * g.y + x] = hdk_mg_dot_row(x, y);
 #elif HD_MG_STAGE == HD_MG_DIR
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w) {
-        HD_SET(phi, 0, x, y, zz, hd_mg_dir_of(HD_GET(E, 0, x, y, zz), HD_GET(phi, 0, x, y, zz), hd_mg_beta));
+        HD_SET(phi, 0, x, y, zz, hdk_mg_dir_of(HD_GET(E, 0, x, y, zz), HD_GET(phi, 0, x, y, zz), hd_mg_beta));
         HD_SET(E, 0, x, y, zz, 0.0f);
     }
 #elif HD_MG_STAGE == HD_MG_UPDATE
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w) {
         float l = HD_GET(phi2, 0, x, y, zz);
-        float f = hd_mg_update_of(HD_GET(phi, 0, x, y, zz), l, HD_GET(E, 0, x, y, zz), hd_mg_alpha);
+        float f = hdk_mg_update_of(HD_GET(phi, 0, x, y, zz), l, HD_GET(E, 0, x, y, zz), hd_mg_alpha);
         HD_SET(phi, 0, x, y, zz, f);
         HD_SET(phi2, 0, x, y, zz, l);
     }
 #elif HD_MG_STAGE == HD_MG_EXTRAP
-    /* surface boundary: hd_diffuse_extrapolate on the voxels of colour hd_pc.x, so none it reads
+    /* surface boundary: hdk_diffuse_extrapolate on the voxels of colour hd_pc.x, so none it reads
        is being written (the CPU's hd__cpu_mg_extrap_row) */
     if (x < g.x && y < g.y && zz < g.z * hd_pc.w && ((x + y + zz % g.z + hd_pc.x) & 1) == 0) {
         float v = 0.0f;
-        if (hd_diffuse_extrapolate(x, y, zz % g.z, zz / g.z, v) != 0) {
+        if (hdk_diffuse_extrapolate(x, y, zz % g.z, zz / g.z, v) != 0) {
             HD_SET(phi, 0, x, y, zz, v);
             HD_SET(phi2, 0, x, y, zz, -v);
         }

@@ -1002,7 +1002,7 @@ static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination wh
 
 #ifdef HYBRIDDIFF_TESTING
 /* For src/hd_test_hooks.h: overwrites E or phi (channel-planar floats). */
-/* A GL_R16F grid gets the floats rounded to nearest even on the host (hd_f2h, the CPU backend's
+/* A GL_R16F grid gets the floats rounded to nearest even on the host (hdk_f2h, the CPU backend's
    halves): the GL's own conversion may truncate, as llvmpipe's image stores do. */
 static hd_result hd__gl_write_tex(const hd__view *vw, const hd__gl_tex *t, const float *src)
 {
@@ -1011,7 +1011,7 @@ static hd_result hd__gl_write_tex(const hd__view *vw, const hd__gl_tex *t, const
     if (t->format == GL_R16F) {
         if (!(h = (uint16_t *)hd__calloc(vw, n, sizeof(uint16_t))))
             return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "gl: no memory to convert an illumination grid");
-        for (i = 0; i < n; ++i) h[i] = hd_f2h(src[i]);
+        for (i = 0; i < n; ++i) h[i] = hdk_f2h(src[i]);
     }
     vw->be->gl.BindTexture(GL_TEXTURE_3D, t->name);
     vw->be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, t->extent[0], t->extent[1], t->extent[2], GL_RED,

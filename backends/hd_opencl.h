@@ -756,7 +756,7 @@ static hd_result hd__cl_unmap_illumination(const hd__view *vw, hd_illumination w
 
 /* Copies E or phi between the colour layout, mapped, and the API's x-fastest channel-planar
    order, one direction per call: into dst (src NULL; binary16 widened with the CPU's exact
-   hd_h2f) or from src (dst NULL; rounded with the CPU's hd_f2h). */
+   hdk_h2f) or from src (dst NULL; rounded with the CPU's hdk_f2h). */
 static hd_result hd__cl_copy_illumination(const hd__view *vw, hd_illumination which, const float *src, float *dst, const int *list,
                                           int count)
 {
@@ -773,8 +773,8 @@ static hd_result hd__cl_copy_illumination(const hd__view *vw, hd_illumination wh
                 size_t s = hd__cl_slot(vw, x, y, zz);
                 if (be->gg.f16) {
                     uint16_t v;
-                    if (src != NULL) { v = hd_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
-                    else { memcpy(&v, m + 2 * s, 2); *dst++ = hd_h2f(v); }
+                    if (src != NULL) { v = hdk_f2h(*src++); memcpy(m + 2 * s, &v, 2); }
+                    else { memcpy(&v, m + 2 * s, 2); *dst++ = hdk_h2f(v); }
                 } else {
                     if (src != NULL) memcpy(m + 4 * s, src++, 4);
                     else memcpy(dst++, m + 4 * s, 4);

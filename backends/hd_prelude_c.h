@@ -23,61 +23,61 @@ typedef hd_v4 hd_f4; /* the parameter block's vectors are the kernels' vec4 */
 #define HD_I(v) ((int)(v))
 #define HD_U(v) ((hd_u32)(v))
 
-HD_FN hd_v3 hd_v3_make(float x, float y, float z) { hd_v3 r; r.x = x; r.y = y; r.z = z; return r; }
-HD_FN hd_v4 hd_v4_make(float x, float y, float z, float w)
+HD_FN hd_v3 hdk_v3_make(float x, float y, float z) { hd_v3 r; r.x = x; r.y = y; r.z = z; return r; }
+HD_FN hd_v4 hdk_v4_make(float x, float y, float z, float w)
 {
     hd_v4 r; r.x = x; r.y = y; r.z = z; r.w = w; return r;
 }
-#define HD_V3(x, y, z) hd_v3_make((x), (y), (z))
-#define HD_V4(x, y, z, w) hd_v4_make((x), (y), (z), (w))
-#define HD_XYZ(v4) hd_v3_make((v4).x, (v4).y, (v4).z)
-HD_FN hd_v3 hd_add(hd_v3 a, hd_v3 b) { return hd_v3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
-HD_FN hd_v3 hd_sub(hd_v3 a, hd_v3 b) { return hd_v3_make(a.x - b.x, a.y - b.y, a.z - b.z); }
-HD_FN hd_v3 hd_scale(hd_v3 a, float s) { return hd_v3_make(a.x * s, a.y * s, a.z * s); }
-HD_FN hd_v3 hd_vmul(hd_v3 a, hd_v3 b) { return hd_v3_make(a.x * b.x, a.y * b.y, a.z * b.z); }
-HD_FN hd_v3 hd_vdiv(hd_v3 a, hd_v3 b) { return hd_v3_make(a.x / b.x, a.y / b.y, a.z / b.z); }
-HD_FN hd_v3 hd_madd(hd_v3 p, hd_v3 d, float t)
+#define HD_V3(x, y, z) hdk_v3_make((x), (y), (z))
+#define HD_V4(x, y, z, w) hdk_v4_make((x), (y), (z), (w))
+#define HD_XYZ(v4) hdk_v3_make((v4).x, (v4).y, (v4).z)
+HD_FN hd_v3 hdk_add(hd_v3 a, hd_v3 b) { return hdk_v3_make(a.x + b.x, a.y + b.y, a.z + b.z); }
+HD_FN hd_v3 hdk_sub(hd_v3 a, hd_v3 b) { return hdk_v3_make(a.x - b.x, a.y - b.y, a.z - b.z); }
+HD_FN hd_v3 hdk_scale(hd_v3 a, float s) { return hdk_v3_make(a.x * s, a.y * s, a.z * s); }
+HD_FN hd_v3 hdk_vmul(hd_v3 a, hd_v3 b) { return hdk_v3_make(a.x * b.x, a.y * b.y, a.z * b.z); }
+HD_FN hd_v3 hdk_vdiv(hd_v3 a, hd_v3 b) { return hdk_v3_make(a.x / b.x, a.y / b.y, a.z / b.z); }
+HD_FN hd_v3 hdk_madd(hd_v3 p, hd_v3 d, float t)
 {
-    return hd_v3_make(p.x + d.x * t, p.y + d.y * t, p.z + d.z * t);
+    return hdk_v3_make(p.x + d.x * t, p.y + d.y * t, p.z + d.z * t);
 }
-HD_FN float hd_dot(hd_v3 a, hd_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-HD_FN float hd_len(hd_v3 a) { return sqrtf(hd_dot(a, a)); }
-HD_FN hd_v3 hd_normalize(hd_v3 a) { return hd_scale(a, 1.0f / hd_len(a)); }
+HD_FN float hdk_dot(hd_v3 a, hd_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+HD_FN float hdk_len(hd_v3 a) { return sqrtf(hdk_dot(a, a)); }
+HD_FN hd_v3 hdk_normalize(hd_v3 a) { return hdk_scale(a, 1.0f / hdk_len(a)); }
 
-#define hd_log(x) logf(x)
-#define hd_exp(x) expf(x)
-#define hd_sqrt(x) sqrtf(x)
-#define hd_floor(x) floorf(x)
-#define hd_absf(x) fabsf(x)
-#define hd_powf(x, y) powf((x), (y))
-HD_FN float hd_minf(float a, float b) { return a < b ? a : b; }
-HD_FN float hd_maxf(float a, float b) { return a > b ? a : b; }
-HD_FN int hd_mini(int a, int b) { return a < b ? a : b; }
-HD_FN int hd_maxi(int a, int b) { return a > b ? a : b; }
-HD_FN float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
-HD_FN int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+#define hdk_log(x) logf(x)
+#define hdk_exp(x) expf(x)
+#define hdk_sqrt(x) sqrtf(x)
+#define hdk_floor(x) floorf(x)
+#define hdk_absf(x) fabsf(x)
+#define hdk_powf(x, y) powf((x), (y))
+HD_FN float hdk_minf(float a, float b) { return a < b ? a : b; }
+HD_FN float hdk_maxf(float a, float b) { return a > b ? a : b; }
+HD_FN int hdk_mini(int a, int b) { return a < b ? a : b; }
+HD_FN int hdk_maxi(int a, int b) { return a > b ? a : b; }
+HD_FN float hdk_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+HD_FN int hdk_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 /* IEEE binary16 <-> float32, portable: the storage of E and phi with
    params.illumination_precision = HD_PRECISION_FLOAT16 (the arithmetic stays float32). Both are
-   selects on integer bit patterns, no branches, so a loop over them vectorises. hd_h2f is exact
-   (every half is a float); hd_f2h rounds to nearest, ties to even, as OpenCL's vstore_half_rte:
+   selects on integer bit patterns, no branches, so a loop over them vectorises. hdk_h2f is exact
+   (every half is a float); hdk_f2h rounds to nearest, ties to even, as OpenCL's vstore_half_rte:
    overflow gives inf, tiny values give subnormal halves or zero, NaN stays NaN (quiet, its sign
    and top payload bits kept). */
-HD_FN uint32_t hd_f2u(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
-HD_FN float hd_u2f(uint32_t u) { float f; memcpy(&f, &u, 4); return f; }
-HD_FN float hd_h2f(uint16_t h)
+HD_FN uint32_t hdk_f2u(float f) { uint32_t u; memcpy(&u, &f, 4); return u; }
+HD_FN float hdk_u2f(uint32_t u) { float f; memcpy(&f, &u, 4); return f; }
+HD_FN float hdk_h2f(uint16_t h)
 {
     uint32_t sign = (uint32_t)(h & 0x8000u) << 16, em = h & 0x7fffu;
     /* normal: rebias the exponent (127 - 15 = 112); inf/NaN (exponent 31): exponent 255 */
     uint32_t normal = (em << 13) + (112u << 23) + (uint32_t)(em >= 0x7c00u) * (112u << 23);
     /* subnormal (and zero): mantissa * 2^-24, exact in float; picked by a mask, as a ?: here
        kept GCC 12 from vectorising */
-    uint32_t sub = hd_f2u((float)em * 5.9604644775390625e-8f), m = 0u - (uint32_t)(em < 0x0400u);
-    return hd_u2f(sign | (sub & m) | (normal & ~m));
+    uint32_t sub = hdk_f2u((float)em * 5.9604644775390625e-8f), m = 0u - (uint32_t)(em < 0x0400u);
+    return hdk_u2f(sign | (sub & m) | (normal & ~m));
 }
-HD_FN uint16_t hd_f2h(float f)
+HD_FN uint16_t hdk_f2h(float f)
 {
-    uint32_t u = hd_f2u(f), sign = (u >> 16) & 0x8000u, a = u & 0x7fffffffu;
+    uint32_t u = hdk_f2u(f), sign = (u >> 16) & 0x8000u, a = u & 0x7fffffffu;
     /* NaN: quiet, top 10 payload bits; >= 65520 (rounds past the largest half 65504): inf */
     uint32_t special = a > 0x7f800000u ? 0x7e00u | ((a >> 13) & 0x3ffu) : 0x7c00u;
     /* normal half (a >= 2^-14): drop 13 mantissa bits with round-to-nearest-even; a carry into
@@ -85,14 +85,14 @@ HD_FN uint16_t hd_f2h(float f)
     uint32_t normal = (a - (112u << 23) + 0x0fffu + ((a >> 13) & 1u)) >> 13;
     /* subnormal half (a < 2^-14): adding 0.5 (2^-1) lines the half's last mantissa bit up with
        the float's last one (2^-24 = 2^-1 * 2^-23), and the float adder rounds to nearest even */
-    uint32_t sub = hd_f2u(hd_u2f(a) + 0.5f) - 0x3f000000u;
+    uint32_t sub = hdk_f2u(hdk_u2f(a) + 0.5f) - 0x3f000000u;
     uint32_t h = a >= 0x477ff000u ? special : (a >= 0x38800000u ? normal : sub);
     return (uint16_t)(sign | h);
 }
 /* The illumination's float16 store: saturates at the largest half, 65504, so a bright E or phi
    is clipped instead of becoming inf (and NaN in the image); every backend stores this. */
 #define HD_HALF_MAX 65504.0f
-HD_FN uint16_t hd_f2h_sat(float f) { return hd_f2h(f > HD_HALF_MAX ? HD_HALF_MAX : f); }
+HD_FN uint16_t hdk_f2h_sat(float f) { return hdk_f2h(f > HD_HALF_MAX ? HD_HALF_MAX : f); }
 
 /* The colour-separated layout of the buffers the diffusion reads (sigma_t with its RGB channels,
    E, phi, phi2; also the CPU multigrid's vectors), the same on the CPU and OpenCL backends
@@ -192,9 +192,9 @@ typedef struct hd__kctx {
 #define HD__ST_lv2(i, x, y, z, v) ((void)(x), (void)(y), (void)(z), K->lv2[(i)] = (v))
 #define HD__LD_sig(i, x, y, z) ((void)(i), K->sig[HD__C_AT(x, y, z)])
 #define HD__ST_sig(i, x, y, z, v) ((void)(i), K->sig[HD__C_AT(x, y, z)] = (v))
-#define HD__LD_HALF(buf, x, y, z) (K->f16 != 0 ? hd_h2f(K->buf##h[HD__C_AT(x, y, z)]) : K->buf[HD__C_AT(x, y, z)])
+#define HD__LD_HALF(buf, x, y, z) (K->f16 != 0 ? hdk_h2f(K->buf##h[HD__C_AT(x, y, z)]) : K->buf[HD__C_AT(x, y, z)])
 #define HD__ST_HALF(buf, x, y, z, v) \
-    (K->f16 != 0 ? (void)(K->buf##h[HD__C_AT(x, y, z)] = hd_f2h_sat(v)) : (void)(K->buf[HD__C_AT(x, y, z)] = (v)))
+    (K->f16 != 0 ? (void)(K->buf##h[HD__C_AT(x, y, z)] = hdk_f2h_sat(v)) : (void)(K->buf[HD__C_AT(x, y, z)] = (v)))
 #define HD__LD_E(i, x, y, z) ((void)(i), HD__LD_HALF(E, x, y, z))
 #define HD__LD_phi(i, x, y, z) ((void)(i), HD__LD_HALF(phi, x, y, z))
 #define HD__LD_phi2(i, x, y, z) ((void)(i), HD__LD_HALF(phi2, x, y, z))

@@ -3,7 +3,7 @@
    scripts/embed-kernels turns this file, the shared kernels and hd_entry_cl.h into string
    literals in hd_kernels_embedded.h, which hd_opencl.h compiles at run time. The host passes
    -DHD_MAX_LIGHTS=n, so the parameter block has one definition of its size. */
-/* Forced inlining: PoCL's compiler left hd_diffuse_terms_at, hd_track and hd_sample_value as
+/* Forced inlining: PoCL's compiler left hd_diffuse_terms_at, hdk_track and hdk_sample_value as
    calls, and a call in a work-item loop keeps it from vectorising that loop (the diffusion). */
 #define HD_FN inline __attribute__((always_inline))
 #define HD_LANG_CL 1
@@ -32,21 +32,21 @@ typedef float4 hd_f4;
 #define HD_V3(x, y, z) ((float3)((x), (y), (z)))
 #define HD_V4(x, y, z, w) ((float4)((x), (y), (z), (w)))
 #define HD_XYZ(v4) ((v4).xyz)
-HD_FN hd_v3 hd_add(hd_v3 a, hd_v3 b) { return a + b; }
-HD_FN hd_v3 hd_sub(hd_v3 a, hd_v3 b) { return a - b; }
-HD_FN hd_v3 hd_scale(hd_v3 a, float s) { return a * s; }
-HD_FN hd_v3 hd_vmul(hd_v3 a, hd_v3 b) { return a * b; }
-HD_FN hd_v3 hd_vdiv(hd_v3 a, hd_v3 b) { return a / b; }
-HD_FN hd_v3 hd_madd(hd_v3 p, hd_v3 d, float t) { return p + d * t; }
+HD_FN hd_v3 hdk_add(hd_v3 a, hd_v3 b) { return a + b; }
+HD_FN hd_v3 hdk_sub(hd_v3 a, hd_v3 b) { return a - b; }
+HD_FN hd_v3 hdk_scale(hd_v3 a, float s) { return a * s; }
+HD_FN hd_v3 hdk_vmul(hd_v3 a, hd_v3 b) { return a * b; }
+HD_FN hd_v3 hdk_vdiv(hd_v3 a, hd_v3 b) { return a / b; }
+HD_FN hd_v3 hdk_madd(hd_v3 p, hd_v3 d, float t) { return p + d * t; }
 /* Spelled out, not dot(): the same order of operations as the C prelude. */
-HD_FN float hd_dot(hd_v3 a, hd_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-HD_FN float hd_len(hd_v3 a) { return sqrt(hd_dot(a, a)); }
-HD_FN hd_v3 hd_normalize(hd_v3 a) { return hd_scale(a, 1.0f / hd_len(a)); }
+HD_FN float hdk_dot(hd_v3 a, hd_v3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+HD_FN float hdk_len(hd_v3 a) { return sqrt(hdk_dot(a, a)); }
+HD_FN hd_v3 hdk_normalize(hd_v3 a) { return hdk_scale(a, 1.0f / hdk_len(a)); }
 
 /* PoCL's log() is SLEEF's scalar 1-ulp logf (double-float arithmetic): 3.2x the time of glibc's
    logf and a third of the direct-light stage. This is the FreeBSD/musl logf (< 1 ulp, the same
    class as glibc's), inlined; zero, negative, subnormal, inf and NaN arguments go to log(). */
-HD_FN float hd_log(float x)
+HD_FN float hdk_log(float x)
 {
     uint ix = as_uint(x);
     int k;
@@ -64,17 +64,17 @@ HD_FN float hd_log(float x)
     dk = (float)k;
     return s * (hfsq + r) + dk * 9.0580006145e-06f - hfsq + f + dk * 6.9313812256e-01f;
 }
-#define hd_exp(x) exp(x)
-#define hd_sqrt(x) sqrt(x)
-#define hd_floor(x) floor(x)
-#define hd_absf(x) fabs(x)
-#define hd_powf(x, y) pow((x), (y))
-HD_FN float hd_minf(float a, float b) { return a < b ? a : b; }
-HD_FN float hd_maxf(float a, float b) { return a > b ? a : b; }
-HD_FN int hd_mini(int a, int b) { return a < b ? a : b; }
-HD_FN int hd_maxi(int a, int b) { return a > b ? a : b; }
-HD_FN float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
-HD_FN int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+#define hdk_exp(x) exp(x)
+#define hdk_sqrt(x) sqrt(x)
+#define hdk_floor(x) floor(x)
+#define hdk_absf(x) fabs(x)
+#define hdk_powf(x, y) pow((x), (y))
+HD_FN float hdk_minf(float a, float b) { return a < b ? a : b; }
+HD_FN float hdk_maxf(float a, float b) { return a > b ? a : b; }
+HD_FN int hdk_mini(int a, int b) { return a < b ? a : b; }
+HD_FN int hdk_maxi(int a, int b) { return a > b ? a : b; }
+HD_FN float hdk_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+HD_FN int hdk_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 #define HD_STRUCT(name) typedef struct name {
 #define HD_STRUCT_END(name) } name;
@@ -112,7 +112,7 @@ typedef struct hd__kctx {
     __global half *phi2h;
     int f16;
     __global float *img;
-    __global float *lsum;       /* projection: E + phi, x-fastest (hd_light_sum_voxel) */
+    __global float *lsum;       /* projection: E + phi, x-fastest (hdk_light_sum_voxel) */
     __global const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries */
     int ptab_n;
     __global const float *lv;   /* CD: the light volume being read */
@@ -170,7 +170,7 @@ typedef struct hd__kctx {
 #define HD__LD_sig(i, x, y, z) HD__CL_COL(sig, x, y, z)
 #define HD__ST_sig(i, x, y, z, v) (HD__CL_COL(sig, x, y, z) = (v))
 /* The illumination buffers: float, or binary16 rounded to nearest even and saturated at 65504
-   (as the C prelude's hd_f2h_sat, so both backends store the same bits for the same float). */
+   (as the C prelude's hdk_f2h_sat, so both backends store the same bits for the same float). */
 #define HD__LD_HALF(buf, x, y, z) \
     (K->f16 != 0 ? vload_half((size_t)HD__CL_AT(x, y, z), K->buf##h + K->cid) : HD__CL_COL(buf, x, y, z))
 #define HD__ST_HALF(buf, x, y, z, v) \

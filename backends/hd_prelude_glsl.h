@@ -10,7 +10,7 @@
 /* The projection marches the span between its first and last non-empty cells in one loop
    (hd_k_project.h): the invocations of a GLSL stage run in SIMD lanes. */
 #define HD_PROJECT_MARCH_SPAN 1
-/* hd_track walks to each collision's cell, then takes it (hd_k_common.h, hd_track_rounds). */
+/* hdk_track walks to each collision's cell, then takes it (hd_k_common.h, hdk_track_rounds). */
 #define HD_TRACK_ROUNDS 1
 #define hd_u32 uint
 #define hd_v3 vec3
@@ -25,39 +25,39 @@
 #define HD_V3(x, y, z) vec3((x), (y), (z))
 #define HD_V4(x, y, z, w) vec4((x), (y), (z), (w))
 #define HD_XYZ(v4) ((v4).xyz)
-vec3 hd_add(vec3 a, vec3 b) { return a + b; }
-vec3 hd_sub(vec3 a, vec3 b) { return a - b; }
-vec3 hd_scale(vec3 a, float s) { return a * s; }
-vec3 hd_vmul(vec3 a, vec3 b) { return a * b; }
-vec3 hd_vdiv(vec3 a, vec3 b) { return a / b; }
-vec3 hd_madd(vec3 p, vec3 d, float t) { return p + d * t; }
+vec3 hdk_add(vec3 a, vec3 b) { return a + b; }
+vec3 hdk_sub(vec3 a, vec3 b) { return a - b; }
+vec3 hdk_scale(vec3 a, float s) { return a * s; }
+vec3 hdk_vmul(vec3 a, vec3 b) { return a * b; }
+vec3 hdk_vdiv(vec3 a, vec3 b) { return a / b; }
+vec3 hdk_madd(vec3 p, vec3 d, float t) { return p + d * t; }
 /* Spelled out, not dot(): the same order of operations as the C prelude. */
-float hd_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-float hd_len(vec3 a) { return sqrt(hd_dot(a, a)); }
-vec3 hd_normalize(vec3 a) { return hd_scale(a, 1.0f / hd_len(a)); }
+float hdk_dot(vec3 a, vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+float hdk_len(vec3 a) { return sqrt(hdk_dot(a, a)); }
+vec3 hdk_normalize(vec3 a) { return hdk_scale(a, 1.0f / hdk_len(a)); }
 
-#define hd_log(x) log(x)
-#define hd_exp(x) exp(x)
-#define hd_sqrt(x) sqrt(x)
-#define hd_floor(x) floor(x)
-#define hd_absf(x) abs(x)
-#define hd_powf(x, y) pow((x), (y))
-float hd_minf(float a, float b) { return a < b ? a : b; }
-float hd_maxf(float a, float b) { return a > b ? a : b; }
-int hd_mini(int a, int b) { return a < b ? a : b; }
-int hd_maxi(int a, int b) { return a > b ? a : b; }
-float hd_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
-int hd_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
+#define hdk_log(x) log(x)
+#define hdk_exp(x) exp(x)
+#define hdk_sqrt(x) sqrt(x)
+#define hdk_floor(x) floor(x)
+#define hdk_absf(x) abs(x)
+#define hdk_powf(x, y) pow((x), (y))
+float hdk_minf(float a, float b) { return a < b ? a : b; }
+float hdk_maxf(float a, float b) { return a > b ? a : b; }
+int hdk_mini(int a, int b) { return a < b ? a : b; }
+int hdk_maxi(int a, int b) { return a > b ? a : b; }
+float hdk_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+int hdk_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
-/* v rounded to the nearest binary16, ties to even, as a float: what hd_f2h (hd_prelude_c.h) and
+/* v rounded to the nearest binary16, ties to even, as a float: what hdk_f2h (hd_prelude_c.h) and
    OpenCL's vstore_half_rte store. Float16 illumination (HD_ILLUM_R16F) stores this, so the r16f
    image's own float -> half conversion has nothing left to round: lavapipe and llvmpipe convert
    by truncation (toward zero), measured on every stored voxel of a direct pass (docs/DESIGN-
    VULKAN.md), a bias that E's and phi's iterations accumulate. Normal halves: the 13 dropped
    mantissa bits rounded in integer arithmetic (a carry into the exponent is right); subnormal
    halves (|v| < 2^-14): to a multiple of 2^-24 by roundEven, the scalings exact; |v| >= 65520:
-   inf, as hd_f2h; NaN as it is. */
-float hd_f16_round(float v)
+   inf, as hdk_f2h; NaN as it is. */
+float hdk_f16_round(float v)
 {
     uint u = floatBitsToUint(v), s = u & 0x80000000u, a = u & 0x7fffffffu;
     float nrm = uintBitsToFloat(s | ((a + 0x0fffu + ((a >> 13) & 1u)) & 0xffffe000u));

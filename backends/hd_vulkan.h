@@ -808,7 +808,7 @@ static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
 }
 
 /* Whole image <- host floats (x fastest), submitted and waited for; an r16f image gets them
-   rounded to nearest even (hd_f2h, the CPU backend's rounding). */
+   rounded to nearest even (hdk_f2h, the CPU backend's rounding). */
 static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
 {
     hd__backend *be = vw->be;
@@ -820,7 +820,7 @@ static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const
     if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
     if (im->texel == 2) {
         size_t i;
-        for (i = 0; i < bytes / 2; ++i) ((uint16_t *)be->staging.map)[i] = hd_f2h(src[i]);
+        for (i = 0; i < bytes / 2; ++i) ((uint16_t *)be->staging.map)[i] = hdk_f2h(src[i]);
     } else {
         memcpy(be->staging.map, src, bytes);
     }
@@ -833,7 +833,7 @@ static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const
 
 /* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar), or
    with a slice list (list, count) those z slices only, in its order, in one copy; an r16f
-   image's halves are widened exactly (hd_h2f). */
+   image's halves are widened exactly (hdk_h2f). */
 static hd_result hd__vk_download_image(const hd__view *vw, hd__vk_image *im, float *dst, const int *list, int count)
 {
     hd__backend *be = vw->be;
@@ -866,7 +866,7 @@ static hd_result hd__vk_download_image(const hd__view *vw, hd__vk_image *im, flo
     if (r != HD_SUCCESS) return r;
     if (im->texel == 2) {
         size_t i;
-        for (i = 0; i < bytes / 2; ++i) dst[i] = hd_h2f(((const uint16_t *)be->staging.map)[i]);
+        for (i = 0; i < bytes / 2; ++i) dst[i] = hdk_h2f(((const uint16_t *)be->staging.map)[i]);
     } else {
         memcpy(dst, be->staging.map, bytes);
     }

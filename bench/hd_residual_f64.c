@@ -15,18 +15,18 @@
 #define HD_MAX_LIGHTS 64 /* must match hybriddiff.h: the parameter block's layout */
 #define float double
 #include "backends/hd_prelude_c.h"
-#undef hd_log
-#undef hd_exp
-#undef hd_sqrt
-#undef hd_floor
-#undef hd_absf
-#undef hd_powf
-#define hd_log(x) log(x)
-#define hd_exp(x) exp(x)
-#define hd_sqrt(x) sqrt(x)
-#define hd_floor(x) floor(x)
-#define hd_absf(x) fabs(x)
-#define hd_powf(x, y) pow((x), (y))
+#undef hdk_log
+#undef hdk_exp
+#undef hdk_sqrt
+#undef hdk_floor
+#undef hdk_absf
+#undef hdk_powf
+#define hdk_log(x) log(x)
+#define hdk_exp(x) exp(x)
+#define hdk_sqrt(x) sqrt(x)
+#define hdk_floor(x) floor(x)
+#define hdk_absf(x) fabs(x)
+#define hdk_powf(x, y) pow((x), (y))
 #include "backends/kernels/hd_k_common.h"
 #include "backends/kernels/hd_k_diffuse.h"
 #undef float
@@ -79,7 +79,7 @@ double hdb_residual_f64(const void *params_f32, const float *sig, size_t sig_cou
         for (z = 0; z < gz; ++z)
             for (y = 0; y < gy; ++y)
                 for (x = 0; x < gx; ++x) {
-                    double rhs, r = hd_diffuse_residual(&K, x, y, z, c, &rhs);
+                    double rhs, r = hdk_diffuse_residual(&K, x, y, z, c, &rhs);
                     r2 += r * r;
                     b2 += rhs * rhs;
                 }

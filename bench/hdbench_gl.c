@@ -5,6 +5,7 @@
    Usage: hdbench_gl [file.nrrd [N]]; N: also the sweep's A/B against N voxels per invocation. */
 #define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_BACKEND_GL
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"

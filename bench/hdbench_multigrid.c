@@ -90,7 +90,7 @@ static double residual_kernel_f64(hd_context h, int iterate)
         hd__cpu_mg_residual_f64_into(ctx->vw.be, r, row);
         for (x = 0; x < gx; ++x) {
             float rhs;
-            (void)hd_diffuse_residual(&ctx->vw.be->k, x, y, z, c, &rhs);
+            (void)hdk_diffuse_residual(&ctx->vw.be->k, x, y, z, c, &rhs);
             r2 += (double)row[x] * row[x];
             b2 += (double)rhs * rhs;
         }

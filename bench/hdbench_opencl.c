@@ -3,7 +3,7 @@
      - HD iterations/s and per-stage times, 1 and 3 lights, CPU vs OpenCL;
      - the two design experiments of docs/DESIGN-OPENCL.md, on the same data:
          the diffusion's kernel (one work-item per voxel, a row per work-group) vs the previous
-         one (one work-item per x-row, the shared hd_diffuse_row loop);
+         one (one work-item per x-row, the shared hdk_diffuse_row loop);
          volume reads through a buffer + the shared software trilinear filter vs a 3D image
          with a linear sampler (projection and direct light).
    Usage: hdbench_opencl [data/head.nrrd] [--quick] [--sweep]   (without the file: a synthetic
@@ -13,6 +13,7 @@
    sources plus a few bench-only entry points; the library uses rows and buffers. */
 #define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_STATIC
 #define HYBRIDDIFF_BACKEND_OPENCL
 #include "hybriddiff.h"
@@ -69,7 +70,7 @@ static const char *exp_entries =
     "__kernel void hdx_diffuse_row(HD__CL_BUFFERS, int parity)\n"
     "{\n"
     "    HD__CL_KCTX;\n"
-    "    hd_diffuse_row(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), parity, 0);\n"
+    "    hdk_diffuse_row(&k, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2), parity, 0);\n"
     "}\n";
 /* The image variant: the prelude's K gains the image and its sampler (kernel arguments, not
    __constant samplers: choosing between two of those crashes PoCL 3.1's compiler). */
@@ -78,12 +79,12 @@ static const char *img_prelude =
     "#undef HD_KARGS\n#undef HD_KPASS\n"
     "#define HD_KARGS const hd__kctx *K, __read_only image3d_t hd_vimg, sampler_t hd_vsmp,\n"
     "#define HD_KPASS K, hd_vimg, hd_vsmp,\n"
-    "inline float hd_sample_value(HD_KARGS float3 u) { return read_imagef(hd_vimg, hd_vsmp, (float4)(u, 0.0f)).x; }\n";
+    "inline float hdk_sample_value(HD_KARGS float3 u) { return read_imagef(hd_vimg, hd_vsmp, (float4)(u, 0.0f)).x; }\n";
 static const char *img_entries =
     "__kernel void hdx_project_img(HD__CL_BUFFERS, __read_only image3d_t vimg, sampler_t smp)\n"
-    "{ HD__CL_KCTX; hd_project_pixel(&k, vimg, smp, (int)get_global_id(0), (int)get_global_id(1)); }\n"
+    "{ HD__CL_KCTX; hdk_project_pixel(&k, vimg, smp, (int)get_global_id(0), (int)get_global_id(1)); }\n"
     "__kernel void hdx_direct_img(HD__CL_BUFFERS, __read_only image3d_t vimg, sampler_t smp)\n"
-    "{ HD__CL_KCTX; hd_direct_voxel(&k, vimg, smp, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); }\n";
+    "{ HD__CL_KCTX; hdk_direct_voxel(&k, vimg, smp, (int)get_global_id(0), (int)get_global_id(1), (int)get_global_id(2)); }\n";
 
 /* The embedded lines of one file (by its #line marker), to splice sources. */
 static size_t src_index(const char *file)

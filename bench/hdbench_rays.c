@@ -14,6 +14,7 @@
    Usage: hdbench_rays [--passes N] [--reps R] [data/head.nrrd] */
 #define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"

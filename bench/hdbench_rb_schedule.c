@@ -15,6 +15,7 @@
    Usage: hdbench_rb_schedule [data/head.nrrd] [threads (default 2)]
    Figures, not a test. */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"
 

@@ -23,8 +23,8 @@
     11 LOADS1  one load and the store
     12 LIBLS   LIB, XK x YK x ZK voxels (same-colour voxels of a row x rows x slices) per
                invocation, all loads before all stores
-    13 RB     the library's grey box update as it is now (hd_k_diffuse.h: hd_diffuse_own_of, an
-              axis' two faces over one division, hd_diffuse_box_axis), r32f, 14 loads per voxel,
+    13 RB     the library's grey box update as it is now (hd_k_diffuse.h: hdk_diffuse_own_of, an
+              axis' two faces over one division, hdk_diffuse_box_axis), r32f, 14 loads per voxel,
               ZK voxels per invocation along z: the reference the packed variants are checked
               against (`--check`), itself checked against the library's module
     14 PACKED x-packed texels: PK (4: rgba32f, 2: rg32f) x-consecutive voxels of st, E and phi
@@ -34,7 +34,7 @@
               o, o + 2 with o = (y + z + parity) & 1), their x-neighbours inside the texel except
               one, taken from the texel before (o = 0, component 3) or after (o = 1, component 0);
               the y- and z-neighbours are the same components of the adjacent rows' texels,
-              loaded once per block as the library's hd_diffuse_block does. The whole texel is
+              loaded once per block as the library's hdk_diffuse_block does. The whole texel is
               stored back, the other colour's components as loaded (a half-sweep never writes
               them, so the value stored is the value there). Loads per invocation: 5 per row (st,
               phi, E, the side texel's st and phi) + 4 (YK + ZK) for the block's faces.
@@ -43,7 +43,7 @@
     16 PCOPY  out4 = phi4 / 2 on rgba32f x-packed texels: 1 load and 1 store per 4 voxels (LOADS1's
               twin: what an rgba32f texel op costs against an r32f one)
     17 SGB    RB's update on a block of ZK slices x YK rows (one voxel of the half-sweep's colour per
-              row, the library's hd_diffuse_block shape) with the x-neighbours shared across lanes:
+              row, the library's hdk_diffuse_block shape) with the x-neighbours shared across lanes:
               lane l of a subgroup (64x1 work groups: consecutive x, the same rows) loads per row
               its voxel's st and E and the other colour's voxel of its x-pair (2l + 1 - o: st,
               phi), which is one x-neighbour; the other one is the next / previous lane's
@@ -239,13 +239,13 @@ float lib_value(ivec3 p)
 #ifndef YK
 #define YK 1
 #endif
-/* hd_diffuse_box_den */
+/* hdk_diffuse_box_den */
 float lib_den(float sp, float s, bool inside, float fl)
 {
     return max(sp + (inside ? s : sp), fl);
 }
 
-/* hd_diffuse_box_axis: an axis' two faces over one division */
+/* hdk_diffuse_box_axis: an axis' two faces over one division */
 void lib_axis(float a, float sp, float s0, float s1, float p0, float p1, bool in0, bool in1, float fl, inout float num,
               inout float dn)
 {
@@ -256,7 +256,7 @@ void lib_axis(float a, float sp, float s0, float s1, float p0, float p1, bool in
     dn += t * (d0 + d1);
 }
 
-/* hd_diffuse_own_of + hd_diffuse_box_of + the entry's division: the voxel's sigma_t st and E e,
+/* hdk_diffuse_own_of + hdk_diffuse_box_of + the entry's division: the voxel's sigma_t st and E e,
    its neighbours' sigma_t s* and phi p* (x-, x+, y-, y+, z-, z+), whether each is in the grid */
 float lib_update(float st, float e, float sxm, float sxp, float sym, float syp, float szm, float szp, float pxm,
                  float pxp, float pym, float pyp, float pzm, float pzp, bool ixm, bool ixp, bool iym, bool iyp,

@@ -21,6 +21,7 @@
                          [--variants[=name,name...]] [--ab FILE.spv [--ab-zk n] [--ab-yk n]] */
 #define HYBRIDDIFF_TESTING /* the test hooks and fault injection (src/hd_test_hooks.h) */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_BACKEND_VULKAN
 #include "hybriddiff.h"
 #include "src/hd_test_hooks.h"

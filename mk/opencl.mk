@@ -2,7 +2,8 @@
 # C++17 compile check of the backend, the generated-file check and the OpenCL benchmark.
 #   make conformance-opencl   build and run tests/conformance on OpenCL (part of `make test`)
 #   make compile-opencl-cxx   the OpenCL implementation compiled as C++17, warnings as errors
-#   make check-generated      backends/hd_kernels_embedded.h is up to date with its sources
+#   make check-generated      the generated files are up to date with their sources, and the
+#                             implementation leaves no macro defined (scripts/check-generated)
 #   make bench-opencl         build/hdbench_opencl: OpenCL vs CPU figures in one run
 #   make valgrind-opencl      the quick conformance subset under valgrind (PoCL suppressed)
 #   make physics-opencl       tests/physics on OpenCL (part of `make test`; mk/physics.mk)

@@ -137,11 +137,11 @@ static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh);
    HD_SUCCESS): on success waits for its passes; restores what begin changed. Returns r, or its
    own error where r is HD_SUCCESS. */
 static hd_result hd__be_mg_end(const hd__view *vw, hd_result r);
-/* Level l's sigma_t (l >= 1) restricted from level l - 1's (hd_mg_coarse_sig). */
+/* Level l's sigma_t (l >= 1) restricted from level l - 1's (hdk_mg_coarse_sig). */
 static hd_result hd__be_mg_coarsen(const hd__view *vw, int l);
 /* lo = 0 (the iterate's low part belongs to another phi). */
 static hd_result hd__be_mg_zero_lo(const hd__view *vw);
-/* r = f - A (phi + lo) on the fine grid, summed in double (hd_mg_res_f64), into level 0's rhs. */
+/* r = f - A (phi + lo) on the fine grid, summed in double (hdk_mg_res_f64), into level 0's rhs. */
 static hd_result hd__be_mg_residual_f64(const hd__view *vw);
 /* `sweeps` red-black sweeps of level l's equation (first = 0: red then black; 1: black then red,
    the adjoint order). */
@@ -152,7 +152,7 @@ static hd_result hd__be_mg_residual(const hd__view *vw, int l);
 static hd_result hd__be_mg_restrict(const hd__view *vw, int l);
 /* Level l's correction += P (level l + 1's correction), masked to the medium. */
 static hd_result hd__be_mg_prolong(const hd__view *vw, int l);
-/* Row sums of <r, z> into A (per fine row, x in order, in double: hd_mg_dot_term). */
+/* Row sums of <r, z> into A (per fine row, x in order, in double: hdk_mg_dot_term). */
 static hd_result hd__be_mg_dot_rz(const hd__view *vw);
 /* p = z + beta p, then z = 0 (the next V-cycle starts from it). */
 static hd_result hd__be_mg_direction(const hd__view *vw, float beta);
@@ -163,10 +163,10 @@ static hd_result hd__be_mg_apply(const hd__view *vw);
    sums A (and B), valid until the next primitive; with n = 1 B need not be read back. The core
    adds them in row order (hd__mg_row_sum). */
 static hd_result hd__be_mg_row_sums(const hd__view *vw, int n, const double **a, const double **b);
-/* phi + lo += alpha p in double, phi its float rounding and lo the rest (hd_mg_update_of). */
+/* phi + lo += alpha p in double, phi its float rounding and lo the rest (hdk_mg_update_of). */
 static hd_result hd__be_mg_update(const hd__view *vw, double alpha);
 /* Surface boundary: the empty voxels of colour `colour` get the Marshak extrapolation in phi and
-   lo = -phi (hd_diffuse_extrapolate), with the fine parameters (no right-hand-side flag). */
+   lo = -phi (hdk_diffuse_extrapolate), with the fine parameters (no right-hand-side flag). */
 static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour);
 /* Bytes the solver's buffers hold (counted in method_bytes); 0 without them or with another solver. */
 static size_t hd__be_solver_bytes(const hd__view *vw);
@@ -202,7 +202,7 @@ HD__MAYBE_UNUSED static hd_result hd__be_diffuse_each(const hd__view *vw, int ja
     return r;
 }
 
-/* The projection's TF table for the current TF, step and medium, as hd_project_lookup reads it
+/* The projection's TF table for the current TF, step and medium, as hdk_project_lookup reads it
    (hd_k_project.h): entry j at value j / (n - 1) is (rgb * a * albedo / (4 pi), a), a = 1 -
    exp(-sigma_t dt). n - 1 is a multiple of the TF's segments and at least HD__PTAB_MIN, so each
    table segment lies inside one TF segment. Every backend builds it here, so all of them read
@@ -248,8 +248,8 @@ HD__MAYBE_UNUSED static void hd__project_table(const hd__view *vw, float *dst, i
     k.p = &vw->kp;
     k.tf = vw->tf;
     for (j = 0; j < n; ++j) {
-        hd_v4 c = hd_tf(K, (float)j / (float)(n - 1));
-        float a = 1.0f - hd_exp(-(c.w * vw->kp.medium.x) * dt);
+        hd_v4 c = hdk_tf(K, (float)j / (float)(n - 1));
+        float a = 1.0f - hdk_exp(-(c.w * vw->kp.medium.x) * dt);
         dst[j * 4] = c.x * a * s;
         dst[j * 4 + 1] = c.y * a * s;
         dst[j * 4 + 2] = c.z * a * s;

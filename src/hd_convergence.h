@@ -33,9 +33,9 @@ static void hd__conv_free(hd__ctx *ctx)
 static int hd__conv_in_medium(const hd__ctx *ctx, int x, int y, int z)
 {
     int f = ctx->vw.params.illumination_downsample, c = HD__MAJORANT_CELL;
-    int vx = hd_mini(x * f + f / 2, ctx->vw.dims[0] - 1);
-    int vy = hd_mini(y * f + f / 2, ctx->vw.dims[1] - 1);
-    int vz = hd_mini(z * f + f / 2, ctx->vw.dims[2] - 1);
+    int vx = hdk_mini(x * f + f / 2, ctx->vw.dims[0] - 1);
+    int vy = hdk_mini(y * f + f / 2, ctx->vw.dims[1] - 1);
+    int vz = hdk_mini(z * f + f / 2, ctx->vw.dims[2] - 1);
     size_t k = ((size_t)z * ctx->vw.gdims[1] + (size_t)y) * ctx->vw.gdims[0] + (size_t)x;
     if (ctx->dl.bits && !(ctx->dl.bits[k >> 3] >> (k & 7) & 1u)) return 0; /* E and phi never read */
     return ctx->vw.majorant[((size_t)(vz / c) * ctx->vw.mdims[1] + (size_t)(vy / c)) * ctx->vw.mdims[0] + (size_t)(vx / c)] > 0.0f;

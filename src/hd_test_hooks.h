@@ -1,7 +1,9 @@
 /* hd_test_hooks.h - PRIVATE hooks that run single stages of the schedule (not API: no hd_ names,
-   no stability promise). The conformance suite and the benchmarks include this file after the
-   library's implementation, in the same translation unit, to compare stages across backends:
-   one diffusion sweep, a solve, the projection of illumination they wrote themselves.
+   no stability promise). The conformance suite and the benchmarks call them from the
+   library's implementation's translation unit to compare stages across backends: one diffusion
+   sweep, a solve, the projection of illumination they wrote themselves. The implementation
+   includes this file itself under HYBRIDDIFF_TESTING, before it undefines its macros
+   (backends/hd_undef.h), as the hooks need them; an include after the implementation is a no-op.
    Each hook first brings the context up to date (hd__prepare) exactly as hd_iterate does, in one
    bracket of the backend's (HD__BE_CALL). A translation unit that includes it defines
    HYBRIDDIFF_TESTING before the implementation, which then keeps the backends' test-only
@@ -9,6 +11,13 @@
 #ifndef HYBRIDDIFF_TESTING
 #error "hybriddiff: src/hd_test_hooks.h needs HYBRIDDIFF_TESTING defined before the implementation"
 #endif
+#if !defined(HYBRIDDIFF_IMPLEMENTATION_DONE)
+#error "hybriddiff: src/hd_test_hooks.h comes with the implementation: define HYBRIDDIFF_TESTING and HYBRIDDIFF_IMPLEMENTATION"
+#endif
+/* HD_CORE_H (src/hd_core.h's guard) is defined inside the implementation only: after it, the
+   hooks are already there. */
+#if defined(HD_CORE_H) && !defined(HD__TEST_HOOKS_H)
+#define HD__TEST_HOOKS_H
 
 /* The state a hook starts from: allocations, sigma_t, cleared accumulations. */
 HD__MAYBE_UNUSED static hd_result hd__test_prepare(hd_context h)
@@ -141,3 +150,4 @@ HD__MAYBE_UNUSED static int hd__test_first_scale(hd_context h)
     hd__ctx *ctx = hd__lookup(h);
     return ctx ? hd__first_scale(ctx) : 0;
 }
+#endif /* HD_CORE_H: inside the implementation */

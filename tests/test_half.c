@@ -8,7 +8,7 @@
 #include "hd_test.h"
 #include <stdlib.h>
 
-/* The value of half h computed independently of hd_h2f, in double: (-1)^s 2^(e-15) 1.m, or
+/* The value of half h computed independently of hdk_h2f, in double: (-1)^s 2^(e-15) 1.m, or
    2^-14 0.m for e = 0; NaN for e = 31 with m != 0, inf for m = 0. */
 static double half_value(unsigned h)
 {
@@ -42,28 +42,28 @@ static void test_conversion_table(void)
     size_t i;
     unsigned h;
     for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        h = hd_f2h(cases[i].f);
-        CHECK_MSG(h == cases[i].h, "hd_f2h(%.9g) = 0x%04x, expected 0x%04x", (double)cases[i].f, h, cases[i].h);
+        h = hdk_f2h(cases[i].f);
+        CHECK_MSG(h == cases[i].h, "hdk_f2h(%.9g) = 0x%04x, expected 0x%04x", (double)cases[i].f, h, cases[i].h);
     }
     /* just above the 2^-25 tie, just above the 1 + 2^-11 tie */
-    CHECK(hd_f2h(bits_float(0x33000001u)) == 0x0001);
-    CHECK(hd_f2h(bits_float(0x3f801001u)) == 0x3c01);
-    CHECK(hd_f2h(INFINITY) == 0x7c00 && hd_f2h(-INFINITY) == 0xfc00);
-    h = hd_f2h(NAN);
+    CHECK(hdk_f2h(bits_float(0x33000001u)) == 0x0001);
+    CHECK(hdk_f2h(bits_float(0x3f801001u)) == 0x3c01);
+    CHECK(hdk_f2h(INFINITY) == 0x7c00 && hdk_f2h(-INFINITY) == 0xfc00);
+    h = hdk_f2h(NAN);
     CHECK(is_half_nan(h) && (h & 0x0200u));
-    h = hd_f2h(bits_float(0xff800001u)); /* a signalling NaN with the lowest payload bit: stays NaN, quiet, negative */
+    h = hdk_f2h(bits_float(0xff800001u)); /* a signalling NaN with the lowest payload bit: stays NaN, quiet, negative */
     CHECK(is_half_nan(h) && (h & 0x0200u) && (h & 0x8000u));
 }
 
-/* Every half: hd_h2f gives its exact value (bit for bit against half_value), and back through
-   hd_f2h gives the same half; a NaN stays a NaN of the same sign, made quiet. */
+/* Every half: hdk_h2f gives its exact value (bit for bit against half_value), and back through
+   hdk_f2h gives the same half; a NaN stays a NaN of the same sign, made quiet. */
 static void test_conversion_all_halves(void)
 {
     unsigned h, bad_value = 0, bad_trip = 0;
     for (h = 0; h < 65536u; ++h) {
-        float f = hd_h2f((uint16_t)h);
+        float f = hdk_h2f((uint16_t)h);
         double want = half_value(h);
-        unsigned back = hd_f2h(f);
+        unsigned back = hdk_f2h(f);
         if (is_half_nan(h)) {
             if (f == f || !is_half_nan(back) || (back & 0x8000u) != (h & 0x8000u) || !(back & 0x0200u)) ++bad_trip;
             continue;
@@ -75,7 +75,7 @@ static void test_conversion_all_halves(void)
     CHECK_MSG(bad_trip == 0, "%u halves do not survive the round trip", bad_trip);
 }
 
-/* hd_f2h rounds to nearest, ties to even: for floats spread over every exponent (each 1021st
+/* hdk_f2h rounds to nearest, ties to even: for floats spread over every exponent (each 1021st
    bit pattern below 65520, plus the sign), no other half lies closer and a tie went to the even
    one. The half above 0x7bff counts as 65536, the value rounding aims at past the largest. */
 static void test_conversion_nearest_even(void)
@@ -84,11 +84,11 @@ static void test_conversion_nearest_even(void)
     unsigned bad = 0, checked = 0;
     for (u = 0; u < 0x477ff000u; u += 1021u) {
         float f = bits_float(u);
-        unsigned h = hd_f2h(f);
+        unsigned h = hdk_f2h(f);
         double v = half_value(h), up = h == 0x7bffu ? 65536.0 : half_value(h + 1u), d = fabs(v - (double)f);
         double du = fabs(up - (double)f), dd = h > 0 ? fabs(half_value(h - 1u) - (double)f) : INFINITY;
         ++checked;
-        if (d > du || d > dd || (d == du && (h & 1u)) || (d == dd && (h & 1u)) || hd_f2h(-f) != (h | 0x8000u)) ++bad;
+        if (d > du || d > dd || (d == du && (h & 1u)) || (d == dd && (h & 1u)) || hdk_f2h(-f) != (h | 0x8000u)) ++bad;
     }
     CHECK_MSG(bad == 0, "%u of %u floats not rounded to the nearest even half", bad, checked);
 }
@@ -173,11 +173,11 @@ static void test_half_matches_float(void)
         CHECK(hd_read_illumination(c32, HD_ILLUMINATION_DIRECT, a, n) == HD_SUCCESS);
         CHECK(hd_read_illumination(c16, HD_ILLUMINATION_DIRECT, b, n) == HD_SUCCESS);
         eE = rel_linf(a, b, n);
-        for (i = 0; i < n; ++i) not_half += hd_h2f(hd_f2h(b[i])) != b[i];
+        for (i = 0; i < n; ++i) not_half += hdk_h2f(hdk_f2h(b[i])) != b[i];
         CHECK(hd_read_illumination(c32, HD_ILLUMINATION_SCATTERED, a, n) == HD_SUCCESS);
         CHECK(hd_read_illumination(c16, HD_ILLUMINATION_SCATTERED, b, n) == HD_SUCCESS);
         ePhi = rel_linf(a, b, n);
-        for (i = 0; i < n; ++i) not_half += hd_h2f(hd_f2h(b[i])) != b[i];
+        for (i = 0; i < n; ++i) not_half += hdk_h2f(hdk_f2h(b[i])) != b[i];
         CHECK(hd_read_image_f32(c32, a, ni) == HD_SUCCESS && hd_read_image_f32(c16, b, ni) == HD_SUCCESS);
         eImg = rel_linf(a, b, ni);
         printf("  half vs float (%s, %d it): rel Linf E %.2e (bound %.2e), phi %.2e (bound %.2e), image %.2e\n",

@@ -62,8 +62,8 @@ static void estimate_T(const kfix *f, hd_v3 p, hd_v3 d, float tmax, int mode, in
     int i;
     for (i = 0; i < n; ++i) {
         hd_u32 next;
-        hd_u32 key = hd_rng_key((hd_u32)i, 1u, 1234u, HD_STREAM_DIRECT);
-        double T = hd_transmittance(&f->k, p, d, tmax, key, 1u, mode, &next);
+        hd_u32 key = hdk_rng_key((hd_u32)i, 1u, 1234u, HD_STREAM_DIRECT);
+        double T = hdk_transmittance(&f->k, p, d, tmax, key, 1u, mode, &next);
         s += T; s2 += T * T;
     }
     *mean = s / n;
@@ -86,8 +86,8 @@ static void test_transmittance_homogeneous(void)
         for (mode = HD_TRACK_RATIO; mode <= HD_TRACK_DELTA; ++mode) {
             double mean, se;
             hd_v3 p = HD_V3(-0.45f, -0.1f, 0.05f);
-            hd_v3 d = hd_normalize(HD_V3(1.0f, 0.3f, -0.2f));
-            float tmax = hd_box_exit(&f.k, p, d);
+            hd_v3 d = hdk_normalize(HD_V3(1.0f, 0.3f, -0.2f));
+            float tmax = hdk_box_exit(&f.k, p, d);
             double expect = exp(-3.0 * tmax);
             estimate_T(&f, p, d, tmax, mode, 40000, &mean, &se);
             CHECK_MSG(fabs(mean - expect) < 4 * se, "mode %d global %d: T %.5f +- %.5f, exp(-sigma d) %.5f", mode, global, mean, se, expect);
@@ -118,8 +118,8 @@ static void test_transmittance_step(void)
     for (mode = HD_TRACK_RATIO; mode <= HD_TRACK_DELTA; ++mode) {
         double mean, se;
         hd_v3 p = HD_V3(0.49f, 0.3f, -0.35f);
-        hd_v3 d = hd_normalize(HD_V3(-1.0f, -0.35f, 0.4f));
-        float tmax = hd_box_exit(&f.k, p, d);
+        hd_v3 d = hdk_normalize(HD_V3(-1.0f, -0.35f, 0.4f));
+        float tmax = hdk_box_exit(&f.k, p, d);
         double expect = exp(-4.0 * (16.0 / 32.0) / fabs(d.x));
         estimate_T(&f, p, d, tmax, mode, 40000, &mean, &se);
         CHECK_MSG(fabs(mean - expect) < 4 * se + 1e-6, "mode %d: T %.5f +- %.5f, expected %.5f", mode, mean, se, expect);
@@ -136,14 +136,14 @@ static int solve(kfix *f, double tol, int max_sweeps, double *res_out)
     for (s = 1; s <= max_sweeps; ++s) {
         for (parity = 0; parity < 2; ++parity)
             for (z = 0; z < n; ++z)
-                for (y = 0; y < n; ++y) hd_diffuse_row(&f->k, y, z, 0, parity, 0);
+                for (y = 0; y < n; ++y) hdk_diffuse_row(&f->k, y, z, 0, parity, 0);
         if (s % 10 == 0) {
             double r2 = 0, b2 = 0;
             int x;
             for (z = 0; z < n; ++z)
                 for (y = 0; y < n; ++y)
                     for (x = 0; x < n; ++x) {
-                        float rhs, r = hd_diffuse_residual(&f->k, x, y, z, 0, &rhs);
+                        float rhs, r = hdk_diffuse_residual(&f->k, x, y, z, 0, &rhs);
                         r2 += (double)r * r; b2 += (double)rhs * rhs;
                     }
             res = sqrt(r2 / b2);
@@ -227,7 +227,7 @@ static void test_diffusion_jacobi_matches(void)
     for (s = 0; s < 8000; ++s) {
         float *t;
         for (z = 0; z < n; ++z)
-            for (y = 0; y < n; ++y) hd_diffuse_row(&b.k, y, z, 0, 0, 1);
+            for (y = 0; y < n; ++y) hdk_diffuse_row(&b.k, y, z, 0, 0, 1);
         t = b.phi; b.phi = phi2; phi2 = t; b.k.phi = b.phi; b.k.phi2 = phi2;
     }
     for (i = 0; i < (int)kfix_slots(n); ++i) { /* padding slots: 0 in both */
@@ -358,7 +358,7 @@ static void test_diffusion_surface_extrapolation(void)
     for (s = 0; s < 1; ++s)
         for (parity = 0; parity < 2; ++parity)
             for (z = 0; z < n; ++z)
-                for (y = 0; y < n; ++y) hd_diffuse_row(&f.k, y, z, 0, parity, 0);
+                for (y = 0; y < n; ++y) hdk_diffuse_row(&f.k, y, z, 0, parity, 0);
     for (x = 0; x < (int)kfix_slots(n); ++x) /* padding slots: sigma_t 0, phi 0 */
         if (f.sig[x] == 0.0f && fabs(f.phi[x]) > maxrhs) maxrhs = fabs(f.phi[x]);
     CHECK(maxrhs == 0.0);
@@ -370,12 +370,12 @@ static void test_rng_uniform(void)
 {
     double s = 0, s2 = 0;
     int i, n = 200000, same = 0;
-    hd_u32 key = hd_rng_key(5u, 9u, 1u, HD_STREAM_PROJECT);
+    hd_u32 key = hdk_rng_key(5u, 9u, 1u, HD_STREAM_PROJECT);
     for (i = 0; i < n; ++i) {
-        float u = hd_rand(hd_rng_key((hd_u32)i, 3u, 0u, HD_STREAM_DIRECT), 0u);
+        float u = hdk_rand(hdk_rng_key((hd_u32)i, 3u, 0u, HD_STREAM_DIRECT), 0u);
         CHECK(u >= 0.0f && u < 1.0f);
         s += u; s2 += (double)u * u;
-        if (i > 0 && hd_rand(key, (hd_u32)i) == hd_rand(key, (hd_u32)i - 1)) ++same;
+        if (i > 0 && hdk_rand(key, (hd_u32)i) == hdk_rand(key, (hd_u32)i - 1)) ++same;
     }
     s /= n; s2 = s2 / n - s * s;
     CHECK(fabs(s - 0.5) < 4 * sqrt(1.0 / 12 / n));
@@ -405,8 +405,8 @@ static void proj_fixture(kfix *f, int n, int w)
     f->p.medium.y = 0.9f; f->p.box.w = HD_INV_4PI;
     f->p.chan_color.x = f->p.chan_color.y = f->p.chan_color.z = 1.0f;
     {
-        hd_v3 eye = HD_V3(1.3f, -1.1f, 0.9f), wd = hd_normalize(hd_scale(eye, -1.0f));
-        hd_v3 u = hd_normalize(HD_V3(wd.y, -wd.x, 0.0f));
+        hd_v3 eye = HD_V3(1.3f, -1.1f, 0.9f), wd = hdk_normalize(hdk_scale(eye, -1.0f));
+        hd_v3 u = hdk_normalize(HD_V3(wd.y, -wd.x, 0.0f));
         hd_v3 v = HD_V3(u.y * wd.z - u.z * wd.y, u.z * wd.x - u.x * wd.z, u.x * wd.y - u.y * wd.x);
         f->p.cam_pos = HD_V4(eye.x, eye.y, eye.z, 0.0f);
         f->p.cam_w = HD_V4(wd.x, wd.y, wd.z, 0.0f);
@@ -421,8 +421,8 @@ static void project_pixel_span(const hd__kctx *k, int x, int y, int spans)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
     float len = 0.0f, s0 = 0.0f;
-    hd_project_ray(k, x, y, &pe, &d, &len, &s0);
-    hd_project_finish(k, y * k->p->image.x + x, hd_project_march_span(k, pe, d, len, s0, spans));
+    hdk_project_ray(k, x, y, &pe, &d, &len, &s0);
+    hdk_project_finish(k, y * k->p->image.x + x, hdk_project_march_span(k, pe, d, len, s0, spans));
 }
 
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true
@@ -463,7 +463,7 @@ static void test_projection_skip(void)
         for (y = 0; y < W; ++y)
             for (x = 0; x < W; ++x) {
                 if (spans_of[pass] > 0) project_pixel_span(&f.k, x, y, spans_of[pass]);
-                else hd_project_pixel(&f.k, x, y);
+                else hdk_project_pixel(&f.k, x, y);
             }
     }
     for (i = 0; i < W * W * 4; ++i) {
@@ -483,7 +483,7 @@ static void test_projection_skip(void)
     kfix_free(&f);
 }
 
-/* hd_track_rounds (GLSL's tracker) gives hd_track's T, next dim and collision distance bit for
+/* hdk_track_rounds (GLSL's tracker) gives hdk_track's T, next dim and collision distance bit for
    bit: rays from points all over the projection fixture's scene (a sphere and a block in empty
    space, the true majorants with their halo) toward directions all around, to the box's face and
    stopped halfway, ratio and delta tracking, over the majorant grid, over a grid of majorants 3x
@@ -511,14 +511,14 @@ static void test_track_rounds(void)
         f.p.medium.w = pass == 2 ? 40.0f * 1.5f : 0.0f;
         for (mode = HD_TRACK_RATIO; mode <= HD_TRACK_DELTA; ++mode)
             for (i = 0; i < RAYS; ++i) {
-                hd_u32 key = hd_rng_key((hd_u32)i, 3u, 77u, HD_STREAM_DIRECT), nd[2] = {0u, 0u};
-                hd_v3 p = HD_V3(hd_rand(key, 100u) - 0.5f, hd_rand(key, 101u) - 0.5f, hd_rand(key, 102u) - 0.5f);
-                hd_v3 j = HD_V3(hd_rand(key, 103u) - 0.5f, hd_rand(key, 104u) - 0.5f, hd_rand(key, 105u) - 0.5f);
+                hd_u32 key = hdk_rng_key((hd_u32)i, 3u, 77u, HD_STREAM_DIRECT), nd[2] = {0u, 0u};
+                hd_v3 p = HD_V3(hdk_rand(key, 100u) - 0.5f, hdk_rand(key, 101u) - 0.5f, hdk_rand(key, 102u) - 0.5f);
+                hd_v3 j = HD_V3(hdk_rand(key, 103u) - 0.5f, hdk_rand(key, 104u) - 0.5f, hdk_rand(key, 105u) - 0.5f);
                 /* two in three toward the sphere (centre at voxel 13, 17, 20), the rest anywhere */
-                hd_v3 d = hd_normalize(i % 3 == 2 ? j : hd_add(HD_V3(13.5f / N - 0.5f - p.x, 17.5f / N - 0.5f - p.y, 20.5f / N - 0.5f - p.z), hd_scale(j, 0.2f)));
-                float tmax = hd_box_exit(&f.k, p, d) * (i % 3 == 0 ? 0.5f : 1.0f), th[2] = {0.0f, 0.0f}, T[2];
-                T[0] = hd_track(&f.k, p, d, tmax, key, 1u, mode, &nd[0], &th[0]);
-                T[1] = hd_track_rounds(&f.k, p, d, tmax, key, 1u, mode, &nd[1], &th[1]);
+                hd_v3 d = hdk_normalize(i % 3 == 2 ? j : hdk_add(HD_V3(13.5f / N - 0.5f - p.x, 17.5f / N - 0.5f - p.y, 20.5f / N - 0.5f - p.z), hdk_scale(j, 0.2f)));
+                float tmax = hdk_box_exit(&f.k, p, d) * (i % 3 == 0 ? 0.5f : 1.0f), th[2] = {0.0f, 0.0f}, T[2];
+                T[0] = hdk_track(&f.k, p, d, tmax, key, 1u, mode, &nd[0], &th[0]);
+                T[1] = hdk_track_rounds(&f.k, p, d, tmax, key, 1u, mode, &nd[1], &th[1]);
                 if (memcmp(&T[0], &T[1], sizeof(float)) != 0 || nd[0] != nd[1] || memcmp(&th[0], &th[1], sizeof(float)) != 0)
                     ++differ;
                 if (nd[0] > 3u) ++partial;
@@ -528,13 +528,13 @@ static void test_track_rounds(void)
     }
     fprintf(stderr, "  %d rays, %d with 3 draws or more, %d delta hits, %d empty cells, %d differ\n", rays, partial, hits, empty, differ);
     CHECK(partial > rays / 3 && hits > rays / 10 && empty > 0); /* the test has power */
-    CHECK_MSG(differ == 0, "hd_track_rounds differs from hd_track on %d of %d rays", differ, rays);
+    CHECK_MSG(differ == 0, "hdk_track_rounds differs from hdk_track on %d of %d rays", differ, rays);
     kfix_free(&f);
 }
 
 /* The projection's shortcuts (hd_prelude_c.h; the CPU backend fills them in) give the image of
    the plain path: the summed light grid lsum = E + phi, and the step's TF table with each entry's
-   opacity 1 - exp(-sigma_t dt) and premultiplied colour (hd_project_lookup), its segments inside
+   opacity 1 - exp(-sigma_t dt) and premultiplied colour (hdk_project_lookup), its segments inside
    the TF's. The fixture's TF has one segment, so the table is sampled 64 times finer than it. */
 static void test_projection_tables(void)
 {
@@ -548,7 +548,7 @@ static void test_projection_tables(void)
         for (y = 0; y < N; ++y)
             for (x = 0; x < N; ++x) lsum[(z * N + y) * N + x] = f.E[KAT(f, x, y, z)] + f.phi[KAT(f, x, y, z)];
     for (i = 0; i < T; ++i) {
-        hd_v4 c = hd_tf(&f.k, (float)i / (float)(T - 1));
+        hd_v4 c = hdk_tf(&f.k, (float)i / (float)(T - 1));
         float a = 1.0f - expf(-c.w * f.p.medium.x * f.p.march.x), k = f.p.medium.y * f.p.box.w;
         ptab[i * 4] = c.x * a * k; ptab[i * 4 + 1] = c.y * a * k; ptab[i * 4 + 2] = c.z * a * k; ptab[i * 4 + 3] = a;
     }
@@ -559,7 +559,7 @@ static void test_projection_tables(void)
         f.k.ptab = pass ? ptab : NULL;
         f.k.ptab_n = T;
         for (y = 0; y < W; ++y)
-            for (x = 0; x < W; ++x) hd_project_pixel(&f.k, x, y);
+            for (x = 0; x < W; ++x) hdk_project_pixel(&f.k, x, y);
     }
     for (i = 0; i < W * W * 4; ++i) {
         double d = fabs((double)img[0][i] - img[1][i]);

@@ -88,7 +88,7 @@ static void test_multigrid_matches(void)
    are printed. Measured (max |phi_k - phi_ref| / max phi_ref): surface 7.6e-7 after 5 steps
    (red-black's own distance from the solution, about 1.5e-6, after that); box 8.8e-4 after 4
    steps and 1.9e-6 after 12, RGB 9.0e-4 and 2.1e-6, since the box boundary's transfers skip
-   air (hd_mg_medium; before: box 2.1e-1 and 9.1e-3, RGB 2.3e-1 and 1.4e-2, as trilinear
+   air (hdk_mg_medium; before: box 2.1e-1 and 9.1e-3, RGB 2.3e-1 and 1.4e-2, as trilinear
    interpolation put part of the tissue's correction into air, whose conductance is about 1e4
    times tissue's). Bounds: surface 1e-5 after 6 steps; box and RGB 1e-2 after 4 steps and 2e-5
    after 12 (the unmasked transfers fail both). */

@@ -2,7 +2,7 @@
    (shared source), and with RGB scattering the TF colour there in channels 1..3 (channel k at
    index i + k * voxels, image z + k * dz, like E and phi). Rerun when the transfer function,
    the extinction or the crop box changes. */
-HD_FN void hd_classify_voxel(HD_KARGS int x, int y, int z)
+HD_FN void hdk_classify_voxel(HD_KARGS int x, int y, int z)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x;
@@ -11,12 +11,12 @@ HD_FN void hd_classify_voxel(HD_KARGS int x, int y, int z)
     if (gx == HD_PRM(dims).x && gy == HD_PRM(dims).y && gz == HD_PRM(dims).z) {
         v = HD_GET(vol, i, x, y, z); /* same grid: the voxel itself, no interpolation round-off */
     } else {
-        v = hd_sample_value(HD_KPASS u);
+        v = hdk_sample_value(HD_KPASS u);
     }
     {
-        hd_v4 c = hd_tf(HD_KPASS v);
+        hd_v4 c = hdk_tf(HD_KPASS v);
         /* outside the crop box the voxel holds no medium */
-        HD_SET(sig, i, x, y, z, hd_in_crop(HD_KPASS u) != 0 ? c.w * HD_PRM(medium).x : 0.0f);
+        HD_SET(sig, i, x, y, z, hdk_in_crop(HD_KPASS u) != 0 ? c.w * HD_PRM(medium).x : 0.0f);
         if ((HD_PRM(counts).z & HD_FLAG_RGB_SCATTERING) != 0) {
             int nvox = gx * gy * gz;
             HD_SET(sig, i + nvox, x, y, z + gz, c.x);

@@ -36,7 +36,7 @@
    voxels) at its intensity.
 
    Storage. rho is stored as a fraction of the light's intensity (1 at the held voxels), so one
-   float per voxel per light, whatever the number of colour channels; hd_sum_light_voxel scales
+   float per voxel per light, whatever the number of colour channels; hdk_sum_light_voxel scales
    it by the light's colour and, for an inverse-square point light, 1/r^2 (the convected rho is
    the transmittance; the geometric falloff is applied exactly at summation). Reads lv, writes
    lv2 (ping-pong; the backend rotates one spare buffer through the lights). */
@@ -44,7 +44,7 @@
 #define HD_CD_STEP 0.5f /* pseudo-time step in voxels (of the smallest voxel side) */
 
 /* One convection step of light l at voxel (x, y, z): lv -> lv2. */
-HD_FN void hd_convect_voxel(HD_KARGS int x, int y, int z, int l)
+HD_FN void hdk_convect_voxel(HD_KARGS int x, int y, int z, int l)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int i = (z * gy + y) * gx + x;
@@ -54,22 +54,22 @@ HD_FN void hd_convect_voxel(HD_KARGS int x, int y, int z, int l)
                     (HD_F(z) + 0.5f) * hz - 0.5f * HD_PRM(box).z);
     hd_v4 la = HD_PRM(light_a)[l];
     hd_v3 u;
-    float dtau = HD_CD_STEP * hd_minf(hx, hd_minf(hy, hz));
+    float dtau = HD_CD_STEP * hdk_minf(hx, hdk_minf(hy, hz));
     float wx = 0.0f, wy = 0.0f, wz = 0.0f, up, rho, st, res;
     int xu, yu, zu;
     if (la.w < 0.5f) {
         u = HD_XYZ(la); /* directional: the direction the light travels */
     } else {
-        hd_v3 v = hd_sub(p, HD_XYZ(la));
-        if (hd_absf(v.x) < hx && hd_absf(v.y) < hy && hd_absf(v.z) < hz) {
+        hd_v3 v = hdk_sub(p, HD_XYZ(la));
+        if (hdk_absf(v.x) < hx && hdk_absf(v.y) < hy && hdk_absf(v.z) < hz) {
             HD_SET(lv2, i, x, y, z, 1.0f); /* the held block around a point light */
             return;
         }
-        u = hd_normalize(v);
+        u = hdk_normalize(v);
     }
-    wx = hd_absf(u.x) / hx;
-    wy = hd_absf(u.y) / hy;
-    wz = hd_absf(u.z) / hz;
+    wx = hdk_absf(u.x) / hx;
+    wy = hdk_absf(u.y) / hy;
+    wz = hdk_absf(u.z) / hz;
     /* upwind neighbours; outside the grid: a ghost voxel held at the light's intensity (1) */
     xu = u.x > 0.0f ? x - 1 : x + 1;
     yu = u.y > 0.0f ? y - 1 : y + 1;
@@ -86,7 +86,7 @@ HD_FN void hd_convect_voxel(HD_KARGS int x, int y, int z, int l)
 
 /* E (all channels) at voxel (x, y, z) += light l's volume lv scaled by its colour and falloff;
    first != 0: E = that (the first light of the sum). */
-HD_FN void hd_sum_light_voxel(HD_KARGS int x, int y, int z, int l, int first)
+HD_FN void hdk_sum_light_voxel(HD_KARGS int x, int y, int z, int l, int first)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int nch = HD_PRM(gdims).w;
@@ -97,10 +97,10 @@ HD_FN void hd_sum_light_voxel(HD_KARGS int x, int y, int z, int l, int first)
     float tmax = 0.0f, falloff = 0.0f;
     float rho = HD_GET(lv, i, x, y, z);
     int c;
-    hd_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
+    hdk_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
     for (c = 0; c < nch; ++c) {
         int ic = i + c * nvox;
         float e = first != 0 ? 0.0f : HD_GET(E, ic, x, y, z + c * gz);
-        HD_SET(E, ic, x, y, z + c * gz, e + hd_light_channel(HD_KPASS l, c) * falloff * rho);
+        HD_SET(E, ic, x, y, z + c * gz, e + hdk_light_channel(HD_KPASS l, c) * falloff * rho);
     }
 }

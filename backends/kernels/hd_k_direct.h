@@ -2,31 +2,31 @@
    source). Every voxel of the illumination grid takes exactly one sample per iteration, so the
    iteration count is the sample count and no per-voxel counter is needed:
    E_n = E_{n-1} + (X_n - E_{n-1}) / n with X = L * I_l * T(x -> l), l uniform among L lights. */
-HD_FN void hd_direct_voxel(HD_KARGS int x, int y, int z)
+HD_FN void hdk_direct_voxel(HD_KARGS int x, int y, int z)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
     int nch = HD_PRM(gdims).w, nl = HD_PRM(counts).x;
     int i = (z * gy + y) * gx + x;
     int nvox = gx * gy * gz;
-    hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_DIRECT);
+    hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_DIRECT);
     /* The light is drawn per run of 8 voxels along x, not per voxel: still uniform for every
        voxel (unbiased), and SIMD lanes on a GPU (or in llvmpipe/PoCL) that walk toward the same
        light stay coherent. */
-    hd_u32 lkey = hd_rng_key(HD_U(i) >> 3u, HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_LIGHT);
-    int l = hd_mini(HD_I(hd_rand(lkey, 0u) * HD_F(nl)), nl - 1);
+    hd_u32 lkey = hdk_rng_key(HD_U(i) >> 3u, HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_LIGHT);
+    int l = hdk_mini(HD_I(hdk_rand(lkey, 0u) * HD_F(nl)), nl - 1);
     hd_v3 p = HD_V3(((HD_F(x) + 0.5f) / HD_F(gx) - 0.5f) * HD_PRM(box).x,
                     ((HD_F(y) + 0.5f) / HD_F(gy) - 0.5f) * HD_PRM(box).y,
                     ((HD_F(z) + 0.5f) / HD_F(gz) - 0.5f) * HD_PRM(box).z);
     float tmax = 0.0f, falloff = 0.0f, T, w;
     hd_u32 next_dim = 0u;
     int c;
-    hd_v3 d = hd_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
-    T = hd_transmittance(HD_KPASS p, d, tmax, key, 1u, HD_PRM(counts).y, HD_REF(next_dim));
+    hd_v3 d = hdk_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
+    T = hdk_transmittance(HD_KPASS p, d, tmax, key, 1u, HD_PRM(counts).y, HD_REF(next_dim));
     w = 1.0f / HD_F(HD_PRM(frame).x);
     for (c = 0; c < nch; ++c) {
         int ic = i + c * nvox;
         float e = HD_GET(E, ic, x, y, z + c * gz);
-        float sample_x = HD_F(nl) * hd_light_channel(HD_KPASS l, c) * falloff * T;
+        float sample_x = HD_F(nl) * hdk_light_channel(HD_KPASS l, c) * falloff * T;
         HD_SET(E, ic, x, y, z + c * gz, e + (sample_x - e) * w);
     }
 }
@@ -34,9 +34,9 @@ HD_FN void hd_direct_voxel(HD_KARGS int x, int y, int z)
 /* The same at illumination-grid index i (x fastest): the dispatch over the list of voxels whose
    E is read (src/hd_direct_mask.h, hd__direct_mask). The random key stays the voxel's grid index, so a
    tracked voxel's E is bit-identical to tracking every voxel. */
-HD_FN void hd_direct_index(HD_KARGS int i)
+HD_FN void hdk_direct_index(HD_KARGS int i)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y;
     int row = i / gx;
-    hd_direct_voxel(HD_KPASS i - row * gx, row % gy, row / gy);
+    hdk_direct_voxel(HD_KPASS i - row * gx, row % gy, row / gy);
 }

@@ -1,7 +1,7 @@
 /* hd_k_path.h - PT_SS and PT_MS: camera path tracing, one full path per pixel per iteration
    (shared source).
 
-   From the camera, delta tracking (hd_free_flight, the DDA walker shared with the direct-light
+   From the camera, delta tracking (hdk_free_flight, the DDA walker shared with the direct-light
    stage) finds the first real collision. At every collision vertex x:
      - the path weight w *= albedo * c(x): the TF colour is the per-channel scattering albedo, so
        the expected weight is exactly the chance the path survives as scattering in each channel
@@ -15,7 +15,7 @@
    PT_SS is this kernel with counts.w = 1 and g = 0 (set by the host): one collision, one shadow
    ray, isotropic phase; so PT_MS with max_bounces = 1 and g = 0 is the same estimator.
    Every loop is bounded: at most counts.w (max_bounces <= 100000) vertices per path, each
-   free flight and shadow ray at most HD_MAX_TRACK_STEPS (hd_track).
+   free flight and shadow ray at most HD_MAX_TRACK_STEPS (hdk_track).
    A camera ray that leaves the box unscattered sees the background; scattered rays that leave
    add nothing (the background is a backdrop, not a light, as in HD's projection). Alpha is 1 if
    the camera ray collides, so its mean is 1 - T_cam as in the projection.
@@ -26,47 +26,47 @@
 #define HD_PT_RR_BOUNCES 3 /* Russian roulette from this many vertices on */
 
 #ifndef HD_PRELUDE_HAS_TRIG
-#define hd_cos(x) cos(x)
-#define hd_sin(x) sin(x)
+#define hdk_cos(x) cos(x)
+#define hdk_sin(x) sin(x)
 #endif
 
-HD_FN hd_v3 hd_cross(hd_v3 a, hd_v3 b)
+HD_FN hd_v3 hdk_cross(hd_v3 a, hd_v3 b)
 {
     return HD_V3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 
 /* Henyey-Greenstein phase function per steradian; mu = cosine between the propagation
    directions before and after scattering; g = 0 is isotropic, 1 / (4 pi). */
-HD_FN float hd_phase_hg(float g, float mu)
+HD_FN float hdk_phase_hg(float g, float mu)
 {
     float den = 1.0f + g * g - 2.0f * g * mu;
-    if (hd_absf(g) < 1.0e-3f) return HD_INV_4PI;
-    return HD_INV_4PI * (1.0f - g * g) / (den * hd_sqrt(den));
+    if (hdk_absf(g) < 1.0e-3f) return HD_INV_4PI;
+    return HD_INV_4PI * (1.0f - g * g) / (den * hdk_sqrt(den));
 }
 
 /* A direction drawn from the HG phase function around the propagation direction d (unit). */
-HD_FN hd_v3 hd_sample_phase_hg(hd_v3 d, float g, float xi0, float xi1)
+HD_FN hd_v3 hdk_sample_phase_hg(hd_v3 d, float g, float xi0, float xi1)
 {
     float mu, s, st, ph;
     hd_v3 a, b1, b2;
-    if (hd_absf(g) < 1.0e-3f) {
+    if (hdk_absf(g) < 1.0e-3f) {
         mu = 1.0f - 2.0f * xi0;
     } else {
         s = (1.0f - g * g) / (1.0f - g + 2.0f * g * xi0);
         mu = (1.0f + g * g - s * s) / (2.0f * g);
     }
-    mu = hd_clampf(mu, -1.0f, 1.0f);
-    st = hd_sqrt(hd_maxf(0.0f, 1.0f - mu * mu));
+    mu = hdk_clampf(mu, -1.0f, 1.0f);
+    st = hdk_sqrt(hdk_maxf(0.0f, 1.0f - mu * mu));
     ph = 6.28318531f * xi1;
-    a = hd_absf(d.x) > 0.9f ? HD_V3(0.0f, 1.0f, 0.0f) : HD_V3(1.0f, 0.0f, 0.0f);
-    b1 = hd_normalize(hd_cross(a, d));
-    b2 = hd_cross(d, b1);
-    return hd_normalize(hd_add(hd_scale(d, mu), hd_add(hd_scale(b1, st * hd_cos(ph)), hd_scale(b2, st * hd_sin(ph)))));
+    a = hdk_absf(d.x) > 0.9f ? HD_V3(0.0f, 1.0f, 0.0f) : HD_V3(1.0f, 0.0f, 0.0f);
+    b1 = hdk_normalize(hdk_cross(a, d));
+    b2 = hdk_cross(d, b1);
+    return hdk_normalize(hdk_add(hdk_scale(d, mu), hdk_add(hdk_scale(b1, st * hdk_cos(ph)), hdk_scale(b2, st * hdk_sin(ph)))));
 }
 
 /* Light l's radiance in colour channel c (0..2) for a path: with 1 illumination channel the
    light_b.x weight times the lights' common colour. */
-HD_FN float hd_light_rgb(HD_KARGS int l, int c)
+HD_FN float hdk_light_rgb(HD_KARGS int l, int c)
 {
     hd_v4 lb = HD_PRM(light_b)[l];
     if (HD_PRM(gdims).w == 1) {
@@ -75,21 +75,21 @@ HD_FN float hd_light_rgb(HD_KARGS int l, int c)
     return c == 0 ? lb.x : (c == 1 ? lb.y : lb.z);
 }
 
-HD_FN void hd_path_pixel(HD_KARGS int px, int py)
+HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
-    hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_PATH);
+    hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_PATH);
     hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
-    hd_v3 d = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
+    hd_v3 d = hdk_camera_dir(HD_KPASS HD_F(px) + hdk_rand(key, 0u), HD_F(py) + hdk_rand(key, 1u));
     float t1 = 0.0f;
-    float t0 = hd_box_entry(HD_KPASS o, d, HD_REF(t1));
+    float t0 = hdk_box_entry(HD_KPASS o, d, HD_REF(t1));
     int nl = HD_PRM(counts).x, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
     float albedo = HD_PRM(medium).y, g = HD_PRM(medium).z;
     float lr = 0.0f, lg = 0.0f, lb = 0.0f, alpha = 0.0f;
     float wr = 1.0f, wg = 1.0f, wb = 1.0f;
     hd_u32 dim = 2u;
     int vertices = 0;
-    hd_v3 p = hd_madd(o, d, t0);
+    hd_v3 p = hdk_madd(o, d, t0);
     float tmax = t1 - t0;
     if (!(t0 < t1)) { /* misses the box */
         lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z;
@@ -97,7 +97,7 @@ HD_FN void hd_path_pixel(HD_KARGS int px, int py)
     }
     while (tmax > 0.0f) {
         hd_u32 nd = 0u;
-        float t = hd_free_flight(HD_KPASS p, d, tmax, key, dim, HD_REF(nd));
+        float t = hdk_free_flight(HD_KPASS p, d, tmax, key, dim, HD_REF(nd));
         hd_v4 c;
         int l;
         float lt = 0.0f, falloff = 0.0f, tr, f;
@@ -108,31 +108,31 @@ HD_FN void hd_path_pixel(HD_KARGS int px, int py)
             break;
         }
         alpha = 1.0f;
-        p = hd_madd(p, d, t);
-        c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS hd_world_to_tex(HD_KPASS p)));
+        p = hdk_madd(p, d, t);
+        c = hdk_tf(HD_KPASS hdk_sample_value(HD_KPASS hdk_world_to_tex(HD_KPASS p)));
         wr *= albedo * c.x; wg *= albedo * c.y; wb *= albedo * c.z;
         /* next-event estimation toward one light */
-        l = hd_mini(HD_I(hd_rand(key, dim) * HD_F(nl)), nl - 1);
+        l = hdk_mini(HD_I(hdk_rand(key, dim) * HD_F(nl)), nl - 1);
         dim += 1u;
-        ld = hd_light_dir(HD_KPASS l, p, HD_REF(lt), HD_REF(falloff));
-        tr = hd_transmittance(HD_KPASS p, ld, lt, key, dim, mode, HD_REF(nd));
+        ld = hdk_light_dir(HD_KPASS l, p, HD_REF(lt), HD_REF(falloff));
+        tr = hdk_transmittance(HD_KPASS p, ld, lt, key, dim, mode, HD_REF(nd));
         dim = nd;
-        f = HD_F(nl) * falloff * tr * hd_phase_hg(g, hd_dot(d, ld));
-        lr += wr * f * hd_light_rgb(HD_KPASS l, 0);
-        lg += wg * f * hd_light_rgb(HD_KPASS l, 1);
-        lb += wb * f * hd_light_rgb(HD_KPASS l, 2);
+        f = HD_F(nl) * falloff * tr * hdk_phase_hg(g, hdk_dot(d, ld));
+        lr += wr * f * hdk_light_rgb(HD_KPASS l, 0);
+        lg += wg * f * hdk_light_rgb(HD_KPASS l, 1);
+        lb += wb * f * hdk_light_rgb(HD_KPASS l, 2);
         vertices += 1;
         if (vertices >= max_vertices) break;
         if (vertices >= HD_PT_RR_BOUNCES) {
-            float q = hd_minf(hd_maxf(wr, hd_maxf(wg, wb)), 0.95f);
-            float xi = hd_rand(key, dim);
+            float q = hdk_minf(hdk_maxf(wr, hdk_maxf(wg, wb)), 0.95f);
+            float xi = hdk_rand(key, dim);
             dim += 1u;
             if (!(xi < q)) break;
             wr /= q; wg /= q; wb /= q;
         }
-        d = hd_sample_phase_hg(d, g, hd_rand(key, dim), hd_rand(key, dim + 1u));
+        d = hdk_sample_phase_hg(d, g, hdk_rand(key, dim), hdk_rand(key, dim + 1u));
         dim += 2u;
-        tmax = hd_box_exit(HD_KPASS p, d);
+        tmax = hdk_box_exit(HD_KPASS p, d);
     }
-    hd_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
+    hdk_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
 }

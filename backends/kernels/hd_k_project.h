@@ -6,19 +6,19 @@
 
 #ifndef HD_PRELUDE_SAMPLES_LIGHT
 /* Trilinear E + phi of channel c at texture coordinate u, on the illumination grid. */
-HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
+HD_FN float hdk_sample_light(HD_KARGS hd_v3 u, int c)
 {
     int nx = HD_PRM(gdims).x, ny = HD_PRM(gdims).y, nz = HD_PRM(gdims).z;
     float wx = 0.0f, wy = 0.0f, wz = 0.0f;
-    int x0 = hd_lerp_axis(u.x, nx, HD_REF(wx));
-    int y0 = hd_lerp_axis(u.y, ny, HD_REF(wy));
-    int z0 = hd_lerp_axis(u.z, nz, HD_REF(wz));
-    int x1 = hd_mini(x0 + 1, nx - 1), y1 = hd_mini(y0 + 1, ny - 1), z1 = hd_mini(z0 + 1, nz - 1);
+    int x0 = hdk_lerp_axis(u.x, nx, HD_REF(wx));
+    int y0 = hdk_lerp_axis(u.y, ny, HD_REF(wy));
+    int z0 = hdk_lerp_axis(u.z, nz, HD_REF(wz));
+    int x1 = hdk_mini(x0 + 1, nx - 1), y1 = hdk_mini(y0 + 1, ny - 1), z1 = hdk_mini(z0 + 1, nz - 1);
     int za = z0 + c * nz, zb = z1 + c * nz;
     int r00 = (za * ny + y0) * nx, r10 = (za * ny + y1) * nx;
     int r01 = (zb * ny + y0) * nx, r11 = (zb * ny + y1) * nx;
 #ifdef HD_PRELUDE_LIGHT_SUM
-    /* a backend that keeps E + phi summed in one grid (hd_light_sum_voxel): the same sums, half
+    /* a backend that keeps E + phi summed in one grid (hdk_light_sum_voxel): the same sums, half
        the loads */
     if (HD_LIGHT_SUM_READY) {
         float s000 = HD_GET(lsum, r00 + x0, x0, y0, za), s100 = HD_GET(lsum, r00 + x1, x1, y0, za);
@@ -49,8 +49,8 @@ HD_FN float hd_sample_light(HD_KARGS hd_v3 u, int c)
 #ifdef HD_PRELUDE_LIGHT_SUM
 /* lsum = E + phi at voxel (x, y, zz) of the illumination grid (zz = z + c * gz for channel c),
    stored x-fastest at (zz * gy + y) * gx + x: rebuilt by the backend after a pass that changed E
-   or phi, read by hd_sample_light. */
-HD_FN void hd_light_sum_voxel(HD_KARGS int x, int y, int zz)
+   or phi, read by hdk_sample_light. */
+HD_FN void hdk_light_sum_voxel(HD_KARGS int x, int y, int zz)
 {
     int i = (zz * HD_PRM(gdims).y + y) * HD_PRM(gdims).x + x;
     HD_SET(lsum, i, x, y, zz, HD_GET(E, i, x, y, zz) + HD_GET(phi, i, x, y, zz));
@@ -58,18 +58,18 @@ HD_FN void hd_light_sum_voxel(HD_KARGS int x, int y, int zz)
 #endif
 
 /* The camera ray through image position (fx, fy) in pixels (top row first). */
-HD_FN hd_v3 hd_camera_dir(HD_KARGS float fx, float fy)
+HD_FN hd_v3 hdk_camera_dir(HD_KARGS float fx, float fy)
 {
     float sx = 2.0f * fx / HD_F(HD_PRM(image).x) - 1.0f;
     float sy = 1.0f - 2.0f * fy / HD_F(HD_PRM(image).y);
-    hd_v3 d = hd_add(HD_XYZ(HD_PRM(cam_w)),
-                     hd_add(hd_scale(HD_XYZ(HD_PRM(cam_u)), sx), hd_scale(HD_XYZ(HD_PRM(cam_v)), sy)));
-    return hd_normalize(d);
+    hd_v3 d = hdk_add(HD_XYZ(HD_PRM(cam_w)),
+                     hdk_add(hdk_scale(HD_XYZ(HD_PRM(cam_u)), sx), hdk_scale(HD_XYZ(HD_PRM(cam_v)), sy)));
+    return hdk_normalize(d);
 }
 
 /* Folds one frame value into the running mean of pixel i (RGBA) of the image region that
    starts at pixel region.x (0; a reduced frame's region: hd_k_upsample.h). */
-HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
+HD_FN void hdk_accumulate_pixel(HD_KARGS int i, hd_v4 v)
 {
     float w = HD_PRM(march).y;
     int b = (i + HD_PRM(region).x) * 4;
@@ -85,27 +85,27 @@ HD_FN void hd_accumulate_pixel(HD_KARGS int i, hd_v4 v)
    opacity. n - 1 is a multiple of the TF's segments, so each table segment lies inside one TF
    segment: a transparent TF segment stays exactly 0 (the empty-space skip relies on it) and the
    interpolated opacity differs from the exact one only by the exponential's curvature. */
-HD_FN hd_v4 hd_project_lookup(HD_KARGS float v)
+HD_FN hd_v4 hdk_project_lookup(HD_KARGS float v)
 {
     float f = 0.0f;
-    int a = hd_table_segment(v, HD_PTAB_N, HD_REF(f));
+    int a = hdk_table_segment(v, HD_PTAB_N, HD_REF(f));
     return HD_V4(HD_TABLE_LERP(ptab, a, f, 0), HD_TABLE_LERP(ptab, a, f, 1), HD_TABLE_LERP(ptab, a, f, 2),
                  HD_TABLE_LERP(ptab, a, f, 3));
 }
 #endif
 
 /* Adds one sample's emission to (r, g, b) and its absorption to T: colour and extinction from
-   the TF at the volume sample (or the step's table), the light from hd_sample_light. */
-HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_INOUT(float) r,
+   the TF at the volume sample (or the step's table), the light from hdk_sample_light. */
+HD_FN void hdk_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_INOUT(float) r,
                              HD_INOUT(float) g, HD_INOUT(float) b)
 {
     hd_v4 c;    /* rgb: the emission's colour weights */
     float e;    /* the emission's scale: transmittance so far (and opacity, albedo / (4 pi)) */
     float keep; /* the share of T the step keeps */
-    if (hd_in_crop(HD_KPASS u) == 0) return; /* no medium outside the crop box */
+    if (hdk_in_crop(HD_KPASS u) == 0) return; /* no medium outside the crop box */
 #ifdef HD_PRELUDE_PROJECT_TABLE
     if (HD_PROJECT_TABLE_READY) {
-        c = hd_project_lookup(HD_KPASS hd_sample_value(HD_KPASS u));
+        c = hdk_project_lookup(HD_KPASS hdk_sample_value(HD_KPASS u));
         if (!(c.w > 0.0f)) return;
         e = HD_DEREF(T);
         keep = 1.0f - c.w;
@@ -113,50 +113,50 @@ HD_FN void hd_project_sample(HD_KARGS hd_v3 u, float dt, HD_INOUT(float) T, HD_I
 #endif
     {
         float st, a;
-        c = hd_tf(HD_KPASS hd_sample_value(HD_KPASS u));
+        c = hdk_tf(HD_KPASS hdk_sample_value(HD_KPASS u));
         st = c.w * HD_PRM(medium).x;
         if (!(st > 0.0f)) return;
-        a = 1.0f - hd_exp(-st * dt);
+        a = 1.0f - hdk_exp(-st * dt);
         e = HD_DEREF(T) * a * HD_PRM(medium).y * HD_PRM(box).w; /* albedo / (4 pi) */
         keep = 1.0f - a;
     }
     if (HD_PRM(gdims).w == 1) {
-        float l0 = hd_sample_light(HD_KPASS u, 0) * e;
+        float l0 = hdk_sample_light(HD_KPASS u, 0) * e;
         HD_DEREF(r) += c.x * l0 * HD_PRM(chan_color).x;
         HD_DEREF(g) += c.y * l0 * HD_PRM(chan_color).y;
         HD_DEREF(b) += c.z * l0 * HD_PRM(chan_color).z;
     } else {
-        HD_DEREF(r) += c.x * hd_sample_light(HD_KPASS u, 0) * e;
-        HD_DEREF(g) += c.y * hd_sample_light(HD_KPASS u, 1) * e;
-        HD_DEREF(b) += c.z * hd_sample_light(HD_KPASS u, 2) * e;
+        HD_DEREF(r) += c.x * hdk_sample_light(HD_KPASS u, 0) * e;
+        HD_DEREF(g) += c.y * hdk_sample_light(HD_KPASS u, 1) * e;
+        HD_DEREF(b) += c.z * hdk_sample_light(HD_KPASS u, 2) * e;
     }
     HD_DEREF(T) *= keep;
 }
 
 /* The index of the first sample past se, for a march that resumes at se after empty cells
    (none before n): samples sit at s0 + n dt, n below HD_MAX_MARCH_STEPS. */
-HD_FN int hd_march_resume(float se, float s0, float idt, int n)
+HD_FN int hdk_march_resume(float se, float s0, float idt, int n)
 {
-    float m = hd_floor((se - s0) * idt) + 1.0f;
+    float m = hdk_floor((se - s0) * idt) + 1.0f;
     if (!(se > s0)) return n;
-    return m < HD_F(HD_MAX_MARCH_STEPS) ? hd_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
+    return m < HD_F(HD_MAX_MARCH_STEPS) ? hdk_maxi(HD_I(m), n) : HD_MAX_MARCH_STEPS;
 }
 
 /* Pixel (px, py)'s camera ray for this frame: its entry into the box pe, unit direction d, the
    length len of its chord (at most the box diagonal; negative for a miss) and its jitter s0. */
-HD_FN void hd_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(hd_v3) d, HD_INOUT(float) len,
+HD_FN void hdk_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(hd_v3) d, HD_INOUT(float) len,
                           HD_INOUT(float) s0)
 {
     int i = py * HD_PRM(image).x + px;
-    hd_u32 key = hd_rng_key(HD_U(i), HD_U(HD_PRM(frame).y), HD_U(HD_PRM(frame).z), HD_STREAM_PROJECT);
+    hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).y), HD_U(HD_PRM(frame).z), HD_STREAM_PROJECT);
     hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
-    hd_v3 dir = hd_camera_dir(HD_KPASS HD_F(px) + hd_rand(key, 0u), HD_F(py) + hd_rand(key, 1u));
+    hd_v3 dir = hdk_camera_dir(HD_KPASS HD_F(px) + hdk_rand(key, 0u), HD_F(py) + hdk_rand(key, 1u));
     float t1 = 0.0f;
-    float t0 = hd_box_entry(HD_KPASS o, dir, HD_REF(t1));
-    HD_DEREF(pe) = hd_madd(o, dir, t0);
+    float t0 = hdk_box_entry(HD_KPASS o, dir, HD_REF(t1));
+    HD_DEREF(pe) = hdk_madd(o, dir, t0);
     HD_DEREF(d) = dir;
-    HD_DEREF(len) = hd_minf(t1 - t0, HD_BOX_DIAGONAL);
-    HD_DEREF(s0) = hd_rand(key, 2u) * HD_PRM(march).x;
+    HD_DEREF(len) = hdk_minf(t1 - t0, HD_BOX_DIAGONAL);
+    HD_DEREF(s0) = hdk_rand(key, 2u) * HD_PRM(march).x;
 }
 
 /* The march of the ray pe + s d, s in [0, len), returns (r, g, b, T): the emission it gathered
@@ -164,22 +164,22 @@ HD_FN void hd_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(
    jitter), so the step advances however far the eye is; n stays below HD_MAX_MARCH_STEPS, and
    the march stops once T falls below march.z. Empty space is skipped through the majorant grid
    (cells of mdims.w voxels, each majorant bounding every trilinear sample inside the cell with a
-   one-voxel halo, src/hd_volume.h), walked cell by cell (hd_cell_walk, the 3D DDA hd_track also
+   one-voxel halo, src/hd_volume.h), walked cell by cell (hd_cell_walk, the 3D DDA hdk_track also
    walks): in a cell whose majorant is 0 every sample has sigma_t = 0 and adds nothing. The walk
    visits each cell once and ends at the grid's far face or at len (the grid's last cell reaches
    to len). Two marches take the same samples, in the same order, to the same image; each
    backend's prelude picks one (HD_PROJECT_MARCH_SPAN):
 
-   hd_project_march_cells (CPU, OpenCL) walks the cells and marches each non-empty one in turn:
+   hdk_project_march_cells (CPU, OpenCL) walks the cells and marches each non-empty one in turn:
    after a run of empty cells it resumes at the first sample past the next one's entry, so no
    sample of an empty cell is taken. The tight loop a processor running one ray at a time wants.
 
-   hd_project_march_span (GLSL: llvmpipe, lavapipe, GPUs) first walks every cell and keeps the
+   hdk_project_march_span (GLSL: llvmpipe, lavapipe, GPUs) first walks every cell and keeps the
    spans of consecutive non-empty cells, from a span's first cell's entry to its last cell's exit,
    the first spans - 1 of them apart and any after them merged into the last (spans: 1 to
-   HD_MARCH_SPANS, which hd_project_pixel passes); then one
+   HD_MARCH_SPANS, which hdk_project_pixel passes); then one
    loop marches the spans, resuming past each one's entry as the cell march does. Samples in empty
-   cells inside a merged span add nothing (hd_project_sample returns at a zero opacity; a rounding
+   cells inside a merged span add nothing (hdk_project_sample returns at a zero opacity; a rounding
    difference at a cell face stays inside the halo). Where rays run in the lanes of one SIMD
    instruction stream and the compiler runs both sides of every branch under a mask (llvmpipe and
    lavapipe do), every iteration of one loop that both walks and samples pays for both; here the
@@ -187,26 +187,26 @@ HD_FN void hd_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(
 #ifndef HD_MARCH_SPANS
 #define HD_MARCH_SPANS 6 /* spans the span march keeps apart: 6 measured best of 1, 4, 6, 8 on llvmpipe */
 #endif
-HD_FN hd_v4 hd_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0)
+HD_FN hd_v4 hdk_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0)
 {
     float dt = HD_PRM(march).x, idt = 1.0f / dt;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
-    hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
+    hd_cell_walk w = hdk_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
     float se = 0.0f; /* where the ray entered the current cell */
     int skipped = 1;  /* the cells since the last sample were empty: n must catch up with se */
     int n = 0;
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
     for (;;) {
-        int ax = hd_cell_walk_axis(w);
-        float sc = hd_cell_walk_end(w, ax, md, len);
-        if (HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f) {
+        int ax = hdk_cell_walk_axis(w);
+        float sc = hdk_cell_walk_end(w, ax, md, len);
+        if (HD_GET1(maj, hdk_cell_walk_index(w, md)) > 0.0f) {
             float s;
-            if (skipped != 0) n = hd_march_resume(se, s0, idt, n);
+            if (skipped != 0) n = hdk_march_resume(se, s0, idt, n);
             skipped = 0;
             s = s0 + HD_F(n) * dt;
             while (s < sc && n < HD_MAX_MARCH_STEPS) {
-                hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r),
+                hdk_project_sample(HD_KPASS hdk_world_to_tex(HD_KPASS hdk_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r),
                                   HD_REF(g), HD_REF(b));
                 if (T < HD_PRM(march).z) break;
                 ++n;
@@ -218,17 +218,17 @@ HD_FN hd_v4 hd_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
         }
         if (!(sc < len) || n >= HD_MAX_MARCH_STEPS || cells <= 1) break;
         se = sc;
-        hd_cell_walk_step(HD_REF(w), ax);
+        hdk_cell_walk_step(HD_REF(w), ax);
         --cells;
     }
     return HD_V4(r, g, b, T);
 }
 
-HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, int spans)
+HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, int spans)
 {
     float dt = HD_PRM(march).x, idt = 1.0f / dt;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
-    hd_cell_walk w = hd_cell_walk_begin(HD_KPASS pe, d);
+    hd_cell_walk w = hdk_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
     float se = 0.0f;                /* where the ray entered the current cell */
     float sa[HD_MARCH_SPANS], sb[HD_MARCH_SPANS]; /* span j: from sa[j] to sb[j] */
@@ -237,9 +237,9 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
     int cells = md.x + md.y + md.z; /* each step moves one index toward the grid's far face */
     for (j = 0; j < HD_MARCH_SPANS; ++j) { sa[j] = 0.0f; sb[j] = 0.0f; }
     for (;;) {
-        int ax = hd_cell_walk_axis(w);
-        float sc = hd_cell_walk_end(w, ax, md, len);
-        int occ = HD_GET1(maj, hd_cell_walk_index(w, md)) > 0.0f ? 1 : 0;
+        int ax = hdk_cell_walk_axis(w);
+        float sc = hdk_cell_walk_end(w, ax, md, len);
+        int occ = HD_GET1(maj, hdk_cell_walk_index(w, md)) > 0.0f ? 1 : 0;
         if (occ != 0) {
             if (prev == 0 && k < spans - 1) { ++k; sa[k] = se; }
             sb[k] = sc;
@@ -247,21 +247,21 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
         prev = occ;
         if (!(sc < len) || cells <= 1) break;
         se = sc;
-        hd_cell_walk_step(HD_REF(w), ax);
+        hdk_cell_walk_step(HD_REF(w), ax);
         --cells;
     }
     j = 0;
-    n = k >= 0 ? hd_march_resume(sa[0], s0, idt, 0) : 0;
+    n = k >= 0 ? hdk_march_resume(sa[0], s0, idt, 0) : 0;
     s = s0 + HD_F(n) * dt;
     while (j <= k && n < HD_MAX_MARCH_STEPS) {
         if (s < sb[j]) { /* a sample of span j, else on to the next span */
-            hd_project_sample(HD_KPASS hd_world_to_tex(HD_KPASS hd_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r), HD_REF(g),
+            hdk_project_sample(HD_KPASS hdk_world_to_tex(HD_KPASS hdk_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r), HD_REF(g),
                               HD_REF(b));
             if (T < HD_PRM(march).z) break;
             ++n;
         } else {
             ++j;
-            if (j <= k) n = hd_march_resume(sa[j], s0, idt, n);
+            if (j <= k) n = hdk_march_resume(sa[j], s0, idt, n);
         }
         s = s0 + HD_F(n) * dt;
     }
@@ -270,21 +270,21 @@ HD_FN hd_v4 hd_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s
 
 /* Folds the march's (r, g, b, T) into pixel i: the background behind it, and T = 0 where the
    march stopped on it. */
-HD_FN void hd_project_finish(HD_KARGS int i, hd_v4 m)
+HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m)
 {
     float T = m.w < HD_PRM(march).z ? 0.0f : m.w;
-    hd_accumulate_pixel(HD_KPASS i, HD_V4(m.x + T * HD_PRM(background).x, m.y + T * HD_PRM(background).y,
+    hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + T * HD_PRM(background).x, m.y + T * HD_PRM(background).y,
                                           m.z + T * HD_PRM(background).z, 1.0f - T));
 }
 
-HD_FN void hd_project_pixel(HD_KARGS int px, int py)
+HD_FN void hdk_project_pixel(HD_KARGS int px, int py)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
     float len = 0.0f, s0 = 0.0f;
-    hd_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0));
+    hdk_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0));
 #ifdef HD_PROJECT_MARCH_SPAN
-    hd_project_finish(HD_KPASS py * HD_PRM(image).x + px, hd_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS));
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS));
 #else
-    hd_project_finish(HD_KPASS py * HD_PRM(image).x + px, hd_project_march_cells(HD_KPASS pe, d, len, s0));
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_cells(HD_KPASS pe, d, len, s0));
 #endif
 }

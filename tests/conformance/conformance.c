@@ -637,8 +637,8 @@ static void case_downsample(hd_voxel_type type, const int *d, int factor, int rg
 
 /* HD with binary16 illumination storage (params.illumination_precision FLOAT16), whole
    iterations. Bound: relative L2 <= 1e-3 (the stochastic one), no Linf bound. Every backend
-   rounds the same float to the same half (round to nearest even: hd_f2h, vstore_half_rte, and
-   on Vulkan / GL hd_f16_round before the r16f imageStore, whose own conversion truncates on
+   rounds the same float to the same half (round to nearest even: hdk_f2h, vstore_half_rte, and
+   on Vulkan / GL hdk_f16_round before the r16f imageStore, whose own conversion truncates on
    lavapipe and llvmpipe: without it these cases measure rel L2 4.1e-3 to 6.3e-3, a bias, not
    noise), but a float that differs by one ulp between them (log/exp, a flipped tracking decision, as in
    the float32 cases) can land on the other side of a rounding boundary: one half ulp, 2^-11 =

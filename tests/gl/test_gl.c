@@ -11,10 +11,10 @@
    3. a texture of the wrong size or format is refused with HD_ERROR_INVALID_TEXTURE, and the
       other backends' hd_gl_render_to_texture is HD_ERROR_UNSUPPORTED (tests/test_core.c side:
       the CPU build of this call is compiled in every other test program).
-   4. float16 illumination stores: hd_f16_round (hd_prelude_glsl.h, the embedded GLSL) and an
-      r16f imageStore give hd_f2h's bits (the CPU's round to nearest even) for every finite half,
+   4. float16 illumination stores: hdk_f16_round (hd_prelude_glsl.h, the embedded GLSL) and an
+      r16f imageStore give hdk_f2h's bits (the CPU's round to nearest even) for every finite half,
       both signs, the midpoint above it (a tie) and the floats either side of that midpoint,
-      and for overflow (>= 65520: inf) and inf; the same store without hd_f16_round is counted
+      and for overflow (>= 65520: inf) and inf; the same store without hdk_f16_round is counted
       and printed (llvmpipe truncates), not checked: a driver may round.
    5. the caller's context (use_current_context) not current, or another one current: hd_iterate
       and hd_read_image_f32 return HD_ERROR_GL_CONTEXT_NOT_CURRENT with one logged error and count
@@ -29,6 +29,7 @@
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
 #define HYBRIDDIFF_IMPLEMENTATION
+#define HD__KEEP_MACROS /* white-box: reaches the implementation's macros after it */
 #define HYBRIDDIFF_BACKEND_GL
 #include "hybriddiff.h"
 #include <GL/glcorearb.h>
@@ -249,7 +250,7 @@ static void run_calls(int use_current, const char *what)
 }
 
 /* The prelude's text (source string 2 of hd_glsl_embedded.h) between #version and a main()
-   that stores hd_f16_round(src[i]) (or src[i] itself, raw != 0) into an r16f 512x512 image. */
+   that stores hdk_f16_round(src[i]) (or src[i] itself, raw != 0) into an r16f 512x512 image. */
 static GLuint round_program(int raw)
 {
     static const char *head = "#version 430 core\n#define HD_GLSL_CUSTOM_BUFFERS 1\n";
@@ -268,7 +269,7 @@ static GLuint round_program(int raw)
     GLint ok = 0;
     GLuint sh = glCreateShader(GL_COMPUTE_SHADER), prog = glCreateProgram();
     src[n++] = head;
-    src[n++] = raw ? "#define HD_T_ROUND(v) (v)\n" : "#define HD_T_ROUND(v) hd_f16_round(v)\n";
+    src[n++] = raw ? "#define HD_T_ROUND(v) (v)\n" : "#define HD_T_ROUND(v) hdk_f16_round(v)\n";
     for (i = 0; i < HD__GL_SOURCE_LINES; ++i) {
         if (strncmp(hd__gl_source[i], "#line 1 ", 8) == 0) in = strcmp(hd__gl_source[i], "#line 1 2\n") == 0;
         else if (in) src[n++] = hd__gl_source[i];
@@ -284,7 +285,7 @@ static GLuint round_program(int raw)
     return prog;
 }
 
-/* Check 4: returns how many of the stores differ from hd_f2h. */
+/* Check 4: returns how many of the stores differ from hdk_f2h. */
 static int round_mismatches(const float *in, int count, int raw)
 {
     static uint16_t out[512 * 512];
@@ -305,9 +306,9 @@ static int round_mismatches(const float *in, int count, int raw)
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RED, GL_HALF_FLOAT, out);
     for (i = 0; i < count; ++i) {
-        uint16_t want = hd_f2h(in[i]);
+        uint16_t want = hdk_f2h(in[i]);
         if (out[i] != want) {
-            if (!raw && bad < 5) printf("  hd_f16_round: %.9g (0x%08x) stored 0x%04x, hd_f2h 0x%04x\n", in[i], (unsigned)hd_f2u(in[i]), out[i], want);
+            if (!raw && bad < 5) printf("  hdk_f16_round: %.9g (0x%08x) stored 0x%04x, hdk_f2h 0x%04x\n", in[i], (unsigned)hdk_f2u(in[i]), out[i], want);
             ++bad;
         }
     }
@@ -328,19 +329,19 @@ static void check_f16_round(void)
         for (h = 0; h < 0x7c00u; ++h) {
             /* the midpoint of two neighbouring halves has 12 significant bits: exact in float;
                above the largest half (65504) the midpoint is 65520, where inf begins */
-            float v = hd_h2f((uint16_t)(sign | h)), mid = h < 0x7bffu ? 0.5f * (v + hd_h2f((uint16_t)(sign | (h + 1)))) : (s ? -65520.0f : 65520.0f);
+            float v = hdk_h2f((uint16_t)(sign | h)), mid = h < 0x7bffu ? 0.5f * (v + hdk_h2f((uint16_t)(sign | (h + 1)))) : (s ? -65520.0f : 65520.0f);
             in[n++] = v;
             in[n++] = mid;
-            in[n++] = hd_u2f(hd_f2u(mid) - 1u);
-            in[n++] = hd_u2f(hd_f2u(mid) + 1u);
+            in[n++] = hdk_u2f(hdk_f2u(mid) - 1u);
+            in[n++] = hdk_u2f(hdk_f2u(mid) + 1u);
         }
         in[n++] = s ? -1e30f : 1e30f;
-        in[n++] = hd_u2f(hd_f2u(1.0f / 0.0f) | ((uint32_t)s << 31));
+        in[n++] = hdk_u2f(hdk_f2u(1.0f / 0.0f) | ((uint32_t)s << 31));
     }
     bad = round_mismatches(in, n, 0);
     raw = round_mismatches(in, n, 1);
-    CHECK(bad == 0, "hd_f16_round + r16f imageStore: %d of %d values differ from hd_f2h", bad, n);
-    printf("float16 stores: hd_f16_round + r16f imageStore equal hd_f2h for %d of %d values; the raw store for %d (the driver's own conversion)\n",
+    CHECK(bad == 0, "hdk_f16_round + r16f imageStore: %d of %d values differ from hdk_f2h", bad, n);
+    printf("float16 stores: hdk_f16_round + r16f imageStore equal hdk_f2h for %d of %d values; the raw store for %d (the driver's own conversion)\n",
            n - bad, n, n - raw);
 }
 
