@@ -15,8 +15,9 @@ static float hd__raw_value(const hd_volume_desc *v, size_t i)
 static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
 {
     float lo = v->value_range[0], hi = v->value_range[1], scale = 1.0f / (hi - lo);
-    /* the width of a finite range may pass FLT_MAX ({-3e38, 3e38}): then in double */
-    int wide = !hd__finite(hi - lo);
+    /* the width of a finite range may pass FLT_MAX ({-3e38, 3e38}), or its inverse (a
+       denormal width): then in double */
+    int wide = !hd__finite(hi - lo) || !hd__finite(scale);
     double dscale = 1.0 / ((double)hi - (double)lo);
     size_t i, ncell;
     int d, x, y, z;

@@ -286,6 +286,44 @@ static void test_logger_after_destroy(void)
     CHECK(destroyed_logger_calls == 0);
 }
 
+/* Value ranges whose width or its inverse leaves float ({-2^127, 2^127}: the width overflows;
+   {0, 2^-140}, a denormal: its inverse overflows) map the voxels as an ordinary range does: the
+   same pattern of TF coordinates 0, 1/4, 1/2, 1 (exact in both) gives the image of range {0, 1}. */
+static void test_value_range_extremes(void)
+{
+    static float f[PN * PN * PN], t[PN * PN * PN];
+    static float ref[PW * PW * 4], img[PW * PW * 4];
+    static const float levels[4] = {0.0f, 0.25f, 0.5f, 1.0f};
+    const float big = ldexpf(1.0f, 127), tiny = ldexpf(1.0f, -140);
+    const float ranges[2][2] = {{-big, big}, {0.0f, tiny}};
+    hd_desc d;
+    hd_context c;
+    int i, k;
+    for (i = 0; i < PN * PN * PN; ++i) t[i] = levels[(i * 7 + i / 13) % 4];
+    param_desc(&d, HD_METHOD_HD);
+    d.volume.type = HD_VOXEL_F32;
+    d.volume.data = t;
+    CHECK(hd_create(&d, &c) == HD_SUCCESS && hd_iterate(c, 2) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(c, ref, PW * PW * 4) == HD_SUCCESS);
+    hd_destroy(c);
+    for (k = 0; k < 2; ++k) {
+        float nz = 0.0f;
+        /* lo + t (hi - lo), exactly: k 0 as -2^127 + 2 (t 2^127) (hi - lo overflows), k 1 as t 2^-140 */
+        for (i = 0; i < PN * PN * PN; ++i) f[i] = k == 0 ? (t[i] == 1.0f ? big : -big + (t[i] * big) * 2.0f) : t[i] * tiny;
+        param_desc(&d, HD_METHOD_HD);
+        d.volume.type = HD_VOXEL_F32;
+        d.volume.data = f;
+        d.volume.value_range[0] = ranges[k][0];
+        d.volume.value_range[1] = ranges[k][1];
+        CHECK(hd_create(&d, &c) == HD_SUCCESS && hd_iterate(c, 2) == HD_SUCCESS);
+        CHECK(hd_read_image_f32(c, img, PW * PW * 4) == HD_SUCCESS);
+        for (i = 0; i < PW * PW * 4; ++i) nz += img[i];
+        CHECK_MSG(nz > 0.0f && memcmp(img, ref, sizeof img) == 0, "value range {%g, %g}: the image differs from range {0, 1}'s",
+                  (double)ranges[k][0], (double)ranges[k][1]);
+        hd_destroy(c);
+    }
+}
+
 const hd_test_case hd_tests_params[] = {
     {"param_table_invalidation", test_param_table_invalidation},
     {"param_table_dependence", test_param_table_dependence},
@@ -293,5 +331,6 @@ const hd_test_case hd_tests_params[] = {
     {"param_codes", test_param_codes},
     {"handle_retirement", test_handle_retirement},
     {"logger_after_destroy", test_logger_after_destroy},
+    {"value_range_extremes", test_value_range_extremes},
 };
 const int hd_tests_params_count = sizeof hd_tests_params / sizeof hd_tests_params[0];
