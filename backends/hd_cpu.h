@@ -452,14 +452,20 @@ static int hd__cpu_row_variant(const hd__kctx *K)
 }
 
 /* HD__CPU_FLATTEN: every call inside inlined, so each variant's loop is one body the compiler
-   can vectorise (with both precisions GCC 12 stopped inlining the terms into half the loops) */
-#if defined(__GNUC__) || defined(__clang__)
+   can vectorise (with both precisions GCC 12 stopped inlining the terms into half the loops).
+   HYBRIDDIFF_FAST_COMPILE drops it and HD__CPU_INLINE's always_inline: each loop compiles once
+   with its flags at run time, the compile about half as long, the diffusion 3-5x slower
+   (docs/PERFORMANCE.md, "Compile time"). */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(HYBRIDDIFF_FAST_COMPILE)
 #define HD__CPU_INLINE static inline __attribute__((always_inline))
 #define HD__CPU_FLATTEN __attribute__((flatten))
-#define HD__CPU_NOINLINE __attribute__((noinline))
 #else
 #define HD__CPU_INLINE static inline
 #define HD__CPU_FLATTEN
+#endif
+#if defined(__GNUC__) || defined(__clang__)
+#define HD__CPU_NOINLINE __attribute__((noinline))
+#else
 #define HD__CPU_NOINLINE
 #endif
 
@@ -526,19 +532,23 @@ HD__CPU_INLINE float hd__cpu_nb_sigp(const hd__kctx *K, float st, float sc, int 
     return rgb != 0 ? hdk_diffuse_sigp_of(K, st, hdk_diffuse_albedo_of(K, sc, rgb)) : ag * st;
 }
 
-/* The interior voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into
-   out[id]: num / den, or with residual the residual num - den phi. rgb, rhs, surface and residual
-   are literals at every call (HD__CPU_COLOUR_SWITCH), so the loop has no test; so are the
-   in-grid flags iym, iyp, izm, izp of the y-1, y+1, z-1, z+1 rows (1) except in edge rows. */
+/* The voxels id = lo .. hi of one colour of a row (offsets o, x parity cp) into out[id]: num / den,
+   or with residual the residual num - den phi. rgb, rhs, surface and residual are literals at
+   every call (HD__CPU_COLOUR_SWITCH), so the loop has no test; so are the in-grid flags iym, iyp,
+   izm, izp of the y-1, y+1, z-1, z+1 rows (1) except in edge rows, and (ends 0) the x-1 and x+1
+   ones. ends 1: the x in-grid flags per voxel, for the row's end voxels; an outside neighbour's
+   loads then read the inside one's slot, whose value the kernels ignore (a slot past the
+   half-row may lie past the buffer or in a row another thread is writing). */
 HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o, int lo, int hi, int cp, float *out,
-                                        int rgb, int rhs, int surface, int residual, int iym, int iyp, int izm,
-                                        int izp)
+                                        int rgb, int rhs, int surface, int residual, int ends, int iym, int iyp,
+                                        int izm, int izp)
 {
     const float *sg = K->sig;
     const size_t *s = o->s, *a = o->a, *p = o->p;
-    int id;
+    int id, gx = K->p->gdims.x;
     for (id = lo; id <= hi; ++id) {
-        int xm = id - 1 + cp, xq = id + cp;
+        int x = 2 * id + cp, ixm = !ends || x > 0, ixp = !ends || x < gx - 1;
+        int xm = id - 1 + cp + !ixm, xq = id + cp - !ixp;
         float sp, dn, den, num;
         float st = sg[s[0] + id], al = hdk_diffuse_albedo_of(K, rgb != 0 ? sg[a[0] + id] : 0.0f, rgb);
         float ag = hdk_diffuse_ag(K, al);
@@ -549,46 +559,57 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
                                             HD__CPU_NB(2, id), HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                             HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                             HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
-                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, iym, iyp,
+                                            HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), ixm, ixp, iym, iyp,
                                             izm, izp, &den);
         else
             num = hdk_diffuse_box_of(K, num, dn, sp, HD__CPU_NB(1, xm), HD__CPU_NB(1, xq), HD__CPU_NB(2, id),
                                     HD__CPU_NB(3, id), HD__CPU_NB(4, id), HD__CPU_NB(5, id),
                                     HD__CPU_LD(phi, p[1] + xm), HD__CPU_LD(phi, p[1] + xq),
                                     HD__CPU_LD(phi, p[2] + id), HD__CPU_LD(phi, p[3] + id),
-                                    HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), 1, 1, iym, iyp, izm,
+                                    HD__CPU_LD(phi, p[4] + id), HD__CPU_LD(phi, p[5] + id), ixm, ixp, iym, iyp, izm,
                                     izp, &den);
 #undef HD__CPU_NB
         out[id] = residual ? num - den * HD__CPU_LD(phi, p[0] + id) : num / den;
     }
 }
 
-/* The row's end voxels x = 0 (if first) and x = gx - 1 (if last) of the colour with x parity x0
-   into out[x >> 1], through `terms` with literal in-grid flags, so they take no branch either
-   (through hdk_diffuse_terms' run-time flags they cost about 5 % of a red-black sweep); the y/z
-   flags iym .. izp as the loop's. */
-#define HD__CPU_ROW_ENDS(terms, rgb, rhs, residual, iym, iyp, izm, izp)                               \
-    do {                                                                                            \
-        float den_, num_;                                                                           \
-        if (x0 == 0) {                                                                              \
-            num_ = terms(K, 0, y, z, c, 0, 1, iym, iyp, izm, izp, rgb, rhs, &den_);                  \
-            out[0] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0]) : num_ / den_;               \
-        }                                                                                           \
-        if (((gx - 1 - x0) & 1) == 0) {                                                             \
-            num_ = terms(K, gx - 1, y, z, c, 1, 0, iym, iyp, izm, izp, rgb, rhs, &den_);             \
-            out[(gx - 1) >> 1] = (residual) ? num_ - den_ * HD__CPU_LD(phi, o.p[0] + ((gx - 1) >> 1)) \
-                                            : num_ / den_;                                          \
-        }                                                                                           \
-    } while (0)
-/* One case of the variant switch: the interior loop and the ends with rgb, rhs and the boundary
+/* Voxels id = lo .. hi of one colour of a row into out[id], as hd__cpu_colour_loop's, with every
+   flag at run time (the x in-grid flags per voxel): the row's end voxels and the variants no loop
+   is compiled for (HD__CPU_COLOUR_SWITCH). One out-of-line copy per storage precision, shared by
+   every variant: each variant's own inlined copies of its end voxels were most of the backend's
+   compile time (docs/PERFORMANCE.md, "Compile time"). */
+static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_voxels(const hd__kctx *K, const hd__cpu_rows *o, int x0, int lo,
+                                                            int hi, int residual, int iym, int iyp, int izm, int izp,
+                                                            float *out)
+{
+    int f = K->p->counts.z, rgb = (f & HD_FLAG_RGB_SCATTERING) != 0, rhs = (f & HD_FLAG_DIFFUSE_RHS) != 0;
+    int surface = (f & HD_FLAG_SURFACE_BOUNDARY) != 0;
+    hd__kctx k = *K;
+    if (k.f16) {
+        k.f16 = 1;
+        hd__cpu_colour_loop(&k, o, lo, hi, x0, out, rgb, rhs, surface, residual, 1, iym, iyp, izm, izp);
+    } else {
+        k.f16 = 0;
+        hd__cpu_colour_loop(&k, o, lo, hi, x0, out, rgb, rhs, surface, residual, 1, iym, iyp, izm, izp);
+    }
+}
+
+/* Whether variant v's loop (hd__cpu_row_variant: rgb | rhs << 1 | surface << 2) is compiled for the
+   pass (residual) and storage precision (K->f16), both literals where it is used: the combinations
+   the library runs. HD_FLAG_DIFFUSE_RHS comes only with the multigrid solver's levels, which are
+   float32 and the only grids the residual pass runs on; the others go through hd__cpu_voxels. */
+#define HD__CPU_VARIANT_BUILT(v, residual) (((v) & 2) != 0 ? !K->f16 : !(residual))
+/* One case of the variant switch: the interior voxels' loop with rgb, rhs and the boundary
    literal (and the y/z in-grid flags ym .. zp: literal 1s in interior rows). */
 #define HD__CPU_COLOUR_CASE(rgb, rhs, surface, residual, ym, yp, zm, zp)                             \
     do {                                                                                            \
-        hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual, ym, yp, \
-                            zm, zp);                                                                \
-        if (surface) HD__CPU_ROW_ENDS(hdk_diffuse_terms_surface, rgb, rhs, residual, ym, yp, zm, zp);  \
-        else HD__CPU_ROW_ENDS(hdk_diffuse_terms_box, rgb, rhs, residual, ym, yp, zm, zp);              \
+        if (HD__CPU_VARIANT_BUILT((rgb) | (rhs) << 1, residual))                                     \
+            hd__cpu_colour_loop(K, &o, 1 - x0, (gx - 2 - x0) >> 1, x0, out, rgb, rhs, surface, residual, 0, ym, yp, \
+                                zm, zp);                                                            \
+        else                                                                                        \
+            hd__cpu_voxels(K, &o, x0, 1 - x0, (gx - 2 - x0) >> 1, residual, ym, yp, zm, zp, out);      \
     } while (0)
+/* The switch, then the row's end voxels x = 0 (if of this colour) and x = gx - 1 (if so). */
 #define HD__CPU_COLOUR_SWITCH(residual, ym, yp, zm, zp)                                              \
     switch (hd__cpu_row_variant(K)) {                                                               \
     case 0: HD__CPU_COLOUR_CASE(0, 0, 0, residual, ym, yp, zm, zp); break;                         \
@@ -599,7 +620,10 @@ HD__CPU_INLINE void hd__cpu_colour_loop(const hd__kctx *K, const hd__cpu_rows *o
     case 5: HD__CPU_COLOUR_CASE(1, 0, 1, residual, ym, yp, zm, zp); break;                         \
     case 6: HD__CPU_COLOUR_CASE(0, 1, 1, residual, ym, yp, zm, zp); break;                         \
     default: HD__CPU_COLOUR_CASE(1, 1, 1, residual, ym, yp, zm, zp); break;                        \
-    }
+    }                                                                                               \
+    if (x0 == 0) hd__cpu_voxels(K, &o, x0, 0, 0, residual, ym, yp, zm, zp, out);                     \
+    if (((gx - 1 - x0) & 1) == 0)                                                                   \
+        hd__cpu_voxels(K, &o, x0, (gx - 1) >> 1, (gx - 1) >> 1, residual, ym, yp, zm, zp, out);
 
 /* Relaxes the voxels of x parity x0 of row (y, z) of channel c (3 <= gx) into phi (red-black: in
    place, the colour reads only the other one) or phi2 (Jacobi): computed into a local half-row,
@@ -652,11 +676,18 @@ static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_diffuse_edge_row(hd__backen
     HD__CPU_ROW_ON_COPY(y > 0, y < gy - 1, z > 0, z < gz - 1);
 }
 
+/* The per-voxel sweep of a row under 3 voxels, out of line: the flattened row function would
+   otherwise carry an inlined copy of it. */
+static HD__CPU_NOINLINE void hd__cpu_diffuse_row_short(const hd__kctx *K, int y, int z, int c, int parity, int jacobi)
+{
+    hdk_diffuse_row(K, y, z, c, parity, jacobi);
+}
+
 static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c, int parity)
 {
     const hd__kparams *p = be->grid->k->p;
     if (p->gdims.x < 3) {
-        hdk_diffuse_row(be->grid->k, y, z, c, parity, be->jacobi);
+        hd__cpu_diffuse_row_short(be->grid->k, y, z, c, parity, be->jacobi);
         return;
     }
     if (hd__cpu_edge_row(p, y, z)) {
@@ -896,20 +927,28 @@ static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_residual_edge_row(hd__backe
     hd__cpu_residual_halves(be, y, z, c, y > 0, y < gy - 1, z > 0, z < gz - 1);
 }
 
+/* The per-voxel residual of row (y, z) of channel c, out of line as hd__cpu_diffuse_row_short. */
+static HD__CPU_NOINLINE void hd__cpu_residual_voxels(hd__backend *be, int y, int z, int c)
+{
+    const hd__kctx *K = be->grid->k;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    float rhs;
+    for (x = 0; x < gx; ++x)
+        be->grid->res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hdk_diffuse_residual(K, x, y, z, c, &rhs);
+}
+
 /* Row r = (c * gz + z) * gy + y. The per-voxel path (hdk_diffuse_residual) where the loop does not
    apply: rows under 3 voxels, and edge rows under the surface boundary without rhs, whose empty
    voxels hdk_diffuse_residual gives residual 0 (the V-cycle's grids all solve with rhs). */
 static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
 {
     const hd__kctx *K = be->grid->k;
-    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z, x;
+    int gx = K->p->gdims.x, gy = K->p->gdims.y, gz = K->p->gdims.z;
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
     int edge = hd__cpu_edge_row(K->p, y, z);
     int f = K->p->counts.z & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
     if (gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
-        float rhs;
-        for (x = 0; x < gx; ++x)
-            be->grid->res[hd__split_slot(gx, gy, x, y, z + c * gz)] = hdk_diffuse_residual(K, x, y, z, c, &rhs);
+        hd__cpu_residual_voxels(be, y, z, c);
     } else if (edge) {
         hd__cpu_residual_edge_row(be, y, z, c);
     } else {
