@@ -75,6 +75,7 @@ help:
 	@echo "  make eval-paper                     the evaluation at the paper's scale (out/eval-paper)"
 	@echo "  make eval-multigrid                 the multigrid study: PSNR against PT_MS over time (docs/eval/multigrid/)"
 	@echo "  make bench-energy                   HD's mean radiance and PSNR against PT_MS per scene (docs/DESIGN-ENERGY.md)"
+	@echo "  make compile-time                   CPU seconds to compile each backend's implementation against stb_image.h"
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)
 
