@@ -453,15 +453,22 @@ static int hd__cpu_row_variant(const hd__kctx *K)
 
 /* HD__CPU_FLATTEN: every call inside inlined, so each variant's loop is one body the compiler
    can vectorise (with both precisions GCC 12 stopped inlining the terms into half the loops).
-   HYBRIDDIFF_FAST_COMPILE drops it and HD__CPU_INLINE's always_inline: each loop compiles once
-   with its flags at run time, the compile about half as long, the diffusion 3-5x slower
-   (docs/PERFORMANCE.md, "Compile time"). */
+   HYBRIDDIFF_FAST_COMPILE (the user's, before the implementation) drops it and HD__CPU_INLINE's
+   always_inline, and (HD__CPU_ROW_LOOPS 0) relaxes every row through the kernels' per-voxel path
+   (hdk_diffuse_row, hdk_diffuse_residual): the same bits, the implementation compiled in half
+   the time (1.4-1.5x stb_image.h's at -O2), the diffusion 5-10x slower (docs/PERFORMANCE.md,
+   "Compile time"). */
 #if (defined(__GNUC__) || defined(__clang__)) && !defined(HYBRIDDIFF_FAST_COMPILE)
 #define HD__CPU_INLINE static inline __attribute__((always_inline))
 #define HD__CPU_FLATTEN __attribute__((flatten))
 #else
 #define HD__CPU_INLINE static inline
 #define HD__CPU_FLATTEN
+#endif
+#ifdef HYBRIDDIFF_FAST_COMPILE
+#define HD__CPU_ROW_LOOPS 0
+#else
+#define HD__CPU_ROW_LOOPS 1
 #endif
 #if defined(__GNUC__) || defined(__clang__)
 #define HD__CPU_NOINLINE __attribute__((noinline))
@@ -676,8 +683,8 @@ static HD__CPU_NOINLINE HD__CPU_FLATTEN void hd__cpu_diffuse_edge_row(hd__backen
     HD__CPU_ROW_ON_COPY(y > 0, y < gy - 1, z > 0, z < gz - 1);
 }
 
-/* The per-voxel sweep of a row under 3 voxels, out of line: the flattened row function would
-   otherwise carry an inlined copy of it. */
+/* The per-voxel sweep of a row under 3 voxels (of every row without HD__CPU_ROW_LOOPS), out of
+   line: the flattened row function would otherwise carry an inlined copy of it. */
 static HD__CPU_NOINLINE void hd__cpu_diffuse_row_short(const hd__kctx *K, int y, int z, int c, int parity, int jacobi)
 {
     hdk_diffuse_row(K, y, z, c, parity, jacobi);
@@ -686,7 +693,7 @@ static HD__CPU_NOINLINE void hd__cpu_diffuse_row_short(const hd__kctx *K, int y,
 static HD__CPU_FLATTEN void hd__cpu_diffuse_row_at(hd__backend *be, int y, int z, int c, int parity)
 {
     const hd__kparams *p = be->grid->k->p;
-    if (p->gdims.x < 3) {
+    if (!HD__CPU_ROW_LOOPS || p->gdims.x < 3) {
         hd__cpu_diffuse_row_short(be->grid->k, y, z, c, parity, be->jacobi);
         return;
     }
@@ -938,7 +945,7 @@ static HD__CPU_NOINLINE void hd__cpu_residual_voxels(hd__backend *be, int y, int
 }
 
 /* Row r = (c * gz + z) * gy + y. The per-voxel path (hdk_diffuse_residual) where the loop does not
-   apply: rows under 3 voxels, and edge rows under the surface boundary without rhs, whose empty
+   apply (or without HD__CPU_ROW_LOOPS): rows under 3 voxels, and edge rows under the surface boundary without rhs, whose empty
    voxels hdk_diffuse_residual gives residual 0 (the V-cycle's grids all solve with rhs). */
 static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
 {
@@ -947,7 +954,7 @@ static HD__CPU_FLATTEN void hd__cpu_residual_row(hd__backend *be, int r)
     int y = r % gy, z = (r / gy) % gz, c = r / (gy * gz);
     int edge = hd__cpu_edge_row(K->p, y, z);
     int f = K->p->counts.z & (HD_FLAG_SURFACE_BOUNDARY | HD_FLAG_DIFFUSE_RHS);
-    if (gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
+    if (!HD__CPU_ROW_LOOPS || gx < 3 || (edge && f == HD_FLAG_SURFACE_BOUNDARY)) {
         hd__cpu_residual_voxels(be, y, z, c);
     } else if (edge) {
         hd__cpu_residual_edge_row(be, y, z, c);
