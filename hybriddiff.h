@@ -41,6 +41,9 @@
       HYBRIDDIFF_STATIC          make every function static (private to one translation unit)
       HYBRIDDIFF_NO_ZLIB         build the file loaders without zlib (gzip-encoded files are then
                                  rejected with HD_ERROR_UNSUPPORTED_ENCODING); otherwise link -lz
+      HYBRIDDIFF_FAST_COMPILE    CPU backend: compile the implementation in about half the time
+                                 (no per-flag copies of the diffusion's row loops), the same
+                                 images, the diffusion 5-10x slower (docs/PERFORMANCE.md)
       HD_MAX_CONTEXTS            live contexts per process (default 64)
 
    Conventions (docs/METHOD.md has the method)
