@@ -388,8 +388,8 @@ static void hd__cpu_direct_chunk(hd__backend *be, int item)
    per-voxel path made those few rows a large share of a sweep; the colour layout spares the
    permutes a stride-2 loop over an x-fastest layout needs for every load (docs/DESIGN-CPU.md
    has both measurements, bench/hdbench_rb_schedule.c reproduces them). The two end
-   voxels go through hdk_diffuse_terms_box / _surface with literal in-grid flags (the x-1 or x+1
-   neighbour lies outside the row). */
+   voxels (the x-1 or x+1 neighbour lies outside the row) go through hd__cpu_voxels, the same loop
+   body with every flag at run time, one out-of-line copy per precision. */
 #define HD__CPU_ROW_MAX 8192
 
 /* A grid the diffusion passes work on. */
