@@ -49,6 +49,8 @@
    Conventions (docs/METHOD.md has the method)
       - The volume fills a box centred on the origin whose largest side has length 1; the other
         sides follow dims * spacing. Voxel centres sit at (i + 0.5) / n in texture space.
+        volume.transform (hd_set_volume_transform) places that box in the world; the camera,
+        the lights, the depth buffer and extinction (per unit length) are in world units.
       - sigma_t(x) = TF_alpha(v(x)) * extinction, sigma_s = albedo * sigma_t; v(x) is the trilinear
         interpolation of the normalised voxel values, the TF is sampled after interpolation.
       - One HD iteration = one direct-light sample per voxel + the diffusion sweeps + one frame.
@@ -133,7 +135,12 @@ extern "C" {
     X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
     X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes") \
     X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current") \
-    X(HD_ERROR_INVALID_TEXTURE, "GL backend: the texture is not a GL_RGBA8 2D texture of the camera's size")
+    X(HD_ERROR_INVALID_TEXTURE, "GL backend: the texture is not a GL_RGBA8 2D texture of the camera's size") \
+    X(HD_ERROR_INVALID_TRANSFORM, "the volume transform is non-finite, singular, not affine or out of range") \
+    X(HD_ERROR_TRANSFORM_SHEAR, "the volume transform shears (its columns are not orthogonal): the grid cannot follow it") \
+    X(HD_ERROR_DEPTH_SIZE, "the depth buffer's size is not the camera's") \
+    X(HD_ERROR_INVALID_DEPTH, "a depth value is NaN, infinite or outside [0, 1]") \
+    X(HD_ERROR_DEPTH_NEEDS_PROJECTION, "depth needs a camera given by its projection matrix")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -232,6 +239,7 @@ typedef enum hd_illumination {
 #define HD_LIGHT_INIT HD_ZERO_INIT
 #define HD_CAMERA_INIT HD_ZERO_INIT
 #define HD_LOAD_OPTIONS_INIT HD_ZERO_INIT
+#define HD_DEPTH_DESC_INIT HD_ZERO_INIT
 
 /* ---- callbacks ------------------------------------------------------------------------------ */
 /* Silent unless a logger is given. hd_log_stderr is a ready one. */
@@ -262,8 +270,10 @@ typedef struct hd_allocator {
    - the volume's extent (dims * spacing) over its smallest spacing, per axis pair, is at most
      HD_MAX_SPACING_RATIO, so a voxel spans enough float steps of the box for the march;
    - the sum over the lights of intensity * max(colour) is at most HD_MAX_LIGHT_POWER;
-   - point-light positions and camera eye/target components are at most HD_MAX_LIGHT_DISTANCE
-     and HD_MAX_CAMERA_DISTANCE in magnitude (world units: the box's largest side is 1). */
+   - point-light positions and camera eye/target components (a matrix camera's ray origins) are
+     at most HD_MAX_LIGHT_DISTANCE world units and HD_MAX_CAMERA_DISTANCE times the volume's
+     largest world side in magnitude, measured from the volume's centre along its own axes
+     (volume.transform; with the default transform the world's, and the largest side is 1). */
 /* Loop bounds, the same on every backend (backends/kernels/hd_k_common.h): one transmittance or
    free-flight walk ends after 2^16 collisions and majorant cells with transmittance 0 (reached
    only with an extinction or majorant above about 3.8e4 per world unit); one projection ray after 2^24 samples (a valid one needs at most
@@ -282,6 +292,16 @@ typedef struct hd_volume_desc {
     const void *data;     /* dims[0]*dims[1]*dims[2] voxels; copied by hd_create */
     float value_range[2]; /* raw value mapped to TF coordinate 0 and 1; {0,0} -> {0,255} for U8,
                              {0,65535} for U16, {0,1} for F32. Values outside are clamped. */
+    float transform[16];  /* volume to world, a 4x4 affine matrix, column-major (element row r,
+                             column c at [c * 4 + r]), applied to the box above (centred at 0,
+                             largest side 1); all zero: the identity (the box as it is). Per-axis
+                             scale, rotation, reflection and translation: its first three columns
+                             must be orthogonal (a shear cannot be followed by the axis-aligned
+                             illumination grid: HD_ERROR_TRANSFORM_SHEAR), each of length in
+                             [1e-6, 1e6], translation within +-HD_MAX_LIGHT_DISTANCE, last row
+                             (0, 0, 0, 1) (else HD_ERROR_INVALID_TRANSFORM). Lengths in world
+                             units follow it: extinction is per world unit, 1/r^2 in world units.
+                             hd_set_volume_transform changes it. */
 } hd_volume_desc;
 
 /* RGBA entries placed at TF coordinates i/(count-1), linearly interpolated.
@@ -295,7 +315,8 @@ typedef struct hd_light {
     hd_light_type type;
     float direction[3]; /* DIRECTIONAL: the direction the light travels in (need not be unit;
                            any nonzero finite vector) */
-    float position[3];  /* POINT: position in world space (the volume box is centred at 0),
+    float position[3];  /* POINT: position in world space (the volume box is centred at 0
+                           unless volume.transform moves it),
                            components within +-HD_MAX_LIGHT_DISTANCE */
     float color[3];     /* linear RGB, >= 0; {0,0,0} -> {1,1,1} */
     float intensity;    /* >= 0; 0 -> 1. Over all lights, sum of intensity * max(color) <=
@@ -303,6 +324,29 @@ typedef struct hd_light {
     int inverse_square; /* POINT: 1 = intensity / r^2 falloff (r in world units), 0 = none */
 } hd_light;
 
+/* How a projection's NDC z maps to the depth buffer's values (hd_set_depth) and which end is
+   near: the convention the host renders its scene with. */
+typedef enum hd_depth_range {
+    HD_DEPTH_NEG_ONE_TO_ONE = 0, /* GL's default: NDC z in [-1, 1], near at -1; depth = (z + 1) / 2 */
+    HD_DEPTH_ZERO_TO_ONE,        /* D3D, Vulkan, Metal (GL with glClipControl): NDC z = depth in
+                                    [0, 1], near at 0 */
+    HD_DEPTH_REVERSED,           /* zero-to-one with near at 1 and far at 0 (reversed-Z; an
+                                    infinite far plane is allowed) */
+    HD_DEPTH_RANGE_COUNT
+} hd_depth_range;
+
+/* A look-at camera (eye, target, up, fov_y), or the host's own matrices: when projection is not
+   all zero, view and projection define the camera and eye, target, up and fov_y are ignored.
+   Matrices are column-major (element row r, column c at [c * 4 + r]), the GL convention
+   (clip = projection * view * world, a column vector on the right): view maps world to eye
+   space (all zero: identity), projection eye to clip space. A perspective projection has the
+   last row (0, 0, a, 0), a != 0 (any frustum: off-centre, jittered, left- or right-handed, an
+   infinite far plane), an orthographic one (0, 0, 0, b), b != 0; view's last row is
+   (0, 0, 0, 1). Anything else, a non-finite or singular projection * view: HD_ERROR_INVALID_CAMERA.
+   Pixel (px, py) of the image (top row first) sees the ray through NDC
+   x = 2 (px + 0.5) / width - 1, y = 1 - 2 (py + 0.5) / height (jittered within the pixel), from
+   the eye (perspective; medium between the eye and the near plane is drawn as with the look-at
+   camera) or from the near plane (orthographic). */
 typedef struct hd_camera {
     float eye[3];    /* {0,0,0} together with target {0,0,0} -> eye {0,0,2.5}; eye and target
                         components within +-HD_MAX_CAMERA_DISTANCE */
@@ -311,7 +355,19 @@ typedef struct hd_camera {
     float fov_y;     /* vertical field of view in degrees, 0 -> 40; must be in (0, 180) */
     int width;       /* image size, 0 -> 512 */
     int height;      /* 0 -> 512 */
+    float view[16];       /* world -> eye, column-major; all zero: identity (with a projection) */
+    float projection[16]; /* eye -> clip, column-major; all zero: the look-at camera above */
+    hd_depth_range depth_range; /* the projection's NDC z convention (hd_set_depth) */
 } hd_camera;
+
+/* The host's depth buffer (hd_set_depth): width x height floats, rows top first (the image's
+   order; a GL depth buffer read with glReadPixels is bottom first), each the window depth in
+   [0, 1] the host's projection wrote under camera.depth_range (1, or 0 when reversed: nothing
+   there). */
+typedef struct hd_depth_desc {
+    const float *data; /* NULL: no depth */
+    int width, height; /* the camera's */
+} hd_depth_desc;
 
 typedef struct hd_params {
     hd_method method;
@@ -493,7 +549,9 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      lights, seed                              -> E, phi, image
      albedo, anisotropy, disable_diffusion,
      diffusion_boundary                        -> phi, image
-     camera, step, background, frame_window    -> image only (E and phi are kept)
+     volume transform                          -> E, phi, image
+     camera, depth, step, background,
+     frame_window                              -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering,
      illumination_precision                    -> E, phi, image (new grids)
@@ -507,6 +565,25 @@ HDDEF hd_result hd_set_transfer_function(hd_context ctx, const hd_transfer_funct
 HDDEF hd_result hd_set_lights(hd_context ctx, const hd_light *lights, int count);
 HDDEF hd_result hd_set_camera(hd_context ctx, const hd_camera *camera);
 HDDEF hd_result hd_set_params(hd_context ctx, const hd_params *params);
+
+/* The volume-to-world transform (hd_volume_desc.transform; NULL: the identity), checked as there.
+   Invalidates E, phi and the image (the lights' directions change in the volume's frame). The
+   current camera and lights must stay within their limits under it (HD_ERROR_INVALID_CAMERA,
+   HD_ERROR_INVALID_LIGHT), else nothing changes. */
+HDDEF hd_result hd_set_volume_transform(hd_context ctx, const float transform[16]);
+
+/* The host scene's depth (hd_depth_desc; NULL or data NULL: none), copied at the call and used
+   by every later frame until replaced or cleared: each camera ray (and each path's first free
+   flight) ends where it meets the scene's surface, so what stands in front of the volume hides
+   it and what stands inside cuts it; where there is geometry (a value other than the far
+   plane's) the background is not added. The depth belongs to a matrix camera's projection
+   (camera.projection, HD_ERROR_DEPTH_NEEDS_PROJECTION otherwise) and its size: a camera set
+   with another width or height, or a look-at camera, drops it (logged). A reduced frame
+   (params.render_scale) reads each ray's nearest full-resolution pixel. Errors:
+   HD_ERROR_DEPTH_SIZE (width x height not the camera's), HD_ERROR_NULL_POINTER (NULL data with
+   a nonzero size), HD_ERROR_INVALID_DEPTH (a NaN, infinite or out-of-[0, 1] value); each logs
+   one line and changes nothing. Invalidates the image only (the light is kept). */
+HDDEF hd_result hd_set_depth(hd_context ctx, const hd_depth_desc *depth);
 
 /* Runs n >= 1 iterations of the current method, each refining the light (HD, CD) and projecting
    one frame; it refines even light that has converged (hd_stats.light_converged). */

@@ -253,6 +253,13 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* The projection and the path tracers read the core's copy of the host's depth in place. */
+static hd_result hd__be_upload_depth(const hd__view *vw)
+{
+    vw->be->k.dep = vw->depth;
+    return HD_SUCCESS;
+}
+
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */

@@ -9,7 +9,7 @@
     __global float *restrict img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img; k.lsum = 0; k.ptab = 0; k.ptab_n = 0; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
+    k.phi2 = phi2; k.img = img; k.lsum = 0; k.ptab = 0; k.ptab_n = 0; k.dep = 0; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
     k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0; \
     k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
@@ -121,10 +121,12 @@ __kernel void hd_k_convect(HD__CL_BUFFERS, __global const float *lv, __global fl
 HD__CL_SUM_LIGHT(hd_k_sum_light, 0)
 HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
 
-/* PT_SS / PT_MS: one path per pixel (x, y). */
-__kernel void hd_k_path(HD__CL_BUFFERS)
+/* PT_SS / PT_MS: one path per pixel (x, y); dep: the host's depth buffer (a placeholder while
+   depth_dims.z is 0). */
+__kernel void hd_k_path(HD__CL_BUFFERS, __global const float *restrict dep)
 {
     HD__CL_KCTX;
+    k.dep = dep;
     hdk_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
 
@@ -329,15 +331,17 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
 #ifdef HD_CL_PROJECTION_PROGRAM
 /* One work-item per pixel (x, y); the global size is rounded up to whole work-groups
    (hd__be_project), so items past the image's width or height do nothing. lsum and the table
-   (ptab_n entries) as hd_k_project.h reads them. With HD_FLAG_UPSAMPLE the same kernel runs a
-   reduced frame's upsample pass (hd_k_upsample.h). */
+   (ptab_n entries) as hd_k_project.h reads them, dep the host's depth buffer (a placeholder while
+   depth_dims.z is 0). With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass
+   (hd_k_upsample.h). */
 #define HD__CL_PROJECT(name, is16) \
-    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n) \
+    __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n, \
+                       __global const float *restrict dep) \
     { \
         int px = (int)get_global_id(0), py = (int)get_global_id(1); \
         HD__CL_KCTX; \
         k.f16 = (is16); \
-        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; \
+        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; k.dep = dep; \
         if (px >= p->image.x || py >= p->image.y) return; \
         if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
             hdk_upsample_pixel(&k, px, py); \

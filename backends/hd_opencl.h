@@ -81,6 +81,9 @@ struct hd__backend {
     /* kernel arguments 0..8, in the order of HD__CL_BUFFERS in hd_entry_cl.h */
     cl_mem params, vol, tf, maj, sig, E, phi, phi2, img;
     cl_mem dl;               /* the direct light's list of voxels (vw->dl_idx), direct kernels' argument 9 */
+    cl_mem dep;              /* the host's depth buffer (vw->depth; a placeholder without one): the
+                                projection's argument 12, the path kernel's 9 */
+    size_t dep_floats;       /* what dep holds (0: the placeholder) */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
        gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (ptab_n
@@ -384,7 +387,7 @@ static void hd__be_destroy(hd__view *vw)
     if (be->queue) clFinish(be->queue);
     hd__gpu_free(vw, &be->gg);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf); hd__cl_release(&be->maj);
-    hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab);
+    hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab); hd__cl_release(&be->dep);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
@@ -615,6 +618,23 @@ static hd_result hd__be_classify(const hd__view *vw)
     return hd__cl_bind_run(vw, HD__CL_CLASSIFY, 3, (size_t)vw->gdims[0], (size_t)vw->gdims[1], (size_t)vw->gdims[2]);
 }
 
+/* The host's depth buffer into dep (made again when its size changes; a 16-byte placeholder
+   without one), written blocking: the core's copy may change before the next call. */
+static hd_result hd__be_upload_depth(const hd__view *vw)
+{
+    hd__backend *be = vw->be;
+    size_t n = vw->depth ? (size_t)vw->depth_w * vw->depth_h : 0;
+    hd_result r;
+    if (!be->dep || n != be->dep_floats) {
+        hd__cl_release(&be->dep);
+        be->dep_floats = 0;
+        if ((r = hd__cl_buffer(vw, &be->dep, n * sizeof(float), NULL, "the depth buffer")) != HD_SUCCESS) return r;
+        be->dep_floats = n;
+    }
+    if (n) HD__CL_TRY(vw, clEnqueueWriteBuffer(be->queue, be->dep, CL_TRUE, 0, n * sizeof(float), vw->depth, 0, NULL, NULL), "clEnqueueWriteBuffer(depth)");
+    return HD_SUCCESS;
+}
+
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {
@@ -701,7 +721,8 @@ static hd_result hd__be_project(const hd__view *vw)
     gy = ((size_t)vw->kp.image.y + local[1] - 1) / local[1] * local[1];
     n = be->ptab_n;
     HD__CL_ARG(vw, k, 11, n);
-    if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_bind(vw, k)) != HD_SUCCESS ||
+    if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 12, 1, be->dep)) != HD_SUCCESS ||
+        (r = hd__cl_bind(vw, k)) != HD_SUCCESS ||
         (r = hd__cl_run_local(vw, k, 2, gx, gy, 1, local)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);
@@ -839,7 +860,8 @@ static hd_result hd__be_sum_lights(const hd__view *vw)
 /* One path per pixel, folded into the image with weight march.y. */
 static hd_result hd__be_path(const hd__view *vw)
 {
-    hd_result r = hd__cl_bind_run(vw, HD__CL_PATH, 2, (size_t)vw->kp.image.x, (size_t)vw->kp.image.y, 1);
+    hd_result r = hd__cl_mems(vw, HD__CL_PATH, 9, 1, vw->be->dep);
+    if (r == HD_SUCCESS) r = hd__cl_bind_run(vw, HD__CL_PATH, 2, (size_t)vw->kp.image.x, (size_t)vw->kp.image.y, 1);
     return r != HD_SUCCESS ? r : hd__cl_finish(vw);
 }
 

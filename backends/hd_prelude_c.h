@@ -157,6 +157,7 @@ typedef struct hd__kctx {
     float *lsum;       /* projection: E + phi summed, x-fastest channel-planar (NULL: read both) */
     const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries (NULL: TF and exp) */
     int ptab_n;
+    const float *dep;  /* the host's depth buffer, depth_dims.x * y window depths (hd_set_depth) */
     const float *lv;   /* CD: the light volume being read (one light's rho) */
     float *lv2;        /* CD: the light volume being written (ping-pong) */
 } hd__kctx;

@@ -49,6 +49,7 @@ static void hd__ctx_free(hd__ctx *ctx)
     hd__free(&ctx->vw, ctx->vw.majorant);
     hd__free(&ctx->vw, ctx->vw.tf);
     hd__free(&ctx->vw, ctx->srgb);
+    hd__free(&ctx->vw, ctx->vw.depth);
     hd__free(&ctx->vw, ctx);
 }
 
@@ -59,6 +60,9 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     hd__ctx *ctx;
     hd_result r;
     hd_light default_light;
+    hd__xform xf;
+    hd__camframe cf;
+    float box[3], kbox[3];
     if (!desc) return HD_ERROR_NULL_POINTER; /* no logger to tell */
     log = &desc->logger;
     if (!out_ctx) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_create: out_ctx is NULL");
@@ -73,8 +77,13 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     default_light.direction[2] = -1.0f;
     if (!d.lights && d.light_count == 0) { d.lights = &default_light; d.light_count = 1; }
     if ((r = hd__check_lights(d.lights, d.light_count, log)) != HD_SUCCESS) return r;
+    hd__volume_box(&d.volume, box);
+    if ((r = hd__xform_make(d.volume.transform, box, d.volume.dims, &xf, log)) != HD_SUCCESS) return r;
+    hd__xform_box(&xf, box, kbox);
+    if ((r = hd__check_lights_frame(d.lights, d.light_count, &xf, log)) != HD_SUCCESS) return r;
     hd__camera_defaults(&d.camera);
     if ((r = hd__check_camera(&d.camera, log)) != HD_SUCCESS) return r;
+    if ((r = hd__camera_frame(&d.camera, &xf, kbox, &cf, log)) != HD_SUCCESS) return r;
     hd__params_defaults(&d.params);
     if ((r = hd__check_params(&d.params, log)) != HD_SUCCESS) return r;
     if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
@@ -93,9 +102,12 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     ctx->vw.camera = d.camera;
     ctx->vw.params = d.params;
     ctx->vw.desc.volume.data = NULL; /* the caller's buffer is not kept */
+    ctx->xf = xf;
+    ctx->cf = cf;
     hd__set_lights(ctx, d.lights, d.light_count);
     if ((r = hd__set_tf(ctx, &d.transfer_function)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
     if ((r = hd__prepare_volume(ctx, &d.volume)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    hd__xform_box(&ctx->xf, ctx->box, ctx->kbox);
     hd__build_majorants(ctx);
     if ((r = hd__check_majorant(ctx, &ctx->vw.params)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
     hd__set_grid(ctx);
@@ -156,6 +168,7 @@ HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
     int channels_before;
     HD__GET_CTX(ctx, h);
     if ((r = hd__check_lights(lights, count, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_lights_frame(lights, count, &ctx->xf, &ctx->vw.log)) != HD_SUCCESS) return r;
     channels_before = ctx->vw.channels;
     hd__set_lights(ctx, lights, count);
     ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
@@ -166,15 +179,78 @@ HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
 HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
 {
     hd_camera c;
+    hd__camframe cf;
     hd_result r;
+    int resized;
     HD__GET_CTX(ctx, h);
     if (!camera) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_camera: camera is NULL");
     c = *camera;
     hd__camera_defaults(&c);
     if ((r = hd__check_camera(&c, &ctx->vw.log)) != HD_SUCCESS) return r;
-    if (c.width != ctx->vw.camera.width || c.height != ctx->vw.camera.height) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
+    if ((r = hd__camera_frame(&c, &ctx->xf, ctx->kbox, &cf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    resized = c.width != ctx->vw.camera.width || c.height != ctx->vw.camera.height;
+    if (resized) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
+    /* the depth belongs to a matrix camera of its size */
+    if (ctx->vw.depth && (resized || !cf.matrix)) {
+        HD__INFO(&ctx->vw.log, "hd_set_camera: the depth buffer (%dx%d) is dropped: the camera is %s", ctx->vw.depth_w, ctx->vw.depth_h,
+                 resized ? "resized" : "a look-at camera");
+        hd__free(&ctx->vw, ctx->vw.depth);
+        ctx->vw.depth = NULL;
+        ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        ctx->dirty |= HD__DIRTY_DEPTH;
+    }
     ctx->vw.camera = c;
+    ctx->cf = cf;
     ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_volume_transform(hd_context h, const float transform[16])
+{
+    hd__xform xf;
+    hd__camframe cf;
+    float kbox[3];
+    hd_result r;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__xform_make(transform, ctx->box, ctx->vw.dims, &xf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    hd__xform_box(&xf, ctx->box, kbox);
+    if ((r = hd__check_lights_frame(ctx->lights, ctx->light_count, &xf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__camera_frame(&ctx->vw.camera, &xf, kbox, &cf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    ctx->xf = xf;
+    ctx->cf = cf;
+    memcpy(ctx->kbox, kbox, sizeof kbox);
+    if (transform) memcpy(ctx->vw.desc.volume.transform, transform, sizeof ctx->vw.desc.volume.transform);
+    else memset(ctx->vw.desc.volume.transform, 0, sizeof ctx->vw.desc.volume.transform);
+    ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
+{
+    hd_result r;
+    size_t n;
+    float *buf;
+    HD__GET_CTX(ctx, h);
+    if (!depth || (!depth->data && depth->width == 0 && depth->height == 0)) {
+        if (ctx->vw.depth) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
+        hd__free(&ctx->vw, ctx->vw.depth);
+        ctx->vw.depth = NULL;
+        ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        return HD_SUCCESS;
+    }
+    if (!depth->data)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_depth: data is NULL with a size of %dx%d", depth->width, depth->height);
+    if ((r = hd__check_depth(depth, &ctx->vw.camera, &ctx->cf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    n = (size_t)depth->width * (size_t)depth->height;
+    buf = ctx->vw.depth_w == depth->width && ctx->vw.depth_h == depth->height ? ctx->vw.depth : NULL;
+    if (!buf && !(buf = (float *)hd__alloc(&ctx->vw, n * sizeof(float))))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_set_depth: cannot allocate %dx%d depth values", depth->width, depth->height);
+    memcpy(buf, depth->data, n * sizeof(float));
+    if (buf != ctx->vw.depth) hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = buf;
+    ctx->vw.depth_w = depth->width;
+    ctx->vw.depth_h = depth->height;
+    ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
 

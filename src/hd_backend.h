@@ -76,6 +76,10 @@ HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduc
 }
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
+/* The host's depth buffer changed (hd_set_depth): vw->depth, vw->depth_w x depth_h floats, or
+   NULL (free what the backend holds). The projection and the path tracers read it as hdk_depth_t
+   (hd_k_project.h) does, through their buffer `dep`, while vw->kp.depth_dims.z is 1. */
+static hd_result hd__be_upload_depth(const hd__view *vw);
 /* Zeroes what the HD__DIRTY_* bits in what name: DIRECT (E and CD's light volumes), PHI (phi,
    phi2), IMAGE (the image). */
 static hd_result hd__be_clear(const hd__view *vw, unsigned what);

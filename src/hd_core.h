@@ -6,6 +6,7 @@
      hd_validate.h     checks of the volume, TF, lights and camera, and their defaults
      hd_params.h       hd_params as one table: defaults, checks, what each field invalidates
      hd_volume.h       the volume, majorants, TF and lights (the inputs the backend uploads)
+     hd_scene.h        the volume transform, the camera's rays in the volume's frame, depth
      hd_kparams.h      the kernels' parameter block packed from the context
      hd_multigrid.h    HD_SOLVER_MULTIGRID's driver over the backend's level primitives
      hd_direct_mask.h  where the direct light is tracked
@@ -67,10 +68,30 @@ typedef struct hd__dl {
     int all;                 /* track every voxel (a test hook: the reference for the mask) */
 } hd__dl;
 
+/* The volume-to-world transform, decomposed (src/hd_scene.h). */
+typedef struct hd__xform {
+    int identity;   /* all zero or the identity: every map below is skipped (exactly today's box) */
+    double q[3][3]; /* q[r][c]: row r of the box's unit axis c in the world */
+    double t[3];    /* the box's centre in the world */
+    double s[3];    /* world length of the box's unit along each axis */
+} hd__xform;
+
+/* What hdk_camera_ray and hdk_depth_t read (hd_k_params.h's cam_* and depth_* slots). */
+typedef struct hd__camframe {
+    int matrix;      /* 1: from the host's matrices (depth may be given) */
+    float pos[3], ou[3], ov[3], u[3], v[3], w[3];
+    float dm[16];    /* the inverse of projection * view into the volume's frame, row-major */
+    float depth_z[3]; /* NDC z = [0] * depth + [1]; [2]: the far plane's depth */
+} hd__camframe;
+
 typedef struct hd__ctx {
     hd__view vw;             /* what the backend sees (src/hd_internal.h) */
     /* volume */
-    float box[3];            /* world size of the volume box */
+    float box[3];            /* size of the volume box (largest side 1) */
+    float kbox[3];           /* its world extents along its own axes: box scaled by the transform
+                                (src/hd_scene.h; the kernels' box) */
+    hd__xform xf;            /* the volume-to-world transform, decomposed */
+    hd__camframe cf;         /* the camera's rays in the volume's frame (hd__camera_frame) */
     float *cell_range;       /* per majorant cell: min and max value incl. the filter halo */
     float max_sigma;         /* max over the whole grid */
     /* inputs */
@@ -118,6 +139,7 @@ static hd_result hd__prepare(hd__ctx *ctx);
 #include "hd_validate.h"
 #include "hd_params.h"
 #include "hd_volume.h"
+#include "hd_scene.h"
 #include "hd_kparams.h"
 #include "hd_multigrid.h"
 #include "hd_direct_mask.h"

@@ -31,7 +31,8 @@ enum {
     HD__DIRTY_ALLOC = 16,  /* illumination grids must be (re)allocated (size or channels) */
     HD__DIRTY_IMAGE_ALLOC = 32, /* the image must be (re)allocated (its size changed) */
     HD__DIRTY_JACOBI = 64, /* Jacobi's second buffer must be allocated or freed */
-    HD__DIRTY_ALL = 127
+    HD__DIRTY_DEPTH = 128, /* the host's depth buffer (vw.depth) changed: upload it or free it */
+    HD__DIRTY_ALL = 255
 };
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -72,6 +73,10 @@ typedef struct hd__view {
     uint32_t *dl_idx;        /* their grid indices in bricks */
     size_t dl_count;
     unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
+    /* the host's depth buffer (hd_set_depth): depth_w x depth_h window depths, rows top first,
+       NULL: none (kp.depth_dims.z = 0) */
+    float *depth;
+    int depth_w, depth_h;
 } hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */

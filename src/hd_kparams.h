@@ -5,7 +5,8 @@ static void hd__fill_kparams(hd__ctx *ctx)
 {
     hd__kparams *k = &ctx->vw.kp;
     const hd_camera *c = &ctx->vw.camera;
-    float w[3], u[3], v[3], th, aspect;
+    const hd__camframe *cf = &ctx->cf;
+    const float *box = ctx->kbox; /* the volume's world extents (src/hd_scene.h) */
     int i;
     memset(k, 0, sizeof *k);
     k->dims.x = ctx->vw.dims[0]; k->dims.y = ctx->vw.dims[1]; k->dims.z = ctx->vw.dims[2]; k->dims.w = ctx->vw.tf_count;
@@ -23,20 +24,21 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->frame.y = (int32_t)ctx->frames;
     k->frame.z = (int32_t)ctx->vw.params.seed;
     k->image.x = c->width; k->image.y = c->height; k->image.z = (int32_t)ctx->vw.params.method;
-    k->box.x = ctx->box[0]; k->box.y = ctx->box[1]; k->box.z = ctx->box[2]; k->box.w = 0.0795774715f;
+    k->box.x = box[0]; k->box.y = box[1]; k->box.z = box[2]; k->box.w = 0.0795774715f;
     k->medium.x = ctx->vw.params.extinction; k->medium.y = ctx->vw.params.albedo;
     k->medium.z = ctx->vw.params.method == HD_METHOD_PT_SS ? 0.0f : ctx->vw.params.anisotropy;
     k->medium.w = ctx->vw.params.majorant;
     for (i = 0; i < 3; ++i) {
-        float h = ctx->box[i] / (float)ctx->vw.gdims[i];
+        float h = box[i] / (float)ctx->vw.gdims[i];
         (&k->grid.x)[i] = 1.0f / (h * h);
         (&k->gridh.x)[i] = h;
     }
     k->grid.w = 1e-3f; /* sigma' floor: keeps D finite in empty space */
+    k->gridh.w = HD_BOX_DIAGONAL * hd__max3(box); /* a camera ray's chord is at most this long */
     {
-        float vs = ctx->box[0] / (float)ctx->vw.dims[0];
-        if (ctx->box[1] / (float)ctx->vw.dims[1] < vs) vs = ctx->box[1] / (float)ctx->vw.dims[1];
-        if (ctx->box[2] / (float)ctx->vw.dims[2] < vs) vs = ctx->box[2] / (float)ctx->vw.dims[2];
+        float vs = box[0] / (float)ctx->vw.dims[0];
+        if (box[1] / (float)ctx->vw.dims[1] < vs) vs = box[1] / (float)ctx->vw.dims[1];
+        if (box[2] / (float)ctx->vw.dims[2] < vs) vs = box[2] / (float)ctx->vw.dims[2];
         k->march.x = ctx->vw.params.step * vs;
     }
     {
@@ -47,24 +49,22 @@ static void hd__fill_kparams(hd__ctx *ctx)
         k->march.y = (float)(1.0 / (double)(f < win ? f : win));
     }
     k->march.z = 1e-4f; /* stop marching below this transmittance */
-    /* camera basis, through unit vectors (hd__unit3: a tiny up must not underflow the cross
-       product; hd__check_camera keeps it away from parallel) */
-    for (i = 0; i < 3; ++i) v[i] = c->target[i] - c->eye[i];
-    hd__unit3(v, w);
-    hd__unit3(c->up, u);
-    v[0] = w[1] * u[2] - w[2] * u[1];
-    v[1] = w[2] * u[0] - w[0] * u[2];
-    v[2] = w[0] * u[1] - w[1] * u[0];
-    hd__unit3(v, u);
-    v[0] = u[1] * w[2] - u[2] * w[1];
-    v[1] = u[2] * w[0] - u[0] * w[2];
-    v[2] = u[0] * w[1] - u[1] * w[0];
-    th = tanf(0.5f * c->fov_y * 3.14159265f / 180.0f);
-    aspect = (float)c->width / (float)c->height;
-    k->cam_pos.x = c->eye[0]; k->cam_pos.y = c->eye[1]; k->cam_pos.z = c->eye[2];
-    k->cam_u.x = u[0] * th * aspect; k->cam_u.y = u[1] * th * aspect; k->cam_u.z = u[2] * th * aspect;
-    k->cam_v.x = v[0] * th; k->cam_v.y = v[1] * th; k->cam_v.z = v[2] * th;
-    k->cam_w.x = w[0]; k->cam_w.y = w[1]; k->cam_w.z = w[2];
+    /* the camera's rays in the volume's frame (hd__camera_frame); the host's depth buffer */
+    k->cam_pos.x = cf->pos[0]; k->cam_pos.y = cf->pos[1]; k->cam_pos.z = cf->pos[2];
+    k->cam_u.x = cf->u[0]; k->cam_u.y = cf->u[1]; k->cam_u.z = cf->u[2];
+    k->cam_v.x = cf->v[0]; k->cam_v.y = cf->v[1]; k->cam_v.z = cf->v[2];
+    k->cam_w.x = cf->w[0]; k->cam_w.y = cf->w[1]; k->cam_w.z = cf->w[2];
+    k->cam_ou.x = cf->ou[0]; k->cam_ou.y = cf->ou[1]; k->cam_ou.z = cf->ou[2];
+    k->cam_ov.x = cf->ov[0]; k->cam_ov.y = cf->ov[1]; k->cam_ov.z = cf->ov[2];
+    if (ctx->vw.depth && cf->matrix) {
+        k->depth_dims.x = ctx->vw.depth_w; k->depth_dims.y = ctx->vw.depth_h; k->depth_dims.z = 1;
+        k->depth_z.x = cf->depth_z[0]; k->depth_z.y = cf->depth_z[1]; k->depth_z.z = cf->depth_z[2];
+        for (i = 0; i < 4; ++i) {
+            (&k->depth_m0.x)[i] = cf->dm[i]; (&k->depth_m1.x)[i] = cf->dm[4 + i];
+            (&k->depth_m2.x)[i] = cf->dm[8 + i]; (&k->depth_m3.x)[i] = cf->dm[12 + i];
+        }
+    }
+
     k->background.x = ctx->vw.params.background[0];
     k->background.y = ctx->vw.params.background[1];
     k->background.z = ctx->vw.params.background[2];
@@ -79,10 +79,21 @@ static void hd__fill_kparams(hd__ctx *ctx)
     for (i = 0; i < ctx->light_count; ++i) {
         const hd_light *l = &ctx->lights[i];
         hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];
+        /* in the volume's frame: directions by Q^T, positions by Q^T (p - t) (src/hd_scene.h) */
         if (l->type == HD_LIGHT_DIRECTIONAL) {
-            float n[3];
+            float n[3], m[3];
             hd__unit3(l->direction, n); /* nonzero: hd__check_lights */
+            if (!ctx->xf.identity) {
+                double dn[3] = {n[0], n[1], n[2]}, dm[3];
+                hd__xform_dir(&ctx->xf, dn, dm);
+                hd__store3(m, dm);
+                hd__unit3(m, n);
+            }
             a->x = n[0]; a->y = n[1]; a->z = n[2]; a->w = 0.0f;
+        } else if (!ctx->xf.identity) {
+            double q[3];
+            hd__xform_point(&ctx->xf, l->position, q);
+            a->x = (float)q[0]; a->y = (float)q[1]; a->z = (float)q[2]; a->w = 1.0f;
         } else {
             a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
         }

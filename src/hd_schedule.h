@@ -48,6 +48,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
         dirty |= HD__DIRTY_IMAGE;
     }
     ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
+    if (dirty & HD__DIRTY_DEPTH) {
+        if ((r = hd__be_upload_depth(&ctx->vw)) != HD_SUCCESS) return r;
+        ctx->dirty &= ~(unsigned)HD__DIRTY_DEPTH;
+    }
     if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
     if (dirty & HD__DIRTY_IMAGE) {
         ctx->frames = ctx->converged_frames = 0;

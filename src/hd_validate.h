@@ -144,21 +144,23 @@ static void hd__camera_defaults(hd_camera *c)
     if (c->height == 0) c->height = 512;
 }
 
-/* Checks a camera whose defaults are filled in. */
+/* Checks a camera whose defaults are filled in. A camera given by matrices (projection not all
+   zero) ignores eye, target, up and fov_y; its matrices and the distance limit of every camera
+   are checked where its rays are made (hd__camera_frame, src/hd_scene.h). */
 static hd_result hd__check_camera(const hd_camera *c, const hd_logger *log)
 {
     float f[3], fu[3], uu[3], cr[3], lf, lc;
-    int i;
-    if (!hd__finite3(c->eye) || !hd__finite3(c->target) || !hd__finite3(c->up) || !hd__finite(c->fov_y))
-        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera has a NaN or infinite value");
-    for (i = 0; i < 3; ++i)
-        if (fabsf(c->eye[i]) > HD_MAX_CAMERA_DISTANCE || fabsf(c->target[i]) > HD_MAX_CAMERA_DISTANCE)
-            return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye or target component beyond %g world units",
-                           (double)HD_MAX_CAMERA_DISTANCE);
-    if (!(c->fov_y > 0.0f && c->fov_y < 180.0f))
-        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera fov_y = %g degrees is outside (0, 180)", (double)c->fov_y);
+    int i, matrix = 0;
+    for (i = 0; i < 16; ++i) matrix |= c->projection[i] != 0.0f;
+    if ((int)c->depth_range < 0 || c->depth_range >= HD_DEPTH_RANGE_COUNT)
+        return HD__ERR(log, HD_ERROR_INVALID_ENUM, "camera depth_range %d is not a hd_depth_range", (int)c->depth_range);
     if (c->width < 1 || c->height < 1 || c->width > HD_MAX_IMAGE_DIM || c->height > HD_MAX_IMAGE_DIM)
         return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "image size %dx%d is outside 1..%d", c->width, c->height, HD_MAX_IMAGE_DIM);
+    if (matrix) return HD_SUCCESS;
+    if (!hd__finite3(c->eye) || !hd__finite3(c->target) || !hd__finite3(c->up) || !hd__finite(c->fov_y))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera has a NaN or infinite value");
+    if (!(c->fov_y > 0.0f && c->fov_y < 180.0f))
+        return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera fov_y = %g degrees is outside (0, 180)", (double)c->fov_y);
     f[0] = c->target[0] - c->eye[0]; f[1] = c->target[1] - c->eye[1]; f[2] = c->target[2] - c->eye[2];
     lf = sqrtf(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
     if (!(lf > 1e-6f)) return HD__ERR(log, HD_ERROR_INVALID_CAMERA, "camera eye and target coincide");

@@ -46,6 +46,7 @@ static void kfix_init(kfix *f, int n, float extinction, float majorant_factor)
     f->p.grid.x = f->p.grid.y = f->p.grid.z = (float)n * (float)n;
     f->p.grid.w = 1e-3f;
     f->p.gridh.x = f->p.gridh.y = f->p.gridh.z = 1.0f / (float)n;
+    f->p.gridh.w = HD_BOX_DIAGONAL; /* the chord bound of a box of largest side 1 */
     f->k.p = &f->p; f->k.vol = f->vol; f->k.tf = f->tf; f->k.maj = f->maj;
     f->k.sig = f->sig; f->k.E = f->E; f->k.phi = f->phi;
 }
@@ -421,8 +422,9 @@ static void project_pixel_span(const hd__kctx *k, int x, int y, int spans)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
     float len = 0.0f, s0 = 0.0f;
-    hdk_project_ray(k, x, y, &pe, &d, &len, &s0);
-    hdk_project_finish(k, y * k->p->image.x + x, hdk_project_march_span(k, pe, d, len, s0, spans));
+    int geo = 0;
+    hdk_project_ray(k, x, y, &pe, &d, &len, &s0, &geo);
+    hdk_project_finish(k, y * k->p->image.x + x, hdk_project_march_span(k, pe, d, len, s0, spans), geo);
 }
 
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true

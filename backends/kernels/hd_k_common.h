@@ -31,7 +31,7 @@
    (2^24, where step indices stay exact in float) never shortens a valid march. */
 #define HD_MAX_TRACK_STEPS 65536
 #define HD_MAX_MARCH_STEPS 16777216
-#define HD_BOX_DIAGONAL 1.7320509f
+#define HD_BOX_DIAGONAL 1.7320509f /* per unit of the box's largest side (gridh.w: times that side) */
 
 /* ---- random numbers: a stateless hash of 32-bit integers, bit-identical everywhere -------- */
 /* lowbias32 (C. Wellons): full avalanche with two multiplies. */

@@ -14,12 +14,20 @@ HD_PARAM_I4(region)     /* x = the first pixel of the frame's region of the imag
 HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / (4 pi) */
 HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
 HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */
-HD_PARAM_F4(gridh)      /* xyz = h of the illumination grid (world), w = unused */
+HD_PARAM_F4(gridh)      /* xyz = h of the illumination grid (world), w = the box's diagonal bound (HD_BOX_DIAGONAL * largest side) */
 HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = unused */
-HD_PARAM_F4(cam_pos)    /* eye */
-HD_PARAM_F4(cam_u)      /* image right, scaled by tan(fov/2) * aspect */
-HD_PARAM_F4(cam_v)      /* image up, scaled by tan(fov/2) */
-HD_PARAM_F4(cam_w)      /* forward, unit */
+HD_PARAM_F4(cam_pos)    /* the ray origin at the image centre (all in the volume's frame, hdk_camera_ray) */
+HD_PARAM_F4(cam_u)      /* the direction's change per NDC x (look-at: image right * tan(fov/2) * aspect) */
+HD_PARAM_F4(cam_v)      /* its change per NDC y (look-at: image up * tan(fov/2)) */
+HD_PARAM_F4(cam_w)      /* the direction at the image centre (look-at: forward, unit) */
+HD_PARAM_F4(cam_ou)     /* the origin's change per NDC x (orthographic; 0 for a perspective camera) */
+HD_PARAM_F4(cam_ov)     /* the origin's change per NDC y */
+HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on */
+HD_PARAM_F4(depth_z)    /* NDC z = x * depth + y; z = the far plane's depth (no geometry there) */
+HD_PARAM_F4(depth_m0)   /* rows 0..3 of the inverse of projection * view, clip to the volume's frame */
+HD_PARAM_F4(depth_m1)
+HD_PARAM_F4(depth_m2)
+HD_PARAM_F4(depth_m3)
 HD_PARAM_F4(background) /* rgb radiance behind the volume */
 HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */
 HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates; w = 1: on */

@@ -18,7 +18,10 @@
    free flight and shadow ray at most HD_MAX_TRACK_STEPS (hdk_track).
    A camera ray that leaves the box unscattered sees the background; scattered rays that leave
    add nothing (the background is a backdrop, not a light, as in HD's projection). Alpha is 1 if
-   the camera ray collides, so its mean is 1 - T_cam as in the projection.
+   the camera ray collides, so its mean is 1 - T_cam as in the projection. With the host's depth
+   (hdk_depth_t) the first free flight ends at the scene's surface: a path that reaches it ends
+   there with nothing (the geometry is opaque and black for the volume's image) and sees no
+   background; scattered rays do not see the geometry (the light ignores it, as HD's does).
    Random numbers: key (pixel, iteration, seed, HD_STREAM_PATH); dims 0, 1 jitter the pixel,
    then every decision takes the next dims in order. Frames go into the image's running mean with
    weight march.y, which the host sets to 1/n for these methods (a plain progressive mean). */
@@ -79,10 +82,14 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
     hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_PATH);
-    hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
-    hd_v3 d = hdk_camera_dir(HD_KPASS HD_F(px) + hdk_rand(key, 0u), HD_F(py) + hdk_rand(key, 1u));
+    hd_v3 o = HD_V3(0.0f, 0.0f, 0.0f);
+    float sx = 0.0f, sy = 0.0f;
+    float fx = HD_F(px) + hdk_rand(key, 0u), fy = HD_F(py) + hdk_rand(key, 1u);
+    hd_v3 d = hdk_camera_ray(HD_KPASS fx, fy, HD_REF(o), HD_REF(sx), HD_REF(sy));
     float t1 = 0.0f;
     float t0 = hdk_box_entry(HD_KPASS o, d, HD_REF(t1));
+    int geo = 0;
+    float td = hdk_depth_t(HD_KPASS px, py, fx, fy, sx, sy, o, d, HD_REF(geo));
     int nl = HD_PRM(counts).x, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
     float albedo = HD_PRM(medium).y, g = HD_PRM(medium).z;
     float lr = 0.0f, lg = 0.0f, lb = 0.0f, alpha = 0.0f;
@@ -92,8 +99,10 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
     hd_v3 p = hdk_madd(o, d, t0);
     float tmax = t1 - t0;
     if (!(t0 < t1)) { /* misses the box */
-        lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z;
+        if (geo == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
         tmax = 0.0f;
+    } else if (geo != 0) { /* the first free flight ends at the scene's surface */
+        tmax = hdk_maxf(hdk_minf(tmax, td - t0), 0.0f);
     }
     while (tmax > 0.0f) {
         hd_u32 nd = 0u;
@@ -104,7 +113,7 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         hd_v3 ld;
         dim = nd;
         if (!(t < tmax)) {
-            if (vertices == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
+            if (vertices == 0 && geo == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
             break;
         }
         alpha = 1.0f;

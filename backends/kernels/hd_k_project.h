@@ -57,14 +57,52 @@ HD_FN void hdk_light_sum_voxel(HD_KARGS int x, int y, int zz)
 }
 #endif
 
-/* The camera ray through image position (fx, fy) in pixels (top row first). */
-HD_FN hd_v3 hdk_camera_dir(HD_KARGS float fx, float fy)
+/* The camera ray through image position (fx, fy) in pixels (top row first), at NDC (sx, sy):
+   origin cam_pos + sx cam_ou + sy cam_ov, unit direction along cam_w + sx cam_u + sy cam_v (the
+   host's hd__camera_frame: a look-at camera has ou = ov = 0, a perspective projection too, an
+   orthographic one u = v = 0). Returns the direction; the origin and NDC go to o, sx and sy. */
+HD_FN hd_v3 hdk_camera_ray(HD_KARGS float fx, float fy, HD_INOUT(hd_v3) o, HD_INOUT(float) sx, HD_INOUT(float) sy)
 {
-    float sx = 2.0f * fx / HD_F(HD_PRM(image).x) - 1.0f;
-    float sy = 1.0f - 2.0f * fy / HD_F(HD_PRM(image).y);
+    float x = 2.0f * fx / HD_F(HD_PRM(image).x) - 1.0f;
+    float y = 1.0f - 2.0f * fy / HD_F(HD_PRM(image).y);
     hd_v3 d = hdk_add(HD_XYZ(HD_PRM(cam_w)),
-                     hdk_add(hdk_scale(HD_XYZ(HD_PRM(cam_u)), sx), hdk_scale(HD_XYZ(HD_PRM(cam_v)), sy)));
+                     hdk_add(hdk_scale(HD_XYZ(HD_PRM(cam_u)), x), hdk_scale(HD_XYZ(HD_PRM(cam_v)), y)));
+    HD_DEREF(o) = hdk_add(HD_XYZ(HD_PRM(cam_pos)), hdk_add(hdk_scale(HD_XYZ(HD_PRM(cam_ou)), x), hdk_scale(HD_XYZ(HD_PRM(cam_ov)), y)));
+    HD_DEREF(sx) = x;
+    HD_DEREF(sy) = y;
     return hdk_normalize(d);
+}
+
+/* Where the camera ray o + t d of pixel (px, py) at jittered position (fx, fy), NDC (sx, sy),
+   meets the host's depth buffer (depth_dims.z = 1; hd_set_depth): the buffer's value at the
+   full-resolution pixel under (fx, fy) (the pixel itself in a full frame; a reduced frame's
+   frame is image.x x image.y) mapped to NDC z (depth_z), unprojected through the inverse of
+   projection * view (depth_m0..3, into the volume's frame) and measured along d. Returns that t
+   (>= 0) with *hit = 1, or 3e38 with *hit = 0 where there is no buffer or the value is the far
+   plane's (nothing there), or the point is not in front of the camera. */
+HD_FN float hdk_depth_t(HD_KARGS int px, int py, float fx, float fy, float sx, float sy, hd_v3 o, hd_v3 d,
+                       HD_INOUT(int) hit)
+{
+    hd_i4 dd = HD_PRM(depth_dims);
+    int x = px, y = py;
+    float w, z, hx, hy, hz, hw;
+    hd_v4 m0 = HD_PRM(depth_m0), m1 = HD_PRM(depth_m1), m2 = HD_PRM(depth_m2), m3 = HD_PRM(depth_m3);
+    HD_DEREF(hit) = 0;
+    if (dd.z == 0) return 3.0e38f;
+    if (dd.x != HD_PRM(image).x || dd.y != HD_PRM(image).y) {
+        x = hdk_clampi(HD_I(fx * HD_F(dd.x) / HD_F(HD_PRM(image).x)), 0, dd.x - 1);
+        y = hdk_clampi(HD_I(fy * HD_F(dd.y) / HD_F(HD_PRM(image).y)), 0, dd.y - 1);
+    }
+    w = HD_GET1(dep, y * dd.x + x);
+    if (w == HD_PRM(depth_z).z) return 3.0e38f;
+    z = w * HD_PRM(depth_z).x + HD_PRM(depth_z).y;
+    hx = m0.x * sx + m0.y * sy + m0.z * z + m0.w;
+    hy = m1.x * sx + m1.y * sy + m1.z * z + m1.w;
+    hz = m2.x * sx + m2.y * sy + m2.z * z + m2.w;
+    hw = m3.x * sx + m3.y * sy + m3.z * z + m3.w;
+    if (!(hw > 0.0f)) return 3.0e38f;
+    HD_DEREF(hit) = 1;
+    return hdk_maxf(hdk_dot(hdk_sub(HD_V3(hx / hw, hy / hw, hz / hw), o), d), 0.0f);
 }
 
 /* Folds one frame value into the running mean of pixel i (RGBA) of the image region that
@@ -143,19 +181,26 @@ HD_FN int hdk_march_resume(float se, float s0, float idt, int n)
 }
 
 /* Pixel (px, py)'s camera ray for this frame: its entry into the box pe, unit direction d, the
-   length len of its chord (at most the box diagonal; negative for a miss) and its jitter s0. */
+   length len of its chord (at most the box diagonal; negative for a miss) and its jitter s0.
+   With the host's depth the chord ends where the ray meets the scene (hdk_depth_t; *geo = 1
+   where there is geometry): the jittered samples, each standing for one step, cover [0, len)
+   exactly in expectation, as at the box's far face, so the last step is not shortened. */
 HD_FN void hdk_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT(hd_v3) d, HD_INOUT(float) len,
-                          HD_INOUT(float) s0)
+                          HD_INOUT(float) s0, HD_INOUT(int) geo)
 {
     int i = py * HD_PRM(image).x + px;
     hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).y), HD_U(HD_PRM(frame).z), HD_STREAM_PROJECT);
-    hd_v3 o = HD_XYZ(HD_PRM(cam_pos));
-    hd_v3 dir = hdk_camera_dir(HD_KPASS HD_F(px) + hdk_rand(key, 0u), HD_F(py) + hdk_rand(key, 1u));
+    hd_v3 o = HD_V3(0.0f, 0.0f, 0.0f);
+    float sx = 0.0f, sy = 0.0f;
+    float fx = HD_F(px) + hdk_rand(key, 0u), fy = HD_F(py) + hdk_rand(key, 1u);
+    hd_v3 dir = hdk_camera_ray(HD_KPASS fx, fy, HD_REF(o), HD_REF(sx), HD_REF(sy));
     float t1 = 0.0f;
     float t0 = hdk_box_entry(HD_KPASS o, dir, HD_REF(t1));
+    float td = hdk_depth_t(HD_KPASS px, py, fx, fy, sx, sy, o, dir, geo);
     HD_DEREF(pe) = hdk_madd(o, dir, t0);
     HD_DEREF(d) = dir;
-    HD_DEREF(len) = hdk_minf(t1 - t0, HD_BOX_DIAGONAL);
+    HD_DEREF(len) = hdk_minf(t1 - t0, HD_PRM(gridh).w);
+    if (HD_DEREF(geo) != 0) HD_DEREF(len) = hdk_minf(HD_DEREF(len), td - t0);
     HD_DEREF(s0) = hdk_rand(key, 2u) * HD_PRM(march).x;
 }
 
@@ -268,23 +313,25 @@ HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
     return HD_V4(r, g, b, T);
 }
 
-/* Folds the march's (r, g, b, T) into pixel i: the background behind it, and T = 0 where the
-   march stopped on it. */
-HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m)
+/* Folds the march's (r, g, b, T) into pixel i: the background behind it (none where the host's
+   geometry is, geo = 1), and T = 0 where the march stopped on it. */
+HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m, int geo)
 {
     float T = m.w < HD_PRM(march).z ? 0.0f : m.w;
-    hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + T * HD_PRM(background).x, m.y + T * HD_PRM(background).y,
-                                          m.z + T * HD_PRM(background).z, 1.0f - T));
+    float bg = geo != 0 ? 0.0f : T;
+    hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + bg * HD_PRM(background).x, m.y + bg * HD_PRM(background).y,
+                                          m.z + bg * HD_PRM(background).z, 1.0f - T));
 }
 
 HD_FN void hdk_project_pixel(HD_KARGS int px, int py)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
     float len = 0.0f, s0 = 0.0f;
-    hdk_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0));
+    int geo = 0;
+    hdk_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0), HD_REF(geo));
 #ifdef HD_PROJECT_MARCH_SPAN
-    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS));
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS), geo);
 #else
-    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_cells(HD_KPASS pe, d, len, s0));
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_cells(HD_KPASS pe, d, len, s0), geo);
 #endif
 }

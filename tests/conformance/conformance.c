@@ -26,7 +26,7 @@
    is the library's and fails; HD_CONFORMANCE_REQUIRE=1 (CI) makes a skip fail too.
    `conformance-opencl --quick`: one case per stage (what `make valgrind-opencl` runs); `--crop`:
    the crop box cases only; `--render`: the per-frame API's; `--direct`: the direct light's and
-   the self-check. */
+   the self-check; `--scene`: the host scene's (matrices, a placed volume, depth). */
 #include "hd_api.h"
 #include <math.h>
 #include <stdio.h>
@@ -959,6 +959,136 @@ static void direct_cases(const int *odd, const int *other)
     case_direct_selfcheck(odd, 16);
 }
 
+/* The volume inside a host's scene: the camera given by view and projection matrices under a
+   depth convention, optionally the volume placed by a transform (rotated, scaled 2 x 1 x 0.5,
+   translated, the camera and lights moved with it), and the host's depth: a wall in front of
+   the volume over the image's left third, a post through its middle (a strip at the volume
+   centre's eye depth), nothing elsewhere. Whole iterations against the reference; besides, on
+   the backend every wall pixel is exactly empty (rgb and alpha 0) and every pixel without
+   geometry equals the backend's own image without depth within the stochastic bound. */
+static void case_scene(hd_method method, hd_depth_range range, int placed, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    errors e = {0.0, 0.0, 0.0, -1.0};
+    float xf[16], *depth, eye[3] = {1.2f, 0.8f, 1.9f}, t[3] = {0.0f, 0.0f, 0.0f};
+    double f = 0.0, fw[3], sd[3], ud[3], up[3] = {0.0, 1.0, 0.0}, nrm, V[16], P[16], nn = 0.1, ff = 50.0;
+    double th = tan(20.0 * 3.14159265358979 / 180.0);
+    int i, k, w, h;
+    scene_init(&s, HD_VOXEL_U8, 37, 33, 29, 2, 1, 1);
+    s.params.method = method;
+    w = s.camera.width; h = s.camera.height;
+    memset(xf, 0, sizeof xf);
+    if (placed) {
+        /* 30 degrees about the tilted axis (0.3, 1, 0.5) (Rodrigues), columns scaled 2, 1, 0.5 */
+        double ax[3] = {0.3, 1.0, 0.5}, an = sqrt(0.3 * 0.3 + 1.0 + 0.25), c = cos(3.14159265358979 / 6.0), sn = sin(3.14159265358979 / 6.0);
+        for (i = 0; i < 3; ++i) ax[i] /= an;
+        for (k = 0; k < 3; ++k)
+            for (i = 0; i < 3; ++i) {
+                double rik = (i == k ? c : 0.0) + (1.0 - c) * ax[i] * ax[k];
+                if ((i + 1) % 3 == k) rik -= sn * ax[3 - i - k];
+                if ((k + 1) % 3 == i) rik += sn * ax[3 - i - k];
+                xf[k * 4 + i] = (float)(rik * (k == 0 ? 2.0 : k == 1 ? 1.0 : 0.5));
+            }
+        t[0] = 3.0f; t[1] = -1.0f; t[2] = 2.0f;
+        for (i = 0; i < 3; ++i) xf[12 + i] = t[i];
+        xf[15] = 1.0f;
+        for (i = 0; i < 3; ++i) eye[i] += t[i];
+        for (k = 0; k < s.light_count; ++k)
+            for (i = 0; i < 3; ++i) s.lights[k].position[i] += t[i];
+    }
+    /* the look-at view toward the volume's centre, GL's frustum rows for the convention */
+    for (i = 0; i < 3; ++i) { fw[i] = (double)t[i] - eye[i]; f += fw[i] * fw[i]; }
+    for (i = 0; i < 3; ++i) fw[i] /= sqrt(f);
+    sd[0] = fw[1] * up[2] - fw[2] * up[1]; sd[1] = fw[2] * up[0] - fw[0] * up[2]; sd[2] = fw[0] * up[1] - fw[1] * up[0];
+    nrm = sqrt(sd[0] * sd[0] + sd[1] * sd[1] + sd[2] * sd[2]);
+    for (i = 0; i < 3; ++i) sd[i] /= nrm;
+    ud[0] = sd[1] * fw[2] - sd[2] * fw[1]; ud[1] = sd[2] * fw[0] - sd[0] * fw[2]; ud[2] = sd[0] * fw[1] - sd[1] * fw[0];
+    memset(V, 0, sizeof V);
+    memset(P, 0, sizeof P);
+    for (i = 0; i < 3; ++i) { V[i * 4] = sd[i]; V[i * 4 + 1] = ud[i]; V[i * 4 + 2] = -fw[i]; }
+    V[12] = -(sd[0] * eye[0] + sd[1] * eye[1] + sd[2] * eye[2]);
+    V[13] = -(ud[0] * eye[0] + ud[1] * eye[1] + ud[2] * eye[2]);
+    V[14] = fw[0] * eye[0] + fw[1] * eye[1] + fw[2] * eye[2];
+    V[15] = 1.0;
+    P[0] = 1.0 / (th * (double)w / h); P[5] = 1.0 / th; P[11] = -1.0;
+    if (range == HD_DEPTH_NEG_ONE_TO_ONE) { P[10] = -(ff + nn) / (ff - nn); P[14] = -2.0 * ff * nn / (ff - nn); }
+    else if (range == HD_DEPTH_ZERO_TO_ONE) { P[10] = ff / (nn - ff); P[14] = ff * nn / (nn - ff); }
+    else { P[10] = 0.0; P[14] = nn; }
+    for (i = 0; i < 16; ++i) { s.camera.view[i] = (float)V[i]; s.camera.projection[i] = (float)P[i]; }
+    s.camera.depth_range = range;
+    depth = (float *)malloc(sizeof(float) * (size_t)w * h);
+    {
+        double dist = sqrt(f), zs[2], dz[2];
+        zs[0] = -0.5; zs[1] = -dist; /* eye-space z of the wall and of the post */
+        for (k = 0; k < 2; ++k) {
+            double ndc = (P[10] * zs[k] + P[14]) / -zs[k];
+            dz[k] = range == HD_DEPTH_NEG_ONE_TO_ONE ? 0.5 * (ndc + 1.0) : ndc;
+        }
+        for (i = 0; i < w * h; ++i) {
+            int x = i % w;
+            depth[i] = x < w / 3 ? (float)dz[0] : (x >= w / 2 - 2 && x < w / 2 + 2) ? (float)dz[1] : range == HD_DEPTH_REVERSED ? 0.0f : 1.0f;
+        }
+    }
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s scene: matrices (%s)%s, depth wall + post, x%d", hd_api_cpu.method_name(method),
+             range == HD_DEPTH_NEG_ONE_TO_ONE ? "GL" : range == HD_DEPTH_ZERO_TO_ONE ? "0..1" : "reversed-Z", placed ? ", placed" : "", n);
+    if (pair_create(&p, &s)) {
+        hd_depth_desc dd;
+        hd_context plain;
+        hd_desc d = scene_desc(&s);
+        hd_result r;
+        dd.data = depth; dd.width = w; dd.height = h;
+        if (placed) BOTH(&p, set_volume_transform, (p.ref, xf), (p.dut, xf));
+        BOTH(&p, set_depth, (p.ref, &dd), (p.dut, &dd));
+        BOTH(&p, iterate, (p.ref, n), (p.dut, n));
+        pair_compare(&p, method_is_pt(method) ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &e);
+        if (p.ok && (r = hd_api_backend.create(&d, &plain)) == HD_SUCCESS) {
+            size_t np = (size_t)w * h * 4, j;
+            float *a = (float *)calloc(np, sizeof(float)), *b = (float *)calloc(np, sizeof(float));
+            double d2 = 0.0, r2 = 0.0;
+            int wall_bad = 0;
+            if (placed && (r = hd_api_backend.set_volume_transform(plain, xf)) != HD_SUCCESS) pair_fail(&p, "backend transform (without depth)", r);
+            if ((r = hd_api_backend.iterate(plain, n)) != HD_SUCCESS) pair_fail(&p, "backend iterate (without depth)", r);
+            if ((r = hd_api_backend.read_image_f32(plain, a, np)) != HD_SUCCESS) pair_fail(&p, "backend read (without depth)", r);
+            hd_api_backend.read_image_f32(p.dut, b, np);
+            for (j = 0; j < (size_t)w * h; ++j) {
+                int x = (int)(j % (size_t)w), c;
+                for (c = 0; c < 4; ++c) {
+                    if (x < w / 3) wall_bad += b[j * 4 + c] != 0.0f;
+                    else if (!(x >= w / 2 - 2 && x < w / 2 + 2)) {
+                        d2 += ((double)b[j * 4 + c] - a[j * 4 + c]) * ((double)b[j * 4 + c] - a[j * 4 + c]);
+                        r2 += (double)a[j * 4 + c] * a[j * 4 + c];
+                    }
+                }
+            }
+            if (wall_bad) pair_fail(&p, "a wall pixel shows the volume", HD_SUCCESS);
+            if (!(r2 > 1.0)) pair_fail(&p, "the volume is hardly in view", HD_SUCCESS);
+            if (!(sqrt(d2 / (r2 > 0.0 ? r2 : 1.0)) <= TOL_STOCH_L2)) pair_fail(&p, "pixels without geometry differ from the image without depth", HD_SUCCESS);
+            hd_api_backend.destroy(plain);
+            free(a);
+            free(b);
+        } else if (p.ok) {
+            pair_fail(&p, "backend create (without depth)", r);
+        }
+    }
+    report(name, &p, &g, &e, 0);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+    free(depth);
+}
+
+/* inside a host's scene */
+static void scene_cases(void)
+{
+    case_scene(HD_METHOD_HD, HD_DEPTH_NEG_ONE_TO_ONE, 0, 4);
+    case_scene(HD_METHOD_HD, HD_DEPTH_REVERSED, 1, 4);
+    case_scene(HD_METHOD_PT_SS, HD_DEPTH_ZERO_TO_ONE, 1, 4);
+}
+
 /* the per-frame API */
 static void render_cases(const int *odd, const int *other)
 {
@@ -999,6 +1129,7 @@ int main(int argc, char **argv)
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     int render = argc > 1 && strcmp(argv[1], "--render") == 0, direct = argc > 1 && strcmp(argv[1], "--direct") == 0;
+    int scenes = argc > 1 && strcmp(argv[1], "--scene") == 0;
     int hard = 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available(&hard)) {
@@ -1009,13 +1140,15 @@ int main(int argc, char **argv)
                     require ? "; HD_CONFORMANCE_REQUIRE=1: a skip fails" : "");
         return hard || require ? 1 : 0;
     }
-    if (quick || crop || render || direct) { /* quick: one case per stage, for valgrind; crop: the
+    if (quick || crop || render || direct || scenes) { /* quick: one case per stage, for valgrind; crop: the
                                       crop box cases; render: the per-frame API's; direct: the
                                       direct light's and the rule's self-check */
         if (direct) {
             direct_cases(odd, other);
         } else if (render) {
             render_cases(odd, other);
+        } else if (scenes) {
+            scene_cases();
         } else if (quick) {
             case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
             case_project(HD_VOXEL_U16, odd, 1, 1);
@@ -1065,6 +1198,8 @@ int main(int argc, char **argv)
     case_method(HD_METHOD_PT_MS, HD_VOXEL_U8, other, 16, 1, 1, 8);
     crop_cases(odd, other);
     render_cases(odd, other);
+    /* inside a host's scene: matrices, a placed volume, depth */
+    scene_cases();
     /* binary16 illumination storage */
     case_half(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 0, HD_SOLVER_RED_BLACK, 8);
     case_half(HD_METHOD_HD, HD_VOXEL_U16, odd, 3, 1, 0, HD_SOLVER_RED_BLACK, 8);
