@@ -2,8 +2,8 @@
    CT (HD, the CT TF, one light refined for a few iterations, not to convergence: the frames
    project the same light), a matrix camera (GL perspective) at N x N, frames timed one by one
    (the device drained after each), interleaved:
-     plain: hd_set_camera (the same camera: the image restarts as a new depth buffer restarts it)
-            and one frame;
+     plain: no depth (hd_set_depth(NULL) drops the previous variant's) and hd_set_camera (the
+            same camera: the image restarts as a new depth buffer restarts it), one frame;
      far:   hd_set_depth with every value the far plane's (no geometry: the rays are as long as
             without depth, so this is the whole overhead: the call's check and copy, the upload
             and the per-ray unprojection) and one frame;
@@ -42,7 +42,8 @@ static double now_s(void)
 static int frame(hd_context ctx, const hd_camera *cam, const hd_depth_desc *dd, double *ms)
 {
     double t0 = now_s();
-    if ((dd ? hd_set_depth(ctx, dd) : hd_set_camera(ctx, cam)) != HD_SUCCESS) return 1;
+    /* plain: no depth (hd_set_depth(NULL) drops the previous variant's buffer) */
+    if ((dd ? hd_set_depth(ctx, dd) : hd_set_depth(ctx, NULL) || hd_set_camera(ctx, cam)) != HD_SUCCESS) return 1;
     if (hd__test_project(ctx, 1) != HD_SUCCESS || hd__test_finish(ctx) != HD_SUCCESS) return 1;
     *ms = 1e3 * (now_s() - t0);
     return 0;
