@@ -140,7 +140,8 @@ extern "C" {
     X(HD_ERROR_TRANSFORM_SHEAR, "the volume transform shears (its columns are not orthogonal): the grid cannot follow it") \
     X(HD_ERROR_DEPTH_SIZE, "the depth buffer's size is not the camera's") \
     X(HD_ERROR_INVALID_DEPTH, "a depth value is NaN, infinite or outside [0, 1]") \
-    X(HD_ERROR_DEPTH_NEEDS_PROJECTION, "depth needs a camera given by its projection matrix")
+    X(HD_ERROR_DEPTH_NEEDS_PROJECTION, "depth needs a camera given by its projection matrix") \
+    X(HD_ERROR_NO_FRAME, "the image holds no frame yet: render one first")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -616,7 +617,9 @@ HDDEF hd_result hd_refine(hd_context ctx, int n);
 HDDEF hd_result hd_render(hd_context ctx);
 
 /* The image, top row first. RGBA8: sRGB-encoded radiance * exposure, alpha = opacity.
-   Float: linear RGB radiance and opacity. Sizes are in bytes / in floats. */
+   Float: linear RGB radiance and opacity. Sizes are in bytes / in floats. While the image holds
+   no frame (after hd_create, a change of the camera's size, or a change that restarts the image,
+   before the next hd_render or hd_iterate) both return HD_ERROR_NO_FRAME and leave dst as it was. */
 HDDEF hd_result hd_read_image_rgba8(hd_context ctx, uint8_t *dst, size_t dst_bytes);
 HDDEF hd_result hd_read_image_f32(hd_context ctx, float *dst, size_t dst_floats);
 /* An illumination volume, channel-planar: channel c of voxel (x,y,z) at

@@ -118,6 +118,8 @@ typedef struct hd__ctx {
     hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
     hd__dl dl;
     uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
+    int image_empty;         /* the image holds no frame: new (a new camera size) or reset, none
+                                projected since (the read-backs say HD_ERROR_NO_FRAME) */
 } hd__ctx;
 
 /* The path tracers keep no illumination grid: the image is their whole state. */

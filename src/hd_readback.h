@@ -1,6 +1,17 @@
 /* hd_readback.h - the image and illumination read back, the sRGB encoding and the statistics.
    Part of the core (src/hd_core.h). */
 /* ---- read-back --------------------------------------------------------------------------------- */
+/* The image read back (in the bracket, after hd__prepare): HD_ERROR_NO_FRAME, logged, while it
+   holds no frame (after hd_create, a new camera size or a change that restarted the image, before
+   the next hd_render or hd_iterate), rather than an empty, transparent image. */
+static hd_result hd__read_image(hd__ctx *ctx, float *dst, const char *call)
+{
+    if (ctx->image_empty)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_NO_FRAME, "%s: the %dx%d image holds no frame yet (render one first)", call,
+                       ctx->vw.camera.width, ctx->vw.camera.height);
+    return hd__be_read_image(&ctx->vw, dst);
+}
+
 HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
 {
     hd_result r;
@@ -9,7 +20,7 @@ HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
     if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_f32: dst is NULL");
     need = (size_t)ctx->vw.camera.width * ctx->vw.camera.height * 4;
     if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_f32: %zu floats given, %zu needed", dst_floats, need);
-    HD__BE_CALL(r, ctx, hd__be_read_image(&ctx->vw, dst));
+    HD__BE_CALL(r, ctx, hd__read_image(ctx, dst, "hd_read_image_f32"));
     return r;
 }
 
@@ -73,7 +84,7 @@ HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes
     if (dst_bytes < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_rgba8: %zu bytes given, %zu needed", dst_bytes, need);
     tmp = (float *)hd__alloc(&ctx->vw, need * sizeof(float));
     if (!tmp) return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_read_image_rgba8: no memory for the conversion");
-    HD__BE_CALL(r, ctx, hd__be_read_image(&ctx->vw, tmp));
+    HD__BE_CALL(r, ctx, hd__read_image(ctx, tmp, "hd_read_image_rgba8"));
     if (r == HD_SUCCESS) {
         float e = ctx->vw.params.exposure;
         t = hd__srgb_table(ctx);

@@ -56,6 +56,7 @@ static hd_result hd__prepare(hd__ctx *ctx)
     if (dirty & HD__DIRTY_IMAGE) {
         ctx->frames = ctx->converged_frames = 0;
         ctx->frame_scale = 0;
+        ctx->image_empty = 1;
     }
     /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
     if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
@@ -166,6 +167,7 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     ctx->seconds[2] += t2 - t0;
     /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
     if (r == HD_SUCCESS && !ctx->no_measure) hd__frame_cost_add(ctx, s, hd__scale_pixels(ctx, s), t2 - t1);
+    if (r == HD_SUCCESS) ctx->image_empty = 0;
     return r;
 }
 
@@ -187,6 +189,7 @@ static hd_result hd__iterate_pt(hd__ctx *ctx)
     ctx->frames++;
     hd__fill_kparams(ctx);
     if ((r = hd__be_path(&ctx->vw)) != HD_SUCCESS) return r;
+    ctx->image_empty = 0;
     ctx->seconds[0] += hd__now() - t0;
     return HD_SUCCESS;
 }
