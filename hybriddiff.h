@@ -141,7 +141,10 @@ extern "C" {
     X(HD_ERROR_DEPTH_SIZE, "the depth buffer's size is not the camera's") \
     X(HD_ERROR_INVALID_DEPTH, "a depth value is NaN, infinite or outside [0, 1]") \
     X(HD_ERROR_DEPTH_NEEDS_PROJECTION, "depth needs a camera given by its projection matrix") \
-    X(HD_ERROR_NO_FRAME, "the image holds no frame yet: render one first")
+    X(HD_ERROR_NO_FRAME, "the image holds no frame yet: render one first") \
+    X(HD_ERROR_VOLUME_MISMATCH, "the update's voxel type or dims differ from the context's volume") \
+    X(HD_ERROR_BOX_OUTSIDE_VOLUME, "the update's box is empty or reaches outside the volume") \
+    X(HD_ERROR_INVALID_VOXELS, "a voxel value of the update is NaN or infinite")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -241,6 +244,7 @@ typedef enum hd_illumination {
 #define HD_CAMERA_INIT HD_ZERO_INIT
 #define HD_LOAD_OPTIONS_INIT HD_ZERO_INIT
 #define HD_DEPTH_DESC_INIT HD_ZERO_INIT
+#define HD_VOLUME_UPDATE_INIT HD_ZERO_INIT
 
 /* ---- callbacks ------------------------------------------------------------------------------ */
 /* Silent unless a logger is given. hd_log_stderr is a ready one. */
@@ -451,6 +455,14 @@ typedef struct hd_params {
                                frames (hd_stats.image_bytes); where that fails, the call returns
                                HD_ERROR_OUT_OF_MEMORY / _OUT_OF_DEVICE_MEMORY and full frames still
                                work. The path tracers ignore it. Else HD_ERROR_INVALID_PARAMETER */
+    int light_window;       /* a change that keeps E and phi as the warm start of the new light
+                               (hd_update_volume, and the setters' "warm" changes listed above
+                               hd_set_transfer_function) re-weights the direct light's running
+                               mean so it holds at most this many samples' worth of the light
+                               before the change: the next samples weigh 1/(w + 1), 1/(w + 2), ...
+                               and the old light fades as the new one's samples come in. Smaller
+                               follows a changing volume with less lag and more noise. 0 -> 8;
+                               1..1000000 */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -490,6 +502,21 @@ typedef struct hd_desc {
                                                       eglGetProcAddress; NULL -> eglGetProcAddress */
     } gl;
 } hd_desc;
+
+/* New voxels for the whole volume or a box of it (hd_update_volume). */
+typedef struct hd_volume_update {
+    hd_voxel_type type;  /* must be the context's volume type */
+    int dims[3];         /* must be the context's volume dims */
+    int offset[3];       /* the box's first voxel (x, y, z) */
+    int size[3];         /* the box's voxels per axis, each >= 1 and inside the volume;
+                            {0,0,0} with offset {0,0,0}: the whole volume */
+    const void *data;    /* the box's voxels, x fastest, mapped to TF coordinates by the
+                            context's value_range (hd_create's) */
+    size_t row_pitch;    /* bytes from a row of the box to the next; 0: size[0] voxels. To update
+                            a box of a whole volume in memory: data = its first voxel, row_pitch =
+                            dims[0] voxels, slice_pitch = dims[0] * dims[1] voxels */
+    size_t slice_pitch;  /* bytes from a z slice of the box to the next; 0: row_pitch * size[1] */
+} hd_volume_update;
 
 /* ---- outputs --------------------------------------------------------------------------------- */
 typedef struct hd_stats {
@@ -585,6 +612,25 @@ HDDEF hd_result hd_set_volume_transform(hd_context ctx, const float transform[16
    a nonzero size), HD_ERROR_INVALID_DEPTH (a NaN, infinite or out-of-[0, 1] value); each logs
    one line and changes nothing. Invalidates the image only (the light is kept). */
 HDDEF hd_result hd_set_depth(hd_context ctx, const hd_depth_desc *depth);
+
+/* New voxels for the whole volume or a box of it, same type and dims, without a new context (an
+   animated or simulated volume, a time series). The core's copy, the majorant grid and the
+   direct light's mask change for the box's cells only, the backend uploads the box alone, and
+   the light continues from where it was: E and phi are the warm start of the new solution and
+   the direct light's running mean is re-weighted (params.light_window); the light's convergence
+   estimate restarts (hd_stats.light_converged is 0 until the new light converges); the image
+   restarts (the path tracers restart their means). Voxels equal to those held change nothing.
+   The device work runs at the next call that reaches the device (hd_render, hd_iterate, ...).
+   Errors, each with one log line, leave the context as it was: a NULL update or data
+   HD_ERROR_NULL_POINTER; another type or other dims HD_ERROR_VOLUME_MISMATCH; a box not inside
+   the volume (or empty) HD_ERROR_BOX_OUTSIDE_VOLUME; a pitch below the box's row or slice
+   HD_ERROR_INVALID_PARAMETER; a NaN or infinite F32 voxel HD_ERROR_INVALID_VOXELS. */
+HDDEF hd_result hd_update_volume(hd_context ctx, const hd_volume_update *update);
+
+/* A clean restart of the light and the image: E, phi (CD's light volumes) and the image start
+   from zero at the next call, as in a new context, instead of from the warm start a change
+   keeps. */
+HDDEF hd_result hd_reset(hd_context ctx);
 
 /* Runs n >= 1 iterations of the current method, each refining the light (HD, CD) and projecting
    one frame; it refines even light that has converged (hd_stats.light_converged). */

@@ -260,6 +260,14 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* hd_update_volume: the kernels read vw->vol and vw->majorant in place, so the core's copy is
+   already the backend's. */
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
+{
+    (void)vw; (void)vox; (void)cells;
+    return HD_SUCCESS;
+}
+
 #define HD__BE_SPLIT_LAYOUT 1 /* sig, E, phi in the colour layout: hd_get_stats counts its padding */
 
 /* Frees an illumination buffer of either precision and clears its pointers. */

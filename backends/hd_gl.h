@@ -842,6 +842,31 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
     return hd__gl_buffer_data(vw, &be->maj, ncell * sizeof(float), vw->majorant, GL_DYNAMIC_DRAW, "uploading the majorant grid");
 }
 
+/* hd_update_volume: the box of the volume into the volume texture (one TexSubImage3D from the
+   core's copy, the unpack row length and image height set for it and put back to the bracket's
+   0), the majorant cells' rows into their buffer. */
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
+{
+    hd__backend *be = vw->be;
+    int y, z;
+    be->gl.BindTexture(GL_TEXTURE_3D, be->vol.name);
+    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, vw->dims[0]);
+    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, vw->dims[1]);
+    be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, vox->lo[0], vox->lo[1], vox->lo[2], vox->hi[0] - vox->lo[0], vox->hi[1] - vox->lo[1],
+                         vox->hi[2] - vox->lo[2], GL_RED, GL_FLOAT,
+                         vw->vol + ((size_t)vox->lo[2] * vw->dims[1] + vox->lo[1]) * vw->dims[0] + vox->lo[0]);
+    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+    be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->maj);
+    for (z = cells->lo[2]; z < cells->hi[2]; ++z)
+        for (y = cells->lo[1]; y < cells->hi[1]; ++y) {
+            size_t at = ((size_t)z * vw->mdims[1] + y) * vw->mdims[0] + (size_t)cells->lo[0];
+            be->gl.BufferSubData(GL_COPY_WRITE_BUFFER, (GLintptr)(at * sizeof(float)),
+                                 (GLsizeiptr)((size_t)(cells->hi[0] - cells->lo[0]) * sizeof(float)), vw->majorant + at);
+        }
+    return hd__gl_check(vw, "updating the volume", __LINE__);
+}
+
 static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
     return hd__gpu_alloc_illumination(vw, &vw->be->gg, illum_floats);

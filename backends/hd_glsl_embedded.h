@@ -221,7 +221,7 @@ static const char *const hd__gl_source[] = {
 "HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */\n",
 "HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */\n",
 "HD_PARAM_F4(gridh)      /* xyz = h of the illumination grid (world), w = the box's diagonal bound (HD_BOX_DIAGONAL * largest side) */\n",
-"HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = unused */\n",
+"HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = the direct light's sample weight */\n",
 "HD_PARAM_F4(cam_pos)    /* the ray origin at the image centre (all in the volume's frame, hdk_camera_ray) */\n",
 "HD_PARAM_F4(cam_u)      /* the direction's change per NDC x (look-at: image right * tan(fov/2) * aspect) */\n",
 "HD_PARAM_F4(cam_v)      /* its change per NDC y (look-at: image up * tan(fov/2)) */\n",
@@ -751,9 +751,12 @@ static const char *const hd__gl_source[] = {
 "}\n",
 "#line 1 6\n",
 "/* hd_k_direct.h - stage 1 of HD: direct light per voxel by tracking toward one light (shared\n",
-"   source). Every voxel of the illumination grid takes exactly one sample per iteration, so the\n",
-"   iteration count is the sample count and no per-voxel counter is needed:\n",
-"   E_n = E_{n-1} + (X_n - E_{n-1}) / n with X = L * I_l * T(x -> l), l uniform among L lights. */\n",
+"   source). Every voxel of the illumination grid takes exactly one sample per iteration, so one\n",
+"   count serves every voxel and no per-voxel counter is needed:\n",
+"   E_n = E_{n-1} + (X_n - E_{n-1}) / n with X = L * I_l * T(x -> l), l uniform among L lights.\n",
+"   The host gives 1 / n as march.w: n is the iteration count, or after a warm start (a change\n",
+"   that keeps E as the start of the new light) the count capped at params.light_window, so the\n",
+"   light before the change fades. */\n",
 "HD_FN void hdk_direct_voxel(HD_KARGS int x, int y, int z)\n",
 "{\n",
 "    int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;\n",
@@ -774,7 +777,7 @@ static const char *const hd__gl_source[] = {
 "    int c;\n",
 "    hd_v3 d = hdk_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));\n",
 "    T = hdk_transmittance(HD_KPASS p, d, tmax, key, 1u, HD_PRM(counts).y, HD_REF(next_dim));\n",
-"    w = 1.0f / HD_F(HD_PRM(frame).x);\n",
+"    w = HD_PRM(march).w;\n",
 "    for (c = 0; c < nch; ++c) {\n",
 "        int ic = i + c * nvox;\n",
 "        float e = HD_GET(E, ic, x, y, z + c * gz);\n",
@@ -2459,7 +2462,7 @@ static const char *const hd__gl_source_mg[] = {
 "#endif\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 2132 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 2135 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_FILES (sizeof hd__gl_source_files / sizeof hd__gl_source_files[0])

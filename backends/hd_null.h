@@ -8,7 +8,7 @@
 
 /* The primitives, in hd_backend.h's order: their counters' indices (hd__null_calls names them). */
 #define HD__NULL_PRIMITIVES(X) \
-    X(upload_inputs) X(alloc_illumination) X(alloc_jacobi) X(alloc_image) X(alloc_lights) X(clear) \
+    X(upload_inputs) X(update_volume) X(alloc_illumination) X(alloc_jacobi) X(alloc_image) X(alloc_lights) X(clear) \
     X(classify) X(direct) X(direct_list) X(diffuse) X(diffuse_sweeps) X(convect) X(sum_lights) \
     X(project) X(upsample) X(path) X(upload_depth) X(read_image) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
@@ -77,6 +77,12 @@ static hd_result hd__be_end(const hd__view *vw, hd_result r)
 
 static hd_result hd__be_upload_inputs(const hd__view *vw) { hd__null_call(vw, HD__NULL_upload_inputs); return HD_SUCCESS; }
 static hd_result hd__be_upload_depth(const hd__view *vw) { hd__null_call(vw, HD__NULL_upload_depth); return HD_SUCCESS; }
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
+{
+    (void)vox; (void)cells;
+    hd__null_call(vw, HD__NULL_update_volume);
+    return HD_SUCCESS;
+}
 static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
     hd__null_call(vw, HD__NULL_alloc_illumination);

@@ -447,6 +447,30 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* hd_update_volume: the box of the volume and the majorant cells, each one rectangular write
+   from the core's copies (blocking: they may change as soon as this returns). */
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
+{
+    hd__backend *be = vw->be;
+    size_t o[3], n[3], f = sizeof(float);
+    size_t vr = (size_t)vw->dims[0] * f, vs = vr * (size_t)vw->dims[1];
+    size_t mr = (size_t)vw->mdims[0] * f, ms = mr * (size_t)vw->mdims[1];
+    int d;
+    for (d = 0; d < 3; ++d) {
+        o[d] = (size_t)vox->lo[d] * (d == 0 ? f : 1);
+        n[d] = (size_t)(vox->hi[d] - vox->lo[d]) * (d == 0 ? f : 1);
+    }
+    HD__CL_TRY(vw, clEnqueueWriteBufferRect(be->queue, be->vol, CL_TRUE, o, o, n, vr, vs, vr, vs, vw->vol, 0, NULL, NULL),
+               "clEnqueueWriteBufferRect(volume)");
+    for (d = 0; d < 3; ++d) {
+        o[d] = (size_t)cells->lo[d] * (d == 0 ? f : 1);
+        n[d] = (size_t)(cells->hi[d] - cells->lo[d]) * (d == 0 ? f : 1);
+    }
+    HD__CL_TRY(vw, clEnqueueWriteBufferRect(be->queue, be->maj, CL_TRUE, o, o, n, mr, ms, mr, ms, vw->majorant, 0, NULL, NULL),
+               "clEnqueueWriteBufferRect(majorant)");
+    return HD_SUCCESS;
+}
+
 /* Elements of a colour-layout grid of `slices` z-slices (gz per channel): each row of gx voxels
    takes 2 * ((gx + 1) / 2) slots, one of them padding when gx is odd. */
 #define HD__BE_SPLIT_LAYOUT 1 /* hd_get_stats counts the layout's padding slots */

@@ -1487,6 +1487,47 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* hd_update_volume: the box of the volume through the staging buffer into the volume image (one
+   region, submitted and waited for), the majorant cells' rows written in place. */
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
+{
+    hd__backend *be = vw->be;
+    hd__vk_image *im = &be->vol;
+    int w = vox->hi[0] - vox->lo[0], h = vox->hi[1] - vox->lo[1], dz = vox->hi[2] - vox->lo[2], x, y, z;
+    size_t bytes = (size_t)w * h * dz * (size_t)im->texel, k = 0;
+    VkBufferImageCopy reg = hd__vk_region(im);
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    HD__VK_IDLE(vw); /* the staging buffer and the majorants are free */
+    if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
+    for (z = vox->lo[2]; z < vox->hi[2]; ++z)
+        for (y = vox->lo[1]; y < vox->hi[1]; ++y) {
+            const float *row = vw->vol + ((size_t)z * vw->dims[1] + y) * vw->dims[0] + vox->lo[0];
+            if (im->texel == 2)
+                for (x = 0; x < w; ++x) ((uint16_t *)be->staging.map)[k + (size_t)x] = hdk_f2h(row[x]);
+            else
+                memcpy((float *)be->staging.map + k, row, (size_t)w * sizeof(float));
+            k += (size_t)w;
+        }
+    reg.imageOffset.x = vox->lo[0];
+    reg.imageOffset.y = vox->lo[1];
+    reg.imageOffset.z = vox->lo[2];
+    reg.imageExtent.width = (uint32_t)w;
+    reg.imageExtent.height = (uint32_t)h;
+    reg.imageExtent.depth = (uint32_t)dz;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
+    hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
+    for (z = cells->lo[2]; z < cells->hi[2]; ++z)
+        for (y = cells->lo[1]; y < cells->hi[1]; ++y) {
+            size_t at = ((size_t)z * vw->mdims[1] + y) * vw->mdims[0] + (size_t)cells->lo[0];
+            memcpy((float *)be->maj.map + at, vw->majorant + at, (size_t)(cells->hi[0] - cells->lo[0]) * sizeof(float));
+        }
+    return HD_SUCCESS;
+}
+
 static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats)
 {
     hd__backend *be = vw->be;

@@ -152,12 +152,7 @@ HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_functio
     if ((r = hd__check_tf(tf, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
     hd__build_majorants(ctx);
-    if (ctx->vw.params.majorant > 0.0f &&
-        (ctx->vw.params.majorant < ctx->max_sigma / (1.0f + 1e-5f) || ctx->vw.params.majorant > hd__majorant_cap(ctx->max_sigma))) {
-        HD__INFO(&ctx->vw.log, "params.majorant %g is outside 1..16x the new TF's largest extinction %g: using the majorant grid",
-                 (double)ctx->vw.params.majorant, (double)ctx->max_sigma);
-        ctx->vw.params.majorant = 0.0f;
-    }
+    hd__majorant_follow(ctx, "new TF");
     ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
@@ -269,6 +264,26 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
     hd__set_channels(ctx);
     if (ctx->dirty & HD__DIRTY_ALLOC) hd__set_grid(ctx);
     if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
+    return HD_SUCCESS;
+}
+
+/* ---- a volume that changes ------------------------------------------------------------------- */
+/* The voxels, majorant cells and (at the next hd__prepare) the backend's copy and the direct
+   light's mask follow the update; E and phi are the warm start of the new light. */
+HDDEF hd_result hd_update_volume(hd_context h, const hd_volume_update *update)
+{
+    hd_result r;
+    int changed;
+    HD__GET_CTX(ctx, h);
+    if ((r = hd__update_voxels(ctx, update, &changed)) != HD_SUCCESS || !changed) return r;
+    ctx->dirty |= HD__DIRTY_VOLUME | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI | HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_reset(hd_context h)
+{
+    HD__GET_CTX(ctx, h);
+    ctx->dirty |= HD__INV_LIGHT;
     return HD_SUCCESS;
 }
 

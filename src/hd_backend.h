@@ -58,6 +58,27 @@ static hd_result hd__be_end(const hd__view *vw, hd_result r);
 /* ---- allocation (the core calls these from hd__prepare when its dirty bits say so) ----------- */
 /* The volume, TF and majorant of the view are new: upload them (classification follows). */
 static hd_result hd__be_upload_inputs(const hd__view *vw);
+/* A box of a grid, [lo, hi) per axis x, y, z. */
+typedef struct hd__box {
+    int lo[3], hi[3];
+} hd__box;
+/* The majorant cells whose value range (their voxels and a one-voxel halo, src/hd_volume.h) holds
+   a voxel of the box vox: the cells hd_update_volume changes with it. */
+HD__MAYBE_UNUSED static hd__box hd__box_cells(const hd__view *vw, const hd__box *vox)
+{
+    hd__box c;
+    int d, m = HD__MAJORANT_CELL;
+    for (d = 0; d < 3; ++d) {
+        c.lo[d] = vox->lo[d] > 0 ? (vox->lo[d] - 1) / m : 0;
+        c.hi[d] = vox->hi[d] / m + 1;
+        if (c.hi[d] > vw->mdims[d]) c.hi[d] = vw->mdims[d];
+    }
+    return c;
+}
+/* hd_update_volume: vw->vol's voxels in the box vox changed, and with them vw->majorant's cells
+   in the box cells (hd__box_cells): upload those alone, nothing else of the volume or grid.
+   hd__be_classify follows (the core calls it); the illumination is kept. */
+static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells);
 /* E, phi and phi2 for illum_floats values (0: free them; PT methods), contents undefined until
    hd__be_clear. Multigrid levels on the old grid may be dropped here; hd__be_mg_begin remakes
    them whenever they are missing or the grid changed. */

@@ -113,8 +113,8 @@ static hd_result hd__conv_fold(hd__ctx *ctx, hd_illumination which, double *dsq,
 }
 
 /* After a light iteration: the estimate of E + phi's relative RMS error (hd_stats.light_error).
-   E is a Monte Carlo mean of n samples, whose change is (s_n - E_n-1) / n: its RMS times sqrt(n)
-   estimates the standard error. phi follows a fixed-point iteration, whose remaining error is
+   E is a Monte Carlo mean of n samples (ctx->dl_n: capped by a warm start), whose change is
+   (s_n - E_n-1) / n: its RMS times sqrt(n) estimates the standard error. phi follows a fixed-point iteration, whose remaining error is
    about its change times q / (1 - q) for a contraction q, taken from successive changes.
    CD's E is deterministic and counted with phi. */
 static hd_result hd__light_measure(hd__ctx *ctx)
@@ -130,7 +130,7 @@ static hd_result hd__light_measure(hd__ctx *ctx)
         return HD_SUCCESS;
     }
     if (ctx->vw.params.method == HD_METHOD_HD) {
-        err = sqrt((double)ctx->iterations * de);
+        err = sqrt((double)(ctx->dl_n ? ctx->dl_n : 1) * de); /* the samples E's mean holds */
     } else {
         err = 0.0;
         dp += de;

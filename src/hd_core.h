@@ -120,6 +120,10 @@ typedef struct hd__ctx {
     uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
     int image_empty;         /* the image holds no frame: new (a new camera size) or reset, none
                                 projected since (the read-backs say HD_ERROR_NO_FRAME) */
+    uint64_t dl_n;           /* samples E's running mean holds: the next weighs 1 / (dl_n + 1); a
+                                warm start caps it at params.light_window (src/hd_schedule.h) */
+    hd__box upd;             /* the voxels hd_update_volume changed since the last hd__prepare
+                                (HD__DIRTY_VOLUME), [lo, hi) */
 } hd__ctx;
 
 /* The path tracers keep no illumination grid: the image is their whole state. */

@@ -65,30 +65,85 @@ static void hd__direct_mask_free(hd__ctx *ctx)
     ctx->vw.dl_count = 0;
 }
 
-/* Builds dl_bits and dl_idx for the current TF, extinction, crop box and grid. */
-static hd_result hd__direct_mask(hd__ctx *ctx)
+/* dl_idx from dl_bits (every grid voxel with the test hook dl.all), brick by brick
+   (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries, one work item's, start
+   side by side, so their rays read the same part of the volume. */
+static hd_result hd__direct_list_build(hd__ctx *ctx)
 {
-    const int *n = ctx->vw.dims, *g = ctx->vw.gdims;
-    int dn[3], d, x, y, z, j;
-    size_t gvox = (size_t)g[0] * g[1] * g[2], ncell = (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2], ndual, i, k;
+    const int *g = ctx->vw.gdims;
+    size_t gvox = (size_t)g[0] * g[1] * g[2], i, k;
+    int bx, by, bz, x, y, z, b = HD__DL_BRICK;
+    hd__free(&ctx->vw, ctx->vw.dl_idx);
+    ctx->vw.dl_gen++;
+    if (ctx->dl.all) ctx->vw.dl_count = gvox;
+    ctx->vw.dl_idx = (uint32_t *)hd__alloc(&ctx->vw, (ctx->vw.dl_count ? ctx->vw.dl_count : 1) * sizeof(uint32_t));
+    if (!ctx->vw.dl_idx)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's list (%zu voxels)", ctx->vw.dl_count);
+    if (ctx->dl.all) {
+        for (k = 0; k < gvox; ++k) ctx->vw.dl_idx[k] = (uint32_t)k;
+        return HD_SUCCESS;
+    }
+    for (bz = 0, i = 0; bz < g[2]; bz += b)
+        for (by = 0; by < g[1]; by += b)
+            for (bx = 0; bx < g[0]; bx += b)
+                for (z = bz; z < bz + b && z < g[2]; ++z)
+                    for (y = by; y < by + b && y < g[1]; ++y)
+                        for (x = bx, k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx; x < bx + b && x < g[0]; ++x, ++k)
+                            if (ctx->dl.bits[k >> 3] >> (k & 7) & 1u) ctx->vw.dl_idx[i++] = (uint32_t)k;
+    return HD_SUCCESS;
+}
+
+/* Builds dl_bits and dl_idx for the current TF, extinction, crop box, grid and volume: with vox
+   NULL (or no mask yet) everywhere; else only for the grid voxels whose reads reach a dual cell
+   holding a voxel of the box vox (the voxels hd_update_volume changed), the others' bits kept.
+   *changed (may be NULL) says whether any bit changed; the list is rebuilt when one did. */
+static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *changed)
+{
+    const int *n = ctx->vw.dims, *g = ctx->vw.gdims, M = HD__MAJORANT_CELL;
+    int dn[3], G0[3], G1[3], Gn[3], D0[3], D1[3], Dn[3], d, x, y, z, j, full = !vox || !ctx->dl.bits, any = 0;
+    size_t gvox = (size_t)g[0] * g[1] * g[2], k;
     int32_t *entry_run = NULL;
     uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL;
     int (*span)[2] = NULL;
     hd_result r = HD_SUCCESS;
-    hd__direct_mask_free(ctx);
+    if (changed) *changed = 0;
     for (d = 0; d < 3; ++d) dn[d] = n[d] > 1 ? n[d] - 1 : 1;
-    ndual = (size_t)dn[0] * dn[1] * dn[2];
-    ctx->dl.bits = (uint8_t *)hd__calloc(&ctx->vw, (gvox + 7) / 8, 1);
-    entry_run = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
-    cell = (uint8_t *)hd__alloc(&ctx->vw, ndual);
-    ax = (uint8_t *)hd__alloc(&ctx->vw, (size_t)g[0] * dn[1] * dn[2]);
-    ay = (uint8_t *)hd__alloc(&ctx->vw, (size_t)g[0] * g[1] * dn[2]);
-    span = (int (*)[2])hd__alloc(&ctx->vw, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
-    crop = (uint8_t *)hd__alloc(&ctx->vw, (size_t)(dn[0] + dn[1] + dn[2]));
-    if (!ctx->dl.bits || !entry_run || !cell || !ax || !ay || !span || !crop) {
-        r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
-        goto done;
+    if (full) {
+        hd__direct_mask_free(ctx);
+        ctx->dl.bits = (uint8_t *)hd__calloc(&ctx->vw, (gvox + 7) / 8, 1);
+        ctx->vw.dl_count = 0;
     }
+    span = (int (*)[2])hd__alloc(&ctx->vw, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
+    entry_run = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
+    crop = (uint8_t *)hd__alloc(&ctx->vw, (size_t)(dn[0] + dn[1] + dn[2]));
+    if (!ctx->dl.bits || !span || !entry_run || !crop) goto oom;
+    for (d = 0, k = 0; d < 3; ++d)
+        for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
+    /* the grid voxels to redo, G0..G1 per axis (the spans are monotone in x: a range), and the
+       dual cells D0..D1 their reads reach */
+    for (d = 0, k = 0; d < 3; k += (size_t)g[d], ++d) {
+        int a = 0, b = dn[d] - 1;
+        if (!full) {
+            a = vox->lo[d] - 1 > 0 ? vox->lo[d] - 1 : 0;       /* dual cell j holds voxels j and j + 1 */
+            b = vox->hi[d] - 1 < dn[d] - 1 ? vox->hi[d] - 1 : dn[d] - 1;
+        }
+        G0[d] = g[d];
+        G1[d] = -1;
+        for (x = 0; x < g[d]; ++x)
+            if (span[k + x][0] <= b && span[k + x][1] >= a) {
+                if (x < G0[d]) G0[d] = x;
+                G1[d] = x;
+            }
+        if (G1[d] < G0[d]) goto done; /* no grid voxel reads there */
+        Gn[d] = G1[d] - G0[d] + 1;
+        D0[d] = span[k + G0[d]][0];
+        D1[d] = span[k + G1[d]][1];
+        Dn[d] = D1[d] - D0[d] + 1;
+    }
+    cell = (uint8_t *)hd__calloc(&ctx->vw, (size_t)Dn[0] * Dn[1] * Dn[2], 1);
+    ax = (uint8_t *)hd__alloc(&ctx->vw, (size_t)Gn[0] * Dn[1] * Dn[2]);
+    ay = (uint8_t *)hd__alloc(&ctx->vw, (size_t)Gn[0] * Gn[1] * Dn[2]);
+    if (!cell || !ax || !ay) goto oom;
     /* runs of zero-alpha entries; with no extinction nothing is medium */
     for (j = 0, k = 0; j < ctx->vw.tf_count; ++j) {
         int zero = !(ctx->vw.tf[4 * j + 3] > 0.0f) || !(ctx->vw.params.extinction > 0.0f);
@@ -105,106 +160,97 @@ static hd_result hd__direct_mask(hd__ctx *ctx)
        majorant cell (those whose lower corner it holds): the cell's value range, filter halo
        included, covers their 8 voxels, so when it lies in one zero run they are all empty and no
        voxel's run is needed; elsewhere the runs of the cell's block of voxels are computed once */
-    memset(cell, 0, ndual);
-    for (i = 0; i < ncell; ++i) {
-        enum { M = HD__MAJORANT_CELL, B = HD__MAJORANT_CELL + 1 };
-        int32_t blk[B * B * B];
-        int c[3], lo[3], hi[3], bx, by, bz;
-        const float *vol = ctx->vw.vol;
-        if (hd__dl_run_range(entry_run, ctx->vw.tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
-        c[0] = (int)(i % (size_t)ctx->vw.mdims[0]);
-        c[1] = (int)(i / (size_t)ctx->vw.mdims[0] % (size_t)ctx->vw.mdims[1]);
-        c[2] = (int)(i / ((size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1]));
-        for (d = 0; d < 3; ++d) {
-            lo[d] = c[d] * M;                                       /* first dual cell and voxel */
-            hi[d] = lo[d] + M < dn[d] ? lo[d] + M : dn[d];          /* dual cells end (exclusive) */
-        }
-        if (lo[0] >= hi[0] || lo[1] >= hi[1] || lo[2] >= hi[2]) continue;
-        /* runs of voxels lo .. min(hi, n - 1) */
-        bx = (hi[0] < n[0] - 1 ? hi[0] : n[0] - 1) - lo[0] + 1;
-        by = (hi[1] < n[1] - 1 ? hi[1] : n[1] - 1) - lo[1] + 1;
-        bz = (hi[2] < n[2] - 1 ? hi[2] : n[2] - 1) - lo[2] + 1;
-        for (z = 0; z < bz; ++z)
-            for (y = 0; y < by; ++y)
-                for (x = 0; x < bx; ++x)
-                    blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
-                                                          vol[((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x]);
-        for (z = lo[2]; z < hi[2]; ++z)
-            for (y = lo[1]; y < hi[1]; ++y)
-                for (x = lo[0]; x < hi[0]; ++x) {
-                    int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
-                    size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
-                    size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
-                    /* the block's rows of the 4 voxel rows, at x and x1 */
-                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
-                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
-                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
-                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
-                    int xa = x - lo[0], xb = x1 - lo[0];
-                    int32_t a = b0[xa];
-                    float v = vol[r00 + x];
-                    uint8_t full = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
-                                     b3[xa] == a && b3[xb] == a);
-                    /* 8 equal values interpolate to that value exactly, whatever the weights */
-                    if (full && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
-                        vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
-                        !(hd__tf_alpha(ctx, v) * ctx->vw.params.extinction > 0.0f))
-                        full = 0;
-                    if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full = 0;
-                    cell[((size_t)z * dn[1] + y) * dn[0] + x] = full;
+    {
+        int cx, cy, cz;
+        for (cz = D0[2] / M; cz <= D1[2] / M; ++cz)
+            for (cy = D0[1] / M; cy <= D1[1] / M; ++cy)
+                for (cx = D0[0] / M; cx <= D1[0] / M; ++cx) {
+                    enum { B = HD__MAJORANT_CELL + 1 };
+                    int32_t blk[B * B * B];
+                    int c[3], lo[3], hi[3], bx, by, bz;
+                    const float *vol = ctx->vw.vol;
+                    size_t i = ((size_t)cz * ctx->vw.mdims[1] + cy) * ctx->vw.mdims[0] + cx;
+                    if (hd__dl_run_range(entry_run, ctx->vw.tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
+                    c[0] = cx; c[1] = cy; c[2] = cz;
+                    for (d = 0; d < 3; ++d) {
+                        lo[d] = c[d] * M;                              /* first dual cell and voxel */
+                        hi[d] = lo[d] + M < dn[d] ? lo[d] + M : dn[d]; /* dual cells end (exclusive) */
+                        if (lo[d] < D0[d]) lo[d] = D0[d];              /* those to redo */
+                        if (hi[d] > D1[d] + 1) hi[d] = D1[d] + 1;
+                    }
+                    if (lo[0] >= hi[0] || lo[1] >= hi[1] || lo[2] >= hi[2]) continue;
+                    /* runs of voxels lo .. min(hi, n - 1) */
+                    bx = (hi[0] < n[0] - 1 ? hi[0] : n[0] - 1) - lo[0] + 1;
+                    by = (hi[1] < n[1] - 1 ? hi[1] : n[1] - 1) - lo[1] + 1;
+                    bz = (hi[2] < n[2] - 1 ? hi[2] : n[2] - 1) - lo[2] + 1;
+                    for (z = 0; z < bz; ++z)
+                        for (y = 0; y < by; ++y)
+                            for (x = 0; x < bx; ++x)
+                                blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
+                                                                      vol[((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x]);
+                    for (z = lo[2]; z < hi[2]; ++z)
+                        for (y = lo[1]; y < hi[1]; ++y)
+                            for (x = lo[0]; x < hi[0]; ++x) {
+                                int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
+                                size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
+                                size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
+                                /* the block's rows of the 4 voxel rows, at x and x1 */
+                                const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
+                                const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
+                                const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
+                                const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
+                                int xa = x - lo[0], xb = x1 - lo[0];
+                                int32_t a = b0[xa];
+                                float v = vol[r00 + x];
+                                uint8_t full_cell = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
+                                                      b3[xa] == a && b3[xb] == a);
+                                /* 8 equal values interpolate to that value exactly, whatever the weights */
+                                if (full_cell && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
+                                    vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
+                                    !(hd__tf_alpha(ctx, v) * ctx->vw.params.extinction > 0.0f))
+                                    full_cell = 0;
+                                if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full_cell = 0;
+                                cell[((size_t)(z - D0[2]) * Dn[1] + (y - D0[1])) * Dn[0] + (x - D0[0])] = full_cell;
+                            }
                 }
     }
     /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
-    for (d = 0, k = 0; d < 3; ++d)
-        for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
-    for (z = 0; z < dn[2]; ++z)
-        for (y = 0; y < dn[1]; ++y)
-            for (x = 0; x < g[0]; ++x) {
-                const uint8_t *c = cell + ((size_t)z * dn[1] + y) * dn[0];
+    for (z = 0; z < Dn[2]; ++z)
+        for (y = 0; y < Dn[1]; ++y)
+            for (x = 0; x < Gn[0]; ++x) {
+                const uint8_t *c = cell + ((size_t)z * Dn[1] + y) * Dn[0];
                 uint8_t v = 0;
-                for (j = span[x][0]; j <= span[x][1]; ++j) v |= c[j];
-                ax[((size_t)z * dn[1] + y) * g[0] + x] = v;
+                for (j = span[G0[0] + x][0]; j <= span[G0[0] + x][1]; ++j) v |= c[j - D0[0]];
+                ax[((size_t)z * Dn[1] + y) * Gn[0] + x] = v;
             }
-    for (z = 0; z < dn[2]; ++z)
-        for (y = 0; y < g[1]; ++y)
-            for (x = 0; x < g[0]; ++x) {
+    for (z = 0; z < Dn[2]; ++z)
+        for (y = 0; y < Gn[1]; ++y)
+            for (x = 0; x < Gn[0]; ++x) {
                 uint8_t v = 0;
-                for (j = span[g[0] + y][0]; j <= span[g[0] + y][1]; ++j) v |= ax[((size_t)z * dn[1] + j) * g[0] + x];
-                ay[((size_t)z * g[1] + y) * g[0] + x] = v;
+                for (j = span[g[0] + G0[1] + y][0]; j <= span[g[0] + G0[1] + y][1]; ++j) v |= ax[((size_t)z * Dn[1] + (j - D0[1])) * Gn[0] + x];
+                ay[((size_t)z * Gn[1] + y) * Gn[0] + x] = v;
             }
-    ctx->vw.dl_count = 0;
-    for (z = 0, k = 0; z < g[2]; ++z)
-        for (y = 0; y < g[1]; ++y)
-            for (x = 0; x < g[0]; ++x, ++k) {
-                uint8_t v = 0;
-                for (j = span[g[0] + g[1] + z][0]; j <= span[g[0] + g[1] + z][1]; ++j)
-                    v |= ay[((size_t)j * g[1] + y) * g[0] + x];
+    for (z = 0; z < Gn[2]; ++z)
+        for (y = 0; y < Gn[1]; ++y)
+            for (x = 0; x < Gn[0]; ++x) {
+                uint8_t v = 0, was;
+                k = ((size_t)(G0[2] + z) * g[1] + (size_t)(G0[1] + y)) * g[0] + (size_t)(G0[0] + x);
+                for (j = span[g[0] + g[1] + G0[2] + z][0]; j <= span[g[0] + g[1] + G0[2] + z][1]; ++j)
+                    v |= ay[((size_t)(j - D0[2]) * Gn[1] + y) * Gn[0] + x];
+                was = (uint8_t)(ctx->dl.bits[k >> 3] >> (k & 7) & 1u);
+                if (v == was) continue;
+                any = 1;
                 if (v) {
                     ctx->dl.bits[k >> 3] |= (uint8_t)(1u << (k & 7));
                     ++ctx->vw.dl_count;
+                } else {
+                    ctx->dl.bits[k >> 3] &= (uint8_t)~(1u << (k & 7));
+                    --ctx->vw.dl_count;
                 }
             }
-    if (ctx->dl.all) ctx->vw.dl_count = gvox;
-    ctx->vw.dl_idx = (uint32_t *)hd__alloc(&ctx->vw, (ctx->vw.dl_count ? ctx->vw.dl_count : 1) * sizeof(uint32_t));
-    if (!ctx->vw.dl_idx) {
-        r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's list (%zu voxels)", ctx->vw.dl_count);
-        goto done;
-    }
-    if (ctx->dl.all) {
-        for (k = 0; k < gvox; ++k) ctx->vw.dl_idx[k] = (uint32_t)k;
-    } else {
-        /* brick by brick (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries,
-           one work item's, start side by side, so their rays read the same part of the volume */
-        int bx, by, bz, b = HD__DL_BRICK;
-        for (bz = 0, i = 0; bz < g[2]; bz += b)
-            for (by = 0; by < g[1]; by += b)
-                for (bx = 0; bx < g[0]; bx += b)
-                    for (z = bz; z < bz + b && z < g[2]; ++z)
-                        for (y = by; y < by + b && y < g[1]; ++y)
-                            for (x = bx, k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx; x < bx + b && x < g[0]; ++x, ++k)
-                                if (ctx->dl.bits[k >> 3] >> (k & 7) & 1u) ctx->vw.dl_idx[i++] = (uint32_t)k;
-    }
 done:
+    if (full || any) r = hd__direct_list_build(ctx);
+    if (changed) *changed = full || any;
     hd__free(&ctx->vw, entry_run);
     hd__free(&ctx->vw, cell);
     hd__free(&ctx->vw, ax);
@@ -212,6 +258,19 @@ done:
     hd__free(&ctx->vw, span);
     hd__free(&ctx->vw, crop);
     if (r != HD_SUCCESS) hd__direct_mask_free(ctx);
+    return r;
+oom:
+    r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
+    hd__free(&ctx->vw, entry_run);
+    hd__free(&ctx->vw, cell);
+    hd__free(&ctx->vw, ax);
+    hd__free(&ctx->vw, ay);
+    hd__free(&ctx->vw, span);
+    hd__free(&ctx->vw, crop);
+    hd__direct_mask_free(ctx);
     ctx->vw.dl_gen++;
     return r;
 }
+
+/* The whole mask (hd__direct_mask_box everywhere). */
+static hd_result hd__direct_mask(hd__ctx *ctx) { return hd__direct_mask_box(ctx, NULL, NULL); }

@@ -49,6 +49,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
         k->march.y = (float)(1.0 / (double)(f < win ? f : win));
     }
     k->march.z = 1e-4f; /* stop marching below this transmittance */
+    k->march.w = 1.0f / (float)(ctx->dl_n < 1 ? 1 : ctx->dl_n); /* E's running mean: the new sample's weight */
     /* the camera's rays in the volume's frame (hd__camera_frame); the host's depth buffer */
     k->cam_pos.x = cf->pos[0]; k->cam_pos.y = cf->pos[1]; k->cam_pos.z = cf->pos[2];
     k->cam_u.x = cf->u[0]; k->cam_u.y = cf->u[1]; k->cam_u.z = cf->u[2];

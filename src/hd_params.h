@@ -9,6 +9,13 @@
 /* What a change invalidates (hd__params_dirty ORs the rows' bits into the context's dirty set). */
 #define HD__DIRTY_PATHS 0x100u /* the path tracers' running mean only: the image while the
                                   method is PT_SS or PT_MS, nothing for HD and CD */
+#define HD__DIRTY_WARM_E 0x200u   /* E's solution changed, its mean is the warm start of the new one:
+                                     re-weighted to hold at most light_window samples (src/hd_schedule.h) */
+#define HD__DIRTY_WARM_PHI 0x400u /* phi's solution changed, phi is the warm start of the new one */
+#define HD__DIRTY_VOLUME 0x800u   /* hd_update_volume changed the voxels of the context's box upd:
+                                     uploaded, reclassified and the direct light's mask redone there */
+#define HD__DIRTY_TF 0x1000u      /* the TF's colours changed and nothing the light depends on: the
+                                     TF is uploaded again, nothing reclassified */
 #define HD__INV_NONE 0u        /* the same solution, estimator or encoding */
 #define HD__INV_IMAGE ((unsigned)HD__DIRTY_IMAGE)
 #define HD__INV_PHI ((unsigned)(HD__DIRTY_PHI | HD__DIRTY_IMAGE))
@@ -59,7 +66,8 @@
     FLOAT(render_budget, 0.0f, 0.0f, HD__MAX_RENDER_BUDGET, 0, "in [0, 10] seconds", HD__INV_NONE) \
     FLOAT3(crop_min, 0.0f, 0.0f, 1.0f, "in [0, 1]", HD__INV_MEDIUM) \
     FLOAT3(crop_max, 1.0f, 0.0f, 1.0f, "in [0, 1]", HD__INV_MEDIUM) \
-    INT(render_scale, 1, -1, HD__MAX_RENDER_SCALE, "1..8 or HD_RENDER_SCALE_AUTO (-1)", HD__INV_IMAGE)
+    INT(render_scale, 1, -1, HD__MAX_RENDER_SCALE, "1..8 or HD_RENDER_SCALE_AUTO (-1)", HD__INV_IMAGE) \
+    INT(light_window, 8, 1, 1000000, "in 1..1000000", HD__INV_NONE)
 
 /* ---- defaults: a zero field gets the row's default --------------------------------------------- */
 #define HD__PD_ENUM(n, t, def, count, inv) if ((int)p->n == 0) p->n = def;

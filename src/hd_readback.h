@@ -156,7 +156,8 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
     out->seconds_diffusion = ctx->seconds[1];
     out->seconds_projection = ctx->seconds[2];
     if (!hd__method_is_pt(ctx->vw.params.method)) {
-        int fresh = (ctx->dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) != 0;
+        int fresh = (ctx->dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_SIGMA | HD__DIRTY_ALLOC | HD__DIRTY_WARM_E |
+                                   HD__DIRTY_WARM_PHI | HD__DIRTY_VOLUME)) != 0;
         out->light_error = fresh ? 1.0 : ctx->light_error;
         out->light_converged = !fresh && hd__light_converged(ctx);
     }

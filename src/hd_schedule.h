@@ -52,19 +52,42 @@ static hd_result hd__prepare(hd__ctx *ctx)
         if ((r = hd__be_upload_depth(&ctx->vw)) != HD_SUCCESS) return r;
         ctx->dirty &= ~(unsigned)HD__DIRTY_DEPTH;
     }
-    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = 0;
+    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = 0;
+    /* a warm start: E's mean keeps at most light_window samples of the light before the change
+       (the iteration count, the random numbers' key, runs on) */
+    if ((dirty & HD__DIRTY_WARM_E) && ctx->dl_n > (uint64_t)ctx->vw.params.light_window) ctx->dl_n = (uint64_t)ctx->vw.params.light_window;
     if (dirty & HD__DIRTY_IMAGE) {
         ctx->frames = ctx->converged_frames = 0;
         ctx->frame_scale = 0;
         ctx->image_empty = 1;
     }
     /* the measured voxels follow the medium and the grid; the error estimate follows E and phi */
-    if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC)) hd__conv_free(ctx);
-    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) {
+    if (dirty & (HD__DIRTY_SIGMA | HD__DIRTY_ALLOC | HD__DIRTY_VOLUME)) hd__conv_free(ctx);
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI)) {
         hd__conv_reset(ctx);
         ctx->light_gen++;
     }
     hd__fill_kparams(ctx);
+    if (dirty & HD__DIRTY_VOLUME) {
+        /* hd_update_volume's voxels and majorant cells; with SIGMA the whole medium follows */
+        hd__box cells = hd__box_cells(&ctx->vw, &ctx->upd);
+        if ((r = hd__be_update_volume(&ctx->vw, &ctx->upd, &cells)) != HD_SUCCESS) return r;
+        if (!(dirty & HD__DIRTY_SIGMA)) {
+            int changed = 0;
+            if (!pt) {
+                ++ctx->sig_gen;
+                if ((r = hd__be_classify(&ctx->vw)) != HD_SUCCESS) return r;
+            }
+            if (ctx->vw.params.method == HD_METHOD_HD) {
+                if ((r = hd__direct_mask_box(ctx, &ctx->upd, &changed)) != HD_SUCCESS) return r;
+                if (changed && (r = hd__be_direct_list(&ctx->vw)) != HD_SUCCESS) return r;
+            }
+        }
+        ctx->dirty &= ~(unsigned)HD__DIRTY_VOLUME;
+    }
+    if ((dirty & HD__DIRTY_TF) && !(dirty & HD__DIRTY_SIGMA)) {
+        if ((r = hd__be_upload_inputs(&ctx->vw)) != HD_SUCCESS) return r;
+    }
     if (dirty & HD__DIRTY_SIGMA) {
         if ((r = hd__be_upload_inputs(&ctx->vw)) != HD_SUCCESS) return r;
         if (!pt) {
@@ -112,6 +135,7 @@ static hd_result hd__light_iteration(hd__ctx *ctx)
     hd_result r;
     double t0 = hd__now(), t1, t2;
     ctx->iterations++;
+    ctx->dl_n++;
     hd__fill_kparams(ctx);
     if (ctx->vw.params.method == HD_METHOD_CD) {
         int l;

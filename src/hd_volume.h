@@ -10,17 +10,76 @@ static float hd__raw_value(const hd_volume_desc *v, size_t i)
     }
 }
 
+/* The map from raw values to TF coordinates [0, 1] of value_range {lo, hi}: NaN maps to 0,
+   values outside are clamped. The width of a finite range may pass FLT_MAX ({-3e38, 3e38}), or
+   its inverse (a denormal width): then in double. */
+typedef struct hd__norm {
+    float lo, scale;
+    int wide;
+    double dscale;
+} hd__norm;
+static hd__norm hd__norm_of(const hd_volume_desc *v)
+{
+    hd__norm m;
+    float lo = v->value_range[0], hi = v->value_range[1];
+    m.lo = lo;
+    m.scale = 1.0f / (hi - lo);
+    m.wide = !hd__finite(hi - lo) || !hd__finite(m.scale);
+    m.dscale = 1.0 / ((double)hi - (double)lo);
+    return m;
+}
+static float hd__norm_value(const hd__norm *m, float raw)
+{
+    float t = m->wide ? (float)(((double)raw - (double)m->lo) * m->dscale) : (raw - m->lo) * m->scale;
+    return t != t ? 0.0f : (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t));
+}
+
+/* The value range a trilinear sample inside each majorant cell of the box can take: the min and
+   max over the cell's voxels and a one-voxel halo (voxels c M - 1 .. c M + M per axis). */
+static void hd__cell_ranges(hd__ctx *ctx, const hd__box *cells)
+{
+    const int *n = ctx->vw.dims, *md = ctx->vw.mdims, M = HD__MAJORANT_CELL;
+    int cx, cy, cz, x, y, z;
+    for (cz = cells->lo[2]; cz < cells->hi[2]; ++cz)
+        for (cy = cells->lo[1]; cy < cells->hi[1]; ++cy)
+            for (cx = cells->lo[0]; cx < cells->hi[0]; ++cx) {
+                int x0 = cx * M - 1 < 0 ? 0 : cx * M - 1, x1 = cx * M + M < n[0] - 1 ? cx * M + M : n[0] - 1;
+                int y0 = cy * M - 1 < 0 ? 0 : cy * M - 1, y1 = cy * M + M < n[1] - 1 ? cy * M + M : n[1] - 1;
+                int z0 = cz * M - 1 < 0 ? 0 : cz * M - 1, z1 = cz * M + M < n[2] - 1 ? cz * M + M : n[2] - 1;
+                float lo = 1.0f, hi = 0.0f;
+                for (z = z0; z <= z1; ++z)
+                    for (y = y0; y <= y1; ++y) {
+                        const float *row = ctx->vw.vol + ((size_t)z * n[1] + y) * n[0];
+                        for (x = x0; x <= x1; ++x) {
+                            if (row[x] < lo) lo = row[x];
+                            if (row[x] > hi) hi = row[x];
+                        }
+                    }
+                ctx->cell_range[2 * (((size_t)cz * md[1] + cy) * md[0] + cx)] = lo;
+                ctx->cell_range[2 * (((size_t)cz * md[1] + cy) * md[0] + cx) + 1] = hi;
+            }
+}
+
+/* The whole grid of majorant cells. */
+static hd__box hd__all_cells(const hd__ctx *ctx)
+{
+    hd__box b;
+    int d;
+    for (d = 0; d < 3; ++d) {
+        b.lo[d] = 0;
+        b.hi[d] = ctx->vw.mdims[d];
+    }
+    return b;
+}
+
 /* Normalises the voxels to TF coordinates and records, per majorant cell, the value range a
    trilinear sample inside the cell can take (its voxels and a one-voxel halo). */
 static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
 {
-    float lo = v->value_range[0], hi = v->value_range[1], scale = 1.0f / (hi - lo);
-    /* the width of a finite range may pass FLT_MAX ({-3e38, 3e38}), or its inverse (a
-       denormal width): then in double */
-    int wide = !hd__finite(hi - lo) || !hd__finite(scale);
-    double dscale = 1.0 / ((double)hi - (double)lo);
+    hd__norm m = hd__norm_of(v);
+    hd__box all;
     size_t i, ncell;
-    int d, x, y, z;
+    int d;
     double extent[3], emax = 0.0; /* double: dims * spacing may pass FLT_MAX (hd__check_extent) */
     for (d = 0; d < 3; ++d) {
         ctx->vw.dims[d] = v->dims[d];
@@ -36,32 +95,9 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
     ctx->vw.majorant = (float *)hd__calloc(&ctx->vw, ncell, sizeof(float));
     if (!ctx->vw.vol || !ctx->cell_range || !ctx->vw.majorant)
         return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "cannot allocate the volume (%zu voxels)", ctx->vw.nvox);
-    for (i = 0; i < ctx->vw.nvox; ++i) {
-        float t = wide ? (float)(((double)hd__raw_value(v, i) - (double)lo) * dscale) : (hd__raw_value(v, i) - lo) * scale;
-        ctx->vw.vol[i] = t != t ? 0.0f : (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t));
-    }
-    for (i = 0; i < ncell; ++i) { ctx->cell_range[2 * i] = 1.0f; ctx->cell_range[2 * i + 1] = 0.0f; }
-    /* each voxel widens the range of every cell whose halo-extended footprint holds it */
-    for (z = 0; z < ctx->vw.dims[2]; ++z)
-        for (y = 0; y < ctx->vw.dims[1]; ++y)
-            for (x = 0; x < ctx->vw.dims[0]; ++x) {
-                float val = ctx->vw.vol[((size_t)z * ctx->vw.dims[1] + y) * ctx->vw.dims[0] + x];
-                int c0[3], c1[3], p[3], cx, cy, cz;
-                p[0] = x; p[1] = y; p[2] = z;
-                for (d = 0; d < 3; ++d) {
-                    c0[d] = (p[d] - 1 + HD__MAJORANT_CELL) / HD__MAJORANT_CELL - 1; /* cell whose last halo voxel is p */
-                    c1[d] = (p[d] + 1) / HD__MAJORANT_CELL;                         /* cell whose first halo voxel is p */
-                    if (c0[d] < 0) c0[d] = 0;
-                    if (c1[d] > ctx->vw.mdims[d] - 1) c1[d] = ctx->vw.mdims[d] - 1;
-                }
-                for (cz = c0[2]; cz <= c1[2]; ++cz)
-                    for (cy = c0[1]; cy <= c1[1]; ++cy)
-                        for (cx = c0[0]; cx <= c1[0]; ++cx) {
-                            float *r = &ctx->cell_range[2 * (((size_t)cz * ctx->vw.mdims[1] + cy) * ctx->vw.mdims[0] + cx)];
-                            if (val < r[0]) r[0] = val;
-                            if (val > r[1]) r[1] = val;
-                        }
-            }
+    for (i = 0; i < ctx->vw.nvox; ++i) ctx->vw.vol[i] = hd__norm_value(&m, hd__raw_value(v, i));
+    all = hd__all_cells(ctx);
+    hd__cell_ranges(ctx, &all);
     return HD_SUCCESS;
 }
 
@@ -100,25 +136,40 @@ static int hd__crop_meets(const hd__ctx *ctx, int d, double a, double b, double 
 
 #define HD__CROP_CELL_EPS 0.25 /* voxels: a sample the DDA places in a cell may lie this far out */
 
-/* The majorant per cell; 0 in a cell outside the crop box, which holds no medium, so tracking
-   and the projection skip it. max_sigma stays that of the whole volume, so the limits on a
-   global majorant do not move with the crop box. */
-static void hd__build_majorants(hd__ctx *ctx)
+/* The majorant of cell (cx, cy, cz), index i, without the crop box. */
+static float hd__cell_majorant(const hd__ctx *ctx, size_t i)
+{
+    return hd__range_majorant(ctx, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]);
+}
+
+/* The majorant per cell of the box; 0 in a cell outside the crop box, which holds no medium, so
+   tracking and the projection skip it. Returns the largest majorant of the box's cells, crop box
+   or not. */
+static float hd__build_majorants_box(hd__ctx *ctx, const hd__box *cells)
 {
     int cx, cy, cz, c = HD__MAJORANT_CELL;
-    size_t i;
-    ctx->max_sigma = 0.0f;
-    for (cz = 0, i = 0; cz < ctx->vw.mdims[2]; ++cz)
-        for (cy = 0; cy < ctx->vw.mdims[1]; ++cy)
-            for (cx = 0; cx < ctx->vw.mdims[0]; ++cx, ++i) {
-                float m = hd__range_majorant(ctx, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]);
-                if (m > ctx->max_sigma) ctx->max_sigma = m;
+    float top = 0.0f;
+    for (cz = cells->lo[2]; cz < cells->hi[2]; ++cz)
+        for (cy = cells->lo[1]; cy < cells->hi[1]; ++cy)
+            for (cx = cells->lo[0]; cx < cells->hi[0]; ++cx) {
+                size_t i = ((size_t)cz * ctx->vw.mdims[1] + cy) * ctx->vw.mdims[0] + cx;
+                float m = hd__cell_majorant(ctx, i);
+                if (m > top) top = m;
                 if (!hd__crop_meets(ctx, 0, (double)(cx * c) / ctx->vw.dims[0], (double)((cx + 1) * c) / ctx->vw.dims[0], HD__CROP_CELL_EPS) ||
                     !hd__crop_meets(ctx, 1, (double)(cy * c) / ctx->vw.dims[1], (double)((cy + 1) * c) / ctx->vw.dims[1], HD__CROP_CELL_EPS) ||
                     !hd__crop_meets(ctx, 2, (double)(cz * c) / ctx->vw.dims[2], (double)((cz + 1) * c) / ctx->vw.dims[2], HD__CROP_CELL_EPS))
                     m = 0.0f;
                 ctx->vw.majorant[i] = m;
             }
+    return top;
+}
+
+/* Every cell's majorant. max_sigma stays that of the whole volume, so the limits on a global
+   majorant do not move with the crop box. */
+static void hd__build_majorants(hd__ctx *ctx)
+{
+    hd__box all = hd__all_cells(ctx);
+    ctx->max_sigma = hd__build_majorants_box(ctx, &all);
 }
 
 /* ---- inputs --------------------------------------------------------------------------------- */
@@ -194,4 +245,127 @@ static void hd__set_grid(hd__ctx *ctx)
 {
     int d, f = ctx->vw.params.illumination_downsample;
     for (d = 0; d < 3; ++d) ctx->vw.gdims[d] = (ctx->vw.dims[d] + f - 1) / f;
+}
+
+/* A global majorant (params.majorant) the medium has outgrown or that is above 16x its largest
+   extinction is dropped for the majorant grid, with a line in the log; `what` names the change. */
+static void hd__majorant_follow(hd__ctx *ctx, const char *what)
+{
+    if (ctx->vw.params.majorant > 0.0f &&
+        (ctx->vw.params.majorant < ctx->max_sigma / (1.0f + 1e-5f) || ctx->vw.params.majorant > hd__majorant_cap(ctx->max_sigma))) {
+        HD__INFO(&ctx->vw.log, "params.majorant %g is outside 1..16x the %s's largest extinction %g: using the majorant grid",
+                 (double)ctx->vw.params.majorant, what, (double)ctx->max_sigma);
+        ctx->vw.params.majorant = 0.0f;
+    }
+}
+
+/* ---- hd_update_volume ------------------------------------------------------------------------- */
+static size_t hd__voxel_bytes(hd_voxel_type t) { return t == HD_VOXEL_U8 ? 1 : t == HD_VOXEL_U16 ? 2 : 4; }
+
+static float hd__raw_at(hd_voxel_type t, const unsigned char *p)
+{
+    if (t == HD_VOXEL_U8) return (float)*p;
+    if (t == HD_VOXEL_U16) {
+        uint16_t v;
+        memcpy(&v, p, sizeof v);
+        return (float)v;
+    }
+    {
+        float v;
+        memcpy(&v, p, sizeof v);
+        return v;
+    }
+}
+
+/* Checks an update (every error before anything changes, one log line each), then writes its
+   voxels into the core's copy and brings the majorant cells they reach up to date. The changed
+   voxels' bounding box joins ctx->upd for hd__prepare (HD__DIRTY_VOLUME); *changed = 0 when every
+   voxel equals the one held. */
+static hd_result hd__update_voxels(hd__ctx *ctx, const hd_volume_update *u, int *changed)
+{
+    const hd_logger *log = &ctx->vw.log;
+    const hd_volume_desc *v = &ctx->vw.desc.volume;
+    const int *dims = ctx->vw.dims;
+    static const char *types[] = {"INVALID", "U8", "U16", "F32"};
+    hd__norm m = hd__norm_of(v);
+    hd__box box, chg, cells;
+    size_t es, rp, sp;
+    int d, x, y, z, whole;
+    float top;
+    *changed = 0;
+    if (!u) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_update_volume: update is NULL");
+    if (u->type != v->type || u->dims[0] != dims[0] || u->dims[1] != dims[1] || u->dims[2] != dims[2])
+        return HD__ERR(log, HD_ERROR_VOLUME_MISMATCH, "hd_update_volume: the update is %s %dx%dx%d, the volume %s %dx%dx%d",
+                       (int)u->type >= 0 && u->type < HD_VOXEL_COUNT ? types[u->type] : "(not a type)", u->dims[0], u->dims[1],
+                       u->dims[2], types[v->type], dims[0], dims[1], dims[2]);
+    whole = u->size[0] == 0 && u->size[1] == 0 && u->size[2] == 0;
+    for (d = 0; d < 3; ++d) {
+        box.lo[d] = u->offset[d];
+        box.hi[d] = whole ? dims[d] : u->offset[d] + (u->size[d] > 0 ? u->size[d] : 0);
+        if (u->size[d] < 0 || (!whole && u->size[d] == 0) || u->offset[d] < 0 || u->offset[d] > dims[d] ||
+            (whole ? u->offset[d] != 0 : u->size[d] > dims[d] - u->offset[d]))
+            return HD__ERR(log, HD_ERROR_BOX_OUTSIDE_VOLUME,
+                           "hd_update_volume: the box at (%d, %d, %d) of size (%d, %d, %d) is not inside the %dx%dx%d volume", u->offset[0],
+                           u->offset[1], u->offset[2], u->size[0], u->size[1], u->size[2], dims[0], dims[1], dims[2]);
+    }
+    if (!u->data) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_update_volume: data is NULL");
+    es = hd__voxel_bytes(v->type);
+    rp = u->row_pitch ? u->row_pitch : (size_t)(box.hi[0] - box.lo[0]) * es;
+    sp = u->slice_pitch ? u->slice_pitch : rp * (size_t)(box.hi[1] - box.lo[1]);
+    if (rp < (size_t)(box.hi[0] - box.lo[0]) * es || sp < rp * (size_t)(box.hi[1] - box.lo[1]))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "hd_update_volume: row_pitch %zu or slice_pitch %zu is below the box's %zu-byte rows, %d per slice",
+                       u->row_pitch, u->slice_pitch, (size_t)(box.hi[0] - box.lo[0]) * es, box.hi[1] - box.lo[1]);
+    if (v->type == HD_VOXEL_F32)
+        for (z = box.lo[2]; z < box.hi[2]; ++z)
+            for (y = box.lo[1]; y < box.hi[1]; ++y) {
+                const unsigned char *row = (const unsigned char *)u->data + (size_t)(z - box.lo[2]) * sp + (size_t)(y - box.lo[1]) * rp;
+                for (x = 0; x < box.hi[0] - box.lo[0]; ++x) {
+                    float f = hd__raw_at(HD_VOXEL_F32, row + (size_t)x * 4);
+                    if (!hd__finite(f))
+                        return HD__ERR(log, HD_ERROR_INVALID_VOXELS, "hd_update_volume: voxel (%d, %d, %d) is %g", box.lo[0] + x, y, z, (double)f);
+                }
+            }
+    /* the new voxels, and the bounding box of those that differ */
+    for (d = 0; d < 3; ++d) {
+        chg.lo[d] = dims[d];
+        chg.hi[d] = 0;
+    }
+    for (z = box.lo[2]; z < box.hi[2]; ++z)
+        for (y = box.lo[1]; y < box.hi[1]; ++y) {
+            const unsigned char *row = (const unsigned char *)u->data + (size_t)(z - box.lo[2]) * sp + (size_t)(y - box.lo[1]) * rp;
+            float *dst = ctx->vw.vol + ((size_t)z * dims[1] + y) * dims[0];
+            for (x = box.lo[0]; x < box.hi[0]; ++x) {
+                float t = hd__norm_value(&m, hd__raw_at(v->type, row + (size_t)(x - box.lo[0]) * es));
+                if (t == dst[x]) continue;
+                dst[x] = t;
+                if (x < chg.lo[0]) chg.lo[0] = x;
+                if (x >= chg.hi[0]) chg.hi[0] = x + 1;
+                if (y < chg.lo[1]) chg.lo[1] = y;
+                if (y >= chg.hi[1]) chg.hi[1] = y + 1;
+                if (z < chg.lo[2]) chg.lo[2] = z;
+                if (z >= chg.hi[2]) chg.hi[2] = z + 1;
+            }
+        }
+    if (chg.hi[0] == 0) return HD_SUCCESS;
+    *changed = 1;
+    cells = hd__box_cells(&ctx->vw, &chg);
+    hd__cell_ranges(ctx, &cells);
+    top = hd__build_majorants_box(ctx, &cells);
+    if (top >= ctx->max_sigma) {
+        ctx->max_sigma = top;
+    } else { /* the largest may have been in the box: over every cell again, without writing */
+        size_t i, ncell = (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2];
+        ctx->max_sigma = 0.0f;
+        for (i = 0; i < ncell; ++i) {
+            float mj = hd__cell_majorant(ctx, i);
+            if (mj > ctx->max_sigma) ctx->max_sigma = mj;
+        }
+    }
+    hd__majorant_follow(ctx, "new volume");
+    if (!(ctx->dirty & HD__DIRTY_VOLUME)) ctx->upd = chg;
+    for (d = 0; d < 3; ++d) {
+        if (chg.lo[d] < ctx->upd.lo[d]) ctx->upd.lo[d] = chg.lo[d];
+        if (chg.hi[d] > ctx->upd.hi[d]) ctx->upd.hi[d] = chg.hi[d];
+    }
+    return HD_SUCCESS;
 }

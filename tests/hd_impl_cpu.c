@@ -42,3 +42,32 @@ unsigned hdt_slot_generation(int slot, unsigned generation)
 }
 int hdt_slots(void);
 int hdt_slots(void) { return HD_MAX_CONTEXTS; }
+
+/* The core's view of the volume for test_living.c: a checksum-free copy of what hd_update_volume
+   must keep equal to a fresh context's (voxels, cell ranges, majorants, the largest extinction,
+   the direct light's mask and list), after hd__prepare (run by hd_read_illumination's bracket). */
+typedef struct hdt_volume_state {
+    size_t nvox, ncell, gvox, dl_count;
+    float *vol, *cell_range, *majorant, max_sigma;
+    unsigned char *bits;
+    uint32_t *dl_idx;
+    uint64_t dl_n;
+} hdt_volume_state;
+int hdt_volume_state_get(hd_context h, hdt_volume_state *s);
+int hdt_volume_state_get(hd_context h, hdt_volume_state *s)
+{
+    hd__ctx *ctx = hd__lookup(h);
+    if (!ctx) return 0;
+    s->nvox = ctx->vw.nvox;
+    s->ncell = (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2];
+    s->gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
+    s->dl_count = ctx->vw.dl_count;
+    s->vol = ctx->vw.vol;
+    s->cell_range = ctx->cell_range;
+    s->majorant = ctx->vw.majorant;
+    s->max_sigma = ctx->max_sigma;
+    s->bits = ctx->dl.bits;
+    s->dl_idx = ctx->vw.dl_idx;
+    s->dl_n = ctx->dl_n;
+    return 1;
+}

@@ -1,5 +1,8 @@
 /* test_living.c - volumes and settings that change while rendering, on the CPU backend: a read
-   of the image before any frame exists says so (HD_ERROR_NO_FRAME). */
+   of the image before any frame exists says so (HD_ERROR_NO_FRAME); hd_update_volume keeps the
+   core's volume state equal to a fresh context's, keeps E and phi as the warm start with E's mean
+   re-weighted, converges to the fresh context's light, changes nothing for equal voxels, and
+   refuses bad updates with the context unchanged. */
 #include "hybriddiff.h"
 #include "hd_test.h"
 #include <stdlib.h>
@@ -88,7 +91,277 @@ static void test_no_frame(void)
     free(b);
 }
 
+/* ---- hd_update_volume ------------------------------------------------------------------------ */
+typedef struct hdt_volume_state {
+    size_t nvox, ncell, gvox, dl_count;
+    float *vol, *cell_range, *majorant, max_sigma;
+    unsigned char *bits;
+    uint32_t *dl_idx;
+    uint64_t dl_n;
+} hdt_volume_state;
+int hdt_volume_state_get(hd_context h, hdt_volume_state *s);
+
+static float vox2[N * N * N];
+static uint8_t vox8[N * N * N], vox8b[N * N * N];
+
+/* The new volume: inside the box [B0, B1) the blob moved 3 voxels along x, outside as before. */
+enum { BX0 = 6, BX1 = 23, BY0 = 3, BY1 = 21, BZ0 = 2, BZ1 = 22 };
+static void make_moved(void)
+{
+    int x, y, z;
+    for (z = 0; z < N; ++z)
+        for (y = 0; y < N; ++y)
+            for (x = 0; x < N; ++x) {
+                int in = x >= BX0 && x < BX1 && y >= BY0 && y < BY1 && z >= BZ0 && z < BZ1;
+                size_t i = ((size_t)z * N + y) * N + x;
+                vox2[i] = in ? blob(x, y, z, 14.5f) : vox[i];
+                vox8[i] = (uint8_t)(vox[i] * 255.0f + 0.5f);
+                vox8b[i] = (uint8_t)(vox2[i] * 255.0f + 0.5f);
+            }
+}
+
+/* An update of the box [B0, B1) of a whole volume in memory (pitches of the whole volume). */
+static hd_volume_update box_update(hd_voxel_type type, const void *whole)
+{
+    hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+    size_t es = type == HD_VOXEL_U8 ? 1 : 4;
+    u.type = type;
+    u.dims[0] = u.dims[1] = u.dims[2] = N;
+    u.offset[0] = BX0; u.offset[1] = BY0; u.offset[2] = BZ0;
+    u.size[0] = BX1 - BX0; u.size[1] = BY1 - BY0; u.size[2] = BZ1 - BZ0;
+    u.row_pitch = N * es;
+    u.slice_pitch = (size_t)N * N * es;
+    u.data = (const char *)whole + (((size_t)BZ0 * N + BY0) * N + BX0) * es;
+    return u;
+}
+
+/* Renders until the light has converged and the image is final (at most `most` calls); the
+   number of calls, or -1. */
+static int render_to_rest(hd_context c, int most)
+{
+    hd_stats st;
+    int i;
+    for (i = 1; i <= most; ++i) {
+        uint64_t frames;
+        CHECK(hd_get_stats(c, &st) == HD_SUCCESS);
+        frames = st.frames;
+        CHECK(hd_render(c) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &st) == HD_SUCCESS);
+        if (st.light_converged && st.frames == frames && frames > 0) return i;
+    }
+    return -1;
+}
+
+/* The core's volume state of a and b (after a read in a bracket, so both are prepared). */
+static int same_volume_state(hd_context a, hd_context b)
+{
+    static float e[N * N * N];
+    hdt_volume_state s, t;
+    int ok;
+    CHECK(hd_read_illumination(a, HD_ILLUMINATION_DIRECT, e, N * N * N) == HD_SUCCESS);
+    CHECK(hd_read_illumination(b, HD_ILLUMINATION_DIRECT, e, N * N * N) == HD_SUCCESS);
+    if (!hdt_volume_state_get(a, &s) || !hdt_volume_state_get(b, &t)) return 0;
+    ok = s.nvox == t.nvox && s.ncell == t.ncell && s.gvox == t.gvox && s.max_sigma == t.max_sigma && s.dl_count == t.dl_count &&
+         memcmp(s.vol, t.vol, s.nvox * sizeof(float)) == 0 && memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0 &&
+         memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0 && s.bits && t.bits &&
+         memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0 && memcmp(s.dl_idx, t.dl_idx, s.dl_count * sizeof(uint32_t)) == 0;
+    CHECK_MSG(ok, "vol %d, cell ranges %d, majorants %d, max_sigma %g/%g, mask %d, list %zu/%zu",
+              memcmp(s.vol, t.vol, s.nvox * sizeof(float)) == 0, memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0,
+              memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0, (double)s.max_sigma, (double)t.max_sigma,
+              s.bits && t.bits && memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0, s.dl_count, t.dl_count);
+    return ok;
+}
+
+static double rel_l2(const float *a, const float *b, size_t n)
+{
+    double d = 0.0, r = 0.0;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        d += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+        r += (double)b[i] * b[i];
+    }
+    return r > 0.0 ? sqrt(d / r) : sqrt(d);
+}
+
+/* Equal voxels (the whole volume, and a box of it through pitches) change nothing: the light stays
+   converged, the finished image is not touched, nothing is redone. */
+static void test_update_same(void)
+{
+    hd_desc d;
+    hd_test_log log;
+    hd_context c;
+    hd_stats a, b;
+    hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+    static float img0[W * W * 4], img1[W * W * 4];
+    make_desc(&d, &log);
+    make_moved();
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(render_to_rest(c, 300) > 0);
+    CHECK(hd_read_image_f32(c, img0, W * W * 4) == HD_SUCCESS);
+    CHECK(hd_get_stats(c, &a) == HD_SUCCESS && a.light_converged);
+    u.type = HD_VOXEL_F32;
+    u.dims[0] = u.dims[1] = u.dims[2] = N;
+    u.data = vox;
+    CHECK(hd_update_volume(c, &u) == HD_SUCCESS);
+    u = box_update(HD_VOXEL_F32, vox);
+    CHECK(hd_update_volume(c, &u) == HD_SUCCESS);
+    CHECK(hd_get_stats(c, &b) == HD_SUCCESS);
+    CHECK_MSG(b.light_converged && b.iterations == a.iterations && b.frames == a.frames && b.light_error == a.light_error,
+              "converged %d, iterations %llu -> %llu, frames %llu -> %llu", b.light_converged, (unsigned long long)a.iterations,
+              (unsigned long long)b.iterations, (unsigned long long)a.frames, (unsigned long long)b.frames);
+    CHECK(hd_render(c) == HD_SUCCESS);
+    CHECK(hd_read_image_f32(c, img1, W * W * 4) == HD_SUCCESS);
+    CHECK(memcmp(img0, img1, sizeof img0) == 0);
+    CHECK(hd_get_stats(c, &b) == HD_SUCCESS && b.iterations == a.iterations && b.frames == a.frames && log.errors == 0);
+    hd_destroy(c);
+}
+
+/* A box update (F32, and U8 through the same value map): the core's volume, majorants and
+   direct-light mask equal a fresh context's with the new volume; E is kept as it was (warm
+   start) and its mean holds at most light_window samples; the light's convergence estimate
+   restarts and converges again; after as many iterations as the fresh context, the image agrees
+   with the fresh one's within the estimator's noise. hd_reset then starts from zero. */
+static void update_vs_fresh(hd_voxel_type type)
+{
+    hd_desc d, d2;
+    hd_test_log log;
+    hd_context c, f;
+    hd_stats st;
+    hd_volume_update u;
+    hdt_volume_state vs;
+    size_t gn;
+    static float e0[N * N * N], e1[N * N * N], p0[N * N * N], p1[N * N * N], img0[W * W * 4], img1[W * W * 4];
+    int renders, k;
+    size_t i;
+    double l2_img, l2_e, l2_phi;
+    make_desc(&d, &log);
+    make_moved();
+    if (type == HD_VOXEL_U8) d.volume.data = vox8;
+    d.volume.type = type;
+    d.params.light_window = 8;
+    d2 = d;
+    d2.volume.data = type == HD_VOXEL_U8 ? (const void *)vox8b : (const void *)vox2;
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_create(&d2, &f) == HD_SUCCESS);
+    CHECK(render_to_rest(c, 300) > 0);
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS);
+    gn = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2];
+    CHECK(gn <= (size_t)N * N * N);
+    CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e0, gn) == HD_SUCCESS);
+    u = box_update(type, type == HD_VOXEL_U8 ? (const void *)vox8b : (const void *)vox2);
+    CHECK(hd_update_volume(c, &u) == HD_SUCCESS);
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS && !st.light_converged && st.light_error == 1.0);
+    CHECK(same_volume_state(c, f));
+    /* the warm start: E as it was, its mean capped at light_window samples */
+    CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e1, gn) == HD_SUCCESS);
+    CHECK(memcmp(e0, e1, gn * sizeof(float)) == 0);
+    CHECK(hdt_volume_state_get(c, &vs) && vs.dl_n == 8);
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS && hdt_volume_state_get(c, &vs) && vs.dl_n == 9);
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS && !st.light_converged);
+    renders = render_to_rest(c, 300);
+    CHECK_MSG(renders > 1, "converged again after %d renders", renders);
+    /* both on to the same number of samples: the old light weighs 8 / 400 of E */
+    for (k = 0; k < 2; ++k) {
+        hd_context h = k ? f : c;
+        hdt_volume_state hs;
+        hd_desc q;
+        CHECK(hd_query_desc(h, &q) == HD_SUCCESS);
+        q.params.frame_window = 256; /* the images compared: means of 256 frames */
+        CHECK(hd_set_params(h, &q.params) == HD_SUCCESS);
+        CHECK(hdt_volume_state_get(h, &hs));
+        CHECK(hd_iterate(h, (int)(400 - hs.dl_n)) == HD_SUCCESS);
+        CHECK(hd_read_image_f32(h, k ? img1 : img0, W * W * 4) == HD_SUCCESS);
+        CHECK(hd_read_illumination(h, HD_ILLUMINATION_DIRECT, k ? e1 : e0, gn) == HD_SUCCESS);
+        CHECK(hd_read_illumination(h, HD_ILLUMINATION_SCATTERED, k ? p1 : p0, gn) == HD_SUCCESS);
+    }
+    /* E where it is read (the fresh context's mask; elsewhere the updated one keeps what it had) */
+    CHECK(hdt_volume_state_get(f, &vs));
+    for (i = 0; i < gn; ++i)
+        if (!(vs.bits[i >> 3] >> (i & 7) & 1u)) e0[i] = e1[i] = 0.0f;
+    l2_img = rel_l2(img0, img1, W * W * 4);
+    l2_e = rel_l2(e0, e1, gn);
+    l2_phi = rel_l2(p0, p1, gn);
+    fprintf(stderr, "  %s box update, 400 samples: rel L2 against the fresh context: image %.2e, E %.2e, phi %.2e; converged again after %d renders\n",
+            type == HD_VOXEL_U8 ? "U8" : "F32", l2_img, l2_e, l2_phi, renders);
+    CHECK_MSG(l2_img < 1e-2 && l2_e < 2.5e-2 && l2_phi < 3e-2, "image %.3e, E %.3e, phi %.3e", l2_img, l2_e, l2_phi);
+    /* a clean restart */
+    CHECK(hd_reset(c) == HD_SUCCESS);
+    CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e1, gn) == HD_SUCCESS);
+    for (k = 0; k < (int)gn && e1[k] == 0.0f; ++k) {}
+    CHECK(k == (int)gn && hdt_volume_state_get(c, &vs) && vs.dl_n == 0);
+    CHECK(hd_get_stats(c, &st) == HD_SUCCESS && st.iterations == 0 && !st.light_converged);
+    CHECK(log.errors == 0);
+    hd_destroy(c);
+    hd_destroy(f);
+}
+static void test_update_box_f32(void) { update_vs_fresh(HD_VOXEL_F32); }
+static void test_update_box_u8(void) { update_vs_fresh(HD_VOXEL_U8); }
+
+/* Each bad update its own result and one log line, the context unchanged: its voxels, its
+   converged light and its finished image. The path tracers restart on a good one. */
+static void test_update_bad(void)
+{
+    hd_desc d;
+    hd_test_log log;
+    hd_context c;
+    hd_stats a, b;
+    hd_volume_update u, good;
+    hdt_volume_state vs;
+    static float saved[N * N * N], bad[N * N * N];
+    int errors = 0, i;
+    make_desc(&d, &log);
+    make_moved();
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(render_to_rest(c, 300) > 0);
+    CHECK(hd_get_stats(c, &a) == HD_SUCCESS && a.light_converged);
+    CHECK(hdt_volume_state_get(c, &vs));
+    memcpy(saved, vs.vol, sizeof saved);
+    good = box_update(HD_VOXEL_F32, vox2);
+#define BAD(stmt, code) do { u = good; stmt; \
+        CHECK_MSG(hd_update_volume(c, &u) == (code) && log.errors == ++errors && log.last_code == (code), "%s: %s", #stmt, log.last); \
+    } while (0)
+    CHECK(hd_update_volume(c, NULL) == HD_ERROR_NULL_POINTER && log.errors == ++errors);
+    BAD(u.data = NULL, HD_ERROR_NULL_POINTER);
+    BAD(u.type = HD_VOXEL_U16, HD_ERROR_VOLUME_MISMATCH);
+    BAD(u.type = (hd_voxel_type)77, HD_ERROR_VOLUME_MISMATCH);
+    BAD(u.dims[2] = N + 1, HD_ERROR_VOLUME_MISMATCH);
+    BAD(u.dims[0] = 0, HD_ERROR_VOLUME_MISMATCH);
+    BAD(u.offset[0] = -1, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.offset[1] = N - 2, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.size[2] = N, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.size[0] = 0, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.size[1] = -3, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.size[0] = u.size[1] = u.size[2] = 0, HD_ERROR_BOX_OUTSIDE_VOLUME); /* whole volume at an offset */
+    BAD(u.offset[2] = 0x7fffffff, HD_ERROR_BOX_OUTSIDE_VOLUME);
+    BAD(u.row_pitch = 4, HD_ERROR_INVALID_PARAMETER);
+    BAD(u.slice_pitch = N * 4, HD_ERROR_INVALID_PARAMETER);
+    memcpy(bad, vox2, sizeof bad);
+    bad[((size_t)(BZ1 - 1) * N + BY1 - 1) * N + BX1 - 1] = NAN; /* the box's last voxel */
+    BAD(u.data = bad + ((size_t)BZ0 * N + BY0) * N + BX0, HD_ERROR_INVALID_VOXELS);
+    bad[((size_t)(BZ1 - 1) * N + BY1 - 1) * N + BX1 - 1] = vox2[((size_t)(BZ1 - 1) * N + BY1 - 1) * N + BX1 - 1];
+    bad[((size_t)BZ0 * N + BY0) * N + BX0 + 3] = -INFINITY;
+    BAD(u.data = bad + ((size_t)BZ0 * N + BY0) * N + BX0, HD_ERROR_INVALID_VOXELS);
+#undef BAD
+    CHECK(strstr(log.last, "inf") != NULL);
+    CHECK(hdt_volume_state_get(c, &vs) && memcmp(saved, vs.vol, sizeof saved) == 0);
+    CHECK(hd_get_stats(c, &b) == HD_SUCCESS && b.light_converged && b.iterations == a.iterations && b.frames == a.frames);
+    CHECK(hd_render(c) == HD_SUCCESS && hd_get_stats(c, &b) == HD_SUCCESS && b.iterations == a.iterations && b.frames == a.frames);
+    /* PT_MS: an update restarts its mean */
+    d.params.method = HD_METHOD_PT_MS;
+    CHECK(hd_set_params(c, &d.params) == HD_SUCCESS);
+    CHECK(hd_iterate(c, 3) == HD_SUCCESS);
+    CHECK(hd_update_volume(c, &good) == HD_SUCCESS);
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_get_stats(c, &b) == HD_SUCCESS && b.iterations == 1 && b.frames == 1);
+    for (i = 0; i < 3; ++i) CHECK(hdt_volume_state_get(c, &vs) && vs.vol[((size_t)(BZ0 + i) * N + BY0) * N + BX0] == vox2[((size_t)(BZ0 + i) * N + BY0) * N + BX0]);
+    CHECK(log.errors == errors);
+    hd_destroy(c);
+}
+
 const hd_test_case hd_tests_living[] = {
     {"living_no_frame", test_no_frame},
+    {"living_update_same", test_update_same},
+    {"living_update_box_f32", test_update_box_f32},
+    {"living_update_box_u8", test_update_box_u8},
+    {"living_update_bad", test_update_bad},
 };
 const int hd_tests_living_count = sizeof hd_tests_living / sizeof hd_tests_living[0];

@@ -42,17 +42,19 @@ static int param_change(const char *name, hd_params *p)
     F(crop_min, p->crop_min[0] = 0.3f)
     F(crop_max, p->crop_max[2] = 0.7f)
     F(render_scale, p->render_scale = 2)
+    F(light_window, p->light_window = 3)
 #undef F
     return 0;
 }
 
 /* The fields whose change leaves every limit as it is: the solver's path to the same solution
    (solver, sweeps), an estimator of the same expectation (tracking), what only the 8-bit encoding
-   or hd_render's loop reads (exposure, light_tolerance, render_budget). Their rows invalidate
-   nothing, though a run of a few iterations can differ. */
+   or hd_render's loop reads (exposure, light_tolerance, render_budget), the warm start's window
+   (light_window: read only at the next warm change). Their rows invalidate nothing, though a run
+   of a few iterations can differ. */
 static int same_limit(const char *name)
 {
-    static const char *names[] = {"solver", "diffusion_sweeps", "tracking", "exposure", "light_tolerance", "render_budget"};
+    static const char *names[] = {"solver", "diffusion_sweeps", "tracking", "exposure", "light_tolerance", "render_budget", "light_window"};
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; ++i)
         if (strcmp(name, names[i]) == 0) return 1;

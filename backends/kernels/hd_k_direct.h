@@ -1,7 +1,10 @@
 /* hd_k_direct.h - stage 1 of HD: direct light per voxel by tracking toward one light (shared
-   source). Every voxel of the illumination grid takes exactly one sample per iteration, so the
-   iteration count is the sample count and no per-voxel counter is needed:
-   E_n = E_{n-1} + (X_n - E_{n-1}) / n with X = L * I_l * T(x -> l), l uniform among L lights. */
+   source). Every voxel of the illumination grid takes exactly one sample per iteration, so one
+   count serves every voxel and no per-voxel counter is needed:
+   E_n = E_{n-1} + (X_n - E_{n-1}) / n with X = L * I_l * T(x -> l), l uniform among L lights.
+   The host gives 1 / n as march.w: n is the iteration count, or after a warm start (a change
+   that keeps E as the start of the new light) the count capped at params.light_window, so the
+   light before the change fades. */
 HD_FN void hdk_direct_voxel(HD_KARGS int x, int y, int z)
 {
     int gx = HD_PRM(gdims).x, gy = HD_PRM(gdims).y, gz = HD_PRM(gdims).z;
@@ -22,7 +25,7 @@ HD_FN void hdk_direct_voxel(HD_KARGS int x, int y, int z)
     int c;
     hd_v3 d = hdk_light_dir(HD_KPASS l, p, HD_REF(tmax), HD_REF(falloff));
     T = hdk_transmittance(HD_KPASS p, d, tmax, key, 1u, HD_PRM(counts).y, HD_REF(next_dim));
-    w = 1.0f / HD_F(HD_PRM(frame).x);
+    w = HD_PRM(march).w;
     for (c = 0; c < nch; ++c) {
         int ic = i + c * nvox;
         float e = HD_GET(E, ic, x, y, z + c * gz);

@@ -15,7 +15,7 @@ HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / 
 HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
 HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */
 HD_PARAM_F4(gridh)      /* xyz = h of the illumination grid (world), w = the box's diagonal bound (HD_BOX_DIAGONAL * largest side) */
-HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = unused */
+HD_PARAM_F4(march)      /* x = ray-march step (world), y = frame weight, z = cutoff T, w = the direct light's sample weight */
 HD_PARAM_F4(cam_pos)    /* the ray origin at the image centre (all in the volume's frame, hdk_camera_ray) */
 HD_PARAM_F4(cam_u)      /* the direction's change per NDC x (look-at: image right * tan(fov/2) * aspect) */
 HD_PARAM_F4(cam_v)      /* its change per NDC y (look-at: image up * tan(fov/2)) */

@@ -615,6 +615,75 @@ static void case_iterate(hd_voxel_type type, const int *d, int lights, int mixed
     scene_free(&s);
 }
 
+/* hd_update_volume halfway through whole iterations (HD or CD): a box of the volume made
+   denser (past the majorants it had) and, with `twice`, a second box that thins the medium, each
+   given through the whole volume's pitches. The backend must upload the box and its majorant
+   cells and keep E and phi: a box or cells not uploaded, or light cleared, differ from the
+   reference. */
+static void case_update(hd_method method, hd_voxel_type type, const int *d, int lights, int twice, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    errors e = {0.0, 0.0, 0.0, -1.0};
+    size_t es = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 ? 2 : 4, i;
+    unsigned char *next;
+    int k;
+    scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
+    s.params.method = method;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "update x%d %s %s %dx%dx%d %dL%s", n, hd_api_cpu.method_name(method), type_name(type), d[0], d[1], d[2],
+             lights, twice ? " twice" : "");
+    next = (unsigned char *)malloc(s.data_bytes);
+    if (next && pair_create(&p, &s)) {
+        memcpy(next, s.data, s.data_bytes);
+        BOTH(&p, iterate, (p.ref, n / 2), (p.dut, n / 2));
+        for (k = 0; k < 1 + twice; ++k) {
+            hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+            int lo[3], hi[3], x, y, z, a;
+            for (a = 0; a < 3; ++a) {
+                lo[a] = k ? d[a] / 2 : d[a] / 5;
+                hi[a] = k ? d[a] - 1 : (3 * d[a]) / 4;
+            }
+            for (z = lo[2]; z < hi[2]; ++z)
+                for (y = lo[1]; y < hi[1]; ++y)
+                    for (x = lo[0]; x < hi[0]; ++x) {
+                        i = ((size_t)z * d[1] + y) * d[0] + x;
+                        if (type == HD_VOXEL_U8) next[i] = (unsigned char)(k ? next[i] / 3 : next[i] + (255 - next[i]) / 2);
+                        else if (type == HD_VOXEL_U16) {
+                            uint16_t v;
+                            memcpy(&v, next + 2 * i, 2);
+                            v = (uint16_t)(k ? v / 3 : v + (65535 - v) / 2);
+                            memcpy(next + 2 * i, &v, 2);
+                        } else {
+                            float v;
+                            memcpy(&v, next + 4 * i, 4);
+                            v = k ? v / 3.0f : v + (1.0f - v) * 0.5f;
+                            memcpy(next + 4 * i, &v, 4);
+                        }
+                    }
+            u.type = type;
+            memcpy(u.dims, d, sizeof u.dims);
+            for (a = 0; a < 3; ++a) {
+                u.offset[a] = lo[a];
+                u.size[a] = hi[a] - lo[a];
+            }
+            u.data = next + (((size_t)lo[2] * d[1] + lo[1]) * d[0] + lo[0]) * es;
+            u.row_pitch = (size_t)d[0] * es;
+            u.slice_pitch = (size_t)d[0] * d[1] * es;
+            BOTH(&p, update_volume, (p.ref, &u), (p.dut, &u));
+            BOTH(&p, iterate, (p.ref, (n - n / 2) / (1 + twice)), (p.dut, (n - n / 2) / (1 + twice)));
+        }
+        pair_compare(&p, CMP_E | CMP_PHI | CMP_IMAGE, &e);
+    }
+    report(name, &p, &g, &e, 0);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+    free(next);
+}
+
 /* HD on a coarser illumination grid (params.illumination_downsample), with RGB scattering
    (params.rgb_scattering) and/or the surface boundary (params.diffusion_boundary): whole
    iterations. */
@@ -1153,6 +1222,7 @@ int main(int argc, char **argv)
             case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_RED_BLACK, 1, 1);
             case_project(HD_VOXEL_U16, odd, 1, 1);
             case_iterate(HD_VOXEL_F32, other, 3, 1, 1, CHANGE_CAMERA, 2);
+            case_update(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 1, 4);
         } else {
             crop_cases(odd, other);
         }
@@ -1178,6 +1248,10 @@ int main(int argc, char **argv)
     case_iterate(HD_VOXEL_U16, odd, 3, 1, 1, CHANGE_TF, 8);
     case_iterate(HD_VOXEL_F32, odd, 16, 0, 1, CHANGE_CAMERA, 8);
     case_iterate(HD_VOXEL_U8, other, 3, 0, 1, CHANGE_CAMERA, 8);
+    /* a volume that changes: hd_update_volume halfway */
+    case_update(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 8);
+    case_update(HD_METHOD_HD, HD_VOXEL_F32, other, 3, 1, 8);
+    case_update(HD_METHOD_CD, HD_VOXEL_U16, odd, 1, 1, 8);
     /* the baselines */
     case_downsample(HD_VOXEL_U8, odd, 2, 0, 0, 1, 8);
     case_downsample(HD_VOXEL_F32, other, 3, 0, 0, 3, 8);

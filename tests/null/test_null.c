@@ -189,9 +189,56 @@ static void test_null_invalidation(void)
     CHECK(hd_destroy(h) == HD_SUCCESS);
 }
 
+/* hd_update_volume reaches the backend once per changed box (hd__be_update_volume, with the
+   box of the changed voxels and its majorant cells), then classification and the direct light's
+   list: no new inputs, grids or image, E and phi not cleared (the warm start); equal voxels reach
+   nothing; hd_reset clears E, phi and the image. */
+static void test_null_update(void)
+{
+    static unsigned char next[N * N * N];
+    hd_desc d;
+    hd_context h;
+    hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+    calls c;
+    const hd__ctx *ctx;
+    make_desc(&d);
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    CHECK(hd_iterate(h, 2) == HD_SUCCESS);
+    ctx = hd__lookup(h);
+    memcpy(next, vox, sizeof next);
+    next[(3 * N + 2) * N + 5] ^= 0x55; /* one voxel: (5, 2, 3) */
+    u.type = HD_VOXEL_U8;
+    u.dims[0] = u.dims[1] = u.dims[2] = N;
+    u.data = next;
+    c = snap(h);
+    CHECK(hd_update_volume(h, &u) == HD_SUCCESS);
+    CHECK(ctx->upd.lo[0] == 5 && ctx->upd.hi[0] == 6 && ctx->upd.lo[1] == 2 && ctx->upd.hi[1] == 3 && ctx->upd.lo[2] == 3 &&
+          ctx->upd.hi[2] == 4);
+    CHECK(delta(h, &c, HD__NULL_update_volume) == 0); /* at the next call that reaches the device */
+    ((hd__backend *)be_of(h))->cleared = 0;
+    c = snap(h);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_update_volume) == 1 && delta(h, &c, HD__NULL_classify) == 1);
+    CHECK(delta(h, &c, HD__NULL_upload_inputs) == 0 && delta(h, &c, HD__NULL_alloc_illumination) == 0 &&
+          delta(h, &c, HD__NULL_alloc_image) == 0 && delta(h, &c, HD__NULL_alloc_lights) == 0);
+    CHECK_MSG(be_of(h)->cleared == HD__DIRTY_IMAGE, "cleared 0x%x", be_of(h)->cleared);
+    CHECK(delta(h, &c, HD__NULL_direct) == 1 && delta(h, &c, HD__NULL_project) == 1);
+    /* the same voxels again: nothing */
+    c = snap(h);
+    CHECK(hd_update_volume(h, &u) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_update_volume) == 0 && delta(h, &c, HD__NULL_classify) == 0 && delta(h, &c, HD__NULL_direct_list) == 0);
+    /* a clean restart */
+    ((hd__backend *)be_of(h))->cleared = 0;
+    CHECK(hd_reset(h) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(be_of(h)->cleared == (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE));
+    CHECK(be_of(h)->calls[HD__NULL_begin] == be_of(h)->calls[HD__NULL_end] && !be_of(h)->misuse);
+    hd_destroy(h);
+}
+
 static const hd_test_case cases[] = {
     {"null_api", test_null_api},
     {"null_invalidation", test_null_invalidation},
+    {"null_update", test_null_update},
 };
 
 int main(void)
