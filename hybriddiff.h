@@ -572,12 +572,23 @@ HDDEF hd_result hd_destroy(hd_context ctx);
    valid until the next call on this context). */
 HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
 
-/* Setters invalidate only what depends on them:
-     transfer function, extinction, majorant   -> majorant grid, E, phi, image
-     lights, seed                              -> E, phi, image
-     albedo, anisotropy, disable_diffusion,
-     diffusion_boundary                        -> phi, image
-     volume transform                          -> E, phi, image
+/* Setters invalidate only what depends on them. "warm": E and phi are kept as the warm start of
+   the new light (the diffusion converges from any start; E's running mean is re-weighted to hold
+   at most params.light_window samples of the old light), the convergence estimate restarts
+   (hd_stats.light_converged is 0 until the new light converges); "reset": zeroed. hd_reset gives
+   the clean restart after a warm change.
+     TF alpha, extinction                      -> majorant grid; E, phi warm; image
+     TF colour only (the same alphas)          -> image only with grey scattering (no light work);
+                                                  phi warm with rgb_scattering
+     the same TF                               -> nothing
+     lights                                    -> E, phi warm; image (CD, another light count:
+                                                  reset)
+     albedo, anisotropy                        -> phi warm (E stays valid); image
+     majorant                                  -> majorant grid, E, phi reset, image
+     seed                                      -> E, phi reset, image
+     disable_diffusion, diffusion_boundary     -> phi reset, image
+     hd_update_volume                          -> the box's majorant cells; E, phi warm; image
+     volume transform                          -> E, phi reset, image
      camera, depth, step, background,
      frame_window                              -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
@@ -585,7 +596,8 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      illumination_precision                    -> E, phi, image (new grids)
      max_bounces                               -> the path tracers' image (nothing for HD, CD)
      solver, sweeps, tracking, exposure,
-     light_tolerance, render_budget            -> nothing (same solution, estimator or encoding)
+     light_tolerance, render_budget,
+     light_window                              -> nothing (same solution, estimator or encoding)
    src/hd_params.h holds this as a table, the one place each field's default, range and
    invalidation are written. An out-of-range enum is HD_ERROR_INVALID_ENUM, any other bad value
    HD_ERROR_INVALID_PARAMETER, each with one logged line; a rejected call changes nothing. */

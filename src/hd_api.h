@@ -147,13 +147,23 @@ HDDEF hd_result hd_query_desc(hd_context h, hd_desc *out)
 HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_function *tf)
 {
     hd_result r;
+    int change;
     HD__GET_CTX(ctx, h);
     if (!tf) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_transfer_function: tf is NULL");
     if ((r = hd__check_tf(tf, &ctx->vw.log)) != HD_SUCCESS) return r;
+    change = hd__tf_change(ctx, tf);
+    if (change == HD__TF_SAME) return HD_SUCCESS;
     if ((r = hd__set_tf(ctx, tf)) != HD_SUCCESS) return r;
+    if (change == HD__TF_COLOUR) {
+        /* alpha as it was: sigma_t, the majorants and the mask stay; with grey scattering E and
+           phi do not depend on the colour (only the projection reads it), with RGB scattering
+           phi's sigma_s per colour does */
+        ctx->dirty |= ctx->vw.sig_channels == 1 ? (HD__DIRTY_TF | HD__DIRTY_IMAGE) : (HD__DIRTY_SIGMA | HD__INV_WARM_PHI);
+        return HD_SUCCESS;
+    }
     hd__build_majorants(ctx);
     hd__majorant_follow(ctx, "new TF");
-    ctx->dirty |= HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
+    ctx->dirty |= HD__INV_WARM_MEDIUM;
     return HD_SUCCESS;
 }
 
@@ -165,9 +175,11 @@ HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
     if ((r = hd__check_lights(lights, count, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_lights_frame(lights, count, &ctx->xf, &ctx->vw.log)) != HD_SUCCESS) return r;
     channels_before = ctx->vw.channels;
+    /* CD keeps one light volume per light: another count makes them anew */
+    if (ctx->vw.params.method == HD_METHOD_CD && count != ctx->light_count) ctx->dirty |= HD__INV_LIGHT;
     hd__set_lights(ctx, lights, count);
-    ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
-    if (ctx->vw.channels != channels_before) ctx->dirty |= HD__DIRTY_ALLOC;
+    ctx->dirty |= HD__INV_WARM_LIGHT;
+    if (ctx->vw.channels != channels_before) ctx->dirty |= HD__DIRTY_ALLOC | HD__INV_LIGHT; /* new grids */
     return HD_SUCCESS;
 }
 

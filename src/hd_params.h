@@ -22,6 +22,11 @@
 #define HD__INV_LIGHT ((unsigned)(HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))
 #define HD__INV_MEDIUM ((unsigned)(HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))
 #define HD__INV_GRIDS ((unsigned)(HD__DIRTY_ALLOC | HD__INV_MEDIUM))
+/* The warm classes: the solution changes, but the diffusion converges from any start and E's mean
+   re-weights (params.light_window), so what is held is the start of the new light, not zeroed */
+#define HD__INV_WARM_PHI ((unsigned)(HD__DIRTY_WARM_PHI | HD__DIRTY_IMAGE))
+#define HD__INV_WARM_LIGHT ((unsigned)(HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI | HD__DIRTY_IMAGE))
+#define HD__INV_WARM_MEDIUM ((unsigned)(HD__DIRTY_SIGMA | HD__INV_WARM_LIGHT))
 #define HD__INV_ALL ((unsigned)HD__DIRTY_ALL)
 
 /* The longest hd_render may refine light or trace paths in one call (params.render_budget). */
@@ -44,9 +49,9 @@
    hd__check_params and hd__check_majorant. */
 #define HD__PARAM_TABLE(ENUM, FLOAT, INT, BOOL, SEED, FLOAT3) \
     ENUM(method, hd_method, HD_METHOD_HD, HD_METHOD_COUNT, HD__INV_ALL) \
-    FLOAT(extinction, 100.0f, 0.0f, 1e6f, 0, "in (0, 1e6]", HD__INV_MEDIUM) \
-    FLOAT(albedo, 0.9f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_PHI) \
-    FLOAT(anisotropy, 0.0f, -1.0f, 1.0f, 1, "in (-1, 1)", HD__INV_PHI) \
+    FLOAT(extinction, 100.0f, 0.0f, 1e6f, 0, "in (0, 1e6]", HD__INV_WARM_MEDIUM) \
+    FLOAT(albedo, 0.9f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_WARM_PHI) \
+    FLOAT(anisotropy, 0.0f, -1.0f, 1.0f, 1, "in (-1, 1)", HD__INV_WARM_PHI) \
     FLOAT(majorant, 0.0f, 0.0f, 1e6f, 0, "in [0, 1e6]", HD__INV_MEDIUM) \
     ENUM(solver, hd_solver, HD_SOLVER_RED_BLACK, HD_SOLVER_COUNT, HD__INV_NONE) \
     INT(diffusion_sweeps, (p->solver == HD_SOLVER_MULTIGRID ? 1 : 4), 1, 100000, "in 1..100000", HD__DIRTY_PATHS) \

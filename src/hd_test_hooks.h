@@ -32,6 +32,7 @@ HD__MAYBE_UNUSED static hd_result hd__test_prepare(hd_context h)
 static hd_result hd__test_direct_once(hd__ctx *ctx)
 {
     ctx->iterations++;
+    ctx->dl_n++; /* E's mean holds one sample more */
     hd__fill_kparams(ctx);
     return hd__be_direct(&ctx->vw);
 }
@@ -89,9 +90,11 @@ HD__MAYBE_UNUSED static hd_result hd__test_residual(hd_context h, double *out)
 /* n projection frames of the current E and phi into the image. */
 static hd_result hd__test_project_once(hd__ctx *ctx)
 {
+    hd_result r;
     ctx->frames++;
     hd__fill_kparams(ctx);
-    return hd__be_project(&ctx->vw);
+    if ((r = hd__be_project(&ctx->vw)) == HD_SUCCESS) ctx->image_empty = 0; /* the image holds a frame */
+    return r;
 }
 HD__MAYBE_UNUSED static hd_result hd__test_project(hd_context h, int n)
 {

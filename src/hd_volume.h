@@ -190,6 +190,22 @@ static hd_result hd__set_tf(hd__ctx *ctx, const hd_transfer_function *tf)
     return HD_SUCCESS;
 }
 
+/* What a new TF changes against the one held: nothing, only its colours (the same entries'
+   alphas), or its alphas (sigma_t). */
+enum { HD__TF_SAME, HD__TF_COLOUR, HD__TF_ALPHA };
+static int hd__tf_change(const hd__ctx *ctx, const hd_transfer_function *tf)
+{
+    static const float ramp[8] = {1.0f, 1.0f, 1.0f, 0.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+    const float *src = tf->rgba ? tf->rgba : ramp;
+    int i, count = tf->rgba ? tf->count : 2, colour = 0;
+    if (count != ctx->vw.tf_count) return HD__TF_ALPHA;
+    for (i = 0; i < count; ++i) {
+        if (memcmp(&src[4 * i + 3], &ctx->vw.tf[4 * i + 3], sizeof(float)) != 0) return HD__TF_ALPHA;
+        if (memcmp(&src[4 * i], &ctx->vw.tf[4 * i], 3 * sizeof(float)) != 0) colour = 1;
+    }
+    return colour ? HD__TF_COLOUR : HD__TF_SAME;
+}
+
 /* Lights of one colour and grey scattering need one illumination channel; lights of different
    colours or RGB scattering need three (and RGB scattering the TF colour beside sigma_t). */
 static float hd__max3(const float v[3]) { return v[0] > v[1] ? (v[0] > v[2] ? v[0] : v[2]) : (v[1] > v[2] ? v[1] : v[2]); }

@@ -28,8 +28,16 @@ int hdt_param_bits(unsigned *direct, unsigned *phi, unsigned *image, unsigned *p
 {
     *direct = HD__DIRTY_DIRECT;
     *phi = HD__DIRTY_PHI;
-    *image = HD__DIRTY_IMAGE;
     *paths = HD__DIRTY_PATHS;
+    *image = HD__DIRTY_IMAGE;
+    return 0;
+}
+/* The warm classes' bits: E and phi kept as the warm start of the new light. */
+int hdt_param_warm_bits(unsigned *warm_e, unsigned *warm_phi);
+int hdt_param_warm_bits(unsigned *warm_e, unsigned *warm_phi)
+{
+    *warm_e = HD__DIRTY_WARM_E;
+    *warm_phi = HD__DIRTY_WARM_PHI;
     return 0;
 }
 /* A slot's generation set close to its end, for the handle tests (the slot must be free). */

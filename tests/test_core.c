@@ -215,15 +215,14 @@ static void test_invalidation(void)
     CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
     CHECK(hd_iterate(ctx, 4) == HD_SUCCESS);
     read_both(ctx, E0, P0, n);
-    /* albedo: phi and the image restart, E is kept */
+    /* albedo: the image restarts, E is kept and phi is the warm start of the new solution */
     CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
     p = d.params;
     p.albedo = 0.5f;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     read_both(ctx, E1, P1, n);
-    CHECK(memcmp(E0, E1, n * 4) == 0);
-    CHECK(P1[n / 2 + N / 2] == 0.0f && P0[n / 2 + N / 2] != 0.0f);
-    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 4 && s.frames == 0);
+    CHECK(memcmp(E0, E1, n * 4) == 0 && memcmp(P0, P1, n * 4) == 0 && P0[n / 2 + N / 2] != 0.0f);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 4 && s.frames == 0 && s.light_error == 1.0);
     /* the diffusion boundary: phi and the image restart, E is kept */
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
     read_both(ctx, E0, P0, n);
@@ -242,16 +241,20 @@ static void test_invalidation(void)
     CHECK(memcmp(E0, E1, n * 4) == 0 && memcmp(P0, P1, n * 4) == 0);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 8 && s.frames == 2);
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS); /* Jacobi runs from the kept phi */
-    /* lights: E restarts */
+    /* lights of another colour: three channels, new grids, E restarts */
     memset(l, 0, sizeof l);
     l[0].direction[0] = 1.0f;
     l[1].type = HD_LIGHT_POINT; l[1].position[1] = 1.0f; l[1].color[0] = 1.0f; l[1].color[1] = 0.5f;
     CHECK(hd_set_lights(ctx, l, 2) == HD_SUCCESS);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 0 && s.illumination_channels == 3);
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS);
-    /* TF: everything restarts */
+    /* TF alpha: sigma_t anew, E and phi the warm start (tests/test_living.c), the image restarts;
+       hd_reset restarts from zero */
     tf.rgba = blob_tf; tf.count = 2;
     CHECK(hd_set_transfer_function(ctx, &tf) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 2 && s.frames == 0 && s.light_error == 1.0);
+    CHECK(hd_iterate(ctx, 1) == HD_SUCCESS);
+    CHECK(hd_reset(ctx) == HD_SUCCESS);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.iterations == 0 && s.frames == 0);
     CHECK(hd_iterate(ctx, 1) == HD_SUCCESS);
     hd_destroy(ctx);

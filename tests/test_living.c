@@ -357,7 +357,77 @@ static void test_update_bad(void)
     hd_destroy(c);
 }
 
+/* ---- setters that keep what stays valid ------------------------------------------------------- */
+/* A TF change of colour only (the same alphas): with grey scattering no light work at all (the
+   light stays converged, no iteration runs, E and phi bit for bit), only the image restarts, in
+   the new colour; the same TF again changes nothing; with RGB scattering phi is the warm start
+   (E bit for bit). An alpha change keeps E and phi as the warm start, E's mean capped. */
+static void test_tf_warm(void)
+{
+    hd_desc d;
+    hd_test_log log;
+    hd_context c;
+    hd_stats a, b;
+    hd_transfer_function tf;
+    hdt_volume_state vs;
+    static float e0[N * N * N], p0[N * N * N], e1[N * N * N], p1[N * N * N], img0[W * W * 4], img1[W * W * 4];
+    float red[12], thin[12];
+    int i, rgb;
+    for (rgb = 0; rgb < 2; ++rgb) {
+        make_desc(&d, &log);
+        d.params.rgb_scattering = rgb;
+        CHECK(hd_create(&d, &c) == HD_SUCCESS);
+        CHECK(render_to_rest(c, 300) > 0);
+        CHECK(hd_get_stats(c, &a) == HD_SUCCESS && a.light_converged);
+        CHECK(hd_read_image_f32(c, img0, W * W * 4) == HD_SUCCESS);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e0, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p0, (size_t)N * N * N) == HD_SUCCESS);
+        /* the same TF: nothing */
+        tf.rgba = tf3;
+        tf.count = 3;
+        CHECK(hd_set_transfer_function(c, &tf) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &b) == HD_SUCCESS && b.light_converged && b.frames == a.frames && b.iterations == a.iterations);
+        /* colour only */
+        memcpy(red, tf3, sizeof red);
+        red[5] = 0.1f; red[6] = 0.1f; red[8] = 1.0f; red[9] = 0.2f;
+        tf.rgba = red;
+        CHECK(hd_set_transfer_function(c, &tf) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &b) == HD_SUCCESS && b.light_converged == !rgb && b.frames == 0 && b.iterations == a.iterations);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e1, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p1, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(memcmp(e0, e1, sizeof e0) == 0 && memcmp(p0, p1, sizeof p0) == 0);
+        for (i = 0; i < 4; ++i) CHECK(hd_render(c) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &b) == HD_SUCCESS);
+        if (!rgb)
+            CHECK_MSG(b.iterations == a.iterations && b.seconds_direct == a.seconds_direct && b.seconds_diffusion == a.seconds_diffusion &&
+                          b.light_converged && b.frames == 4,
+                      "colour only: iterations %llu -> %llu, frames %llu", (unsigned long long)a.iterations,
+                      (unsigned long long)b.iterations, (unsigned long long)b.frames);
+        else
+            CHECK(b.iterations > a.iterations); /* phi re-solved */
+        CHECK(hd_read_image_f32(c, img1, W * W * 4) == HD_SUCCESS);
+        CHECK(rel_l2(img1, img0, W * W * 4) > 0.05);
+        /* alpha: E and phi the warm start */
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e0, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p0, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &a) == HD_SUCCESS);
+        memcpy(thin, red, sizeof thin);
+        thin[7] = 0.15f;
+        tf.rgba = thin;
+        CHECK(hd_set_transfer_function(c, &tf) == HD_SUCCESS);
+        CHECK(hd_get_stats(c, &b) == HD_SUCCESS && !b.light_converged && b.iterations == a.iterations && b.frames == 0);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e1, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p1, (size_t)N * N * N) == HD_SUCCESS);
+        CHECK(memcmp(e0, e1, sizeof e0) == 0 && memcmp(p0, p1, sizeof p0) == 0);
+        CHECK(hdt_volume_state_get(c, &vs) && vs.dl_n == 8);
+        CHECK(render_to_rest(c, 300) > 0);
+        CHECK(log.errors == 0);
+        hd_destroy(c);
+    }
+}
+
 const hd_test_case hd_tests_living[] = {
+    {"living_tf_warm", test_tf_warm},
     {"living_no_frame", test_no_frame},
     {"living_update_same", test_update_same},
     {"living_update_box_f32", test_update_box_f32},

@@ -10,6 +10,7 @@
 int hdt_param_rows(void);
 const char *hdt_param_row(int i, size_t *offset, size_t *size, unsigned *invalidates);
 int hdt_param_bits(unsigned *direct, unsigned *phi, unsigned *image, unsigned *paths);
+int hdt_param_warm_bits(unsigned *warm_e, unsigned *warm_phi);
 unsigned hdt_slot_generation(int slot, unsigned generation);
 int hdt_slots(void);
 
@@ -104,13 +105,16 @@ static void param_run(const hd_params *p, int n, param_state *st)
 
 /* Every field changed alone, on an HD and a PT_MS context after two iterations: what the next
    call would reset (hd_get_stats: iterations 0 when E restarts, frames 0 when the image restarts,
-   light_error 1 when E or phi restarts) is exactly the row's invalidation. */
+   light_error 1 when E or phi restarts or is a warm start) is exactly the row's invalidation; a
+   warm row keeps E and phi as they were (bit for bit) and its iterations. */
 static void test_param_table_invalidation(void)
 {
-    unsigned bd, bp, bi, bpaths;
+    unsigned bd, bp, bi, bpaths, bwe, bwp;
     int i, k, rows = hdt_param_rows();
     static const hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_PT_MS};
+    static float e0[PN * PN * PN * 3], p0[PN * PN * PN * 3], e1[PN * PN * PN * 3], p1[PN * PN * PN * 3];
     hdt_param_bits(&bd, &bp, &bi, &bpaths);
+    hdt_param_warm_bits(&bwe, &bwp);
     CHECK(rows >= 24);
     for (i = 0; i < rows; ++i) {
         size_t off, size;
@@ -128,6 +132,10 @@ static void test_param_table_invalidation(void)
             CHECK(hd_create(&d, &c) == HD_SUCCESS);
             CHECK(hd_iterate(c, 2) == HD_SUCCESS);
             CHECK(hd_query_desc(c, &d) == HD_SUCCESS);
+            if (!pt) {
+                CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e0, sizeof e0 / sizeof e0[0]) == HD_SUCCESS);
+                CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p0, sizeof p0 / sizeof p0[0]) == HD_SUCCESS);
+            }
             p = d.params;
             CHECK_MSG(param_change(name, &p), "params.%s has no change in test_params.c", name);
             CHECK_MSG(memcmp((const char *)&p + off, (const char *)&d.params + off, size) != 0, "params.%s did not change", name);
@@ -138,11 +146,18 @@ static void test_param_table_invalidation(void)
             if (strcmp(name, "method") == 0) inv = bd | bp | bi;
             want_d = (inv & bd) != 0;
             want_i = (inv & bi) != 0;
-            want_fresh = !pt && (inv & (bd | bp)) != 0;
+            want_fresh = !pt && (inv & (bd | bp | bwe | bwp)) != 0;
             CHECK_MSG((s.iterations == 0) == want_d && (s.frames == 0) == want_i && (!pt && s.light_error == 1.0) == want_fresh,
                       "params.%s on %s: iterations %llu, frames %llu, light_error %g; the row invalidates E %d, image %d, light %d",
                       name, pt ? "PT_MS" : "HD", (unsigned long long)s.iterations, (unsigned long long)s.frames, s.light_error,
                       want_d, want_i, want_fresh);
+            if (!pt && (inv & (bwe | bwp)) && !(inv & (bd | bp)) && !(row_inv & ~(bwe | bwp | bi | 1u))) {
+                /* a warm row on the same grid: E and phi as they were */
+                CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e1, sizeof e1 / sizeof e1[0]) == HD_SUCCESS);
+                CHECK(hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, p1, sizeof p1 / sizeof p1[0]) == HD_SUCCESS);
+                CHECK_MSG(memcmp(e0, e1, sizeof e0) == 0 && memcmp(p0, p1, sizeof p0) == 0, "params.%s: a warm row lost E or phi", name);
+                CHECK(hd_get_stats(c, &s) == HD_SUCCESS && s.iterations == 2 && !s.light_converged);
+            }
             hd_destroy(c);
         }
     }
@@ -155,10 +170,11 @@ static void test_param_table_invalidation(void)
 static void test_param_table_dependence(void)
 {
     static param_state a, b;
-    unsigned bd, bp, bi, bpaths;
+    unsigned bd, bp, bi, bpaths, bwe, bwp;
     int i, k, rows = hdt_param_rows();
     static const hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_PT_MS};
     hdt_param_bits(&bd, &bp, &bi, &bpaths);
+    hdt_param_warm_bits(&bwe, &bwp);
     for (i = 0; i < rows; ++i) {
         size_t off, size;
         unsigned inv;
@@ -180,12 +196,35 @@ static void test_param_table_dependence(void)
             de = memcmp(a.e, b.e, sizeof a.e) != 0;
             dphi = memcmp(a.phi, b.phi, sizeof a.phi) != 0;
             dimg = memcmp(a.img, b.img, sizeof a.img) != 0;
-            CHECK_MSG(!de || (eff & bd), "params.%s: E depends on it, its row does not reset E", name);
-            CHECK_MSG(!dphi || (eff & bp), "params.%s: phi depends on it, its row does not reset phi", name);
+            CHECK_MSG(!de || (eff & (bd | bwe)), "params.%s: E depends on it, its row neither resets E nor re-weights it", name);
+            CHECK_MSG(!dphi || (eff & (bp | bwp)), "params.%s: phi depends on it, its row neither resets phi nor restarts its solve", name);
             CHECK_MSG(!dimg || (eff & bi), "params.%s on %s: the image depends on it, its row does not reset the image", name,
                       pt ? "PT_MS" : "HD");
         }
     }
+}
+
+/* The fields whose change keeps E and phi as the warm start of the new light (hybriddiff.h, the
+   table above hd_set_transfer_function): their rows are warm, never a reset, and the walk above
+   checks that a warm row keeps E and phi bit for bit. */
+static void test_param_warm_rows(void)
+{
+    static const char *warm[] = {"extinction", "albedo", "anisotropy"};
+    unsigned bd, bp, bi, bpaths, bwe, bwp;
+    int i, k, found = 0, rows = hdt_param_rows();
+    hdt_param_bits(&bd, &bp, &bi, &bpaths);
+    hdt_param_warm_bits(&bwe, &bwp);
+    for (i = 0; i < rows; ++i) {
+        size_t off, size;
+        unsigned inv;
+        const char *name = hdt_param_row(i, &off, &size, &inv);
+        for (k = 0; k < 3; ++k)
+            if (strcmp(name, warm[k]) == 0) {
+                ++found;
+                CHECK_MSG(!(inv & (bd | bp)) && (inv & bwp) && (inv & bi), "params.%s: row 0x%x is not warm", name, inv);
+            }
+    }
+    CHECK(found == 3);
 }
 
 /* PT_MS after a max_bounces change: the running mean restarts (hd_stats.frames 1 after a call). */
@@ -329,6 +368,7 @@ static void test_value_range_extremes(void)
 const hd_test_case hd_tests_params[] = {
     {"param_table_invalidation", test_param_table_invalidation},
     {"param_table_dependence", test_param_table_dependence},
+    {"param_warm_rows", test_param_warm_rows},
     {"param_max_bounces_restarts", test_param_max_bounces_restarts},
     {"param_codes", test_param_codes},
     {"handle_retirement", test_handle_retirement},

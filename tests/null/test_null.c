@@ -137,7 +137,7 @@ static void test_null_invalidation(void)
     CHECK(hd_set_camera(h, &cam) == HD_SUCCESS);
     c = snap(h);
     CHECK(hd_iterate(h, 1) == HD_SUCCESS && delta(h, &c, HD__NULL_alloc_image) == 1);
-    /* albedo: phi and the image, not sigma_t or E */
+    /* albedo: the image, not sigma_t; E and phi kept (phi the warm start of the new solve) */
     p = d.params;
     p.albedo = 0.5f;
     CHECK(hd_set_params(h, &p) == HD_SUCCESS);
@@ -145,15 +145,15 @@ static void test_null_invalidation(void)
     ((hd__backend *)be_of(h))->cleared = 0;
     CHECK(hd_iterate(h, 1) == HD_SUCCESS);
     CHECK(delta(h, &c, HD__NULL_classify) == 0);
-    CHECK_MSG(be_of(h)->cleared == (HD__DIRTY_PHI | HD__DIRTY_IMAGE), "cleared 0x%x", be_of(h)->cleared);
-    /* extinction: sigma_t again, and E, phi, image */
+    CHECK_MSG(be_of(h)->cleared == HD__DIRTY_IMAGE, "cleared 0x%x", be_of(h)->cleared);
+    /* extinction: sigma_t again and the image; E and phi the warm start */
     p.extinction = 50.0f;
     CHECK(hd_set_params(h, &p) == HD_SUCCESS);
     c = snap(h);
     ((hd__backend *)be_of(h))->cleared = 0;
     CHECK(hd_iterate(h, 1) == HD_SUCCESS);
     CHECK(delta(h, &c, HD__NULL_upload_inputs) == 1 && delta(h, &c, HD__NULL_classify) == 1 && delta(h, &c, HD__NULL_direct_list) == 1);
-    CHECK(be_of(h)->cleared == (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE));
+    CHECK(be_of(h)->cleared == HD__DIRTY_IMAGE);
     /* exposure, tracking, sweeps: nothing */
     p.exposure = 3.0f;
     p.tracking = HD_TRACKING_DELTA;
@@ -227,6 +227,20 @@ static void test_null_update(void)
     c = snap(h);
     CHECK(hd_update_volume(h, &u) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS);
     CHECK(delta(h, &c, HD__NULL_update_volume) == 0 && delta(h, &c, HD__NULL_classify) == 0 && delta(h, &c, HD__NULL_direct_list) == 0);
+    /* a TF of new colours only (grey scattering): the TF uploaded, no light work, the image cleared */
+    {
+        float tf[8] = {0, 0, 0, 0, 1, 1, 1, 1}, red[8] = {0, 0, 0, 0, 1, 0.2f, 0.1f, 1};
+        hd_transfer_function t;
+        t.rgba = tf;
+        t.count = 2;
+        CHECK(hd_set_transfer_function(h, &t) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS);
+        ((hd__backend *)be_of(h))->cleared = 0;
+        c = snap(h);
+        t.rgba = red;
+        CHECK(hd_set_transfer_function(h, &t) == HD_SUCCESS && hd_refine(h, 1) == HD_SUCCESS);
+        CHECK(delta(h, &c, HD__NULL_upload_inputs) == 1 && delta(h, &c, HD__NULL_classify) == 0 && delta(h, &c, HD__NULL_direct_list) == 0);
+        CHECK_MSG(be_of(h)->cleared == HD__DIRTY_IMAGE, "cleared 0x%x", be_of(h)->cleared);
+    }
     /* a clean restart */
     ((hd__backend *)be_of(h))->cleared = 0;
     CHECK(hd_reset(h) == HD_SUCCESS && hd_iterate(h, 1) == HD_SUCCESS);
