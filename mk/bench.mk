@@ -60,3 +60,17 @@ bench-orbit: $(B)/hdbench_orbit $(patsubst %,$(B)/hdbench_orbit_%,$(ORBIT_BACKEN
 	@test -f data/head.nrrd || scripts/fetch-data
 	$(B)/hdbench_orbit $(ORBIT_ARGS)
 	@for b in $(ORBIT_BACKENDS); do echo "== $$b"; $(B)/hdbench_orbit_$$b --no-psnr $(ORBIT_ARGS) || exit 1; done
+
+# make bench-animated: bench/hdbench_animated.c on the CPU backend: a procedural smoke puff at
+# 64^3 and 128^3 (300 frames, camera orbiting, 512^2): hd_update_volume per frame against
+# destroy + create, and the lag (PSNR against each frame's converged light); then the TF slider
+# on the head CT, warm against cold (hd_reset). ANIMATED_ARGS are added to each run.
+.PHONY: bench-animated
+$(B)/hdbench_animated: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+ANIMATED_ARGS ?=
+bench-animated: $(B)/hdbench_animated
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdbench_animated --dims 64 --no-tf $(ANIMATED_ARGS)
+	$(B)/hdbench_animated --dims 128 --no-tf $(ANIMATED_ARGS)
+	$(B)/hdbench_animated --no-puff $(ANIMATED_ARGS)
