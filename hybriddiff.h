@@ -135,7 +135,7 @@ extern "C" {
     X(HD_ERROR_FILE_OUTSIDE_FOLDER, "a detached data file lies outside the header's folder") \
     X(HD_ERROR_FILE_TOO_LARGE, "the volume is larger than the loader's max_bytes") \
     X(HD_ERROR_GL_CONTEXT_NOT_CURRENT, "GL backend: the caller's context (use_current_context) is not current") \
-    X(HD_ERROR_INVALID_TEXTURE, "GL backend: the texture is not a GL_RGBA8 2D texture of the camera's size") \
+    X(HD_ERROR_INVALID_TEXTURE, "GL backend: the texture is not a 2D texture (hd_gl_render_to_texture: not GL_RGBA8 of the camera's size)") \
     X(HD_ERROR_INVALID_TRANSFORM, "the volume transform is non-finite, singular, not affine or out of range") \
     X(HD_ERROR_TRANSFORM_SHEAR, "the volume transform shears (its columns are not orthogonal): the grid cannot follow it") \
     X(HD_ERROR_DEPTH_SIZE, "the depth buffer's size is not the camera's") \
@@ -144,7 +144,10 @@ extern "C" {
     X(HD_ERROR_NO_FRAME, "the image holds no frame yet: render one first") \
     X(HD_ERROR_VOLUME_MISMATCH, "the update's voxel type or dims differ from the context's volume") \
     X(HD_ERROR_BOX_OUTSIDE_VOLUME, "the update's box is empty or reaches outside the volume") \
-    X(HD_ERROR_INVALID_VOXELS, "a voxel value of the update is NaN or infinite")
+    X(HD_ERROR_INVALID_VOXELS, "a voxel value of the update is NaN or infinite") \
+    X(HD_ERROR_OUTPUT_OUTSIDE_TARGET, "the output region does not lie inside the target") \
+    X(HD_ERROR_OUTPUT_SIZE, "the output region's size is not the camera's (the image is written 1:1)") \
+    X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -686,21 +689,134 @@ HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, floa
                                      size_t dst_floats);
 HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
 
+/* ---- output into the renderer's target ------------------------------------------------------
+   What the image is (docs/INTEGRATION.md, "Compositing"): emission-absorption radiance along
+   each ray, PREMULTIPLIED by its opacity, and alpha = 1 - the ray's transmittance through the
+   volume. Composite it over the host's scene with blend ONE, ONE_MINUS_SRC_ALPHA (colour and
+   alpha), in linear space: dst = src + (1 - src.a) dst. params.background is radiance added
+   behind the volume (times the transmittance, alpha unchanged): leave it 0 when compositing,
+   or the host's scene is covered by it. Exposure scales rgb (not alpha) of every format; no
+   tone mapping is applied: a host in linear HDR tone-maps after compositing.
+     HD_OUTPUT_SRGB8        RGBA8, 4 bytes a pixel: rgb sRGB-encoded (clamped to [0, 1]),
+                            alpha linear, as hd_read_image_rgba8. Premultiplied in linear
+                            space before the encoding: a host that samples it through an sRGB
+                            format (GL_SRGB8_ALPHA8, VK_FORMAT_R8G8B8A8_SRGB) gets linear
+                            premultiplied values back and blends them correctly in linear space
+                            (GL_FRAMEBUFFER_SRGB); through a UNORM format it gets the encoded
+                            values, display-ready, whose blend in sRGB space is an approximation.
+     HD_OUTPUT_LINEAR_F16   RGBA binary16, 8 bytes a pixel: linear, rounded to nearest even
+                            (hdk_f2h: above 65504 inf), unclamped.
+     HD_OUTPUT_LINEAR_F32   RGBA float, 16 bytes a pixel: linear, unclamped (hd_read_image_f32
+                            times exposure). */
+typedef enum hd_output_format {
+    HD_OUTPUT_SRGB8 = 0,
+    HD_OUTPUT_LINEAR_F16,
+    HD_OUTPUT_LINEAR_F32,
+    HD_OUTPUT_FORMAT_COUNT
+} hd_output_format;
+
+/* Where in the target the image goes: the region of width x height pixels whose first pixel is
+   (x, y) of the target; the library writes its image there 1:1 (no scaling) and nothing
+   outside it. Zeroed (HD_OUTPUT_INIT, or a NULL pointer): RGBA8 at (0, 0), the camera's size.
+   width and height: 0 -> the camera's; otherwise they must be the camera's
+   (HD_ERROR_OUTPUT_SIZE). A region that does not lie inside the target, or a negative x or y,
+   is HD_ERROR_OUTPUT_OUTSIDE_TARGET; a target whose format does not take `format`,
+   HD_ERROR_OUTPUT_FORMAT; each with one logged line, and the context keeps working. */
+typedef struct hd_output {
+    hd_output_format format;
+    int x, y;          /* the region's first pixel in the target (see each call for the rows) */
+    int width, height; /* 0 -> the camera's; else it must equal it */
+} hd_output;
+#define HD_OUTPUT_INIT HD_ZERO_INIT
+
+/* The image in `format` into a caller's memory, every backend: the region (output->x, y) of a
+   target of rows row_pitch bytes apart (0 -> (x + width) * the pixel's bytes), top row first.
+   The target must hold the region: a row of (x + width) pixels wider than row_pitch is
+   HD_ERROR_OUTPUT_OUTSIDE_TARGET; fewer than (y + height - 1) * row_pitch + (x + width) *
+   pixel bytes in dst_bytes, HD_ERROR_BUFFER_TOO_SMALL; before any frame, HD_ERROR_NO_FRAME (as
+   the other read-backs). Bytes outside the region are not touched. dst needs no alignment. */
+HDDEF hd_result hd_read_image_ex(hd_context ctx, const hd_output *output, void *dst, size_t dst_bytes,
+                                 size_t row_pitch);
+
 /* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): records n iterations of the
    current method into the caller's VkCommandBuffer (passed as void*, in the recording state,
-   from a pool of desc.vulkan.queue_family) instead of submitting them; hd_iterate submits and
-   waits itself. Changed inputs are uploaded first (submitted and waited for). The caller
-   submits the command buffer and waits for it before the next call on this context.
-   HD_RENDER_SCALE_AUTO times recorded frames on the device (timestamps read by the next call).
-   HD_SOLVER_MULTIGRID (with HD or CD diffusing) cannot be recorded: each step reads its dot
-   products back on the host; HD_ERROR_UNSUPPORTED. */
+   from a pool of desc.vulkan.queue_family) instead of submitting them, as hd_iterate runs them
+   (light refined even once converged); hd_iterate submits and waits itself. Changed inputs are
+   uploaded first (submitted and waited for). The caller submits the command buffer and waits
+   for it before the next call on this context. The light's convergence (hd_stats.light_error,
+   light_converged) of recorded iterations is measured by the next call that reaches the device,
+   once they have run (hence that wait). HD_RENDER_SCALE_AUTO times recorded frames on the
+   device (timestamps read by the next call). HD_SOLVER_MULTIGRID (with HD or CD diffusing)
+   cannot be recorded: each step reads its dot products back on the host; HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_vulkan_record(hd_context ctx, void *command_buffer, int n);
+
+/* The caller's Vulkan target of hd_vulkan_record_render: an image or a buffer (one of them).
+   Handles as uint64_t, which holds a VkImage / VkBuffer on 32- and 64-bit platforms alike:
+   target.image = (uint64_t)image. The library cannot query a handle: format, extent and size
+   are as the caller made them (wrong ones are the validation layer's to report).
+   Image: a 2D color image, mip level 0 and array layer 0 written, made with
+   VK_IMAGE_USAGE_TRANSFER_DST_BIT and owned by desc.vulkan.queue_family. Its format: for
+   HD_OUTPUT_SRGB8 VK_FORMAT_R8G8B8A8_UNORM or _SRGB, or B8G8R8A8_UNORM or _SRGB (the same
+   sRGB-encoded bytes; B and R swapped for BGRA); for LINEAR_F16 R16G16B16A16_SFLOAT; for
+   LINEAR_F32 R32G32B32A32_SFLOAT. Rows top first (Vulkan's y down): the image's top row goes
+   to row output->y.
+   Barriers (the library records them; the caller records none around the call): the image must
+   be in `layout` when the command buffer reaches the write; the library's barrier takes it from
+   `layout` (after every earlier command: source stage ALL_COMMANDS, access MEMORY_READ |
+   MEMORY_WRITE) to TRANSFER_DST_OPTIMAL, copies the region in (vkCmdCopyBufferToImage), and
+   takes it to `final_layout` (before every later command: destination stage ALL_COMMANDS,
+   access MEMORY_READ | MEMORY_WRITE). layout UNDEFINED discards the image's contents (pixels
+   outside the region then undefined); final_layout 0 (UNDEFINED) -> `layout`, which must then
+   not be UNDEFINED or PREINITIALIZED. Buffer: the same bytes as hd_read_image_ex, rows top
+   first, `offset` bytes from the buffer's start to the target's first pixel, rows row_pitch
+   apart (0 -> width * pixel bytes), width x height pixels; buffer_size the buffer's size
+   (required: the rows must lie inside it), made with VK_BUFFER_USAGE_TRANSFER_DST_BIT; the
+   same ALL_COMMANDS buffer barriers before and after the copies (vkCmdCopyBuffer). */
+typedef struct hd_vulkan_target {
+    uint64_t image;          /* VkImage, or 0 with a buffer */
+    int format;              /* the image's VkFormat */
+    int layout;              /* the VkImageLayout it is in before the write */
+    int final_layout;        /* the VkImageLayout it is left in; 0 -> layout */
+    int width, height;       /* the target's size in pixels (the image's extent) */
+    uint64_t buffer;         /* VkBuffer, or 0 with an image */
+    uint64_t offset;         /* buffer: bytes to the target's first pixel */
+    uint64_t row_pitch;      /* buffer: bytes from a row to the next, 0 -> width * pixel bytes */
+    uint64_t buffer_size;    /* buffer: its size in bytes */
+} hd_vulkan_target;
+#define HD_VULKAN_TARGET_INIT HD_ZERO_INIT
+
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): what hd_render does, recorded
+   into the caller's command buffer (as hd_vulkan_record's), one call per displayed frame, then
+   with target non-NULL the image written into the caller's image or buffer (output: NULL -> all
+   zero) by the library's compute pass and a transfer, after the frame:
+     HD, CD: while the light has not converged, one light iteration (its convergence measured by
+             the next call, once the caller has run this one), then one projection frame; once
+             it has converged, the projection frame alone (no light work), and once the
+             frame_window frames since are in, no frame: only the write.
+     PT_SS, PT_MS: one path iteration.
+   So hd_stats.light_converged reaches 1 under recording as under hd_render, and frames over
+   converged light cost the projection (and the write) alone. The same rules as
+   hd_vulkan_record: submit and wait before the next call; MULTIGRID is refused. The target's
+   checks (format, layouts, region, pitch) come before anything is recorded: on an error nothing
+   is recorded and the command buffer is as it was. */
+HDDEF hd_result hd_vulkan_record_render(hd_context ctx, void *command_buffer, const hd_vulkan_target *target,
+                                        const hd_output *output);
 
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
    hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must
-   be the camera's) by a compute shader, with no CPU round trip; rows bottom first, GL's order.
-   The context must be current (desc.gl.use_current_context) or share objects with the backend's. */
+   be the camera's: else HD_ERROR_INVALID_TEXTURE) with no CPU round trip; rows bottom first,
+   GL's order. The context must be current (desc.gl.use_current_context) or share objects with
+   the backend's. */
 HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
+/* The same into a region of a 2D texture of any size (level 0), in `output->format`: the
+   texture's internal format must be GL_RGBA8 or GL_SRGB8_ALPHA8 for HD_OUTPUT_SRGB8 (the same
+   sRGB-encoded bytes: an sRGB texture samples as linear premultiplied values), GL_RGBA16F for
+   LINEAR_F16, GL_RGBA32F for LINEAR_F32 (checked with glGetTexLevelParameteriv). Rows bottom
+   first: the image's bottom row goes to texel row output->y, x to column output->x; texels
+   outside the region are not touched. A compute pass encodes the image into a buffer and
+   glTexSubImage2D copies it in from there (a pixel unpack buffer), so the bytes are exactly
+   hd_read_image_ex's. Not a 2D texture: HD_ERROR_INVALID_TEXTURE. */
+HDDEF hd_result hd_gl_render_to_texture_ex(hd_context ctx, unsigned int texture, const hd_output *output);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer

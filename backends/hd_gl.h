@@ -41,8 +41,11 @@
    messages above notification severity to the logger (warning; type ERROR as error). The
    caller's context keeps its own debug callback.
 
-   Output without a CPU round trip: hd_gl_render_to_texture() writes the sRGB-encoded image into
-   the caller's GL_RGBA8 2D texture (hybriddiff.h). */
+   Output without a CPU round trip: hd_gl_render_to_texture(_ex) (hybriddiff.h): the output pass
+   (backends/hd_output_glsl.h) encodes the image into a buffer (sRGB RGBA8, or linear half or
+   float RGBA), which glTexSubImage2D copies from the pixel unpack binding into a region of the
+   caller's 2D texture: one path for every texture format (GL_SRGB8_ALPHA8 cannot be an image
+   unit's format) and exactly hd_read_image_ex's bytes. */
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 /* <GL/gl.h> first, as GLFW and SDL include it: a window header included after this file then
@@ -71,7 +74,7 @@
     X(_HD_GENTEXTURES, GenTextures) X(_HD_DELETETEXTURES, DeleteTextures) X(_HD_BINDTEXTURE, BindTexture) \
     X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
     X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
-    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei)
+    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei) X(_HD_TEXSUBIMAGE2D, TexSubImage2D)
 /* optional: GL 4.4 / ARB_clear_texture, KHR_debug, GL 4.5 / ARB_get_texture_sub_image */
 #define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
     X(DEBUGMESSAGECONTROL, DebugMessageControl) X(GETTEXTURESUBIMAGE, GetTextureSubImage)
@@ -81,6 +84,8 @@
 typedef void (APIENTRYP PFNGL_HD_GENTEXTURESPROC)(GLsizei n, GLuint *textures);
 typedef void (APIENTRYP PFNGL_HD_DELETETEXTURESPROC)(GLsizei n, const GLuint *textures);
 typedef void (APIENTRYP PFNGL_HD_BINDTEXTUREPROC)(GLenum target, GLuint texture);
+typedef void (APIENTRYP PFNGL_HD_TEXSUBIMAGE2DPROC)(GLenum target, GLint level, GLint xoffset, GLint yoffset, GLsizei width,
+                                                    GLsizei height, GLenum format, GLenum type, const void *pixels);
 
 typedef struct hd__gl_fns {
 #define HD__GL_FN(up, name) PFNGL##up##PROC name;
@@ -89,9 +94,9 @@ typedef struct hd__gl_fns {
 } hd__gl_fns;
 
 enum { HD__GL_CLASSIFY, HD__GL_DIRECT, HD__GL_DIFFUSE, HD__GL_PROJECT, HD__GL_CONVECT, HD__GL_SUM_LIGHT,
-       HD__GL_PATH, HD__GL_LIGHT_SUM, HD__GL_TO_TEXTURE, HD__GL_PROGRAM_COUNT };
+       HD__GL_PATH, HD__GL_LIGHT_SUM, HD__GL_OUTPUT, HD__GL_PROGRAM_COUNT };
 static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
-    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "light_sum", "render_to_texture"};
+    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "light_sum", "output"};
 /* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
    surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
@@ -199,6 +204,11 @@ struct hd__backend {
     hd__gpu_grids gg;           /* what the grids are made for (backends/hd_gpu.h) */
     struct hd__gl_mg mg;        /* multigrid's extras and grids while gg.levels */
     GLuint mg_programs[HD__GPU_MG_VARIANTS]; /* HD_SOLVER_MULTIGRID's (backends/hd_gpu.h), compiled on first use */
+    /* the output pass (hd__be_output_texture): the RGBA8 thresholds (hd__output_thresholds),
+       storage buffer 0, made on first use; the encoded image, storage buffer 1 and then the
+       pixel unpack buffer, obuf_bytes long */
+    GLuint otab, obuf;
+    size_t obuf_bytes;
 };
 
 static const char *hd__be_name(void) { return "gl"; }
@@ -411,27 +421,6 @@ static hd_result hd__be_end(const hd__view *vw, hd_result r)
 }
 
 /* ---- programs ---------------------------------------------------------------------------------- */
-static const char *const hd__gl_to_texture_src =
-    "#version 430 core\n"
-    "layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;\n"
-    "layout(std430, binding = 2) readonly buffer hd_b_img { float img[]; };\n"
-    "layout(binding = 0, rgba8) uniform writeonly image2D hd_o;\n"
-    "layout(location = 0) uniform ivec4 hd_pc; /* x = width, y = height */\n"
-    "layout(location = 1) uniform float hd_exposure;\n"
-    "float hd_srgb(float v) {\n"
-    "    if (!(v > 0.0)) return 0.0;\n"
-    "    if (v >= 1.0) return 1.0;\n"
-    "    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;\n"
-    "}\n"
-    "void main() {\n"
-    "    ivec2 p = ivec2(gl_GlobalInvocationID.xy);\n"
-    "    if (p.x >= hd_pc.x || p.y >= hd_pc.y) return;\n"
-    "    int i = 4 * (p.y * hd_pc.x + p.x);\n"
-    "    float e = hd_exposure;\n"
-    "    vec4 c = vec4(hd_srgb(img[i] * e), hd_srgb(img[i + 1] * e), hd_srgb(img[i + 2] * e), clamp(img[i + 3], 0.0, 1.0));\n"
-    "    imageStore(hd_o, ivec2(p.x, hd_pc.y - 1 - p.y), c); /* GL rows: bottom first */\n"
-    "}\n";
-
 /* Compiles and links the program of slot p (a stage, or a diffusion variant) on its first use. */
 static hd_result hd__gl_build(const hd__view *vw, const char *const *src, GLsizei n, const char *name, GLuint *out);
 static hd_result hd__gl_program(const hd__view *vw, int p)
@@ -444,9 +433,10 @@ static hd_result hd__gl_program(const hd__view *vw, int p)
     GLsizei n = 0;
     size_t i;
     if (be->programs[p]) return HD_SUCCESS;
-    if (p == HD__GL_TO_TEXTURE) {
-        src[0] = hd__gl_to_texture_src;
-        n = 1;
+    if (p == HD__GL_OUTPUT) {
+        src[0] = "#version 430 core\n";
+        for (i = 0; i < HD__GL_SOURCE_OUTPUT_LINES; ++i) src[1 + i] = hd__gl_source_output[i];
+        n = (GLsizei)(1 + HD__GL_SOURCE_OUTPUT_LINES);
     } else {
         int len = snprintf(prefix, sizeof prefix,
                            "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
@@ -746,6 +736,7 @@ static void hd__be_destroy(hd__view *vw)
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab); hd__gl_free_buffer(be, &be->dep);
+        hd__gl_free_buffer(be, &be->otab); hd__gl_free_buffer(be, &be->obuf);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
         hd__be_end(vw, HD_SUCCESS);
     }
@@ -1267,34 +1258,69 @@ static hd_result hd__be_path(const hd__view *vw)
 }
 
 /* ---- the image into the caller's texture ---------------------------------------------------------- */
-static hd_result hd__gl_to_texture(const hd__view *vw, GLuint texture)
+/* The output format a texture's internal format takes (-1: none), and the pixel type of its copy. */
+static int hd__gl_output_format(GLint internal, GLenum *type)
 {
+    *type = internal == GL_RGBA16F ? GL_HALF_FLOAT : internal == GL_RGBA32F ? GL_FLOAT : GL_UNSIGNED_BYTE;
+    return internal == GL_RGBA8 || internal == GL_SRGB8_ALPHA8 ? HD_OUTPUT_SRGB8
+           : internal == GL_RGBA16F                            ? HD_OUTPUT_LINEAR_F16
+           : internal == GL_RGBA32F                            ? HD_OUTPUT_LINEAR_F32
+                                                               : -1;
+}
+
+static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
+{
+    static const char *const names[HD_OUTPUT_FORMAT_COUNT] = {"GL_RGBA8 or GL_SRGB8_ALPHA8", "GL_RGBA16F", "GL_RGBA32F"};
+    const char *fn = exact ? "hd_gl_render_to_texture" : "hd_gl_render_to_texture_ex";
     hd__backend *be = vw->be;
-    GLint w = 0, h = 0, format = 0;
+    GLint w = 0, h = 0, internal = 0;
+    GLenum type;
+    int cw = out->width, ch = out->height;
+    size_t bytes = (size_t)cw * ch * hd__output_pixel_bytes(out->format);
     hd_result r;
-    be->gl.BindTexture(GL_TEXTURE_2D, texture);
+    be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)texture);
     if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: %u is not a 2D texture name in the current context", texture);
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 2D texture name in the current context", fn, texture);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
     be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
-    if (w != vw->camera.width || h != vw->camera.height || format != GL_RGBA8)
-        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE,
-                       "hd_gl_render_to_texture: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
-                       texture, (int)w, (int)h, (unsigned)format, vw->camera.width, vw->camera.height);
-    if ((r = hd__gl_program(vw, HD__GL_TO_TEXTURE)) != HD_SUCCESS) return r;
-    be->gl.UseProgram(be->programs[HD__GL_TO_TEXTURE]);
-    be->gl.Uniform4i(0, w, h, 0, 0);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if (exact && (w != cw || h != ch || internal != GL_RGBA8))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
+                       fn, texture, (int)w, (int)h, (unsigned)internal, cw, ch);
+    if (hd__gl_output_format(internal, &type) != (int)out->format)
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "%s: texture %u has internal format 0x%04x; output format %d needs %s", fn,
+                       texture, (unsigned)internal, (int)out->format, names[out->format]);
+    if ((int64_t)out->x + cw > w || (int64_t)out->y + ch > h)
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "%s: region %dx%d at (%d, %d) outside texture %u's %dx%d", fn, cw, ch,
+                       out->x, out->y, texture, (int)w, (int)h);
+    if ((r = hd__gl_program(vw, HD__GL_OUTPUT)) != HD_SUCCESS) return r;
+    if (!be->otab) {
+        float t[HD__OUTPUT_THRESHOLDS];
+        hd__output_thresholds(t);
+        if ((r = hd__gl_buffer_data(vw, &be->otab, sizeof t, t, GL_STATIC_DRAW, "the output's thresholds")) != HD_SUCCESS) return r;
+    }
+    if (be->obuf_bytes < bytes) {
+        be->obuf_bytes = 0;
+        if ((r = hd__gl_buffer_data(vw, &be->obuf, bytes, NULL, GL_STREAM_COPY, "the encoded image")) != HD_SUCCESS) return r;
+        be->obuf_bytes = bytes;
+    }
+    be->gl.UseProgram(be->programs[HD__GL_OUTPUT]);
+    be->gl.Uniform4i(0, cw, ch, (GLint)out->format, 1); /* rows bottom first */
     be->gl.Uniform1f(1, vw->params.exposure);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, be->otab);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, be->obuf);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, be->img);
-    be->gl.BindImageTexture(0, texture, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
-    be->gl.DispatchCompute((GLuint)((w + 7) / 8), (GLuint)((h + 7) / 8), 1);
-    be->gl.MemoryBarrier(GL_ALL_BARRIER_BITS);
-    return hd__gl_check(vw, "render_to_texture", __LINE__);
+    be->gl.DispatchCompute((GLuint)((cw + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ch, 1);
+    be->gl.MemoryBarrier(GL_PIXEL_BUFFER_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    /* the bracket left the unpack state at its defaults (alignment 4: rows of 4, 8 or 16 bytes a
+       pixel are aligned) with no unpack buffer; texture unit 0's 2D binding is restored after */
+    be->gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, be->obuf);
+    be->gl.TexSubImage2D(GL_TEXTURE_2D, 0, out->x, out->y, cw, ch, GL_RGBA, type, NULL);
+    be->gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    return hd__gl_check(vw, "the output into the texture", __LINE__);
 }
 
 static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }
-static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture) { return hd__gl_to_texture(vw, (GLuint)texture); }
 
 /* No recording (a Vulkan feature): the core never calls these. */
 static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
@@ -1305,3 +1331,13 @@ static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots
 static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
 static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
 static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
+static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
+{
+    (void)target; (void)out;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
+}
+static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
+{
+    (void)target; (void)out;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
+}

@@ -13,7 +13,7 @@
     X(project) X(upsample) X(path) X(upload_depth) X(read_image) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
-    X(mg_extrapolate) X(begin) X(end)
+    X(mg_extrapolate) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
 enum {
 #define HD__NULL_X(name) HD__NULL_##name,
     HD__NULL_PRIMITIVES(HD__NULL_X)
@@ -32,6 +32,7 @@ struct hd__backend {
     size_t illum_floats;       /* what hd__be_alloc_illumination asked for */
     int width, height, reduced, lights, jacobi;
     int open;                  /* inside a bracket (hd__be_begin .. hd__be_end) */
+    int recording;             /* inside hd__be_record_begin .. hd__be_record_end */
     int misuse;                /* a primitive called outside a bracket, or a bracket opened twice */
     double *rows;              /* the multigrid's row sums, zeros (hd__be_mg_row_sums) */
     size_t nrows;
@@ -214,19 +215,42 @@ static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour)
 }
 static size_t hd__be_solver_bytes(const hd__view *vw) { (void)vw; return 0; }
 
-/* ---- optional features: none ---------------------------------------------------------------- */
-static unsigned hd__be_features(void) { return 0; }
+/* ---- optional features: recording (nothing recorded, the schedule counted); no GL texture ---- */
+static unsigned hd__be_features(void) { return HD__BE_RECORD; }
 static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
 {
     (void)target; (void)slots;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no recording");
+    hd__null_call(vw, HD__NULL_record_begin);
+    if (vw->be->recording) vw->be->misuse = 1;
+    vw->be->recording = 1;
+    return HD_SUCCESS;
 }
 static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
-static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
-static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
-static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
+static hd_result hd__be_record_end(const hd__view *vw, hd_result r)
 {
-    (void)texture;
+    hd__null_call(vw, HD__NULL_record_end);
+    if (!vw->be->recording) vw->be->misuse = 1;
+    vw->be->recording = 0;
+    return r;
+}
+static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
+static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
+{
+    (void)target; (void)out;
+    hd__null_call(vw, HD__NULL_output_target_check);
+    if (vw->be->recording) vw->be->misuse = 1; /* the check comes before anything is recorded */
+    return HD_SUCCESS;
+}
+static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
+{
+    (void)target; (void)out;
+    hd__null_call(vw, HD__NULL_record_output);
+    if (!vw->be->recording) vw->be->misuse = 1;
+    return HD_SUCCESS;
+}
+static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
+{
+    (void)texture; (void)out; (void)exact;
     return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
 }
 

@@ -765,9 +765,19 @@ static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots
 static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
 static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
 static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
-static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
+static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
 {
-    (void)texture;
+    (void)target; (void)out;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no recording");
+}
+static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
+{
+    (void)target; (void)out;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no recording");
+}
+static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
+{
+    (void)texture; (void)out; (void)exact;
     return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "opencl: no GL texture");
 }
 

@@ -217,6 +217,17 @@ struct hd__backend {
     unsigned long submits, lose_at; /* queue submissions so far; HD_VK_LOSE_DEVICE (0: off) */
     int lost;
     unsigned long validation_messages;
+    /* the output pass (hd__be_record_output, backends/hd_output_glsl.h), made on first use: its
+       set layout (the image, the thresholds, the encoded image), pipeline, pool and set (written
+       for the buffers named in out_img / out_enc), the RGBA8 thresholds (host-visible) and the
+       encoded image (device-local) */
+    VkDescriptorSetLayout out_set_layout;
+    VkPipelineLayout out_layout;
+    VkPipeline out_pipe;
+    VkDescriptorPool out_pool;
+    VkDescriptorSet out_set;
+    VkBuffer out_img, out_enc;
+    hd__vk_buffer otab, obuf;
 };
 
 static const char *hd__be_name(void) { return "vulkan"; }
@@ -1290,6 +1301,11 @@ static void hd__be_destroy(hd__view *vw)
         hd__vk_free_buffer(vw, &be->params); hd__vk_free_buffer(vw, &be->tf); hd__vk_free_buffer(vw, &be->maj);
         hd__vk_free_buffer(vw, &be->img); hd__vk_free_buffer(vw, &be->staging); hd__vk_free_buffer(vw, &be->dummy_buffer);
         hd__vk_free_buffer(vw, &be->dl); hd__vk_free_buffer(vw, &be->ptab); hd__vk_free_buffer(vw, &be->dep);
+        hd__vk_free_buffer(vw, &be->otab); hd__vk_free_buffer(vw, &be->obuf);
+        if (be->out_pipe) be->fn.vkDestroyPipeline(be->device, be->out_pipe, NULL);
+        if (be->out_pool) be->fn.vkDestroyDescriptorPool(be->device, be->out_pool, NULL);
+        if (be->out_layout) be->fn.vkDestroyPipelineLayout(be->device, be->out_layout, NULL);
+        if (be->out_set_layout) be->fn.vkDestroyDescriptorSetLayout(be->device, be->out_set_layout, NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
             if (be->pipelines[i]) be->fn.vkDestroyPipeline(be->device, be->pipelines[i], NULL);
         for (i = 0; i < HD__VK_PIPELINE_COUNT; ++i)
@@ -2083,9 +2099,234 @@ static hd_result hd__be_record_end(const hd__view *vw, hd_result r)
     return r;
 }
 
-/* No GL texture: the core never calls it. */
-static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture)
+/* ---- the image into the caller's image or buffer (hd_vulkan_record_render) --------------------- */
+/* Whether VkFormat f takes output format o; *swap: B and R swapped (a BGRA format). */
+static int hd__vk_output_takes(int f, hd_output_format o, int *swap)
 {
-    (void)texture;
+    *swap = f == VK_FORMAT_B8G8R8A8_UNORM || f == VK_FORMAT_B8G8R8A8_SRGB;
+    if (o == HD_OUTPUT_SRGB8)
+        return f == VK_FORMAT_R8G8B8A8_UNORM || f == VK_FORMAT_R8G8B8A8_SRGB || f == VK_FORMAT_B8G8R8A8_UNORM ||
+               f == VK_FORMAT_B8G8R8A8_SRGB;
+    return f == (o == HD_OUTPUT_LINEAR_F16 ? VK_FORMAT_R16G16B16A16_SFLOAT : VK_FORMAT_R32G32B32A32_SFLOAT);
+}
+
+/* A color image's layouts a transfer may start from (before: UNDEFINED and PREINITIALIZED too). */
+static int hd__vk_output_layout(int l, int before)
+{
+    return l == VK_IMAGE_LAYOUT_GENERAL || l == VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL ||
+           l == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL || l == VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL ||
+           l == VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL || l == VK_IMAGE_LAYOUT_PRESENT_SRC_KHR ||
+           (before && (l == VK_IMAGE_LAYOUT_UNDEFINED || l == VK_IMAGE_LAYOUT_PREINITIALIZED));
+}
+
+static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *t, const hd_output *out)
+{
+    int swap;
+    if (!t->image) return HD_SUCCESS; /* a buffer: the core has checked its rows */
+    if (!hd__vk_output_takes(t->format, out->format, &swap))
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "hd_vulkan_record_render: VkFormat %d does not take output format %d (%s)",
+                       t->format, (int)out->format,
+                       out->format == HD_OUTPUT_SRGB8         ? "R8G8B8A8 or B8G8R8A8, UNORM or SRGB"
+                       : out->format == HD_OUTPUT_LINEAR_F16 ? "R16G16B16A16_SFLOAT"
+                                                             : "R32G32B32A32_SFLOAT");
+    if (!hd__vk_output_layout(t->layout, 1))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_ENUM, "hd_vulkan_record_render: layout %d is not a color image's layout a copy can start from",
+                       t->layout);
+    if (t->final_layout ? !hd__vk_output_layout(t->final_layout, 0) : !hd__vk_output_layout(t->layout, 0))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_ENUM, "hd_vulkan_record_render: final_layout %d%s is not a layout to leave a color image in",
+                       t->final_layout ? t->final_layout : t->layout, t->final_layout ? "" : " (0: layout)");
+    return HD_SUCCESS;
+}
+
+/* The output pass's objects, made on first use: set layout (three storage buffers) and pipeline
+   layout (20 bytes of push constants), pipeline, a pool of one set, the thresholds; the encoded
+   image at least `bytes` long; the set rewritten when the image or the encoded image is a new
+   buffer (nothing is in flight: hd_vulkan_record_render's contract). */
+static hd_result hd__vk_output_prepare(const hd__view *vw, VkDeviceSize bytes)
+{
+    static const VkDescriptorType types[3] = {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                              VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+    hd__backend *be = vw->be;
+    hd_result r;
+    if (!be->out_pipe) {
+        VkDescriptorPoolSize ps;
+        VkDescriptorPoolCreateInfo dpci;
+        VkDescriptorSetAllocateInfo ai;
+        if (!be->out_layout &&
+            (r = hd__vk_layouts(vw, types, 3, 5 * sizeof(int32_t), &be->out_set_layout, &be->out_layout)) != HD_SUCCESS)
+            return r;
+        if (!be->out_pool) {
+            ps.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            ps.descriptorCount = 3;
+            memset(&dpci, 0, sizeof dpci);
+            dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+            dpci.maxSets = 1;
+            dpci.poolSizeCount = 1;
+            dpci.pPoolSizes = &ps;
+            HD__VK_TRY(vw, be->fn.vkCreateDescriptorPool(be->device, &dpci, NULL, &be->out_pool), "vkCreateDescriptorPool");
+            memset(&ai, 0, sizeof ai);
+            ai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+            ai.descriptorPool = be->out_pool;
+            ai.descriptorSetCount = 1;
+            ai.pSetLayouts = &be->out_set_layout;
+            HD__VK_TRY(vw, be->fn.vkAllocateDescriptorSets(be->device, &ai, &be->out_set), "vkAllocateDescriptorSets");
+        }
+        if (!be->otab.buffer) {
+            if ((r = hd__vk_buffer_create(vw, &be->otab, HD__OUTPUT_THRESHOLDS * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+                                          "the output's thresholds")) != HD_SUCCESS)
+                return r;
+            hd__output_thresholds((float *)be->otab.map);
+        }
+        if ((r = hd__vk_compute_pipeline(vw, hd__spv_output, sizeof hd__spv_output, NULL, be->out_layout, &be->out_pipe)) != HD_SUCCESS)
+            return r;
+    }
+    if (be->obuf.bytes < bytes) {
+        hd__vk_free_buffer(vw, &be->obuf);
+        if ((r = hd__vk_buffer_create(vw, &be->obuf, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, 0,
+                                      "the encoded image")) != HD_SUCCESS)
+            return r;
+    }
+    if (be->out_img != be->img.buffer || be->out_enc != be->obuf.buffer) {
+        VkWriteDescriptorSet w[3];
+        VkDescriptorBufferInfo bi[3];
+        const hd__vk_buffer *b[3];
+        int i;
+        b[0] = &be->img; b[1] = &be->otab; b[2] = &be->obuf;
+        for (i = 0; i < 3; ++i) {
+            memset(&w[i], 0, sizeof w[i]);
+            bi[i].buffer = b[i]->buffer;
+            bi[i].offset = 0;
+            bi[i].range = VK_WHOLE_SIZE;
+            w[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+            w[i].dstSet = be->out_set;
+            w[i].dstBinding = (uint32_t)i;
+            w[i].descriptorCount = 1;
+            w[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            w[i].pBufferInfo = &bi[i];
+        }
+        be->fn.vkUpdateDescriptorSets(be->device, 3, w, 0, NULL);
+        be->out_img = be->img.buffer;
+        be->out_enc = be->obuf.buffer;
+    }
+    return HD_SUCCESS;
+}
+
+/* A barrier on a range of buffer b from (src stage, access) to (dst stage, access). */
+static void hd__vk_buffer_barrier(hd__backend *be, VkCommandBuffer cb, VkBuffer b, VkDeviceSize offset, VkDeviceSize size,
+                                  VkPipelineStageFlags src, VkAccessFlags src_access, VkPipelineStageFlags dst,
+                                  VkAccessFlags dst_access)
+{
+    VkBufferMemoryBarrier bb;
+    memset(&bb, 0, sizeof bb);
+    bb.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
+    bb.srcAccessMask = src_access;
+    bb.dstAccessMask = dst_access;
+    bb.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bb.buffer = b;
+    bb.offset = offset;
+    bb.size = size;
+    be->fn.vkCmdPipelineBarrier(cb, src, dst, 0, 0, NULL, 1, &bb, 0, NULL);
+}
+
+/* The caller's image from `from` to `to`, after every earlier command (ALL_COMMANDS, MEMORY_READ |
+   MEMORY_WRITE) or, after the copy, from the transfer's write. */
+static void hd__vk_target_layout(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from, VkImageLayout to, int after)
+{
+    VkImageMemoryBarrier ib;
+    const VkAccessFlags any = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    memset(&ib, 0, sizeof ib);
+    ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    ib.srcAccessMask = after ? (VkAccessFlags)VK_ACCESS_TRANSFER_WRITE_BIT : any;
+    ib.dstAccessMask = after ? any : (VkAccessFlags)VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib.oldLayout = from;
+    ib.newLayout = to;
+    ib.srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.image = im;
+    ib.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    ib.subresourceRange.levelCount = 1;
+    ib.subresourceRange.layerCount = 1;
+    be->fn.vkCmdPipelineBarrier(cb, after ? VK_PIPELINE_STAGE_TRANSFER_BIT : VK_PIPELINE_STAGE_ALL_COMMANDS_BIT,
+                                after ? VK_PIPELINE_STAGE_ALL_COMMANDS_BIT : VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, &ib);
+}
+
+/* The output pass into the encoded image, then the caller's target's barriers and copies
+   (hybriddiff.h, hd_vulkan_target). */
+static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *t, const hd_output *out)
+{
+    hd__backend *be = vw->be;
+    VkCommandBuffer cb = be->rec;
+    const VkAccessFlags any = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    VkDeviceSize px = hd__output_pixel_bytes(out->format), row = (VkDeviceSize)out->width * px;
+    VkDeviceSize bytes = row * (VkDeviceSize)out->height;
+    int32_t pc[5];
+    int swap = 0;
+    hd_result r;
+    if (!cb) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the output recorded outside a recording (internal error)");
+    if ((r = hd__vk_output_prepare(vw, bytes)) != HD_SUCCESS) return r;
+    if (t->image) hd__vk_output_takes(t->format, out->format, &swap);
+    pc[0] = out->width;
+    pc[1] = out->height;
+    pc[2] = (int32_t)out->format;
+    pc[3] = swap ? 2 : 0; /* rows top first, Vulkan's order */
+    memcpy(&pc[4], &vw->params.exposure, sizeof pc[4]);
+    hd__vk_barrier(be, cb); /* the frame's image writes before the pass reads them */
+    be->fn.vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->out_pipe);
+    be->fn.vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, be->out_layout, 0, 1, &be->out_set, 0, NULL);
+    be->fn.vkCmdPushConstants(cb, be->out_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
+    be->fn.vkCmdDispatch(cb, ((uint32_t)out->width + HD__VK_LOCAL_X - 1) / HD__VK_LOCAL_X, (uint32_t)out->height, 1);
+    hd__vk_buffer_barrier(be, cb, be->obuf.buffer, 0, bytes, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    if (t->image) {
+        VkImage im = (VkImage)t->image;
+        VkImageLayout final = (VkImageLayout)(t->final_layout ? t->final_layout : t->layout);
+        VkBufferImageCopy reg;
+        memset(&reg, 0, sizeof reg);
+        reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+        reg.imageSubresource.layerCount = 1;
+        reg.imageOffset.x = out->x;
+        reg.imageOffset.y = out->y;
+        reg.imageExtent.width = (uint32_t)out->width;
+        reg.imageExtent.height = (uint32_t)out->height;
+        reg.imageExtent.depth = 1;
+        hd__vk_target_layout(be, cb, im, (VkImageLayout)t->layout, HD__VK_DST, 0);
+        be->fn.vkCmdCopyBufferToImage(cb, be->obuf.buffer, im, HD__VK_DST, 1, &reg);
+        hd__vk_target_layout(be, cb, im, HD__VK_DST, final, 1);
+    } else {
+        VkBuffer b = (VkBuffer)t->buffer;
+        VkDeviceSize pitch = t->row_pitch ? t->row_pitch : (VkDeviceSize)t->width * px;
+        VkDeviceSize first = t->offset + (VkDeviceSize)out->y * pitch + (VkDeviceSize)out->x * px;
+        VkDeviceSize span = (VkDeviceSize)(out->height - 1) * pitch + row;
+        VkBufferCopy one, *regs = &one;
+        uint32_t n = 1, k;
+        if (pitch == row) {
+            one.srcOffset = 0;
+            one.dstOffset = first;
+            one.size = bytes;
+        } else {
+            n = (uint32_t)out->height;
+            if (!(regs = (VkBufferCopy *)hd__calloc(vw, n, sizeof *regs)))
+                return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "vulkan: no memory for %u copy regions", n);
+            for (k = 0; k < n; ++k) {
+                regs[k].srcOffset = (VkDeviceSize)k * row;
+                regs[k].dstOffset = first + (VkDeviceSize)k * pitch;
+                regs[k].size = row;
+            }
+        }
+        hd__vk_buffer_barrier(be, cb, b, first, span, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, any, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                              VK_ACCESS_TRANSFER_WRITE_BIT);
+        be->fn.vkCmdCopyBuffer(cb, be->obuf.buffer, b, n, regs);
+        hd__vk_buffer_barrier(be, cb, b, first, span, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                              VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, any);
+        if (regs != &one) hd__free(vw, regs);
+    }
+    return HD_SUCCESS;
+}
+
+/* No GL texture: the core never calls it. */
+static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
+{
+    (void)texture; (void)out; (void)exact;
     return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no GL texture");
 }

@@ -339,29 +339,96 @@ HDDEF hd_result hd_render(hd_context h)
 HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
 {
     hd_result r;
+    hd_output o;
     HD__GET_CTX(ctx, h);
     if (!(hd__be_features() & HD__BE_TEXTURE))
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture: this is the %s backend", hd__be_name());
     if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
-    HD__BE_CALL(r, ctx, hd__be_render_to_texture(&ctx->vw, texture));
+    if ((r = hd__output_check(ctx, NULL, &o, "hd_gl_render_to_texture")) != HD_SUCCESS) return r;
+    HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 1));
+    return r;
+}
+
+HDDEF hd_result hd_gl_render_to_texture_ex(hd_context h, unsigned int texture, const hd_output *output)
+{
+    hd_result r;
+    hd_output o;
+    HD__GET_CTX(ctx, h);
+    if (!(hd__be_features() & HD__BE_TEXTURE))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture_ex: this is the %s backend", hd__be_name());
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture_ex: texture 0");
+    if ((r = hd__output_check(ctx, output, &o, "hd_gl_render_to_texture_ex")) != HD_SUCCESS) return r;
+    HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 0));
+    return r;
+}
+
+/* The checks of hd_vulkan_record and _record_render that come before the device: the feature,
+   the command buffer, multigrid (not recordable), the iteration count. */
+static hd_result hd__record_check(hd__ctx *ctx, void *command_buffer, int n, const char *fn)
+{
+    const hd_params *p = &ctx->vw.params;
+    if (!(hd__be_features() & HD__BE_RECORD))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (!command_buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: command_buffer is NULL", fn);
+    if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: n = %d, must be >= 1", fn, n);
+    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: more than 2^31 iterations; reset with a new seed", fn);
+    if (p->solver == HD_SOLVER_MULTIGRID && !p->disable_diffusion && (p->method == HD_METHOD_HD || p->method == HD_METHOD_CD))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED,
+                       "%s: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate", fn);
+    return HD_SUCCESS;
+}
+
+/* hd_vulkan_target's checks that need no device: one of image and buffer, a size, the region
+   inside it, a buffer's rows inside its pitch and size. */
+static hd_result hd__vulkan_target_check(hd__ctx *ctx, const hd_vulkan_target *t, const hd_output *o)
+{
+    const hd_logger *log = &ctx->vw.log;
+    uint64_t px = hd__output_pixel_bytes(o->format), pitch, end;
+    if ((t->image != 0) == (t->buffer != 0))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record_render: the target names %s; give an image or a buffer",
+                       t->image ? "an image and a buffer" : "neither an image nor a buffer");
+    if (t->width < 1 || t->height < 1 || t->width > HD_MAX_IMAGE_DIM || t->height > HD_MAX_IMAGE_DIM)
+        return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "hd_vulkan_record_render: the target is %dx%d pixels; 1..%d each", t->width,
+                       t->height, HD_MAX_IMAGE_DIM);
+    if ((int64_t)o->x + o->width > t->width || (int64_t)o->y + o->height > t->height)
+        return HD__ERR(log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "hd_vulkan_record_render: region %dx%d at (%d, %d) outside the %dx%d target",
+                       o->width, o->height, o->x, o->y, t->width, t->height);
+    if (!t->buffer) return HD_SUCCESS;
+    pitch = t->row_pitch ? t->row_pitch : (uint64_t)t->width * px;
+    if (pitch < (uint64_t)t->width * px)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record_render: row_pitch %llu below the %d-pixel rows' %llu bytes",
+                       (unsigned long long)pitch, t->width, (unsigned long long)((uint64_t)t->width * px));
+    if (pitch > ((uint64_t)1 << 40) || t->offset > ((uint64_t)1 << 62))
+        return HD__ERR(log, HD_ERROR_SIZE_OVERFLOW, "hd_vulkan_record_render: row_pitch %llu or offset %llu is too large",
+                       (unsigned long long)pitch, (unsigned long long)t->offset);
+    end = t->offset + (uint64_t)(o->y + o->height - 1) * pitch + (uint64_t)(o->x + o->width) * px;
+    if (end > t->buffer_size)
+        return HD__ERR(log, HD_ERROR_BUFFER_TOO_SMALL, "hd_vulkan_record_render: the region ends at byte %llu, the buffer holds %llu",
+                       (unsigned long long)end, (unsigned long long)t->buffer_size);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_vulkan_record_render(hd_context h, void *command_buffer, const hd_vulkan_target *target, const hd_output *output)
+{
+    hd_result r;
+    hd_output o;
+    HD__GET_CTX(ctx, h);
+    memset(&o, 0, sizeof o);
+    if ((r = hd__record_check(ctx, command_buffer, 1, "hd_vulkan_record_render")) != HD_SUCCESS) return r;
+    if (target && ((r = hd__output_check(ctx, output, &o, "hd_vulkan_record_render")) != HD_SUCCESS ||
+                   (r = hd__vulkan_target_check(ctx, target, &o)) != HD_SUCCESS))
+        return r;
+    hd__record_cost(ctx);
+    HD__BE_CALL(r, ctx, hd__record_render(ctx, command_buffer, target, &o));
     return r;
 }
 
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
     hd_result r;
-    const hd_params *p;
     HD__GET_CTX(ctx, h);
-    p = &ctx->vw.params;
-    if (!(hd__be_features() & HD__BE_RECORD))
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_vulkan_record: this is the %s backend", hd__be_name());
-    if (!command_buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_vulkan_record: command_buffer is NULL");
-    if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: n = %d, must be >= 1", n);
-    if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
-        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_vulkan_record: more than 2^31 iterations; reset with a new seed");
-    if (p->solver == HD_SOLVER_MULTIGRID && !p->disable_diffusion && (p->method == HD_METHOD_HD || p->method == HD_METHOD_CD))
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED,
-                       "hd_vulkan_record: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate");
+    if ((r = hd__record_check(ctx, command_buffer, n, "hd_vulkan_record")) != HD_SUCCESS) return r;
     hd__record_cost(ctx);
     HD__BE_CALL(r, ctx, hd__record(ctx, command_buffer, n));
     return r;

@@ -13,7 +13,8 @@
      context (hd__ctx) is defined after the backend and cannot be named by it.
    - A backend calls no function of the core's: only the helpers below and those of
      src/hd_internal.h and the kernels. Its public entry points (hd_vulkan_record,
-     hd_gl_render_to_texture) are the core's, over the optional primitives at the end.
+     hd_vulkan_record_render, hd_gl_render_to_texture_ex) are the core's, over the optional
+     primitives at the end.
    The GPU backends make their grids (hd__be_alloc_*, hd__be_clear, the multigrid's levels)
    through backends/hd_gpu.h, which also defines for them the multigrid's primitives that are
    single passes.
@@ -198,13 +199,14 @@ static size_t hd__be_solver_bytes(const hd__view *vw);
 
 /* ---- optional features (hd__be_features says which a backend has) ------------------------------
    A backend without a feature still defines its primitives; the core never calls them then. */
-#define HD__BE_RECORD 1  /* hd_vulkan_record: iterations recorded into the caller's command buffer */
-#define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture: the image encoded into the caller's texture */
+#define HD__BE_RECORD 1  /* hd_vulkan_record, _record_render: work recorded into the caller's command buffer */
+#define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture(_ex): the image encoded into the caller's texture */
 static unsigned hd__be_features(void);
-/* Recording (HD__BE_RECORD). The core's hd_vulkan_record runs its preparation, then
-   hd__be_record_begin, then n iterations of the method whose primitives the backend records
-   into `target` instead of submitting (each with its own parameter slots; `slots` parameter
-   blocks at most), with hd__be_record_mark(vw, 0) and (vw, 1) around each HD or CD frame, then
+/* Recording (HD__BE_RECORD). The core's hd_vulkan_record and hd_vulkan_record_render run their
+   preparation, then hd__be_record_begin, then the method's primitives, which the backend
+   records into `target` instead of submitting (each with its own parameter slots; `slots`
+   parameter blocks at most), with hd__be_record_mark(vw, 0) and (vw, 1) around each HD or CD
+   frame, then (hd_vulkan_record_render with a target) hd__be_record_output, then
    hd__be_record_end with the first error. */
 static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots);
 static void hd__be_record_mark(const hd__view *vw, int end);
@@ -212,10 +214,24 @@ static hd_result hd__be_record_end(const hd__view *vw, hd_result r);
 /* The device time in seconds between the marks of the last recorded frame, once the caller has
    run it: 1 with *seconds set, 0 when there is none to read (none recorded since, no timestamps). */
 static int hd__be_record_seconds(const hd__view *vw, double *seconds);
-/* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line),
-   then writes the image, sRGB-encoded with vw->params.exposure, into it. Runs in a bracket after
-   the core's preparation. */
-static hd_result hd__be_render_to_texture(const hd__view *vw, unsigned texture);
+/* Records, after the frames recorded before it, the image (vw->camera's size) encoded in
+   out->format (hd_read_image_ex's bytes) into the caller's target at (out->x, out->y), with
+   the barriers hybriddiff.h documents at hd_vulkan_target. The core has checked the output
+   (format, size: the camera's) and what needs no device (one of image or buffer, the region
+   inside target->width x height, the buffer's rows inside buffer_size); the backend checks the
+   rest in hd__be_output_target_check (the image's format against out->format, the layouts), each
+   with its own result code and log line, which the core calls in the bracket before
+   hd__be_record_begin, so a refused target leaves the command buffer untouched. */
+static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
+static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
+/* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line:
+   HD_ERROR_INVALID_TEXTURE not a 2D texture, HD_ERROR_OUTPUT_FORMAT its internal format,
+   HD_ERROR_OUTPUT_OUTSIDE_TARGET the region past its size; exact: hd_gl_render_to_texture's
+   rule instead, GL_RGBA8 of exactly the camera's size or HD_ERROR_INVALID_TEXTURE), then writes
+   the image encoded in out->format (hd_read_image_ex's bytes) into its region at (out->x,
+   out->y), rows bottom first. The core has checked out (format, size: the camera's, x and y
+   >= 0). Runs in a bracket after the core's preparation. */
+static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact);
 
 /* ---- helpers a backend may use ----------------------------------------------------------------- */
 /* hd__be_diffuse_sweeps for a backend whose sweeps are separate passes: hd__be_diffuse each. */
@@ -292,6 +308,52 @@ HD__MAYBE_UNUSED static float *hd__project_table_new(const hd__view *vw, int n)
         (void)HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "%s: cannot allocate the projection's TF table (%d entries)",
                       hd__be_name(), n);
     return t;
+}
+
+
+/* ---- the output encodings (hybriddiff.h, hd_output_format), one definition for every path -----
+   HD_OUTPUT_SRGB8: hd__srgb8 of rgb * exposure, hd__alpha8 of alpha; LINEAR_F16: hdk_f2h of
+   rgb * exposure and of alpha; LINEAR_F32: rgb * exposure and alpha. The core's read-backs
+   encode with these on the host; a GPU pass gets the same bytes from the float products (IEEE
+   multiplication, correctly rounded there too) by hdk_f2h's integer steps and, for RGBA8, by
+   counting the thresholds of hd__output_thresholds at or below each value (no pow on the
+   device). */
+HD__MAYBE_UNUSED static uint8_t hd__srgb8(float v)
+{
+    float s;
+    if (!(v > 0.0f)) return 0;
+    if (v >= 1.0f) return 255;
+    s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+    return (uint8_t)(s * 255.0f + 0.5f);
+}
+HD__MAYBE_UNUSED static uint8_t hd__alpha8(float a)
+{
+    return (uint8_t)(a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)(a * 255.0f + 0.5f));
+}
+/* Bytes per pixel of an output format. */
+HD__MAYBE_UNUSED static size_t hd__output_pixel_bytes(hd_output_format f)
+{
+    return f == HD_OUTPUT_LINEAR_F32 ? 16 : f == HD_OUTPUT_LINEAR_F16 ? 8 : 4;
+}
+/* dst[k - 1], k = 1..255: the smallest positive float whose hd__srgb8 is >= k; dst[255 + k - 1]
+   the same for hd__alpha8. Both are non-decreasing in v, so a value's code is the count of its
+   thresholds <= v (NaN, compared false: 0, as hd__srgb8's !(v > 0)). Found by bisection over the
+   positive floats' bit patterns, which are ordered as the floats. */
+#define HD__OUTPUT_THRESHOLDS 510
+HD__MAYBE_UNUSED static void hd__output_thresholds(float *dst)
+{
+    int k, which;
+    for (which = 0; which < 2; ++which)
+        for (k = 1; k <= 255; ++k) {
+            uint32_t lo = 0, hi = 0x3f800000u; /* code(lo) < k <= code(hi): 0.0f and 1.0f */
+            while (hi - lo > 1) {
+                uint32_t mid = lo + (hi - lo) / 2;
+                float v = hdk_u2f(mid);
+                if ((which ? hd__alpha8(v) : hd__srgb8(v)) >= k) hi = mid;
+                else lo = mid;
+            }
+            dst[which * 255 + k - 1] = hdk_u2f(hi);
+        }
 }
 
 #endif

@@ -113,6 +113,8 @@ typedef struct hd__ctx {
     int image_room;          /* the image buffer holds the reduced frames' region (made when a
                                 scale > 1 is first used, hd__image_room) */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
+    int rec_light;           /* light iterations recorded and not yet measured: the next call measures
+                                them once the caller has run them (hd__prepare) */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */

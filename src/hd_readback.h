@@ -24,21 +24,13 @@ HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
     return r;
 }
 
-static uint8_t hd__srgb8(float v)
-{
-    float s;
-    if (!(v > 0.0f)) return 0;
-    if (v >= 1.0f) return 255;
-    s = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
-    return (uint8_t)(s * 255.0f + 0.5f);
-}
-
 /* hd__srgb8 of the floats in [2^-9, 1), the range where it calls powf, by table: the floats there
    in groups of 2^12 consecutive ones (their top 20 bits); entry k is the code every float of
    group k maps to, or 0x100 where the group's first and last floats map to different codes (a
    code boundary inside: those floats take hd__srgb8 itself). hd__srgb8 is non-decreasing, so a
    group whose ends agree maps to that code throughout, and the table gives its bytes exactly at
-   a table lookup per value. NULL when there is no memory for it (hd__srgb8 then does it all). */
+   a table lookup per value. NULL when there is no memory for it (hd__srgb8 then does it all).
+   hd__srgb8 is src/hd_backend.h's, the one definition the GPU passes' thresholds follow too. */
 #define HD__SRGB_LO 0x3B000000u /* 2^-9 */
 #define HD__SRGB_HI 0x3F800000u /* 1.0f */
 #define HD__SRGB_SHIFT 12
@@ -93,7 +85,82 @@ HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes
             dst[4 * i] = hd__srgb8_by(t, tmp[4 * i] * e);
             dst[4 * i + 1] = hd__srgb8_by(t, tmp[4 * i + 1] * e);
             dst[4 * i + 2] = hd__srgb8_by(t, tmp[4 * i + 2] * e);
-            dst[4 * i + 3] = (uint8_t)(a <= 0.0f ? 0 : a >= 1.0f ? 255 : (int)(a * 255.0f + 0.5f));
+            dst[4 * i + 3] = hd__alpha8(a);
+        }
+    }
+    hd__free(&ctx->vw, tmp);
+    return r;
+}
+
+/* The output description of a call with defaults filled in (NULL: all zero), checked against
+   what needs no target: the format, the size (the camera's), x and y not negative. */
+static hd_result hd__output_check(hd__ctx *ctx, const hd_output *in, hd_output *out, const char *fn)
+{
+    int w = ctx->vw.camera.width, h = ctx->vw.camera.height;
+    if (in) *out = *in;
+    else memset(out, 0, sizeof *out);
+    if ((int)out->format < 0 || out->format >= HD_OUTPUT_FORMAT_COUNT)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_ENUM, "%s: output format %d is not a hd_output_format", fn, (int)out->format);
+    if (out->width == 0) out->width = w;
+    if (out->height == 0) out->height = h;
+    if (out->width != w || out->height != h)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_OUTPUT_SIZE, "%s: output region %dx%d, the camera's image is %dx%d (written 1:1)", fn,
+                       out->width, out->height, w, h);
+    if (out->x < 0 || out->y < 0)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "%s: output region at (%d, %d): negative", fn, out->x, out->y);
+    return HD_SUCCESS;
+}
+
+HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *dst, size_t dst_bytes, size_t row_pitch)
+{
+    hd_result r;
+    hd_output o;
+    size_t px, row, need, n, x, y;
+    float *tmp;
+    const uint16_t *t = NULL;
+    unsigned char *d;
+    HD__GET_CTX(ctx, h);
+    if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_ex: dst is NULL");
+    if ((r = hd__output_check(ctx, output, &o, "hd_read_image_ex")) != HD_SUCCESS) return r;
+    px = hd__output_pixel_bytes(o.format);
+    row = ((size_t)o.x + (size_t)o.width) * px; /* a row of the target up to the region's end */
+    if (row_pitch == 0) row_pitch = row;
+    if (row_pitch < row)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_OUTPUT_OUTSIDE_TARGET,
+                       "hd_read_image_ex: region x %d..%d (%zu bytes a pixel) past the row pitch of %zu bytes", o.x, o.x + o.width, px,
+                       row_pitch);
+    if ((size_t)o.y + (size_t)o.height - 1 > ((size_t)-1 - row) / row_pitch)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_SIZE_OVERFLOW, "hd_read_image_ex: the region's last byte overflows a size_t");
+    need = ((size_t)o.y + (size_t)o.height - 1) * row_pitch + row;
+    if (dst_bytes < need)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_ex: %zu bytes given, %zu needed for rows %d..%d", dst_bytes,
+                       need, o.y, o.y + o.height);
+    n = (size_t)o.width * o.height;
+    tmp = (float *)hd__alloc(&ctx->vw, n * 4 * sizeof(float));
+    if (!tmp) return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_read_image_ex: no memory for the conversion");
+    HD__BE_CALL(r, ctx, hd__read_image(ctx, tmp, "hd_read_image_ex"));
+    if (r == HD_SUCCESS) {
+        float e = ctx->vw.params.exposure;
+        if (o.format == HD_OUTPUT_SRGB8) t = hd__srgb_table(ctx);
+        for (y = 0; y < (size_t)o.height; ++y) {
+            d = (unsigned char *)dst + ((size_t)o.y + y) * row_pitch + (size_t)o.x * px;
+            for (x = 0; x < (size_t)o.width; ++x, d += px) {
+                const float *p = tmp + (y * o.width + x) * 4;
+                if (o.format == HD_OUTPUT_LINEAR_F32) {
+                    float v[4];
+                    v[0] = p[0] * e; v[1] = p[1] * e; v[2] = p[2] * e; v[3] = p[3];
+                    memcpy(d, v, sizeof v);
+                } else if (o.format == HD_OUTPUT_LINEAR_F16) {
+                    uint16_t v[4];
+                    v[0] = hdk_f2h(p[0] * e); v[1] = hdk_f2h(p[1] * e); v[2] = hdk_f2h(p[2] * e); v[3] = hdk_f2h(p[3]);
+                    memcpy(d, v, sizeof v);
+                } else {
+                    d[0] = hd__srgb8_by(t, p[0] * e);
+                    d[1] = hd__srgb8_by(t, p[1] * e);
+                    d[2] = hd__srgb8_by(t, p[2] * e);
+                    d[3] = hd__alpha8(p[3]);
+                }
+            }
         }
     }
     hd__free(&ctx->vw, tmp);

@@ -20,6 +20,8 @@ static int hd__image_room_kept(const hd__ctx *ctx)
     return ctx->image_room && ctx->vw.params.render_scale != 1 && !hd__method_is_pt(ctx->vw.params.method);
 }
 
+static hd_result hd__record_measure(hd__ctx *ctx);
+
 /* Brings the device state up to date with what the setters changed, in dependency order. */
 static hd_result hd__prepare(hd__ctx *ctx)
 {
@@ -102,6 +104,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
     }
     if ((r = hd__be_clear(&ctx->vw, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
     ctx->dirty = 0;
+    /* light iterations an earlier call recorded have run by now (the caller waits before the next
+       call): their light is measured, unless a setter has reset it since */
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) ctx->rec_light = 0;
+    if (ctx->rec_light) return hd__record_measure(ctx);
     return HD_SUCCESS;
 }
 
@@ -145,8 +151,9 @@ static hd_result hd__light_iteration(hd__ctx *ctx)
     } else if ((r = hd__be_direct(&ctx->vw)) != HD_SUCCESS) return r;
     t1 = hd__now();
     if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
-    /* iterations recorded into a caller's command buffer have not run yet: nothing to measure */
-    if (ctx->no_measure) hd__conv_reset(ctx);
+    /* iterations recorded into a caller's command buffer have not run yet: the next call measures
+       them (hd__record_measure) */
+    if (ctx->no_measure) ctx->rec_light++;
     else r = hd__light_measure(ctx);
     t2 = hd__now();
     ctx->seconds[0] += t1 - t0;
@@ -241,19 +248,41 @@ static hd_result hd__iterate_n(hd__ctx *ctx, int n, hd_result (*step)(hd__ctx *)
     return r;
 }
 
-/* A light iteration of hd_refine or hd_render. When the light converges, the frames in the
-   image saw light that was still changing: the image starts afresh. */
-static hd_result hd__refine_once(hd__ctx *ctx)
+/* After a measurement of the light that was converged (before) or not: when it has just
+   converged, the frames in the image saw light that was still changing, so the image starts
+   afresh. */
+static void hd__light_settled(hd__ctx *ctx, int before)
 {
-    int before = hd__light_converged(ctx);
-    hd_result r = hd__light_iteration(ctx);
-    if (r == HD_SUCCESS && !before && hd__light_converged(ctx)) {
+    if (!before && hd__light_converged(ctx)) {
         ctx->frames = 0;
         ctx->converged_frames = 0;
         HD__INFO(&ctx->vw.log, "light converged after %llu iterations (estimated error %.3g)",
                  (unsigned long long)ctx->iterations, ctx->light_error);
     }
+}
+
+/* A light iteration of hd_refine or hd_render. */
+static hd_result hd__refine_once(hd__ctx *ctx)
+{
+    int before = hd__light_converged(ctx);
+    hd_result r = hd__light_iteration(ctx);
+    if (r == HD_SUCCESS) hd__light_settled(ctx, before);
     return r;
+}
+
+/* The light iterations the last recording call recorded (ctx->rec_light), measured in the next
+   call's preparation, once the caller has run them: one measurement over all of them (their
+   change over n iterations: for n > 1 E's error is overestimated by about sqrt(n), so the light
+   converges later, never earlier, than one measured per iteration). */
+static hd_result hd__record_measure(hd__ctx *ctx)
+{
+    int before = hd__light_converged(ctx);
+    hd_result r;
+    ctx->rec_light = 0;
+    if ((r = hd__light_measure(ctx)) != HD_SUCCESS) return r;
+    if (!hd__light_converged(ctx)) ctx->converged_frames = 0;
+    hd__light_settled(ctx, before);
+    return HD_SUCCESS;
 }
 
 /* hd_render's work after hd__prepare. */
@@ -289,10 +318,17 @@ static hd_result hd__render(hd__ctx *ctx)
     return hd__project_frame(ctx);
 }
 
+/* A recording that failed is not submitted: no frame to time, no light to measure. */
+static void hd__record_failed(hd__ctx *ctx)
+{
+    ctx->cost.rec_pending = 0;
+    ctx->rec_light = 0;
+}
+
 /* hd_vulkan_record's work after hd__prepare: n iterations whose primitives the backend records
    into the caller's command buffer (HD__BE_RECORD). Recorded iterations have not run when this
-   returns: the light's convergence is not measured, and each HD or CD frame is timed on the
-   device between two marks, read by the next call (hd__record_cost). */
+   returns: their light is measured by the next call (hd__record_measure), and each HD or CD
+   frame is timed on the device between two marks, read by the next call (hd__record_cost). */
 static hd_result hd__record(hd__ctx *ctx, void *target, int n)
 {
     hd_result r;
@@ -319,7 +355,48 @@ static hd_result hd__record(hd__ctx *ctx, void *target, int n)
         ctx->cost.rec_gen = ctx->cost.gen;
     }
     ctx->no_measure = 0;
-    if (r != HD_SUCCESS) ctx->cost.rec_pending = 0; /* a failed recording is not submitted */
+    if (r != HD_SUCCESS) hd__record_failed(ctx);
+    return hd__be_record_end(&ctx->vw, r);
+}
+
+/* hd_vulkan_record_render's work after hd__prepare: hd__render's schedule, recorded. HD and CD:
+   while the light has not converged, one light iteration (measured by the next call) and a
+   frame; once it has, the frame alone, none once the image is done; the path tracers one
+   iteration. Then, with a target, the image written into it (hd__be_record_output), checked
+   (hd__be_output_target_check) before anything is recorded. */
+static hd_result hd__record_render(hd__ctx *ctx, void *cb, const hd_vulkan_target *target, const hd_output *out)
+{
+    hd_result r = HD_SUCCESS;
+    int frame = 1;
+    if (target && (r = hd__be_output_target_check(&ctx->vw, target, out)) != HD_SUCCESS) return r;
+    if (!hd__method_is_pt(ctx->vw.params.method) && ctx->vw.params.render_scale != 1 && (r = hd__image_room(ctx)) != HD_SUCCESS)
+        return r;
+    /* a light iteration, a frame and a reduced frame's upsample pass */
+    if ((r = hd__be_record_begin(&ctx->vw, cb, 5)) != HD_SUCCESS) return r;
+    ctx->no_measure = 1;
+    ctx->cost.rec_pending = 0;
+    if (hd__method_is_pt(ctx->vw.params.method)) {
+        if (ctx->iterations < 0x7fffffffu) r = hd__iterate_method(ctx);
+        frame = 0;
+    } else if (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu) {
+        r = hd__light_iteration(ctx);
+    } else if (hd__light_converged(ctx)) {
+        int s = hd__next_scale(ctx);
+        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) frame = 0;
+        else if ((r = hd__use_scale(ctx, s)) == HD_SUCCESS) ctx->converged_frames++;
+    }
+    if (r == HD_SUCCESS && frame) {
+        hd__be_record_mark(&ctx->vw, 0);
+        r = hd__project_frame(ctx);
+        hd__be_record_mark(&ctx->vw, 1);
+        ctx->cost.rec_pending = 1;
+        ctx->cost.rec_scale = ctx->frame_scale;
+        ctx->cost.rec_pixels = hd__scale_pixels(ctx, ctx->frame_scale);
+        ctx->cost.rec_gen = ctx->cost.gen;
+    }
+    if (r == HD_SUCCESS && target) r = hd__be_record_output(&ctx->vw, target, out);
+    ctx->no_measure = 0;
+    if (r != HD_SUCCESS) hd__record_failed(ctx);
     return hd__be_record_end(&ctx->vw, r);
 }
 

@@ -2,7 +2,7 @@
    1. host state survives: a host GL context (EGL, surfaceless) with its own program, uniform and
       storage buffer bindings (ranges), image units, active texture, 2D/3D textures, generic
       buffer bindings and pixel store parameters; hd_create / hd_set_* / hd_iterate /
-      hd_read_image_* / hd_read_illumination / hd_gl_render_to_texture / hd_destroy on
+      hd_read_image_* / hd_read_illumination / hd_gl_render_to_texture(_ex) / hd_destroy on
       (a) the caller's context (desc.gl.use_current_context) and (b) the backend's own EGL
       context while the host's is current; every queried value is unchanged afterwards, the
       host's context is still current and no GL error is pending;
@@ -25,6 +25,19 @@
       shader cache off (MESA_SHADER_CACHE_DISABLE, set before EGL starts), each method, solver
       and boundary iterated once; no "gl debug" line logged (Mesa warned "used uninitialized"
       of every variable passed to an inout parameter before it was initialised).
+   8. hd_gl_render_to_texture_ex, each output format into a region at (13, 9) of a 70x60
+      texture: GL_RGBA8 and GL_SRGB8_ALPHA8 (HD_OUTPUT_SRGB8), GL_RGBA16F (LINEAR_F16), GL_RGBA32F
+      (LINEAR_F32), read back with glGetTexImage: the region (rows bottom first) is bit for bit
+      hd_read_image_ex's bytes of the same format and, independently, hd_read_image_rgba8's
+      (RGBA8), hdk_f2h of hd_read_image_f32 times the exposure (half), that product itself
+      (float); every texel outside the region keeps the pattern written before. A region past the
+      texture's edge or at a negative x, a format the texture does not take, a region of another
+      size than the camera's and a name that is no 2D texture: each its own hd_result and one
+      logged error, nothing written, and the context renders on.
+   9. the output pass's encodings where they are hardest (every RGBA8 threshold and the float
+      below it, every finite half, the ties between halves and the floats either side of them),
+      written into the image buffer: each format bit for bit hd_read_image_ex's, exposure 1 and
+      0.75.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -177,7 +190,8 @@ static void run_calls(int use_current, const char *what)
     hd_desc d;
     hd_context c;
     hd_result r;
-    GLuint tex, wrong;
+    GLuint tex, wrong, tex16;
+    hd_output o16 = HD_OUTPUT_INIT;
     int m, i, maxd;
     make_desc(&d, vox, 24);
     d.gl.use_current_context = use_current;
@@ -185,9 +199,12 @@ static void run_calls(int use_current, const char *what)
     /* the texture is made before the snapshot: it is the host's */
     glGenTextures(1, &tex);
     glGenTextures(1, &wrong);
+    glGenTextures(1, &tex16);
     {
         GLint prev;
         glGetIntegerv(GL_TEXTURE_BINDING_2D, &prev);
+        glBindTexture(GL_TEXTURE_2D, tex16);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, 64, 64, 0, GL_RGBA, GL_FLOAT, NULL); /* mutable storage */
         glBindTexture(GL_TEXTURE_2D, tex);
         glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 48, 40);
         glBindTexture(GL_TEXTURE_2D, wrong);
@@ -212,6 +229,11 @@ static void run_calls(int use_current, const char *what)
         if (m < 2) CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, illum, sizeof illum / sizeof illum[0]) == HD_SUCCESS, "%s: illum", what);
         r = hd_gl_render_to_texture(c, tex);
         CHECK(r == HD_SUCCESS, "%s: hd_gl_render_to_texture: %s", what, hd_result_string(r));
+        o16.format = HD_OUTPUT_LINEAR_F16;
+        o16.x = 5;
+        o16.y = 11;
+        r = hd_gl_render_to_texture_ex(c, tex16, &o16);
+        CHECK(r == HD_SUCCESS, "%s: hd_gl_render_to_texture_ex: %s", what, hd_result_string(r));
         /* the texture's pixels (read on the host's context, default pack state) */
         {
             host_state mid;
@@ -247,6 +269,7 @@ static void run_calls(int use_current, const char *what)
     CHECK(glGetError() == GL_NO_ERROR, "%s: a GL error is pending after the calls", what);
     glDeleteTextures(1, &tex);
     glDeleteTextures(1, &wrong);
+    glDeleteTextures(1, &tex16);
 }
 
 /* The prelude's text (source string 2 of hd_glsl_embedded.h) between #version and a main()
@@ -482,6 +505,277 @@ static void check_image_room(void)
     hd_destroy(c);
 }
 
+/* Check 8: the output formats into a region of a larger texture. */
+static int out_errors;
+static hd_result out_last;
+static void out_log(void *u, hd_log_level level, hd_result code, const char *msg, const char *f, int l)
+{
+    (void)u; (void)f; (void)l;
+    if (level == HD_LOG_ERROR) { ++out_errors; out_last = code; printf("  logged: %s\n", msg); }
+}
+
+enum { TW = 70, TH = 60, RX = 13, RY = 9, IW = 48, IH = 40 };
+
+/* A TW x TH texture of internal format `internal` filled with a byte pattern (type's texels). */
+static GLuint pattern_texture(GLenum internal, GLenum type, size_t px, unsigned char *pat)
+{
+    GLuint t;
+    GLint prev;
+    size_t i;
+    for (i = 0; i < (size_t)TW * TH * px; ++i) pat[i] = (unsigned char)(i * 131u + 7u);
+    if (type == GL_HALF_FLOAT) /* keep the halves finite (no NaN payload games): exponent below 31 */
+        for (i = 1; i < (size_t)TW * TH * px; i += 2) pat[i] &= 0x3f;
+    if (type == GL_FLOAT)
+        for (i = 3; i < (size_t)TW * TH * px; i += 4) pat[i] &= 0x3f;
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &prev);
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexStorage2D(GL_TEXTURE_2D, 1, internal, TW, TH);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
+    glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, TW, TH, GL_RGBA, type, pat);
+    glBindTexture(GL_TEXTURE_2D, (GLuint)prev);
+    return t;
+}
+
+static void read_texture(GLuint t, GLenum type, unsigned char *dst)
+{
+    GLint prev;
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &prev);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, type, dst);
+    glBindTexture(GL_TEXTURE_2D, (GLuint)prev);
+}
+
+static void check_output_formats(void)
+{
+    static const GLenum internals[4] = {GL_RGBA8, GL_SRGB8_ALPHA8, GL_RGBA16F, GL_RGBA32F};
+    static const GLenum types[4] = {GL_UNSIGNED_BYTE, GL_UNSIGNED_BYTE, GL_HALF_FLOAT, GL_FLOAT};
+    static const hd_output_format formats[4] = {HD_OUTPUT_SRGB8, HD_OUTPUT_SRGB8, HD_OUTPUT_LINEAR_F16, HD_OUTPUT_LINEAR_F32};
+    static const char *const names[4] = {"GL_RGBA8", "GL_SRGB8_ALPHA8", "GL_RGBA16F", "GL_RGBA32F"};
+    static uint8_t vox[24 * 24 * 24], px8[IW * IH * 4];
+    static float img[IW * IH * 4];
+    static unsigned char pat[TW * TH * 16], got[TW * TH * 16], ex[TW * TH * 16];
+    hd_desc d;
+    hd_context c;
+    hd_output o = HD_OUTPUT_INIT;
+    hd_params p;
+    hd_result r;
+    float e = 1.7f;
+    int k;
+    make_desc(&d, vox, 24);
+    d.gl.use_current_context = 1;
+    d.logger.func = out_log;
+    d.params.exposure = e;
+    out_errors = 0;
+    r = hd_create(&d, &c);
+    CHECK(r == HD_SUCCESS, "output formats: hd_create: %s", hd_result_string(r));
+    if (r != HD_SUCCESS) return;
+    CHECK(hd_iterate(c, 3) == HD_SUCCESS, "output formats: iterate");
+    for (k = 0; k < 4; ++k) {
+        size_t pxb = formats[k] == HD_OUTPUT_LINEAR_F32 ? 16 : formats[k] == HD_OUTPUT_LINEAR_F16 ? 8 : 4;
+        GLuint t = pattern_texture(internals[k], types[k], pxb, pat);
+        int x, y, outside = 0, vs_ex = 0, vs_ref = 0, nonzero = 0;
+        CHECK(hd_read_image_f32(c, img, sizeof img / sizeof img[0]) == HD_SUCCESS, "output formats: read f32");
+        CHECK(hd_read_image_rgba8(c, px8, sizeof px8) == HD_SUCCESS, "output formats: read rgba8");
+        o.format = formats[k];
+        o.x = RX;
+        o.y = RY;
+        r = hd_gl_render_to_texture_ex(c, t, &o);
+        CHECK(r == HD_SUCCESS, "output %s: %s", names[k], hd_result_string(r));
+        read_texture(t, types[k], got);
+        /* the same format read back into the same region of a TW x TH host image, top row first */
+        memset(ex, 0, sizeof ex);
+        CHECK(hd_read_image_ex(c, &o, ex, (size_t)TW * TH * pxb, (size_t)TW * pxb) == HD_SUCCESS, "output %s: read_image_ex", names[k]);
+        for (y = 0; y < TH; ++y)
+            for (x = 0; x < TW; ++x) {
+                const unsigned char *g = got + ((size_t)y * TW + x) * pxb;
+                int in = x >= RX && x < RX + IW && y >= RY && y < RY + IH;
+                if (!in) {
+                    outside += memcmp(g, pat + ((size_t)y * TW + x) * pxb, pxb) != 0;
+                    continue;
+                }
+                {
+                    int ix = x - RX, iy = IH - 1 - (y - RY); /* GL rows bottom first */
+                    const float *f = img + ((size_t)iy * IW + ix) * 4;
+                    unsigned char want[16];
+                    int c4;
+                    vs_ex += memcmp(g, ex + ((size_t)(RY + iy) * TW + x) * pxb, pxb) != 0;
+                    if (formats[k] == HD_OUTPUT_SRGB8) {
+                        memcpy(want, px8 + ((size_t)iy * IW + ix) * 4, 4);
+                    } else if (formats[k] == HD_OUTPUT_LINEAR_F16) {
+                        uint16_t hv[4];
+                        for (c4 = 0; c4 < 4; ++c4) hv[c4] = hdk_f2h(c4 < 3 ? f[c4] * e : f[c4]);
+                        memcpy(want, hv, 8);
+                    } else {
+                        float fv[4];
+                        for (c4 = 0; c4 < 4; ++c4) fv[c4] = c4 < 3 ? f[c4] * e : f[c4];
+                        memcpy(want, fv, 16);
+                    }
+                    vs_ref += memcmp(g, want, pxb) != 0;
+                    for (c4 = 0; c4 < (int)pxb; ++c4) nonzero += g[c4] != 0;
+                }
+            }
+        CHECK(outside == 0 && vs_ex == 0 && vs_ref == 0 && nonzero > 0,
+              "output %s: %d texels outside the region changed, %d region texels differ from hd_read_image_ex, %d from the reference",
+              names[k], outside, vs_ex, vs_ref);
+        printf("%s output %s (%s) into (%d, %d) of %dx%d: %d of %d texels differ from hd_read_image_ex, %d from the reference, %d outside changed\n",
+               outside || vs_ex || vs_ref ? "FAIL" : "PASS", names[k], formats[k] == HD_OUTPUT_SRGB8 ? "SRGB8" : formats[k] == HD_OUTPUT_LINEAR_F16 ? "LINEAR_F16" : "LINEAR_F32",
+               RX, RY, TW, TH, vs_ex, IW * IH, vs_ref, outside);
+        if (k == 2) { /* bad input on the RGBA16F texture: one error each, the texture untouched */
+            struct { hd_output_format f; int x, y, w, h; hd_result want; const char *what; } cases[5] = {
+                {HD_OUTPUT_LINEAR_F16, TW - IW + 1, 0, 0, 0, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "a region past the right edge"},
+                {HD_OUTPUT_LINEAR_F16, 0, TH - IH + 1, 0, 0, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "a region past the top"},
+                {HD_OUTPUT_LINEAR_F16, -1, 0, 0, 0, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "a negative x"},
+                {HD_OUTPUT_LINEAR_F32, 0, 0, 0, 0, HD_ERROR_OUTPUT_FORMAT, "float32 into GL_RGBA16F"},
+                {HD_OUTPUT_LINEAR_F16, 0, 0, IW - 1, IH, HD_ERROR_OUTPUT_SIZE, "a region one pixel narrower than the image"}};
+            int j;
+            memcpy(pat, got, (size_t)TW * TH * pxb);
+            for (j = 0; j < 5; ++j) {
+                hd_output b = HD_OUTPUT_INIT;
+                b.format = cases[j].f;
+                b.x = cases[j].x;
+                b.y = cases[j].y;
+                b.width = cases[j].w;
+                b.height = cases[j].h;
+                out_errors = 0;
+                r = hd_gl_render_to_texture_ex(c, t, &b);
+                CHECK(r == cases[j].want && out_errors == 1 && out_last == r, "output: %s: %s, %d errors logged", cases[j].what,
+                      hd_result_string(r), out_errors);
+            }
+            out_errors = 0;
+            r = hd_gl_render_to_texture_ex(c, t + 1000, &o);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE && out_errors == 1, "output: a name that is no texture: %s", hd_result_string(r));
+            r = hd_gl_render_to_texture(c, t);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE, "output: hd_gl_render_to_texture on a 70x60 GL_RGBA16F texture: %s", hd_result_string(r));
+            read_texture(t, types[k], got);
+            CHECK(memcmp(got, pat, (size_t)TW * TH * pxb) == 0, "output: a refused call wrote into the texture");
+            out_errors = 0;
+            CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_gl_render_to_texture_ex(c, t, &o) == HD_SUCCESS && out_errors == 0,
+                  "output: the context does not render on after the refusals");
+            printf("PASS output refusals: region outside (x, y, negative), format, size, not a texture: one error each, nothing written\n");
+        }
+        glDeleteTextures(1, &t);
+    }
+    /* exposure 1 and the float read-back itself: LINEAR_F32 is hd_read_image_f32 */
+    hd_query_desc(c, &d);
+    p = d.params;
+    p.exposure = 1.0f;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS, "output: exposure 1");
+    CHECK(hd_read_image_f32(c, img, sizeof img / sizeof img[0]) == HD_SUCCESS, "output formats: read f32");
+    o.format = HD_OUTPUT_LINEAR_F32;
+    o.x = o.y = 0;
+    CHECK(hd_read_image_ex(c, &o, ex, (size_t)IW * IH * 16, 0) == HD_SUCCESS && memcmp(ex, img, sizeof img) == 0,
+          "output: LINEAR_F32 at exposure 1 is not hd_read_image_f32");
+    hd_destroy(c);
+}
+
+/* Check 9: the output pass's encodings on the values where they are hardest, written straight
+   into the image buffer (white box): every RGBA8 threshold of hd__output_thresholds and the float
+   below it (rgb and alpha), and for the halves every finite binary16 value, the midpoint above it
+   (a tie), the floats either side of that midpoint, overflow and inf. Each output format of the
+   GL pass against hd_read_image_ex, bit for bit, at exposure 1 (so the values reach the encoders
+   as written) and at 0.75. */
+static void check_output_encoding(void)
+{
+    enum { EW = 256, EH = 256 };
+    static uint8_t vox[16 * 16 * 16];
+    static float img[EW * EH * 4];
+    static unsigned char got[EW * EH * 16], ex[EW * EH * 16];
+    static const GLenum internals[3] = {GL_RGBA8, GL_RGBA16F, GL_RGBA32F};
+    static const GLenum types[3] = {GL_UNSIGNED_BYTE, GL_HALF_FLOAT, GL_FLOAT};
+    float th[HD__OUTPUT_THRESHOLDS];
+    hd_desc d;
+    hd_context c;
+    hd_params p;
+    hd_result r;
+    hd__ctx *ctx;
+    int n = 0, k, s2, ie;
+    uint32_t h;
+    make_desc(&d, vox, 16);
+    d.camera.width = EW;
+    d.camera.height = EH;
+    d.gl.use_current_context = 1;
+    d.logger.func = out_log;
+    r = hd_create(&d, &c);
+    CHECK(r == HD_SUCCESS, "output encoding: hd_create: %s", hd_result_string(r));
+    if (r != HD_SUCCESS) return;
+    CHECK(hd_iterate(c, 1) == HD_SUCCESS, "output encoding: iterate");
+    hd__output_thresholds(th);
+    for (k = 0; k < HD__OUTPUT_THRESHOLDS; ++k) {
+        int at = k < 255 ? 0 : 3; /* rgb thresholds in red, alpha's in alpha */
+        img[4 * n + at] = th[k];
+        img[4 * n + 1] = th[k];
+        ++n;
+        img[4 * n + at] = hdk_u2f(hdk_f2u(th[k]) - 1u);
+        img[4 * n + 2] = hdk_u2f(hdk_f2u(th[k]) - 1u);
+        ++n;
+    }
+    for (s2 = 0; s2 < 2; ++s2) /* the halves, both signs: four values a pixel */
+        for (h = 0; h < 0x7c00u; ++h) {
+            uint16_t sign = (uint16_t)(s2 << 15);
+            float v = hdk_h2f((uint16_t)(sign | h));
+            float mid = h < 0x7bffu ? 0.5f * (v + hdk_h2f((uint16_t)(sign | (h + 1)))) : (s2 ? -65520.0f : 65520.0f);
+            img[4 * n] = v;
+            img[4 * n + 1] = mid;
+            img[4 * n + 2] = hdk_u2f(hdk_f2u(mid) - 1u);
+            img[4 * n + 3] = hdk_u2f(hdk_f2u(mid) + 1u);
+            ++n;
+        }
+    img[4 * n] = 1e30f;
+    img[4 * n + 1] = hdk_u2f(0x7f800000u);
+    img[4 * n + 2] = -1e30f;
+    img[4 * n + 3] = 2.0f;
+    ++n;
+    CHECK(n <= EW * EH, "output encoding: %d values do not fit", n);
+    ctx = hd__lookup(c);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, ctx->vw.be->img);
+    glBufferSubData(GL_COPY_WRITE_BUFFER, 0, (GLsizeiptr)sizeof img, img);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+    for (ie = 0; ie < 2; ++ie) {
+        if (ie == 1) {
+            hd_query_desc(c, &d);
+            p = d.params;
+            p.exposure = 0.75f; /* invalidates nothing: the image stays as written */
+            CHECK(hd_set_params(c, &p) == HD_SUCCESS, "output encoding: exposure");
+        }
+        for (k = 0; k < 3; ++k) {
+            hd_output o = HD_OUTPUT_INIT;
+            size_t pxb = k == 2 ? 16 : k == 1 ? 8 : 4, i;
+            GLuint t;
+            int y, bad = 0, first = -1;
+            o.format = k == 0 ? HD_OUTPUT_SRGB8 : k == 1 ? HD_OUTPUT_LINEAR_F16 : HD_OUTPUT_LINEAR_F32;
+            glGenTextures(1, &t);
+            glBindTexture(GL_TEXTURE_2D, t);
+            glTexStorage2D(GL_TEXTURE_2D, 1, internals[k], EW, EH);
+            glBindTexture(GL_TEXTURE_2D, 0);
+            r = hd_gl_render_to_texture_ex(c, t, &o);
+            CHECK(r == HD_SUCCESS, "output encoding: %s", hd_result_string(r));
+            read_texture(t, types[k], got);
+            CHECK(hd_read_image_ex(c, &o, ex, sizeof ex, 0) == HD_SUCCESS, "output encoding: hd_read_image_ex");
+            for (y = 0; y < EH; ++y) /* the texture's rows bottom first */
+                for (i = 0; i < (size_t)EW * pxb; ++i)
+                    if (got[(size_t)y * EW * pxb + i] != ex[(size_t)(EH - 1 - y) * EW * pxb + i]) {
+                        if (first < 0) first = (int)(((size_t)(EH - 1 - y) * EW * pxb + i) / pxb);
+                        ++bad;
+                    }
+            CHECK(bad == 0, "output encoding: format %d, exposure %g: %d bytes differ from hd_read_image_ex (first at pixel %d: %.9g %.9g %.9g %.9g)",
+                  (int)o.format, ie ? 0.75 : 1.0, bad, first, first >= 0 ? img[4 * first] : 0.0, first >= 0 ? img[4 * first + 1] : 0.0,
+                  first >= 0 ? img[4 * first + 2] : 0.0, first >= 0 ? img[4 * first + 3] : 0.0);
+            printf("%s output encoding %s at exposure %g: %d values, %d bytes differ from hd_read_image_ex\n", bad ? "FAIL" : "PASS",
+                   k == 0 ? "SRGB8" : k == 1 ? "LINEAR_F16" : "LINEAR_F32", ie ? 0.75 : 1.0, 4 * n, bad);
+            glDeleteTextures(1, &t);
+        }
+    }
+    hd_destroy(c);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -508,6 +802,8 @@ int main(void)
     run_calls(1, "caller's context");
     check_not_current(dpy, cfg, ctx_attrs, host);
     check_image_room();
+    check_output_formats();
+    check_output_encoding();
     check_shader_warnings();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */

@@ -70,7 +70,7 @@ static void test_null_api(void)
     CHECK(hd_read_illumination(h, HD_ILLUMINATION_DIRECT, ill, sizeof ill / sizeof ill[0]) == HD_SUCCESS);
     CHECK(hd_read_illumination(h, HD_ILLUMINATION_SCATTERED, ill, sizeof ill / sizeof ill[0]) == HD_SUCCESS);
     CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 3 && s.method == HD_METHOD_HD);
-    CHECK(hd_vulkan_record(h, (void *)px, 1) == HD_ERROR_UNSUPPORTED);
+    CHECK(hd_vulkan_record(h, (void *)px, 1) == HD_SUCCESS); /* records nothing, counts the schedule */
     CHECK(hd_gl_render_to_texture(h, 1) == HD_ERROR_UNSUPPORTED);
     t.rgba = tf;
     t.count = 2;
@@ -249,10 +249,138 @@ static void test_null_update(void)
     hd_destroy(h);
 }
 
+/* hd_vulkan_record_render's schedule: light iterations while the light has not converged, each
+   measured by the next call (its read-back of E and phi in the preparation), none once it has
+   (the projection alone), no projection once the image is done; the write into the target every
+   call, checked before anything is recorded. The null backend's light is zero, so the estimate
+   is 0 from the second measurement on: converged at the fourth call's preparation. */
+static void test_null_record_render(void)
+{
+    hd_desc d;
+    hd_context h;
+    hd_stats s;
+    hd_vulkan_target t = HD_VULKAN_TARGET_INIT;
+    hd_output o = HD_OUTPUT_INIT;
+    calls c;
+    int k, cb = 0;
+    make_desc(&d);
+    d.params.frame_window = 2;
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    t.image = 1;
+    t.width = W + 3;
+    t.height = W;
+    o.x = 3;
+    for (k = 0; k < 3; ++k) { /* calls 1-3: a light iteration and a frame each, not converged yet */
+        c = snap(h);
+        CHECK(hd_vulkan_record_render(h, &cb, &t, &o) == HD_SUCCESS);
+        CHECK(delta(h, &c, HD__NULL_direct) == 1 && delta(h, &c, HD__NULL_project) == 1 && delta(h, &c, HD__NULL_record_output) == 1);
+        CHECK(delta(h, &c, HD__NULL_output_target_check) == 1 && delta(h, &c, HD__NULL_record_begin) == 1);
+        /* calls 2 and 3 measured the previous call's iteration: one read of E and one of phi */
+        CHECK_MSG(delta(h, &c, HD__NULL_read_illumination) == (k ? 2u : 0u), "call %d: %lu reads", k + 1,
+                  delta(h, &c, HD__NULL_read_illumination));
+        CHECK(hd_get_stats(h, &s) == HD_SUCCESS && !s.light_converged && s.iterations == (uint64_t)k + 1);
+    }
+    for (k = 0; k < 4; ++k) { /* call 4 measures the third: converged; no light work from then on */
+        c = snap(h);
+        CHECK(hd_vulkan_record_render(h, &cb, &t, &o) == HD_SUCCESS);
+        CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.light_converged && s.iterations == 3);
+        CHECK(delta(h, &c, HD__NULL_direct) == 0 && delta(h, &c, HD__NULL_diffuse_sweeps) == 0 && delta(h, &c, HD__NULL_record_output) == 1);
+        CHECK_MSG(delta(h, &c, HD__NULL_project) == (k < 2 ? 1u : 0u), "converged call %d: %lu frames", k + 1,
+                  delta(h, &c, HD__NULL_project)); /* frame_window 2, then the image is done */
+        CHECK(delta(h, &c, HD__NULL_read_illumination) == (k ? 0u : 2u));
+    }
+    CHECK(s.frames == 2);
+    /* without a target: the frame alone; a camera move: a new image, the light kept */
+    CHECK(hd_query_desc(h, &d) == HD_SUCCESS);
+    d.camera.eye[0] = 1.0f;
+    CHECK(hd_set_camera(h, &d.camera) == HD_SUCCESS);
+    c = snap(h);
+    CHECK(hd_vulkan_record_render(h, &cb, NULL, NULL) == HD_SUCCESS);
+    CHECK(delta(h, &c, HD__NULL_project) == 1 && delta(h, &c, HD__NULL_direct) == 0 && delta(h, &c, HD__NULL_record_output) == 0);
+    /* hd_vulkan_record's iterations are measured by the next call too, as one change */
+    c = snap(h);
+    CHECK(hd_vulkan_record(h, &cb, 3) == HD_SUCCESS && delta(h, &c, HD__NULL_direct) == 3);
+    CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 6);
+    c = snap(h);
+    CHECK(hd_render(h) == HD_SUCCESS && delta(h, &c, HD__NULL_read_illumination) == 2 && delta(h, &c, HD__NULL_direct) == 0);
+    /* refusals before the device: the region, the size, the format enum, the target's kind */
+    {
+        struct { int x, y, w, fmt; uint64_t image, buffer; hd_result want; } bad[6] = {
+            {4, 0, 0, 0, 1, 0, HD_ERROR_OUTPUT_OUTSIDE_TARGET}, {0, 1, 0, 0, 1, 0, HD_ERROR_OUTPUT_OUTSIDE_TARGET},
+            {0, 0, W - 1, 0, 1, 0, HD_ERROR_OUTPUT_SIZE},      {0, 0, 0, 7, 1, 0, HD_ERROR_INVALID_ENUM},
+            {0, 0, 0, 0, 1, 1, HD_ERROR_INVALID_PARAMETER},    {0, 0, 0, 0, 0, 1, HD_ERROR_BUFFER_TOO_SMALL}};
+        for (k = 0; k < 6; ++k) {
+            hd_vulkan_target b = t;
+            hd_output bo = o;
+            bo.x = bad[k].x;
+            bo.y = bad[k].y;
+            bo.width = bad[k].w;
+            bo.format = (hd_output_format)bad[k].fmt;
+            b.image = bad[k].image;
+            b.buffer = bad[k].buffer;
+            c = snap(h);
+            CHECK_MSG(hd_vulkan_record_render(h, &cb, &b, &bo) == bad[k].want, "refusal %d", k);
+            CHECK(delta(h, &c, HD__NULL_record_begin) == 0 && delta(h, &c, HD__NULL_begin) == 0);
+        }
+    }
+    CHECK(hd_vulkan_record_render(h, NULL, NULL, NULL) == HD_ERROR_NULL_POINTER);
+    CHECK(!be_of(h)->misuse);
+    CHECK(be_of(h)->calls[HD__NULL_record_begin] == be_of(h)->calls[HD__NULL_record_end]);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+}
+
+/* hd_read_image_ex on every backend's core path: the region in a larger target, bytes outside
+   untouched, the refusals. */
+static void test_null_read_image_ex(void)
+{
+    static unsigned char buf[(W + 5) * (W + 2) * 16 + 8];
+    hd_desc d;
+    hd_context h;
+    hd_output o = HD_OUTPUT_INIT;
+    size_t pitch = (W + 5) * 8, i, changed = 0, zeros = 0, y;
+    make_desc(&d);
+    CHECK(hd_create(&d, &h) == HD_SUCCESS);
+    CHECK(hd_read_image_ex(h, NULL, buf, sizeof buf, 0) == HD_ERROR_NO_FRAME); /* as the other read-backs */
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    memset(buf, 0x5a, sizeof buf);
+    o.format = HD_OUTPUT_LINEAR_F16;
+    o.x = 4;
+    o.y = 2;
+    CHECK(hd_read_image_ex(h, &o, buf, sizeof buf, pitch) == HD_SUCCESS);
+    for (i = 0; i < sizeof buf; ++i) {
+        size_t row = i / pitch, col = (i % pitch) / 8;
+        int in = row >= 2 && row < 2 + W && col >= 4 && col < 4 + W;
+        if (in) zeros += buf[i] == 0;
+        else changed += buf[i] != 0x5a;
+    }
+    CHECK_MSG(zeros == (size_t)W * W * 8 && changed == 0, "%zu zero bytes in the region, %zu changed outside", zeros, changed);
+    /* the rows' bytes must lie in dst and in row_pitch */
+    CHECK(hd_read_image_ex(h, &o, buf, (2 + W - 1) * pitch + (4 + W) * 8 - 1, pitch) == HD_ERROR_BUFFER_TOO_SMALL);
+    CHECK(hd_read_image_ex(h, &o, buf, (2 + W - 1) * pitch + (4 + W) * 8, pitch) == HD_SUCCESS);
+    CHECK(hd_read_image_ex(h, &o, buf, sizeof buf, (4 + W) * 8 - 1) == HD_ERROR_OUTPUT_OUTSIDE_TARGET);
+    o.x = -1;
+    CHECK(hd_read_image_ex(h, &o, buf, sizeof buf, pitch) == HD_ERROR_OUTPUT_OUTSIDE_TARGET);
+    o.x = 0;
+    o.height = W + 1;
+    CHECK(hd_read_image_ex(h, &o, buf, sizeof buf, pitch) == HD_ERROR_OUTPUT_SIZE);
+    o.height = 0;
+    o.format = HD_OUTPUT_FORMAT_COUNT;
+    CHECK(hd_read_image_ex(h, &o, buf, sizeof buf, pitch) == HD_ERROR_INVALID_ENUM);
+    CHECK(hd_read_image_ex(h, NULL, NULL, sizeof buf, 0) == HD_ERROR_NULL_POINTER);
+    /* NULL: RGBA8, the camera's size, tight rows */
+    memset(buf, 0x5a, sizeof buf);
+    CHECK(hd_read_image_ex(h, NULL, buf, (size_t)W * W * 4, 0) == HD_SUCCESS);
+    for (y = 0, changed = 0; y < (size_t)W * W * 4; ++y) changed += buf[y] != 0;
+    CHECK(changed == 0 && buf[W * W * 4] == 0x5a);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+}
+
 static const hd_test_case cases[] = {
     {"null_api", test_null_api},
     {"null_invalidation", test_null_invalidation},
     {"null_update", test_null_update},
+    {"null_record_render", test_null_record_render},
+    {"null_read_image_ex", test_null_read_image_ex},
 };
 
 int main(void)

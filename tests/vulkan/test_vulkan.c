@@ -60,9 +60,11 @@ static char mg_log[512];      /* the last message that mentions MULTIGRID */
 #define CHECK(cond) \
     do { if (!(cond)) { ++failures; fprintf(stderr, "  %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
 
+static unsigned long err_count; /* errors logged */
 static void count_log(void *user, hd_log_level level, hd_result code, const char *msg, const char *file, int line)
 {
     (void)user; (void)code; (void)file; (void)line;
+    if (level == HD_LOG_ERROR) ++err_count;
     if (strncmp(msg, "vulkan validation", 17) == 0) ++messages;
     if (strstr(msg, "VK_ERROR_DEVICE_LOST")) snprintf(lost_log, sizeof lost_log, "%s", msg);
     if (strstr(msg, "FLOAT16")) snprintf(half_log, sizeof half_log, "%s", msg);
@@ -681,7 +683,7 @@ static void test_record_auto_scale(void)
     }
     hd_destroy(h);
     d.params.render_scale = HD_RENDER_SCALE_AUTO;
-    d.params.render_budget = (float)(100.0 * t);
+    d.params.render_budget = (float)(100.0 * t < 10.0 ? 100.0 * t : 10.0); /* at most 10 s (the parameter's range): a loaded machine */
     if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
     CHECK(record_run(h, 1) == HD_SUCCESS); /* nothing measured yet: scale 4 */
     CHECK(hd_get_stats(h, &s0) == HD_SUCCESS && s0.render_scale == 4);
@@ -699,6 +701,398 @@ static void test_record_auto_scale(void)
     printf("%s HD_RENDER_SCALE_AUTO while recording: a new view's first frame at scale %d with a budget of 100 full frames "
            "(%.1f ms each), %d with an eighth of one\n",
            first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
+}
+
+/* 9, 10: hd_vulkan_record_render into the caller's image or buffer. The test's own objects on the
+   backend's device (white box: its function table), so the validation layer (core and
+   synchronization, the backend's own instance) sees the caller's commands and the library's. */
+typedef struct vk_obj {
+    VkImage image;
+    VkBuffer buffer;
+    VkDeviceMemory memory;
+    void *map;
+} vk_obj;
+
+static int vk_memory(hd__backend *be, VkMemoryRequirements *req, int host, vk_obj *o)
+{
+    VkMemoryAllocateInfo mai;
+    int type = hd__vk_memory_type(be, req->memoryTypeBits,
+                                  host ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
+                                       : VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, 0);
+    if (type < 0) return 0;
+    memset(&mai, 0, sizeof mai);
+    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    mai.allocationSize = req->size;
+    mai.memoryTypeIndex = (uint32_t)type;
+    if (be->fn.vkAllocateMemory(be->device, &mai, NULL, &o->memory) != VK_SUCCESS) return 0;
+    if (host && be->fn.vkMapMemory(be->device, o->memory, 0, VK_WHOLE_SIZE, 0, &o->map) != VK_SUCCESS) return 0;
+    return 1;
+}
+
+static int vk_image(hd__backend *be, VkFormat fmt, int w, int h, vk_obj *o)
+{
+    VkImageCreateInfo ici;
+    VkMemoryRequirements req;
+    memset(o, 0, sizeof *o);
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.format = fmt;
+    ici.extent.width = (uint32_t)w;
+    ici.extent.height = (uint32_t)h;
+    ici.extent.depth = 1;
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    if (be->fn.vkCreateImage(be->device, &ici, NULL, &o->image) != VK_SUCCESS) return 0;
+    be->fn.vkGetImageMemoryRequirements(be->device, o->image, &req);
+    return vk_memory(be, &req, 0, o) && be->fn.vkBindImageMemory(be->device, o->image, o->memory, 0) == VK_SUCCESS;
+}
+
+static int vk_buffer(hd__backend *be, VkDeviceSize bytes, vk_obj *o)
+{
+    VkBufferCreateInfo bci;
+    VkMemoryRequirements req;
+    memset(o, 0, sizeof *o);
+    memset(&bci, 0, sizeof bci);
+    bci.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
+    bci.size = bytes;
+    bci.usage = VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
+    if (be->fn.vkCreateBuffer(be->device, &bci, NULL, &o->buffer) != VK_SUCCESS) return 0;
+    be->fn.vkGetBufferMemoryRequirements(be->device, o->buffer, &req);
+    return vk_memory(be, &req, 1, o) && be->fn.vkBindBufferMemory(be->device, o->buffer, o->memory, 0) == VK_SUCCESS;
+}
+
+static void vk_free(hd__backend *be, vk_obj *o)
+{
+    if (o->image) be->fn.vkDestroyImage(be->device, o->image, NULL);
+    if (o->buffer) be->fn.vkDestroyBuffer(be->device, o->buffer, NULL);
+    if (o->memory) be->fn.vkFreeMemory(be->device, o->memory, NULL);
+    memset(o, 0, sizeof *o);
+}
+
+/* The caller's commands around a call: a command buffer begun, then `after` run on it (the test's
+   copies), ended, submitted and waited for, the host's reads made visible. */
+typedef struct vk_cmd {
+    VkCommandPool pool;
+    VkCommandBuffer cb;
+} vk_cmd;
+static int cmd_begin(hd__backend *be, vk_cmd *c)
+{
+    VkCommandPoolCreateInfo cpci;
+    VkCommandBufferAllocateInfo cbai;
+    VkCommandBufferBeginInfo bi;
+    memset(&cpci, 0, sizeof cpci);
+    cpci.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+    cpci.queueFamilyIndex = be->queue_family;
+    if (be->fn.vkCreateCommandPool(be->device, &cpci, NULL, &c->pool) != VK_SUCCESS) return 0;
+    memset(&cbai, 0, sizeof cbai);
+    cbai.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+    cbai.commandPool = c->pool;
+    cbai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbai.commandBufferCount = 1;
+    be->fn.vkAllocateCommandBuffers(be->device, &cbai, &c->cb);
+    memset(&bi, 0, sizeof bi);
+    bi.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+    return be->fn.vkBeginCommandBuffer(c->cb, &bi) == VK_SUCCESS;
+}
+static int cmd_submit(hd__backend *be, vk_cmd *c, int submit)
+{
+    VkSubmitInfo si;
+    VkMemoryBarrier mb;
+    int ok = 1;
+    memset(&mb, 0, sizeof mb);
+    mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+    be->fn.vkCmdPipelineBarrier(c->cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+    be->fn.vkEndCommandBuffer(c->cb);
+    if (submit) {
+        memset(&si, 0, sizeof si);
+        si.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+        si.commandBufferCount = 1;
+        si.pCommandBuffers = &c->cb;
+        ok = be->fn.vkQueueSubmit(be->queue, 1, &si, VK_NULL_HANDLE) == VK_SUCCESS;
+        be->fn.vkDeviceWaitIdle(be->device);
+    }
+    be->fn.vkDestroyCommandPool(be->device, c->pool, NULL);
+    return ok;
+}
+
+/* The image's whole contents into host buffer `host` (the image in `layout`, GENERAL or
+   TRANSFER_SRC_OPTIMAL). */
+static void cmd_read_image(hd__backend *be, VkCommandBuffer cb, const vk_obj *im, VkImageLayout layout, const vk_obj *host, int w, int h)
+{
+    VkBufferImageCopy reg;
+    memset(&reg, 0, sizeof reg);
+    reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    reg.imageSubresource.layerCount = 1;
+    reg.imageExtent.width = (uint32_t)w;
+    reg.imageExtent.height = (uint32_t)h;
+    reg.imageExtent.depth = 1;
+    be->fn.vkCmdCopyImageToBuffer(cb, im->image, layout, host->buffer, 1, &reg);
+}
+
+/* A barrier and layout transition the caller itself would record (the test's own commands):
+   transfers before and after, or (to_compute) before a compute shader's reads. */
+static void cmd_layout_to(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from, VkImageLayout to, int to_compute)
+{
+    VkImageMemoryBarrier ib;
+    memset(&ib, 0, sizeof ib);
+    ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+    ib.dstAccessMask = to_compute ? VK_ACCESS_SHADER_READ_BIT : VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT;
+    ib.oldLayout = from;
+    ib.newLayout = to;
+    ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.image = im;
+    ib.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    ib.subresourceRange.levelCount = 1;
+    ib.subresourceRange.layerCount = 1;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                to_compute ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1,
+                                &ib);
+}
+static void cmd_layout(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from, VkImageLayout to)
+{
+    cmd_layout_to(be, cb, im, from, to, 0);
+}
+
+enum { OTW = 50, OTH = 37, ORX = 11, ORY = 6 };
+
+/* 9: each format into a region of the caller's image, and into its buffer: the region equal, byte
+   for byte, to hd_read_image_ex of the same format after the caller's submission; everything
+   outside as it was; the refusals; no validation message. */
+static void test_output_target(void)
+{
+    static const struct { VkFormat vk; hd_output_format f; const char *name; } fmts[5] = {
+        {VK_FORMAT_R16G16B16A16_SFLOAT, HD_OUTPUT_LINEAR_F16, "R16G16B16A16_SFLOAT"},
+        {VK_FORMAT_R32G32B32A32_SFLOAT, HD_OUTPUT_LINEAR_F32, "R32G32B32A32_SFLOAT"},
+        {VK_FORMAT_R8G8B8A8_UNORM, HD_OUTPUT_SRGB8, "R8G8B8A8_UNORM"},
+        {VK_FORMAT_R8G8B8A8_SRGB, HD_OUTPUT_SRGB8, "R8G8B8A8_SRGB"},
+        {VK_FORMAT_B8G8R8A8_UNORM, HD_OUTPUT_SRGB8, "B8G8R8A8_UNORM"}};
+    static unsigned char ex[OTW * OTH * 16 + 64];
+    hd_desc d = test_desc();
+    hd_context h;
+    hd__backend *be;
+    vk_obj host, before;
+    int k, ok = 1, bad_total = 0;
+    d.vulkan.enable_validation = have_layer;
+    d.params.exposure = 1.3f;
+    d.params.background[0] = 0.1f; /* red and blue apart: a BGRA target's swap shows */
+    d.params.background[2] = 0.6f;
+    messages = 0;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    be = hd__lookup(h)->vw.be;
+    if (!vk_buffer(be, (VkDeviceSize)OTW * OTH * 16 + 64, &host) || !vk_buffer(be, (VkDeviceSize)OTW * OTH * 16 + 64, &before)) {
+        CHECK(0);
+        return;
+    }
+    for (k = 0; k < 6; ++k) { /* 5 images, then a buffer */
+        hd_vulkan_target t = HD_VULKAN_TARGET_INIT;
+        hd_output o = HD_OUTPUT_INIT;
+        hd_output_format f = k < 5 ? fmts[k].f : HD_OUTPUT_LINEAR_F16;
+        size_t px = f == HD_OUTPUT_LINEAR_F32 ? 16 : f == HD_OUTPUT_LINEAR_F16 ? 8 : 4, pitch = OTW * px + (k < 5 ? 0 : 24);
+        size_t off = k < 5 ? 0 : 40, x, y;
+        vk_obj im;
+        vk_cmd c;
+        hd_result r;
+        int outside = 0, region = 0, nonzero = 0;
+        memset(&im, 0, sizeof im);
+        o.format = f;
+        o.x = ORX;
+        o.y = ORY;
+        t.width = OTW;
+        t.height = OTH;
+        /* the target's contents before: a clear (image) or a fill (buffer), read back */
+        if (!cmd_begin(be, &c)) { CHECK(0); break; }
+        if (k < 5) {
+            VkClearColorValue cc;
+            VkImageSubresourceRange range;
+            if (!vk_image(be, fmts[k].vk, OTW, OTH, &im)) { CHECK(0); break; }
+            cc.float32[0] = 0.25f; cc.float32[1] = 0.5f; cc.float32[2] = 0.75f; cc.float32[3] = 1.0f;
+            memset(&range, 0, sizeof range);
+            range.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+            range.levelCount = range.layerCount = 1;
+            cmd_layout(be, c.cb, im.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+            be->fn.vkCmdClearColorImage(c.cb, im.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &cc, 1, &range);
+            cmd_layout(be, c.cb, im.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
+            cmd_read_image(be, c.cb, &im, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &before, OTW, OTH);
+            t.image = (uint64_t)im.image;
+            t.format = fmts[k].vk;
+            t.layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL; /* where the test's copy left it */
+            if (k & 1) { /* or as a sampled image would be */
+                cmd_layout(be, c.cb, im.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+                t.layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+            }
+            t.final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        } else {
+            be->fn.vkCmdFillBuffer(c.cb, host.buffer, 0, VK_WHOLE_SIZE, 0xa5c3e1f0u);
+            t.buffer = (uint64_t)host.buffer;
+            t.offset = off;
+            t.row_pitch = pitch;
+            t.buffer_size = (uint64_t)OTW * OTH * 16 + 64;
+        }
+        ok &= cmd_submit(be, &c, 1);
+        if (k == 5) memcpy(before.map, host.map, (size_t)OTW * OTH * 16 + 64);
+        /* the frame and the write, recorded after the caller's own write of the target in the same
+           command buffer (the clear or fill again: the same bytes), then the caller's copy: the
+           library's barriers order it after the one and before the other */
+        if (!cmd_begin(be, &c)) { CHECK(0); break; }
+        if (k < 5) {
+            VkClearColorValue cc;
+            VkImageSubresourceRange range;
+            cc.float32[0] = 0.25f; cc.float32[1] = 0.5f; cc.float32[2] = 0.75f; cc.float32[3] = 1.0f;
+            memset(&range, 0, sizeof range);
+            range.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+            range.levelCount = range.layerCount = 1;
+            cmd_layout(be, c.cb, im.image, (VkImageLayout)t.layout, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
+            be->fn.vkCmdClearColorImage(c.cb, im.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &cc, 1, &range);
+            /* left as the clear wrote it (no barrier of the caller's after it), or handed to a
+               compute shader's reads in SHADER_READ_ONLY: either way only the library's barrier
+               orders its copy after the clear */
+            if (k & 1)
+                cmd_layout_to(be, c.cb, im.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 1);
+            else
+                t.layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+        } else {
+            be->fn.vkCmdFillBuffer(c.cb, host.buffer, 0, VK_WHOLE_SIZE, 0xa5c3e1f0u);
+        }
+        r = hd_vulkan_record_render(h, c.cb, &t, &o);
+        CHECK(r == HD_SUCCESS);
+        if (k < 5) cmd_read_image(be, c.cb, &im, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &host, OTW, OTH);
+        ok &= cmd_submit(be, &c, r == HD_SUCCESS) && r == HD_SUCCESS;
+        memset(ex, 0, sizeof ex);
+        CHECK(hd_read_image_ex(h, &o, ex + off, sizeof ex - off, pitch) == HD_SUCCESS);
+        for (y = 0; y < OTH; ++y)
+            for (x = 0; x < OTW; ++x) {
+                size_t at = off + y * pitch + x * px, i;
+                const unsigned char *g = (const unsigned char *)host.map + at, *b = (const unsigned char *)before.map + at;
+                if (x >= ORX && x < ORX + 32 && y >= ORY && y < ORY + 24) {
+                    unsigned char want[16];
+                    memcpy(want, ex + at, px);
+                    if (k == 4) { unsigned char tmp = want[0]; want[0] = want[2]; want[2] = tmp; } /* BGRA */
+                    region += memcmp(g, want, px) != 0;
+                    for (i = 0; i < px; ++i) nonzero += g[i] != 0;
+                } else {
+                    outside += memcmp(g, b, px) != 0;
+                }
+            }
+        if (k == 5) /* the buffer's bytes outside the target's rows: the padding and the offset */
+            for (y = 0; y < OTH; ++y)
+                outside += memcmp((const unsigned char *)host.map + off + y * pitch + OTW * px,
+                                  (const unsigned char *)before.map + off + y * pitch + OTW * px, pitch - OTW * px) != 0;
+        outside += memcmp(host.map, before.map, off) != 0;
+        CHECK(region == 0 && outside == 0 && nonzero > 0);
+        printf("%s output into the caller's %s %s at (%d, %d) of %dx%d: %d of 768 pixels differ from hd_read_image_ex, %d outside changed\n",
+               region || outside || !nonzero ? "FAIL" : "PASS", k < 5 ? "image" : "buffer (offset 40, pitch +24)",
+               k < 5 ? fmts[k].name : "LINEAR_F16", ORX, ORY, OTW, OTH, region, outside);
+        bad_total += region + outside;
+        if (k == 0) { /* refusals before anything is recorded: one error each, the context renders on */
+            hd_vulkan_target b = t;
+            hd_output bo = o;
+            unsigned long before_errors;
+            int j;
+            for (j = 0; j < 7; ++j) {
+                hd_result want;
+                b = t;
+                bo = o;
+                switch (j) {
+                case 0: bo.x = OTW - 32 + 1; want = HD_ERROR_OUTPUT_OUTSIDE_TARGET; break;
+                case 1: bo.y = -2; want = HD_ERROR_OUTPUT_OUTSIDE_TARGET; break;
+                case 2: bo.format = HD_OUTPUT_SRGB8; want = HD_ERROR_OUTPUT_FORMAT; break;
+                case 3: bo.width = 31; want = HD_ERROR_OUTPUT_SIZE; break;
+                case 4: b.buffer = (uint64_t)host.buffer; want = HD_ERROR_INVALID_PARAMETER; break;
+                case 5: b.layout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL; want = HD_ERROR_INVALID_ENUM; break;
+                default: b.image = 0; b.buffer = (uint64_t)host.buffer; b.buffer_size = 100; want = HD_ERROR_BUFFER_TOO_SMALL; break;
+                }
+                err_count = 0;
+                before_errors = err_count;
+                if (!cmd_begin(be, &c)) { CHECK(0); break; }
+                r = hd_vulkan_record_render(h, c.cb, &b, &bo);
+                cmd_submit(be, &c, 1); /* nothing was recorded: an empty command buffer */
+                CHECK(r == want && err_count - before_errors == 1);
+                if (r != want || err_count - before_errors != 1)
+                    printf("  refusal %d: %s (want %s), %lu errors\n", j, hd_result_string(r), hd_result_string(want), err_count - before_errors);
+            }
+            printf("PASS output refusals (region outside, negative y, format, size, image and buffer, layout, short buffer): one error each\n");
+        }
+        if (im.image) vk_free(be, &im);
+    }
+    vk_free(be, &host);
+    vk_free(be, &before);
+    CHECK(hd_iterate(h, 1) == HD_SUCCESS);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    CHECK(ok && messages == 0);
+    printf("%s output targets: %d pixels differ in all, %lu validation messages (core and synchronization%s)\n",
+           ok && !bad_total && messages == 0 ? "PASS" : "FAIL", bad_total, messages, have_layer ? "" : ": no layer");
+}
+
+/* 10: frames over converged light under recording: hd_vulkan_record_render calls, each submitted
+   and waited for, reach light_converged 1 (the light measured by the next call); from then on no
+   light iteration is recorded (iterations stay), the image restarts and its frames go up to
+   frame_window and stop, and the write into the caller's image goes on (equal to the read-back,
+   every call). */
+static void test_record_converged(void)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd_stats s;
+    hd__backend *be;
+    vk_obj im, host;
+    uint64_t it_conv = 0, fr = 0;
+    int calls = 0, conv_at = -1, k, ok = 1, region = 0;
+    static unsigned char ex[32 * 24 * 8];
+    d.vulkan.enable_validation = have_layer;
+    d.params.light_tolerance = 0.2f;
+    d.params.frame_window = 3;
+    messages = 0;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    be = hd__lookup(h)->vw.be;
+    if (!vk_image(be, VK_FORMAT_R16G16B16A16_SFLOAT, 32, 24, &im) || !vk_buffer(be, 32 * 24 * 8, &host)) { CHECK(0); return; }
+    for (calls = 0; calls < 80; ++calls) {
+        hd_vulkan_target t = HD_VULKAN_TARGET_INIT;
+        hd_output o = HD_OUTPUT_INIT;
+        vk_cmd c;
+        o.format = HD_OUTPUT_LINEAR_F16;
+        t.image = (uint64_t)im.image;
+        t.format = VK_FORMAT_R16G16B16A16_SFLOAT;
+        t.layout = calls == 0 ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        t.final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        t.width = 32;
+        t.height = 24;
+        if (!cmd_begin(be, &c)) { CHECK(0); break; }
+        ok &= hd_vulkan_record_render(h, c.cb, &t, &o) == HD_SUCCESS;
+        cmd_read_image(be, c.cb, &im, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &host, 32, 24);
+        ok &= cmd_submit(be, &c, 1);
+        CHECK(hd_read_image_ex(h, &o, ex, sizeof ex, 0) == HD_SUCCESS);
+        region += memcmp(ex, host.map, sizeof ex) != 0;
+        CHECK(hd_get_stats(h, &s) == HD_SUCCESS);
+        if (conv_at < 0 && s.light_converged) {
+            conv_at = calls;
+            it_conv = s.iterations;
+            fr = s.frames;
+        }
+        if (conv_at >= 0 && calls >= conv_at + 6) break;
+    }
+    CHECK(conv_at >= 0);
+    CHECK(hd_get_stats(h, &s) == HD_SUCCESS);
+    /* the read-back after a call's submission measured its light iteration (the next call to reach
+       the device does) and found it converged: the image restarted there (no frame yet), and no
+       later call recorded a light iteration; the image then holds frame_window frames */
+    k = conv_at >= 0 && s.light_converged && s.iterations == it_conv && s.frames == 3 && fr == 0;
+    CHECK(k);
+    vk_free(be, &im);
+    vk_free(be, &host);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    CHECK(ok && region == 0 && messages == 0);
+    printf("%s frames over converged light under recording: light_converged after %d calls (%llu iterations, %llu after 6 more "
+           "calls), %llu frame then, %llu after (frame_window 3); %d written images differ from the read-back; %lu validation messages\n",
+           ok && k && region == 0 && messages == 0 ? "PASS" : "FAIL", conv_at + 1, (unsigned long long)it_conv,
+           (unsigned long long)s.iterations, (unsigned long long)fr, (unsigned long long)s.frames, region, messages);
 }
 
 /* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
@@ -804,6 +1198,8 @@ int main(void)
             test_kept_instance();
             test_image_room();
             test_record_auto_scale();
+            test_output_target();
+            test_record_converged();
         }
     }
     if (failures) printf("FAILED\n");
