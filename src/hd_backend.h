@@ -310,7 +310,6 @@ HD__MAYBE_UNUSED static float *hd__project_table_new(const hd__view *vw, int n)
     return t;
 }
 
-
 /* ---- the output encodings (hybriddiff.h, hd_output_format), one definition for every path -----
    HD_OUTPUT_SRGB8: hd__srgb8 of rgb * exposure, hd__alpha8 of alpha; LINEAR_F16: hdk_f2h of
    rgb * exposure and of alpha; LINEAR_F32: rgb * exposure and alpha. The core's read-backs
