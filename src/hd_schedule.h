@@ -105,8 +105,8 @@ static hd_result hd__prepare(hd__ctx *ctx)
     if ((r = hd__be_clear(&ctx->vw, dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE))) != HD_SUCCESS) return r;
     ctx->dirty = 0;
     /* light iterations an earlier call recorded have run by now (the caller waits before the next
-       call): their light is measured, unless a setter has reset it since */
-    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI)) ctx->rec_light = 0;
+       call): their light is measured, unless a setter has reset it or its estimate since */
+    if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI)) ctx->rec_light = 0;
     if (ctx->rec_light) return hd__record_measure(ctx);
     return HD_SUCCESS;
 }
