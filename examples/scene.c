@@ -10,9 +10,11 @@
      4. the cloud is blended over the scene with ONE, ONE_MINUS_SRC_ALPHA, in linear light;
      5. tone mapping and sRGB encoding into the window.
 
-   Usage: scene [--size WxH] [--frames N] [--out PNG]   (mouse: drag to orbit, wheel to zoom)
-   With --frames the camera turns by a fixed step per frame and the last frame is written to PNG
-   (make scene runs it under xvfb-run: out/scene.png). C99, OpenGL 4.5 core, GLFW. */
+   Usage: scene [--size WxH] [--frames N] [--out PNG] [--check]   (drag to orbit, wheel to zoom)
+   With --frames the camera turns by a fixed step per frame, then rests, and the last frame is
+   written to PNG (make scene runs it under xvfb-run: out/scene.png). --check exits 1 unless the
+   last frame's cloud is finite, covers part of the image and leaves part of it uncovered (the
+   test make test-scene runs). C99, OpenGL 4.5 core, GLFW. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_GL
@@ -161,9 +163,9 @@ static const char *mesh_vs =
     "void main() { n_world = mat3(model) * nrm; gl_Position = mvp * vec4(pos, 1.0); }\n";
 static const char *mesh_fs =
     "#version 450 core\n"
-    "in vec3 n_world; uniform vec3 albedo, sun_dir, sun_rgb; out vec4 colour;\n"
+    "in vec3 n_world; uniform vec3 albedo, sun_dir, sun_rgb; out vec4 colour; /* Lambert, a sky term */\n"
     "void main() { float l = max(dot(normalize(n_world), -sun_dir), 0.0);\n"
-    "  colour = vec4(albedo * (sun_rgb * l + vec3(0.25, 0.3, 0.4)), 1.0); }\n";
+    "  colour = vec4(albedo / 3.14159265 * (sun_rgb * l + vec3(0.8, 0.95, 1.25)), 1.0); }\n";
 /* a full-screen triangle: the cloud's texture blended over the scene, then the tone map */
 static const char *quad_vs =
     "#version 450 core\n"
@@ -239,7 +241,7 @@ typedef struct app {
 } app;
 
 static const float sun_dir[3] = {-0.45f, -0.8f, -0.4f}; /* the direction sunlight travels in */
-static const float sun_rgb[3] = {3.0f, 2.8f, 2.5f};
+static const float sun_rgb[3] = {9.0f, 8.4f, 7.5f}; /* linear radiance units, as the library's */
 
 static void die(const char *what, hd_result r)
 {
@@ -361,6 +363,27 @@ static int write_png(app *a, const char *path)
     return ok;
 }
 
+/* The last frame's cloud, read back as linear floats: finite everywhere, opaque enough over some
+   pixels and absent from others (the sky above it, and where the box in front hides it). */
+static int check_cloud(app *a)
+{
+    size_t n = (size_t)a->w * a->h, covered = 0, clear = 0, bad = 0;
+    float *img = (float *)malloc(n * 4 * sizeof(float));
+    hd_result r;
+    if (!img) return 0;
+    if ((r = hd_read_image_f32(a->hd, img, n * 4)) != HD_SUCCESS) die("hd_read_image_f32", r);
+    for (size_t i = 0; i < n; ++i) {
+        float *p = img + 4 * i;
+        bad += !(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && p[3] >= 0.0f && p[3] <= 1.0f);
+        covered += p[3] > 0.2f;
+        clear += p[3] == 0.0f;
+    }
+    free(img);
+    fprintf(stderr, "scene: cloud over %.1f%% of the image (alpha > 0.2), absent from %.1f%%, %zu bad pixels\n",
+            100.0 * (double)covered / (double)n, 100.0 * (double)clear / (double)n, bad);
+    return bad == 0 && covered > n / 100 && clear > n / 4;
+}
+
 static GLuint texture2d(GLenum format, int w, int h)
 {
     GLuint t;
@@ -375,7 +398,7 @@ static GLuint texture2d(GLenum format, int w, int h)
 int main(int argc, char **argv)
 {
     app a;
-    int frames = -1;
+    int frames = -1, check = 0;
     const char *out_path = NULL;
     static unsigned char cloud[CLOUD_N * CLOUD_N * CLOUD_N];
     float cube[36 * 6];
@@ -392,12 +415,13 @@ int main(int argc, char **argv)
             a.w > 0 && a.h > 0 && a.w <= 4096 && a.h <= 4096) ++i;
         else if (!strcmp(argv[i], "--frames") && i + 1 < argc && (frames = atoi(argv[i + 1])) > 0) ++i;
         else if (!strcmp(argv[i], "--out") && i + 1 < argc) out_path = argv[++i];
+        else if (!strcmp(argv[i], "--check")) check = 1;
         else {
-            fprintf(stderr, "usage: scene [--size WxH] [--frames N] [--out PNG]\n");
+            fprintf(stderr, "usage: scene [--size WxH] [--frames N] [--out PNG] [--check]\n");
             return 2;
         }
     }
-    if (out_path && frames < 0) frames = 64;
+    if ((out_path || check) && frames < 0) frames = 64;
     if (!glfwInit()) { fprintf(stderr, "scene: glfwInit failed (no display?)\n"); return 1; }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
@@ -448,8 +472,8 @@ int main(int argc, char **argv)
 
     /* the scene: a ground plane, a box in front of the cloud, one behind, a post through it */
     meshes[0].model = mat4_mul(mat4_translate(0.0f, -0.05f, 0.0f), mat4_scale(30.0f, 0.1f, 30.0f));
-    meshes[1].model = mat4_mul(mat4_translate(1.6f, 0.5f, 1.9f), mat4_scale(1.0f, 1.0f, 1.0f));
-    meshes[2].model = mat4_mul(mat4_translate(-2.2f, 0.75f, -2.4f), mat4_scale(1.5f, 1.5f, 1.5f));
+    meshes[1].model = mat4_mul(mat4_translate(0.7f, 0.5f, 2.7f), mat4_scale(1.0f, 1.0f, 1.0f));
+    meshes[2].model = mat4_mul(mat4_translate(-1.7f, 0.75f, -2.6f), mat4_scale(1.5f, 1.5f, 1.5f));
     meshes[3].model = mat4_mul(mat4_translate(0.4f, 1.5f, 0.2f), mat4_scale(0.18f, 3.0f, 0.18f));
     meshes[4].model = mat4_mul(mat4_translate(-3.5f, 0.4f, 2.0f), mat4_mul(mat4_rotate_y(0.5f), mat4_scale(0.8f, 0.8f, 0.8f)));
     {
@@ -483,6 +507,7 @@ int main(int argc, char **argv)
 
     /* --frames: the camera turns for all but the last 16 frames, which rest so the light and
        the image converge before the screenshot */
+    if (frames > 0) a.yaw -= 0.02f * (float)(frames > 16 ? frames - 16 : 0); /* ends at the default view */
     for (int f = 0; frames < 0 ? !glfwWindowShouldClose(a.win) : f < frames; ++f) {
         if (frames > 0 && f < frames - 16) a.yaw += 0.02f;
         draw_frame(&a, meshes, 5);
@@ -493,6 +518,7 @@ int main(int argc, char **argv)
         glfwSwapBuffers(a.win);
         glfwPollEvents();
     }
+    if (check && !check_cloud(&a)) return 1;
     hd_destroy(a.hd);
     free(a.depth_rows);
     free(a.depth_top_first);
