@@ -11,8 +11,10 @@
       monotonically: trend reversals are counted; then the renders until hd_stats.light_converged
       after the last step. Run warm (the library's setters) and cold (hd_reset after each step:
       the old behaviour).
+   --scale N|auto sets params.render_scale of the timed frames (both ways; the reference renders
+   full frames).
    Usage: hdbench_animated [--dims S] [--frames F] [--cold C] [--every K] [--size P]
-                           [--budget s] [--no-puff] [--no-tf] [--head path] */
+                           [--budget s] [--scale N|auto] [--no-puff] [--no-tf] [--head path] */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"
@@ -95,6 +97,8 @@ static hd_camera orbit(int frame, int frames, int size)
     return c;
 }
 
+static int render_scale; /* --scale: params.render_scale of the timed frames (0: full frames) */
+
 static hd_desc puff_desc(const float *vol, int s, int size, float budget)
 {
     hd_desc d = HD_DESC_INIT;
@@ -106,6 +110,7 @@ static hd_desc puff_desc(const float *vol, int s, int size, float budget)
     d.camera = orbit(0, 1, size);
     d.params.extinction = 60.0f;
     d.params.render_budget = budget;
+    d.params.render_scale = budget > 0.0f ? render_scale : 0;
     return d;
 }
 
@@ -309,6 +314,10 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--head") && i + 1 < argc) head = argv[++i];
         else if (!strcmp(argv[i], "--no-puff")) puffs = 0;
         else if (!strcmp(argv[i], "--no-tf")) tfs = 0;
+        else if (!strcmp(argv[i], "--scale") && i + 1 < argc) {
+            ++i;
+            render_scale = !strcmp(argv[i], "auto") ? HD_RENDER_SCALE_AUTO : atoi(argv[i]);
+        }
         else {
             fprintf(stderr, "usage: hdbench_animated [--dims S] [--frames F] [--cold C] [--every K] [--size P] [--budget s] [--no-puff] [--no-tf] [--head path]\n");
             return 2;
