@@ -17,7 +17,7 @@
 #include "hdbench_triad.h"
 #include "hd_bench_median.h"
 
-/* The plain constant-coefficient 7-point Jacobi stencil the issue's 70 % target was set with:
+/* The plain constant-coefficient 7-point Jacobi stencil the 70 % target was set with:
    b = (sum of a's 6 neighbours) / 7 over the grid's interior, zero boundary, z-slabs per
    thread. 8 B/voxel (a in, b out): the same convention as the triad. */
 typedef struct stencil_job { const float *a; float *b; int g[3], z0, z1; } stencil_job;

@@ -19,7 +19,7 @@
                 side by side (DIR/<case>-<config>.png), and per configuration a line of figures
                 by image region (where the light is missing or in excess: see region_report)
        --cost A,B: no references; the seconds of one iteration of configurations A and B, timed
-                alternately in one process (cost_case), for the issue's iteration-cost target
+                alternately in one process (cost_case), for the iteration-cost target
 
    Volumes: data/head.nrrd and data/brainsmall.nrrd (scripts/fetch-data), data/skull.nrrd
    (scripts/fetch-skull). Figures in docs/EVALUATION.md ("Energy balance"). */
