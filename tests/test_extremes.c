@@ -522,8 +522,21 @@ static const xt_row xt_background_rows[] = {
     {"background 3e38 x3, frame_window 2, render_scale 2", bg_3e38_w2_s2, HD_SUCCESS, XT_BACKGROUND},
 };
 
-/* Reduced frames of a background at the float limit: a sweep of volumes, image sizes, scales and
-   windows, every frame read back finite (the upsample and the running mean must not overflow). */
+/* An 8^3 U16 volume of three values (a: 65, b: 65534, c: 65535) on which full-resolution frames
+   of a FLT_MAX background turn non-finite (found by tests/fuzz/fuzz_state.c). */
+static const char xt_bg_volume[] =
+    "abacbacaabacbacaabacbacbacaabacbacaabacbacbacaabacbacaabacbacbac"
+    "aabacbacaabacbacaacaabacbacaabacbacaacaabacbacaabacbacaabaabacba"
+    "caabacbacaabacbacbacaabacbacaabacbacbacaabacbacaabacbacbacaabacb"
+    "acaabacbacbacaabacbacaabacbacaacaabacbacaabacbacaabaabacbacaabac"
+    "bacaabaabacbacaabacbacaabacbacbacaabacbacaabacbacbacaabacbacaaba"
+    "cbacbacaabacbacaabacbacaacaabacbacaabacbacaacaabacbacaabacbacaab"
+    "aabacbacaabacbacaabaabacbacaabacbacaabacbacbacaabacbacaabacbacba"
+    "caabacbacaabacbacbacaabacbacaabacbacaacaabacbacaabacbacaacaabacb";
+
+/* A background at the float limit over many frames: the fuzzer's volume at full resolution, then
+   a sweep of volumes, image sizes, reduced scales and windows; every frame read back finite (the
+   projection, the upsample and the running mean must not overflow). */
 static void test_background_reduced(void)
 {
     static const int sizes[3] = {8, 12, 16}, scales[4] = {2, 4, 8, HD_RENDER_SCALE_AUTO};
@@ -532,6 +545,31 @@ static void test_background_reduced(void)
     int v, w, s, win, bg, k, i, bad = 0;
     for (i = 0; i < 64; ++i) alt[i] = (uint8_t)(i % 2 ? 255 : 0);
     for (i = 0; i < 8; ++i) ramp[i] = (uint8_t)(i * 36);
+    for (k = 0; k < 2; ++k) { /* the default light tolerance, then 1 */
+        static uint16_t u16[512];
+        hd_desc d;
+        hd_context c;
+        for (i = 0; i < 512; ++i) u16[i] = (uint16_t)(xt_bg_volume[i] == 'a' ? 65 : xt_bg_volume[i] == 'b' ? 65534 : 65535);
+        memset(&d, 0, sizeof d);
+        d.volume.type = HD_VOXEL_U16;
+        d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = 8;
+        d.volume.data = u16;
+        d.camera.width = 16;
+        d.camera.height = 14;
+        d.threads = 1;
+        XT_SET3(d.params.background, FLT_MAX);
+        d.params.light_tolerance = k ? 1.0f : 0.0f;
+        if (hd_create(&d, &c) != HD_SUCCESS) { CHECK(0); continue; }
+        for (v = 1; v <= 16; ++v) {
+            CHECK(hd_render(c) == HD_SUCCESS);
+            CHECK(hd_read_image_f32(c, img, 16 * 14 * 4) == HD_SUCCESS);
+            if (!xt_finite(img, 16 * 14 * 4)) {
+                CHECK_MSG(0, "U16 8^3, 16x14, light tolerance %s: frame %d of a FLT_MAX background not finite", k ? "1" : "default", v);
+                break;
+            }
+        }
+        CHECK(hd_destroy(c) == HD_SUCCESS);
+    }
     for (v = 0; v < 3; ++v)
         for (w = 0; w < 3; ++w)
             for (s = 0; s < 4; ++s)
@@ -1156,7 +1194,7 @@ static void test_path_restart(void)
 const hd_test_case hd_tests_extremes[] = {
     {"extremes: value range", test_value_range},
     {"extremes: background", test_background},
-    {"extremes: background FLT_MAX with reduced frames", test_background_reduced},
+    {"extremes: background FLT_MAX over many frames", test_background_reduced},
     {"extremes: exposure", test_exposure},
     {"extremes: medium", test_medium},
     {"extremes: lights", test_lights},
