@@ -6,6 +6,8 @@
 #   make fuzz-long    FUZZ_SECONDS per loader (local; keeps new corpus in build/fuzz/work_*)
 #   make fuzz-smoke-api / fuzz-long-api   the same for the API fuzzer (tests/fuzz/fuzz_api.c;
 #                     fuzz-smoke runs fuzz-smoke-api)
+#   make fuzz-smoke-state / fuzz-long-state   the state-machine fuzzer (tests/fuzz/fuzz_state.c:
+#                     call sequences over the whole API; fuzz-smoke runs fuzz-smoke-state)
 #   make asan         build/hdtest and the OpenCL conformance suite under ASan+UBSan+LSan
 #   make tsan         the CPU backend's threaded tests under TSan
 #   make valgrind     build/hdtest's API/loader/error-path suites (CPU) under memcheck, built
@@ -146,3 +148,28 @@ fuzz-long-api: $(FZ)/fuzz_api
 	mkdir -p $(FZ)/work_api
 	$(FZ)/fuzz_api -max_total_time=$(FUZZ_SECONDS) $(FUZZ_API_ARGS) \
 	  -artifact_prefix=tests/fuzz/regressions/api/crash- $(FZ)/work_api tests/fuzz/regressions/api 2>&1 | tail -n 3
+
+# ---- the state-machine fuzzer (tests/fuzz/fuzz_state.c): sequences of up to 48 calls over the
+# whole API on volumes of at most 8^3 and images of at most 16x16, every result, rejected call,
+# image and setter checked against the documented rules after each call (the file's header).
+# -len_control=0: an input needs a few hundred bytes to reach deep call sequences. A call over
+# 5 s fails inside the target; -timeout catches one that never returns. It starts from its
+# regressions only. FUZZ_STATE_RUNS in make test; fuzz-long-state runs FUZZ_STATE_LONG_RUNS,
+# keeping new corpus in build/fuzz/work_state and what it finds in tests/fuzz/regressions/state.
+FUZZ_STATE_RUNS ?= 6000
+FUZZ_STATE_LONG_RUNS ?= 1000000
+FUZZ_STATE_ARGS := -max_len=1024 -len_control=0 -timeout=20 -rss_limit_mb=2048 -print_final_stats=1
+.PHONY: fuzz-smoke-state fuzz-long-state
+fuzz-smoke-state: $(FZ)/fuzz_state
+	@rm -rf $(FZ)/work_state_smoke; mkdir -p $(FZ)/work_state_smoke; start=$$(date +%s); \
+	if ! $(FZ)/fuzz_state -seed=1 -runs=$(FUZZ_STATE_RUNS) $(FUZZ_STATE_ARGS) -artifact_prefix=$(FZ)/crash-state- \
+	     $(FZ)/work_state_smoke tests/fuzz/regressions/state > $(FZ)/fuzz_state.log 2>&1; then \
+	  grep -m1 '^fuzz_state:' $(FZ)/fuzz_state.log; tail -n 40 $(FZ)/fuzz_state.log; \
+	  echo "fuzz-smoke: state FAILED (input in $(FZ)/crash-state-*; HD_FZ_TRACE=1 $(FZ)/fuzz_state INPUT prints its calls)"; exit 1; fi; \
+	echo "fuzz-smoke: state: $(FUZZ_STATE_RUNS) runs, nothing found ($$(( $$(date +%s) - start )) s)"
+fuzz-smoke: fuzz-smoke-state
+fuzz-long-state: $(FZ)/fuzz_state
+	mkdir -p $(FZ)/work_state
+	$(FZ)/fuzz_state -runs=$(FUZZ_STATE_LONG_RUNS) $(FUZZ_STATE_ARGS) \
+	  -artifact_prefix=tests/fuzz/regressions/state/crash- $(FZ)/work_state tests/fuzz/regressions/state 2>&1 | tail -n 3
+TEST_PROGRAMS += $(FZ)/fuzz_state
