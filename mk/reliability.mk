@@ -154,10 +154,11 @@ fuzz-long-api: $(FZ)/fuzz_api
 # image and setter checked against the documented rules after each call (the file's header).
 # -len_control=0: an input needs a few hundred bytes to reach deep call sequences. A call over
 # 5 s fails inside the target; -timeout catches one that never returns. It starts from its
-# regressions only. FUZZ_STATE_RUNS in make test; fuzz-long-state runs FUZZ_STATE_LONG_RUNS,
-# keeping new corpus in build/fuzz/work_state and what it finds in tests/fuzz/regressions/state.
+# regressions only. FUZZ_STATE_RUNS in make test; fuzz-long-state runs FUZZ_SECONDS (or
+# FUZZ_STATE_LONG_RUNS runs when given), keeping new corpus in build/fuzz/work_state and what it
+# finds in tests/fuzz/regressions/state.
 FUZZ_STATE_RUNS ?= 6000
-FUZZ_STATE_LONG_RUNS ?= 1000000
+FUZZ_STATE_LONG_RUNS ?=
 FUZZ_STATE_ARGS := -max_len=1024 -len_control=0 -timeout=20 -rss_limit_mb=2048 -print_final_stats=1
 .PHONY: fuzz-smoke-state fuzz-long-state
 fuzz-smoke-state: $(FZ)/fuzz_state
@@ -170,6 +171,6 @@ fuzz-smoke-state: $(FZ)/fuzz_state
 fuzz-smoke: fuzz-smoke-state
 fuzz-long-state: $(FZ)/fuzz_state
 	mkdir -p $(FZ)/work_state
-	$(FZ)/fuzz_state -runs=$(FUZZ_STATE_LONG_RUNS) $(FUZZ_STATE_ARGS) \
+	$(FZ)/fuzz_state $(if $(FUZZ_STATE_LONG_RUNS),-runs=$(FUZZ_STATE_LONG_RUNS),-max_total_time=$(FUZZ_SECONDS)) $(FUZZ_STATE_ARGS) \
 	  -artifact_prefix=tests/fuzz/regressions/state/crash- $(FZ)/work_state tests/fuzz/regressions/state 2>&1 | tail -n 3
 TEST_PROGRAMS += $(FZ)/fuzz_state

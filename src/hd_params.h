@@ -54,7 +54,7 @@
     FLOAT(anisotropy, 0.0f, -1.0f, 1.0f, 1, "in (-1, 1)", HD__INV_WARM_PHI) \
     FLOAT(majorant, 0.0f, 0.0f, 1e6f, 0, "in [0, 1e6]", HD__INV_MEDIUM) \
     ENUM(solver, hd_solver, HD_SOLVER_RED_BLACK, HD_SOLVER_COUNT, HD__INV_NONE) \
-    INT(diffusion_sweeps, (p->solver == HD_SOLVER_MULTIGRID ? 1 : 4), 1, 100000, "in 1..100000", HD__DIRTY_PATHS) \
+    INT(diffusion_sweeps, (p->solver == HD_SOLVER_MULTIGRID ? 1 : 4), 1, 100000, "in 1..100000", HD__INV_NONE) \
     BOOL(disable_diffusion, HD__INV_PHI) \
     ENUM(tracking, hd_tracking, HD_TRACKING_RATIO, HD_TRACKING_COUNT, HD__INV_NONE) \
     SEED(seed, HD__INV_LIGHT) \

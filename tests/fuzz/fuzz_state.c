@@ -27,9 +27,9 @@
    A failure prints what broke and aborts, which keeps the input. HD_FZ_TRACE=1 in the
    environment prints every call as C, for a reproducer. Work per input stays small: valid
    values that only cost time (extinction above 2000, majorants above 4000, 10^5 sweeps or
-   bounces, n = 2^31 iterations) are not drawn, render budgets above FZ_BUDGET_FAST are drawn as
-   1e30 (which the library must reject or keep bounded), and an input's calls stop after
-   FZ_INPUT_SECONDS. */
+   bounces, n = 2^31 iterations) are not drawn, valid render budgets above FZ_BUDGET_FAST are
+   drawn as FZ_BUDGET_FAST (those above the 10 s bound as they are: rejected), and an input's
+   calls stop after FZ_INPUT_SECONDS. */
 #include "hybriddiff.h" /* the implementation: tests/fuzz/hd_impl_fuzz.c */
 #include <float.h>
 #include <limits.h>
@@ -49,13 +49,9 @@
 #define FZ_OWNERS (FZ_CTX + 2) /* live contexts, one being created, a reference */
 #define FZ_CALL_SECONDS 5.0 /* the longest any one call may take (sanitizer build, loaded machine) */
 #define FZ_INPUT_SECONDS 8.0 /* an input's calls stop after this long (-timeout stays for a hang) */
-#define FZ_BUDGET_FAST 0.001f  /* render budgets drawn as they are; larger ones become 1e30 */
-#define FZ_BUDGET_LIMIT 1.0f   /* a budget above this may be rejected (a library limit) */
-#ifdef FZ_KNOWN_BUGS
-#define FZ_KNOWN(n) ((FZ_KNOWN_BUGS) >> (n) & 1)
-#else
-#define FZ_KNOWN(n) 0
-#endif
+#define FZ_BUDGET_FAST 0.001f /* valid render budgets above this are drawn as this */
+#define FZ_BUDGET_MAX 10.0f   /* params.render_budget's bound (hybriddiff.h) */
+#define FZ_BACKGROUND_MAX 1e6f /* params.background's bound per component */
 
 /* ---- the bytes ---------------------------------------------------------------------------- */
 static const uint8_t *fz_p;
@@ -251,9 +247,6 @@ static void fz_log(void *u, hd_log_level level, hd_result code, const char *msg,
 {
     fz_owner *o = (fz_owner *)u;
     (void)file; (void)line;
-#if FZ_KNOWN(6)
-    if (!fz_owner_live(u)) return;
-#endif
     if (!fz_owner_live(u)) fz_fail("a destroyed context's logger was called (%s: %s)", hd_result_string(code), msg ? msg : "");
     if (!msg || !msg[0]) fz_fail("a log message is empty");
     if (level == HD_LOG_ERROR) { ++o->errors; o->code = code; }
@@ -327,6 +320,14 @@ static void fz_params_defaults(hd_params *p)
     if (p->render_scale == 0) p->render_scale = 1;
     for (i = 0; i < 3; ++i)
         if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
+    /* a float whose default is 0 is stored as +0 (src/hd_params.h: a zero field gets its default) */
+    if (p->anisotropy == 0.0f) p->anisotropy = 0.0f;
+    if (p->majorant == 0.0f) p->majorant = 0.0f;
+    if (p->render_budget == 0.0f) p->render_budget = 0.0f;
+    for (i = 0; i < 3; ++i) {
+        if (p->background[i] == 0.0f) p->background[i] = 0.0f;
+        if (p->crop_min[i] == 0.0f) p->crop_min[i] = 0.0f;
+    }
 }
 
 /* What hd_set_params (and hd_create's params) may return for *p (defaults filled in). */
@@ -338,17 +339,14 @@ static fz_set fz_params_want(const hd_params *p)
         fz_bad_enum((int)p->tracking, HD_TRACKING_COUNT) || fz_bad_enum((int)p->diffusion_boundary, HD_BOUNDARY_COUNT) ||
         fz_bad_enum((int)p->illumination_precision, HD_PRECISION_COUNT))
         bad |= FZ_R(IE);
-#if FZ_KNOWN(2)
-    if (fz_bad_enum((int)p->diffusion_boundary, HD_BOUNDARY_COUNT)) bad |= FZ_R(IP);
-#endif
     if (!fz_finite(p->extinction) || p->extinction < 0.0f || p->extinction > 1e6f) bad |= FZ_R(IP);
     if (!fz_finite(p->albedo) || p->albedo < 0.0f || p->albedo > 1.0f) bad |= FZ_R(IP);
     if (!fz_finite(p->anisotropy) || !(p->anisotropy > -1.0f && p->anisotropy < 1.0f)) bad |= FZ_R(IP);
     if (!fz_finite(p->majorant) || p->majorant < 0.0f || p->majorant > 1e6f) bad |= FZ_R(IP);
     if (p->diffusion_sweeps < 0 || p->diffusion_sweeps > 100000) bad |= FZ_R(IP);
     if (p->disable_diffusion != 0 && p->disable_diffusion != 1) bad |= FZ_R(IP);
-    if (!fz_finite3(p->background) || p->background[0] < 0.0f || p->background[1] < 0.0f || p->background[2] < 0.0f)
-        bad |= FZ_R(IP);
+    for (i = 0; i < 3; ++i)
+        if (!fz_finite(p->background[i]) || !(p->background[i] >= 0.0f && p->background[i] <= FZ_BACKGROUND_MAX)) bad |= FZ_R(IP);
     if (!fz_finite(p->step) || !(p->step >= 0.01f && p->step <= 16.0f)) bad |= FZ_R(IP);
     if (p->frame_window < 0) bad |= FZ_R(IP);
     if (!fz_finite(p->exposure) || p->exposure < 0.0f) bad |= FZ_R(IP);
@@ -356,7 +354,7 @@ static fz_set fz_params_want(const hd_params *p)
     if (p->illumination_downsample < 1 || p->illumination_downsample > 8) bad |= FZ_R(IP);
     if (p->rgb_scattering != 0 && p->rgb_scattering != 1) bad |= FZ_R(IP);
     if (!fz_finite(p->light_tolerance) || p->light_tolerance < 0.0f) bad |= FZ_R(IP);
-    if (!fz_finite(p->render_budget) || p->render_budget < 0.0f) bad |= FZ_R(IP);
+    if (!fz_finite(p->render_budget) || !(p->render_budget >= 0.0f && p->render_budget <= FZ_BUDGET_MAX)) bad |= FZ_R(IP);
     if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > 8)) bad |= FZ_R(IP);
     for (i = 0; i < 3; ++i)
         if (!fz_finite(p->crop_min[i]) || !fz_finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
@@ -364,9 +362,8 @@ static fz_set fz_params_want(const hd_params *p)
             bad |= FZ_R(IP);
     if (p->illumination_precision == HD_PRECISION_FLOAT16 && p->solver == HD_SOLVER_MULTIGRID) bad |= FZ_R(HD_ERROR_UNSUPPORTED);
     if (bad) return bad;
-    /* a global majorant is checked against the TF's largest extinction; a huge budget may be
-       capped by a limit of the library's */
-    return FZ_OK | (p->majorant > 0.0f ? FZ_R(IP) : 0) | (p->render_budget > FZ_BUDGET_LIMIT ? FZ_R(IP) : 0);
+    /* a global majorant is checked against the TF's largest extinction */
+    return FZ_OK | (p->majorant > 0.0f ? FZ_R(IP) : 0);
 }
 
 static void fz_camera_defaults(hd_camera *c)
@@ -626,8 +623,8 @@ static void fz_param_field(hd_params *p, int k)
     case 7: p->solver = (hd_solver)fz_enum(HD_SOLVER_COUNT); break;
     case 8: p->tracking = (hd_tracking)fz_enum(HD_TRACKING_COUNT); break;
     case 9: p->seed = fz_u8(); break;
-    case 10: p->background[i] = FZ_PICK(0.0f, 0.1f, 1.0f, 0.5f, FLT_MAX, 3e38f, 1e30f); break;
-    case 11: p->background[0] = p->background[1] = p->background[2] = FZ_PICK(0.0f, 0.1f, 1.0f, FLT_MAX); break;
+    case 10: p->background[i] = FZ_PICK(0.0f, 0.1f, 1.0f, 0.5f, 1e6f, 999999.94f, 1000000.06f, FLT_MAX, 3e38f, 1e30f); break;
+    case 11: p->background[0] = p->background[1] = p->background[2] = FZ_PICK(0.0f, 0.1f, 1.0f, 1e6f, FLT_MAX); break;
     case 12: p->step = FZ_PICK(0.0f, 0.5f, 0.25f, 1.0f, 0.01f, 16.0f, 4.0f); break;
     case 13: p->frame_window = FZ_INT(0, 1, 2, 8); break;
     case 14: p->exposure = FZ_PICK(0.0f, 1.0f, 2.0f, 0.5f, FLT_MAX, 1e-30f); break;
@@ -638,11 +635,8 @@ static void fz_param_field(hd_params *p, int k)
     case 19: p->illumination_precision = (hd_precision)fz_enum(HD_PRECISION_COUNT); break;
     case 20: p->light_tolerance = FZ_PICK(0.0f, 0.1f, 0.01f, 1.0f, 1e-30f); break;
     case 21:
-        v = FZ_PICK(0.0f, 0.0f, 1e-4f, 1e-3f, 1e30f);
-        p->render_budget = fz_finite(v) && v > FZ_BUDGET_FAST && v < 1e29f ? 1e30f : v;
-#if FZ_KNOWN(1)
-        if (fz_finite(v) && v > FZ_BUDGET_FAST) p->render_budget = FZ_BUDGET_FAST;
-#endif
+        v = FZ_PICK(0.0f, 0.0f, 1e-4f, 1e-3f, 10.0f, 10.000001f, 1e30f);
+        p->render_budget = fz_finite(v) && v > FZ_BUDGET_FAST && v <= FZ_BUDGET_MAX ? FZ_BUDGET_FAST : v;
         break;
     case 22: p->crop_min[i] = FZ_PICK(0.0f, 0.25f, 0.5f); break;
     case 23: p->crop_max[i] = FZ_PICK(0.0f, 1.0f, 0.75f, 0.5f); break;
@@ -652,10 +646,6 @@ static void fz_param_field(hd_params *p, int k)
         p->crop_max[i] = FZ_PICK(0.0f, 1.0f, 0.75f, 0.5f);
         break;
     }
-#if FZ_KNOWN(4)
-    for (i = 0; i < 3; ++i)
-        if (fz_finite(p->background[i]) && p->background[i] > 1e30f) p->background[i] = 1e30f;
-#endif
 }
 
 static void fz_gen_params(hd_params *p)
@@ -954,9 +944,6 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
     }
     if (pt) {
         int dep = light || phi || image || (p->method == HD_METHOD_PT_MS && p->max_bounces != o->max_bounces);
-#if FZ_KNOWN(7)
-        dep = light || phi || image;
-#endif
         if (dep && (b->st.iterations || b->st.frames))
             fz_fail("%s: a change its image depends on kept %llu iterations, %llu frames (max_bounces %d -> %d)",
                     hd_method_name(p->method), (unsigned long long)b->st.iterations, (unsigned long long)b->st.frames,
@@ -1472,9 +1459,6 @@ static void fz_check_reference(int ci, const hd_desc *d)
     if (hd_read_image_f32(fz_c[ci].h, fz_img, npx) != HD_SUCCESS) fz_fail("hd_read_image_f32");
     if (!rc.id) { fz_owner_free(o); return; }
     if (hd_read_image_f32(rc, fz_img2, npx) != HD_SUCCESS) fz_fail("hd_read_image_f32 of the reference");
-#if FZ_KNOWN(3)
-    if (fabs(hi - lo) > FLT_MAX || 1.0 / fabs(hi - lo) > FLT_MAX) npx = 0;
-#endif
     for (i = 3; i < npx; i += 4)
         if (!(fabsf(fz_img[i] - fz_img2[i]) <= 0.01f))
             fz_fail("pixel %zu's alpha is %g, that of the same voxels normalised in double %g (value range {%g, %g})", i / 4,
