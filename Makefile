@@ -67,6 +67,7 @@ help:
 	@echo "benchmarks and evaluation (not part of make test; figures in docs/):"
 	@echo "  make bench                          build/hdbench: CPU backend iterations/s and stage times on the head CT"
 	@echo "  make bench-rb-schedule              the CPU red-black schedule against the previous one, one process"
+	@echo "  make bench-guard                    the per-context in-call guard's cost per call, with and without it, one process"
 	@echo "  make bench-opencl                   OpenCL against the CPU in one run"
 	@echo "  make bench-vulkan                   Vulkan sweeps and iterations/s (BENCH_ARGS: --sweeps, --variants, --ab)"
 	@echo "  make bench-vulkan-multigrid         Vulkan multigrid steps against the CPU, interleaved"

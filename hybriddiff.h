@@ -58,7 +58,8 @@
         so every backend draws the same samples.
 
    Threading: calls on one context must not overlap; different contexts may be used from
-   different threads at the same time.
+   different threads at the same time. A call that would overlap another on its context (from
+   another thread, or from inside the context's own logger) returns HD_ERROR_BUSY.
 
    Integration (docs/INTEGRATION.md has each rule in full, examples/integrate_* use them)
       - Include order: the implementation compiles under plain -std=c99 or -std=c++17 before or
@@ -147,7 +148,8 @@ extern "C" {
     X(HD_ERROR_INVALID_VOXELS, "a voxel value of the update is NaN or infinite") \
     X(HD_ERROR_OUTPUT_OUTSIDE_TARGET, "the output region does not lie inside the target") \
     X(HD_ERROR_OUTPUT_SIZE, "the output region's size is not the camera's (the image is written 1:1)") \
-    X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format")
+    X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format") \
+    X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,

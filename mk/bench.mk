@@ -74,3 +74,16 @@ bench-animated: $(B)/hdbench_animated
 	$(B)/hdbench_animated --dims 64 --no-tf $(ANIMATED_ARGS)
 	$(B)/hdbench_animated --dims 128 --no-tf $(ANIMATED_ARGS)
 	$(B)/hdbench_animated --no-puff $(ANIMATED_ARGS)
+
+# bench/hdbench_guard.c: the per-context in-call guard's cost, the library built with it and
+# without it (HD__NO_CALL_GUARD) in one program: ns per hd_get_stats and per hd_render
+# (docs/PERFORMANCE.md, "The in-call guard").
+.PHONY: bench-guard
+$(B)/hdbench_guard_on.o: bench/hdbench_guard.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -DHB_SIDE=hb_on -c $< -o $@
+$(B)/hdbench_guard_off.o: bench/hdbench_guard.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) -DHB_SIDE=hb_off -DHD__NO_CALL_GUARD -c $< -o $@
+$(B)/hdbench_guard: bench/hdbench_guard.c $(B)/hdbench_guard_on.o $(B)/hdbench_guard_off.o
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< $(B)/hdbench_guard_on.o $(B)/hdbench_guard_off.o -o $@ $(LDLIBS)
+bench-guard: $(B)/hdbench_guard
+	$(B)/hdbench_guard

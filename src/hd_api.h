@@ -122,33 +122,40 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     }
     HD__INFO(&ctx->vw.log, "created: %s backend, volume %dx%dx%d, %d lights", hd__be_name(),
              ctx->vw.dims[0], ctx->vw.dims[1], ctx->vw.dims[2], ctx->light_count);
+    hd__leave(*out_ctx);
     return HD_SUCCESS;
 }
 
 HDDEF hd_result hd_destroy(hd_context h)
 {
-    HD__GET_CTX(ctx, h);
+    hd_result r;
+    hd__ctx *ctx = hd__enter(h, "hd_destroy", &r);
+    if (!ctx) return r;
     hd__slot_release(h);
+    /* another thread's HD_ERROR_BUSY line may still be in the logger: it must not outlive us */
+    while (__atomic_load_n(&ctx->busy_logs, __ATOMIC_ACQUIRE) != 0) sched_yield();
     hd__ctx_free(ctx);
     return HD_SUCCESS;
 }
 
-HDDEF hd_result hd_query_desc(hd_context h, hd_desc *out)
+static hd_result hd__api_query_desc(hd__ctx *ctx, hd_desc *out)
 {
-    HD__GET_CTX(ctx, h);
     if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_query_desc: out_desc is NULL");
     *out = ctx->vw.desc;
     out->camera = ctx->vw.camera;
     out->params = ctx->vw.params;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_query_desc(hd_context h, hd_desc *out)
+{
+    HD__GUARDED(h, "hd_query_desc", hd__api_query_desc(ctx, out));
+}
 
 /* ---- setters ----------------------------------------------------------------------------------- */
-HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_function *tf)
+static hd_result hd__api_set_transfer_function(hd__ctx *ctx, const hd_transfer_function *tf)
 {
     hd_result r;
     int change;
-    HD__GET_CTX(ctx, h);
     if (!tf) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_transfer_function: tf is NULL");
     if ((r = hd__check_tf(tf, &ctx->vw.log)) != HD_SUCCESS) return r;
     change = hd__tf_change(ctx, tf);
@@ -166,12 +173,15 @@ HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_functio
     ctx->dirty |= HD__INV_WARM_MEDIUM;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_transfer_function(hd_context h, const hd_transfer_function *tf)
+{
+    HD__GUARDED(h, "hd_set_transfer_function", hd__api_set_transfer_function(ctx, tf));
+}
 
-HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
+static hd_result hd__api_set_lights(hd__ctx *ctx, const hd_light *lights, int count)
 {
     hd_result r;
     int channels_before;
-    HD__GET_CTX(ctx, h);
     if ((r = hd__check_lights(lights, count, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_lights_frame(lights, count, &ctx->xf, &ctx->vw.log)) != HD_SUCCESS) return r;
     channels_before = ctx->vw.channels;
@@ -182,14 +192,17 @@ HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
     if (ctx->vw.channels != channels_before) ctx->dirty |= HD__DIRTY_ALLOC | HD__INV_LIGHT; /* new grids */
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
+{
+    HD__GUARDED(h, "hd_set_lights", hd__api_set_lights(ctx, lights, count));
+}
 
-HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
+static hd_result hd__api_set_camera(hd__ctx *ctx, const hd_camera *camera)
 {
     hd_camera c;
     hd__camframe cf;
     hd_result r;
     int resized;
-    HD__GET_CTX(ctx, h);
     if (!camera) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_camera: camera is NULL");
     c = *camera;
     hd__camera_defaults(&c);
@@ -211,14 +224,17 @@ HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
     ctx->dirty |= HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_camera(hd_context h, const hd_camera *camera)
+{
+    HD__GUARDED(h, "hd_set_camera", hd__api_set_camera(ctx, camera));
+}
 
-HDDEF hd_result hd_set_volume_transform(hd_context h, const float transform[16])
+static hd_result hd__api_set_volume_transform(hd__ctx *ctx, const float transform[16])
 {
     hd__xform xf;
     hd__camframe cf;
     float kbox[3];
     hd_result r;
-    HD__GET_CTX(ctx, h);
     if ((r = hd__xform_make(transform, ctx->box, ctx->vw.dims, &xf, &ctx->vw.log)) != HD_SUCCESS) return r;
     hd__xform_box(&xf, ctx->box, kbox);
     if ((r = hd__check_lights_frame(ctx->lights, ctx->light_count, &xf, &ctx->vw.log)) != HD_SUCCESS) return r;
@@ -231,13 +247,16 @@ HDDEF hd_result hd_set_volume_transform(hd_context h, const float transform[16])
     ctx->dirty |= HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_volume_transform(hd_context h, const float transform[16])
+{
+    HD__GUARDED(h, "hd_set_volume_transform", hd__api_set_volume_transform(ctx, transform));
+}
 
-HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
+static hd_result hd__api_set_depth(hd__ctx *ctx, const hd_depth_desc *depth)
 {
     hd_result r;
     size_t n;
     float *buf;
-    HD__GET_CTX(ctx, h);
     if (!depth || (!depth->data && depth->width == 0 && depth->height == 0)) {
         if (ctx->vw.depth) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
         hd__free(&ctx->vw, ctx->vw.depth);
@@ -260,12 +279,15 @@ HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
     ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
+{
+    HD__GUARDED(h, "hd_set_depth", hd__api_set_depth(ctx, depth));
+}
 
-HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
+static hd_result hd__api_set_params(hd__ctx *ctx, const hd_params *params)
 {
     hd_params p;
     hd_result r;
-    HD__GET_CTX(ctx, h);
     if (!params) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_params: params is NULL");
     p = *params;
     hd__params_defaults(&p);
@@ -278,44 +300,56 @@ HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
     if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_set_params(hd_context h, const hd_params *params)
+{
+    HD__GUARDED(h, "hd_set_params", hd__api_set_params(ctx, params));
+}
 
 /* ---- a volume that changes ------------------------------------------------------------------- */
 /* The voxels, majorant cells and (at the next hd__prepare) the backend's copy and the direct
    light's mask follow the update; E and phi are the warm start of the new light. */
-HDDEF hd_result hd_update_volume(hd_context h, const hd_volume_update *update)
+static hd_result hd__api_update_volume(hd__ctx *ctx, const hd_volume_update *update)
 {
     hd_result r;
     int changed;
-    HD__GET_CTX(ctx, h);
     if ((r = hd__update_voxels(ctx, update, &changed)) != HD_SUCCESS || !changed) return r;
     ctx->dirty |= HD__DIRTY_VOLUME | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
-
-HDDEF hd_result hd_reset(hd_context h)
+HDDEF hd_result hd_update_volume(hd_context h, const hd_volume_update *update)
 {
-    HD__GET_CTX(ctx, h);
+    HD__GUARDED(h, "hd_update_volume", hd__api_update_volume(ctx, update));
+}
+
+static hd_result hd__api_reset(hd__ctx *ctx)
+{
     ctx->dirty |= HD__INV_LIGHT;
     return HD_SUCCESS;
 }
+HDDEF hd_result hd_reset(hd_context h)
+{
+    HD__GUARDED(h, "hd_reset", hd__api_reset(ctx));
+}
 
 /* ---- iterations and frames ---------------------------------------------------------------- */
-HDDEF hd_result hd_iterate(hd_context h, int n)
+static hd_result hd__api_iterate(hd__ctx *ctx, int n)
 {
     hd_result r;
-    HD__GET_CTX(ctx, h);
     if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: n = %d, must be >= 1", n);
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
         return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_iterate: more than 2^31 iterations; reset with a new seed");
     HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__iterate_method));
     return r;
 }
+HDDEF hd_result hd_iterate(hd_context h, int n)
+{
+    HD__GUARDED(h, "hd_iterate", hd__api_iterate(ctx, n));
+}
 
 
-HDDEF hd_result hd_refine(hd_context h, int n)
+static hd_result hd__api_refine(hd__ctx *ctx, int n)
 {
     hd_result r;
-    HD__GET_CTX(ctx, h);
     if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "hd_refine: n = %d, must be >= 1", n);
     if (hd__method_is_pt(ctx->vw.params.method))
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_refine: method %s has no light volume to refine; use hd_iterate or hd_render",
@@ -325,22 +359,28 @@ HDDEF hd_result hd_refine(hd_context h, int n)
     HD__BE_CALL(r, ctx, hd__iterate_n(ctx, n, hd__refine_once));
     return r;
 }
+HDDEF hd_result hd_refine(hd_context h, int n)
+{
+    HD__GUARDED(h, "hd_refine", hd__api_refine(ctx, n));
+}
 
 
-HDDEF hd_result hd_render(hd_context h)
+static hd_result hd__api_render(hd__ctx *ctx)
 {
     hd_result r;
-    HD__GET_CTX(ctx, h);
     HD__BE_CALL(r, ctx, hd__render(ctx));
     return r;
 }
+HDDEF hd_result hd_render(hd_context h)
+{
+    HD__GUARDED(h, "hd_render", hd__api_render(ctx));
+}
 
 /* The optional features' entry points, for every backend (hd__be_features). */
-HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+static hd_result hd__api_gl_render_to_texture(hd__ctx *ctx, unsigned int texture)
 {
     hd_result r;
     hd_output o;
-    HD__GET_CTX(ctx, h);
     if (!(hd__be_features() & HD__BE_TEXTURE))
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture: this is the %s backend", hd__be_name());
     if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
@@ -348,18 +388,25 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
     HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 1));
     return r;
 }
+HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
+{
+    HD__GUARDED(h, "hd_gl_render_to_texture", hd__api_gl_render_to_texture(ctx, texture));
+}
 
-HDDEF hd_result hd_gl_render_to_texture_ex(hd_context h, unsigned int texture, const hd_output *output)
+static hd_result hd__api_gl_render_to_texture_ex(hd__ctx *ctx, unsigned int texture, const hd_output *output)
 {
     hd_result r;
     hd_output o;
-    HD__GET_CTX(ctx, h);
     if (!(hd__be_features() & HD__BE_TEXTURE))
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture_ex: this is the %s backend", hd__be_name());
     if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture_ex: texture 0");
     if ((r = hd__output_check(ctx, output, &o, "hd_gl_render_to_texture_ex")) != HD_SUCCESS) return r;
     HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 0));
     return r;
+}
+HDDEF hd_result hd_gl_render_to_texture_ex(hd_context h, unsigned int texture, const hd_output *output)
+{
+    HD__GUARDED(h, "hd_gl_render_to_texture_ex", hd__api_gl_render_to_texture_ex(ctx, texture, output));
 }
 
 /* The checks of hd_vulkan_record and _record_render that come before the device: the feature,
@@ -409,11 +456,10 @@ static hd_result hd__vulkan_target_check(hd__ctx *ctx, const hd_vulkan_target *t
     return HD_SUCCESS;
 }
 
-HDDEF hd_result hd_vulkan_record_render(hd_context h, void *command_buffer, const hd_vulkan_target *target, const hd_output *output)
+static hd_result hd__api_vulkan_record_render(hd__ctx *ctx, void *command_buffer, const hd_vulkan_target *target, const hd_output *output)
 {
     hd_result r;
     hd_output o;
-    HD__GET_CTX(ctx, h);
     memset(&o, 0, sizeof o);
     if ((r = hd__record_check(ctx, command_buffer, 1, "hd_vulkan_record_render")) != HD_SUCCESS) return r;
     if (target && ((r = hd__output_check(ctx, output, &o, "hd_vulkan_record_render")) != HD_SUCCESS ||
@@ -423,13 +469,20 @@ HDDEF hd_result hd_vulkan_record_render(hd_context h, void *command_buffer, cons
     HD__BE_CALL(r, ctx, hd__record_render(ctx, command_buffer, target, &o));
     return r;
 }
+HDDEF hd_result hd_vulkan_record_render(hd_context h, void *command_buffer, const hd_vulkan_target *target, const hd_output *output)
+{
+    HD__GUARDED(h, "hd_vulkan_record_render", hd__api_vulkan_record_render(ctx, command_buffer, target, output));
+}
 
-HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+static hd_result hd__api_vulkan_record(hd__ctx *ctx, void *command_buffer, int n)
 {
     hd_result r;
-    HD__GET_CTX(ctx, h);
     if ((r = hd__record_check(ctx, command_buffer, n, "hd_vulkan_record")) != HD_SUCCESS) return r;
     hd__record_cost(ctx);
     HD__BE_CALL(r, ctx, hd__record(ctx, command_buffer, n));
     return r;
+}
+HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
+{
+    HD__GUARDED(h, "hd_vulkan_record", hd__api_vulkan_record(ctx, command_buffer, n));
 }

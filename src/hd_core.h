@@ -126,6 +126,7 @@ typedef struct hd__ctx {
                                 warm start caps it at params.light_window (src/hd_schedule.h) */
     hd__box upd;             /* the voxels hd_update_volume changed since the last hd__prepare
                                 (HD__DIRTY_VOLUME), [lo, hi) */
+    int busy_logs;           /* HD_ERROR_BUSY lines being logged from other threads (hd__enter; __atomic) */
 } hd__ctx;
 
 /* The path tracers keep no illumination grid: the image is their whole state. */

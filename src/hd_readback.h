@@ -12,16 +12,19 @@ static hd_result hd__read_image(hd__ctx *ctx, float *dst, const char *call)
     return hd__be_read_image(&ctx->vw, dst);
 }
 
-HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
+static hd_result hd__api_read_image_f32(hd__ctx *ctx, float *dst, size_t dst_floats)
 {
     hd_result r;
     size_t need;
-    HD__GET_CTX(ctx, h);
     if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_f32: dst is NULL");
     need = (size_t)ctx->vw.camera.width * ctx->vw.camera.height * 4;
     if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_image_f32: %zu floats given, %zu needed", dst_floats, need);
     HD__BE_CALL(r, ctx, hd__read_image(ctx, dst, "hd_read_image_f32"));
     return r;
+}
+HDDEF hd_result hd_read_image_f32(hd_context h, float *dst, size_t dst_floats)
+{
+    HD__GUARDED(h, "hd_read_image_f32", hd__api_read_image_f32(ctx, dst, dst_floats));
 }
 
 /* hd__srgb8 of the floats in [2^-9, 1), the range where it calls powf, by table: the floats there
@@ -63,13 +66,12 @@ static uint8_t hd__srgb8_by(const uint16_t *t, float v)
     return hd__srgb8(v);
 }
 
-HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes)
+static hd_result hd__api_read_image_rgba8(hd__ctx *ctx, uint8_t *dst, size_t dst_bytes)
 {
     hd_result r;
     size_t need, i, n;
     float *tmp;
     const uint16_t *t;
-    HD__GET_CTX(ctx, h);
     if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_rgba8: dst is NULL");
     n = (size_t)ctx->vw.camera.width * ctx->vw.camera.height;
     need = n * 4;
@@ -91,6 +93,10 @@ HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes
     hd__free(&ctx->vw, tmp);
     return r;
 }
+HDDEF hd_result hd_read_image_rgba8(hd_context h, uint8_t *dst, size_t dst_bytes)
+{
+    HD__GUARDED(h, "hd_read_image_rgba8", hd__api_read_image_rgba8(ctx, dst, dst_bytes));
+}
 
 /* The output description of a call with defaults filled in (NULL: all zero), checked against
    what needs no target: the format, the size (the camera's), x and y not negative. */
@@ -111,7 +117,7 @@ static hd_result hd__output_check(hd__ctx *ctx, const hd_output *in, hd_output *
     return HD_SUCCESS;
 }
 
-HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *dst, size_t dst_bytes, size_t row_pitch)
+static hd_result hd__api_read_image_ex(hd__ctx *ctx, const hd_output *output, void *dst, size_t dst_bytes, size_t row_pitch)
 {
     hd_result r;
     hd_output o;
@@ -119,7 +125,6 @@ HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *ds
     float *tmp;
     const uint16_t *t = NULL;
     unsigned char *d;
-    HD__GET_CTX(ctx, h);
     if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_image_ex: dst is NULL");
     if ((r = hd__output_check(ctx, output, &o, "hd_read_image_ex")) != HD_SUCCESS) return r;
     px = hd__output_pixel_bytes(o.format);
@@ -166,12 +171,15 @@ HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *ds
     hd__free(&ctx->vw, tmp);
     return r;
 }
+HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *dst, size_t dst_bytes, size_t row_pitch)
+{
+    HD__GUARDED(h, "hd_read_image_ex", hd__api_read_image_ex(ctx, output, dst, dst_bytes, row_pitch));
+}
 
-HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float *dst, size_t dst_floats)
+static hd_result hd__api_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst, size_t dst_floats)
 {
     hd_result r;
     size_t need;
-    HD__GET_CTX(ctx, h);
     if ((int)which < 0 || which >= HD_ILLUMINATION_COUNT)
         return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_ENUM, "hd_read_illumination: which = %d is not a hd_illumination", (int)which);
     if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_illumination: dst is NULL");
@@ -183,11 +191,14 @@ HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float 
     HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, which, NULL, 0, dst));
     return r;
 }
+HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float *dst, size_t dst_floats)
+{
+    HD__GUARDED(h, "hd_read_illumination", hd__api_read_illumination(ctx, which, dst, dst_floats));
+}
 
-HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
+static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
 {
     size_t gvox;
-    HD__GET_CTX(ctx, h);
     if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_get_stats: out_stats is NULL");
     memset(out, 0, sizeof *out);
     gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
@@ -229,4 +240,8 @@ HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
         out->light_converged = !fresh && hd__light_converged(ctx);
     }
     return HD_SUCCESS;
+}
+HDDEF hd_result hd_get_stats(hd_context h, hd_stats *out)
+{
+    HD__GUARDED(h, "hd_get_stats", hd__api_get_stats(ctx, out));
 }
