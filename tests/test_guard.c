@@ -12,6 +12,7 @@
 #include <pthread.h>
 #include <sched.h>
 #include <stdint.h>
+#include <time.h>
 
 #define GN 8
 static uint8_t g_vox[GN * GN * GN];
@@ -148,7 +149,8 @@ static void test_guard_from_logger(void)
 
 /* ---- two threads on one context ------------------------------------------------------------- */
 #define G_FRAMES 40
-#define G_ROUNDS 1000000
+#define G_ROUNDS 200000
+#define G_SECONDS 5.0
 typedef struct g_side {
     hd_context c;
     int calls, busy, bad, nonfinite, finish;
@@ -171,14 +173,22 @@ static void g_result(g_side *s, hd_result r)
     else if (r != HD_SUCCESS) { ++s->bad; s->bad_r = r; }
 }
 
+static double g_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 /* hd_render and the image read back until G_FRAMES renders and G_FRAMES resizes have gone
-   through and a call has met the other thread's (at most G_ROUNDS rounds). */
+   through and a call has met the other thread's (at most G_ROUNDS rounds and G_SECONDS). */
 static void *g_renderer(void *arg)
 {
     g_side *s = (g_side *)arg;
     static float img[32 * 32 * 4];
     int k, frames = 0;
-    for (k = 0; k < G_ROUNDS && (frames < G_FRAMES || __atomic_load_n(&g_resized, __ATOMIC_ACQUIRE) < G_FRAMES ||
+    double t0 = g_now();
+    for (k = 0; k < G_ROUNDS && g_now() - t0 < G_SECONDS && (frames < G_FRAMES || __atomic_load_n(&g_resized, __ATOMIC_ACQUIRE) < G_FRAMES ||
                                  !__atomic_load_n(&s->finish, __ATOMIC_ACQUIRE)); ++k) {
         hd_result r = hd_render(s->c);
         g_result(s, r);
