@@ -318,6 +318,7 @@ static void fz_params_defaults(hd_params *p)
     if (p->diffusion_boundary == HD_BOUNDARY_DEFAULT) p->diffusion_boundary = HD_BOUNDARY_SURFACE;
     if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
     if (p->render_scale == 0) p->render_scale = 1;
+    if (p->light_window == 0) p->light_window = 8;
     for (i = 0; i < 3; ++i)
         if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
     /* a float whose default is 0 is stored as +0 (src/hd_params.h: a zero field gets its default) */
@@ -356,6 +357,7 @@ static fz_set fz_params_want(const hd_params *p)
     if (!fz_finite(p->light_tolerance) || p->light_tolerance < 0.0f) bad |= FZ_R(IP);
     if (!fz_finite(p->render_budget) || !(p->render_budget >= 0.0f && p->render_budget <= FZ_BUDGET_MAX)) bad |= FZ_R(IP);
     if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > 8)) bad |= FZ_R(IP);
+    if (p->light_window < 1 || p->light_window > 1000000) bad |= FZ_R(IP);
     for (i = 0; i < 3; ++i)
         if (!fz_finite(p->crop_min[i]) || !fz_finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
             !(p->crop_max[i] <= 1.0f) || !(p->crop_min[i] < p->crop_max[i]))
@@ -563,7 +565,9 @@ static void fz_check_image(hd_context h, const char *when)
     fz_snap_take(h, &s);
     n = (size_t)s.cam.width * (size_t)s.cam.height * 4;
     if (n > sizeof fz_img / sizeof fz_img[0]) fz_fail("camera %dx%d", s.cam.width, s.cam.height);
-    if ((r = hd_read_image_f32(h, fz_img, n)) != HD_SUCCESS) fz_fail("%s: hd_read_image_f32: %s", when, hd_result_string(r));
+    r = hd_read_image_f32(h, fz_img, n);
+    if (r == HD_ERROR_NO_FRAME && s.st.frames == 0) return; /* nothing projected since the image was reset */
+    if (r != HD_SUCCESS) fz_fail("%s: hd_read_image_f32: %s", when, hd_result_string(r));
     for (i = 0; i < n; ++i) {
         if (!fz_finite(fz_img[i])) fz_fail("%s: image value %zu (pixel %zu, channel %zu) is %g", when, i, i / 4, i % 4, (double)fz_img[i]);
         if (i % 4 == 3 && !(fz_img[i] >= -1e-5f && fz_img[i] <= 1.00001f)) fz_fail("%s: pixel %zu alpha %g", when, i / 4, (double)fz_img[i]);
@@ -890,7 +894,10 @@ static void fz_end(const fz_pre *pre, hd_result r, fz_set allowed)
         if (r != HD_SUCCESS) {
             if (o->errors != 1 || o->code != r)
                 fz_fail("rejected with %s, logged %d errors (the last %s)", fz_name(r), o->errors, fz_name(o->code));
-            if (o->calls != pre->calls) fz_fail("rejected with %s after %ld allocations", fz_name(r), o->calls - pre->calls);
+            /* HD_ERROR_NO_FRAME is found after the call brought the device state up to date
+               (src/hd_readback.h), which may allocate the image of a new camera size */
+            if (o->calls != pre->calls && r != HD_ERROR_NO_FRAME)
+                fz_fail("rejected with %s after %ld allocations", fz_name(r), o->calls - pre->calls);
             fz_same(fz_c[pre->ci].h, &pre->s, "a rejected call");
         } else if (o->errors) {
             fz_fail("succeeded but logged %d errors (the last %s)", o->errors, fz_name(o->code));
@@ -912,24 +919,27 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
 {
     const hd_params *o = &a->p, *p = &b->p;
     hd_params t = *o;
-    int i, crop = 0, bg = 0, light, light_bits, phi, phi_bits, image, pt = fz_pt(p->method);
+    int i, crop = 0, bg = 0, light, light_bits, warm, phi, phi_bits, image, pt = fz_pt(p->method);
     for (i = 0; i < 3; ++i) {
         crop |= FZ_NE(crop_min[i]) || FZ_NE(crop_max[i]);
         bg |= FZ_NE(background[i]);
     }
-    light = FZ_NE(extinction) || FZ_NE(majorant) || FZ_NE(seed) || crop || FZ_NE(illumination_downsample) ||
-            FZ_NE(rgb_scattering) || FZ_NE(illumination_precision);
+    /* reset: E, phi zeroed; warm: kept as the new light's start (extinction; albedo, anisotropy) */
+    light = FZ_NE(majorant) || FZ_NE(seed) || crop || FZ_NE(illumination_downsample) || FZ_NE(rgb_scattering) ||
+            FZ_NE(illumination_precision);
+    warm = FZ_NE(extinction) || FZ_NE(albedo) || FZ_NE(anisotropy);
     light_bits = FZ_BITS(extinction) || FZ_BITS(majorant) || FZ_BITS(crop_min) || FZ_BITS(crop_max) || light;
-    phi = FZ_NE(albedo) || FZ_NE(anisotropy) || FZ_NE(disable_diffusion) || FZ_NE(diffusion_boundary);
-    phi_bits = FZ_BITS(albedo) || FZ_BITS(anisotropy) || phi;
+    phi = FZ_NE(disable_diffusion) || FZ_NE(diffusion_boundary);
+    phi_bits = FZ_BITS(albedo) || FZ_BITS(anisotropy) || phi || warm;
     image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || bg;
-    /* "solver, sweeps, tracking, exposure, light_tolerance, render_budget -> nothing" */
+    /* "solver, sweeps, tracking, exposure, light_tolerance, render_budget, light_window -> nothing" */
     t.solver = p->solver;
     t.diffusion_sweeps = p->diffusion_sweeps;
     t.tracking = p->tracking;
     t.exposure = p->exposure;
     t.light_tolerance = p->light_tolerance;
     t.render_budget = p->render_budget;
+    t.light_window = p->light_window;
     if (p->method != o->method) {
         if (b->st.iterations || b->st.frames) fz_fail("a new method kept %llu iterations, %llu frames",
                                                       (unsigned long long)b->st.iterations, (unsigned long long)b->st.frames);
@@ -943,7 +953,7 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
         return;
     }
     if (pt) {
-        int dep = light || phi || image || (p->method == HD_METHOD_PT_MS && p->max_bounces != o->max_bounces);
+        int dep = light || warm || phi || image || (p->method == HD_METHOD_PT_MS && p->max_bounces != o->max_bounces);
         if (dep && (b->st.iterations || b->st.frames))
             fz_fail("%s: a change its image depends on kept %llu iterations, %llu frames (max_bounces %d -> %d)",
                     hd_method_name(p->method), (unsigned long long)b->st.iterations, (unsigned long long)b->st.frames,
@@ -953,7 +963,10 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
     if (light && (b->st.iterations || b->st.frames))
         fz_fail("a change of what E depends on kept %llu iterations, %llu frames", (unsigned long long)b->st.iterations,
                 (unsigned long long)b->st.frames);
-    if ((phi || image) && b->st.frames) fz_fail("a change the image depends on kept %llu frames", (unsigned long long)b->st.frames);
+    if ((warm || phi || image) && b->st.frames) fz_fail("a change the image depends on kept %llu frames", (unsigned long long)b->st.frames);
+    if (warm && !light && b->st.iterations != a->st.iterations)
+        fz_fail("a warm change (extinction, albedo, anisotropy) did not keep E: %llu -> %llu iterations",
+                (unsigned long long)a->st.iterations, (unsigned long long)b->st.iterations);
     if (!light_bits && !phi_bits && image && (b->st.iterations != a->st.iterations || b->st.light_converged != a->st.light_converged))
         fz_fail("an image-only change touched the light: %llu -> %llu iterations", (unsigned long long)a->st.iterations,
                 (unsigned long long)b->st.iterations);
@@ -1078,8 +1091,16 @@ static void fz_op_lights(int ci)
         changed |= x->type != y->type || x->intensity != y->intensity || x->inverse_square != y->inverse_square;
         for (k = 0; k < 3; ++k) changed |= x->direction[k] != y->direction[k] || x->position[k] != y->position[k] || x->color[k] != y->color[k];
     }
-    if (changed && (now.st.iterations || now.st.frames))
-        fz_fail("new lights kept %llu iterations, %llu frames", (unsigned long long)now.st.iterations, (unsigned long long)now.st.frames);
+    /* "lights -> E, phi warm; image (CD, another light count: reset)"; new grids for another
+       channel count reset them; the path tracers' image is their state */
+    if (changed && now.st.frames) fz_fail("new lights kept %llu frames", (unsigned long long)now.st.frames);
+    if (changed && (fz_pt(now.p.method) || (now.p.method == HD_METHOD_CD && n != pre.s.nl) ||
+                    now.st.illumination_channels != pre.s.st.illumination_channels) && now.st.iterations)
+        fz_fail("new lights (a reset) kept %llu iterations", (unsigned long long)now.st.iterations);
+    if (changed && !fz_pt(now.p.method) && !(now.p.method == HD_METHOD_CD && n != pre.s.nl) &&
+        now.st.illumination_channels == pre.s.st.illumination_channels && now.st.iterations != pre.s.st.iterations)
+        fz_fail("new lights (warm) did not keep E: %llu -> %llu iterations", (unsigned long long)pre.s.st.iterations,
+                (unsigned long long)now.st.iterations);
 }
 
 static void fz_op_tf(int ci)
@@ -1113,9 +1134,16 @@ static void fz_op_tf(int ci)
     }
     changed = now.ntf != pre.s.ntf;
     for (i = 0; i < 4 * now.ntf && !changed; ++i) changed = now.tf[i] != pre.s.tf[i];
-    if (changed && (now.st.iterations || now.st.frames))
-        fz_fail("a new transfer function kept %llu iterations, %llu frames", (unsigned long long)now.st.iterations,
-                (unsigned long long)now.st.frames);
+    /* "TF alpha, extinction -> E, phi warm; image; TF colour only -> image (phi warm with RGB
+       scattering); the same TF -> nothing": E is kept, the image restarts (the path tracers') */
+    if (changed && now.st.frames)
+        fz_fail("a new transfer function kept %llu frames", (unsigned long long)now.st.frames);
+    if (changed && fz_pt(now.p.method) && now.st.iterations)
+        fz_fail("a new transfer function kept %s's %llu iterations", hd_method_name(now.p.method), (unsigned long long)now.st.iterations);
+    if (!changed && (now.st.iterations != pre.s.st.iterations || now.st.frames != pre.s.st.frames))
+        fz_fail("the same transfer function changed %llu iterations, %llu frames to %llu, %llu",
+                (unsigned long long)pre.s.st.iterations, (unsigned long long)pre.s.st.frames,
+                (unsigned long long)now.st.iterations, (unsigned long long)now.st.frames);
 }
 
 /* n for hd_iterate and hd_refine: 1..4 mostly; 0, -1, INT_MIN; INT_MAX only past iteration 0,
@@ -1183,7 +1211,8 @@ static void fz_op_render(int ci)
         fz_pre pre;
         hd_result r;
         size_t npx = (size_t)s.cam.width * (size_t)s.cam.height * 4;
-        if (hd_read_image_f32(fz_c[ci].h, fz_img2, npx) != HD_SUCCESS) fz_fail("hd_read_image_f32 before hd_render");
+        hd_result r0 = hd_read_image_f32(fz_c[ci].h, fz_img2, npx);
+        if (r0 != HD_SUCCESS && r0 != HD_ERROR_NO_FRAME) fz_fail("hd_read_image_f32 before hd_render: %s", hd_result_string(r0));
         fz_tr("    r = hd_render(c%d);\n", ci);
         fz_begin(ci, &pre, "hd_render");
         r = hd_render(fz_c[ci].h);
@@ -1235,6 +1264,8 @@ static void fz_op_read(int ci, int which)
                   (fz_pt(s.p.method) ? FZ_R(HD_ERROR_UNSUPPORTED) : 0) | (size < need ? FZ_R(HD_ERROR_BUFFER_TOO_SMALL) : 0);
     } else {
         allowed = (null ? FZ_R(HD_ERROR_NULL_POINTER) : 0) | (size < need ? FZ_R(HD_ERROR_BUFFER_TOO_SMALL) : 0);
+        /* an image that holds no frame yet (new, or reset and not projected since) */
+        if (!allowed && s.st.frames == 0) allowed = FZ_OK | FZ_R(HD_ERROR_NO_FRAME);
     }
     if (!allowed) allowed = FZ_OK;
     fz_tr("    r = %s(c%d, %s%s, %zu);\n", which == 0 ? "hd_read_image_f32" : which == 1 ? "hd_read_image_rgba8" : "hd_read_illumination",
