@@ -316,13 +316,14 @@ static hd_result hd__update_voxels(hd__ctx *ctx, const hd_volume_update *u, int 
                        u->dims[2], types[v->type], dims[0], dims[1], dims[2]);
     whole = u->size[0] == 0 && u->size[1] == 0 && u->size[2] == 0;
     for (d = 0; d < 3; ++d) {
-        box.lo[d] = u->offset[d];
-        box.hi[d] = whole ? dims[d] : u->offset[d] + (u->size[d] > 0 ? u->size[d] : 0);
+        /* checked before the box's end is summed: offset + size may pass INT_MAX */
         if (u->size[d] < 0 || (!whole && u->size[d] == 0) || u->offset[d] < 0 || u->offset[d] > dims[d] ||
             (whole ? u->offset[d] != 0 : u->size[d] > dims[d] - u->offset[d]))
             return HD__ERR(log, HD_ERROR_BOX_OUTSIDE_VOLUME,
                            "hd_update_volume: the box at (%d, %d, %d) of size (%d, %d, %d) is not inside the %dx%dx%d volume", u->offset[0],
                            u->offset[1], u->offset[2], u->size[0], u->size[1], u->size[2], dims[0], dims[1], dims[2]);
+        box.lo[d] = u->offset[d];
+        box.hi[d] = whole ? dims[d] : u->offset[d] + u->size[d];
     }
     if (!u->data) return HD__ERR(log, HD_ERROR_NULL_POINTER, "hd_update_volume: data is NULL");
     es = hd__voxel_bytes(v->type);
