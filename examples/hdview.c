@@ -245,8 +245,8 @@ static void screenshot(viewer *v, const char *path)
 
 static void restart(viewer *v)
 {
-    hd_result r = hd_set_lights(v->ctx, v->lights, v->light_count); /* resets E, phi and the image */
-    if (r != HD_SUCCESS) die("hd_set_lights", r);
+    hd_result r = hd_reset(v->ctx); /* E, phi and the image from zero, as in a new context */
+    if (r != HD_SUCCESS) die("hd_reset", r);
 }
 
 static void apply_params(viewer *v)
