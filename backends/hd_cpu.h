@@ -1101,29 +1101,8 @@ static hd_result hd__be_upsample(const hd__view *vw)
 
 /* No recording and no GL texture: the core never calls these (hd__be_features). */
 static unsigned hd__be_features(void) { return 0; }
-static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
-{
-    (void)target; (void)slots;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no recording");
-}
-static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
-static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
-static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
-static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
-{
-    (void)target; (void)out;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no recording");
-}
-static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
-{
-    (void)target; (void)out;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no recording");
-}
-static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
-{
-    (void)texture; (void)out; (void)exact;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "cpu: no GL texture");
-}
+HD__BE_NO_RECORDING("cpu")
+HD__BE_NO_TEXTURE("cpu")
 
 static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {

@@ -1323,21 +1323,4 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
 static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }
 
 /* No recording (a Vulkan feature): the core never calls these. */
-static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)
-{
-    (void)target; (void)slots;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
-}
-static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }
-static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }
-static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; }
-static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
-{
-    (void)target; (void)out;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
-}
-static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out)
-{
-    (void)target; (void)out;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: no recording");
-}
+HD__BE_NO_RECORDING("gl")

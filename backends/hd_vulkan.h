@@ -2325,8 +2325,4 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
 }
 
 /* No GL texture: the core never calls it. */
-static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
-{
-    (void)texture; (void)out; (void)exact;
-    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: no GL texture");
-}
+HD__BE_NO_TEXTURE("vulkan")

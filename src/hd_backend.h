@@ -232,6 +232,34 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
    out->y), rows bottom first. The core has checked out (format, size: the camera's, x and y
    >= 0). Runs in a bracket after the core's preparation. */
 static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact);
+/* The primitives of a feature a backend lacks, in one line each: they log and refuse, though the
+   core never calls them (hd__be_features). NAME is the backend's name in the log line. */
+#define HD__BE_NO_RECORDING(NAME)                                                                       \
+    static hd_result hd__be_record_begin(const hd__view *vw, void *target, int slots)                   \
+    {                                                                                                   \
+        (void)target; (void)slots;                                                                      \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static void hd__be_record_mark(const hd__view *vw, int end) { (void)vw; (void)end; }                \
+    static hd_result hd__be_record_end(const hd__view *vw, hd_result r) { (void)vw; return r; }         \
+    static int hd__be_record_seconds(const hd__view *vw, double *seconds) { (void)vw; (void)seconds; return 0; } \
+    static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target,     \
+                                                const hd_output *out)                                   \
+    {                                                                                                   \
+        (void)target; (void)out;                                                                        \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out) \
+    {                                                                                                   \
+        (void)target; (void)out;                                                                        \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }
+#define HD__BE_NO_TEXTURE(NAME)                                                                         \
+    static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact) \
+    {                                                                                                   \
+        (void)texture; (void)out; (void)exact;                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
+    }
 
 /* ---- helpers a backend may use ----------------------------------------------------------------- */
 /* hd__be_diffuse_sweeps for a backend whose sweeps are separate passes: hd__be_diffuse each. */
