@@ -115,7 +115,7 @@ backends/hd_spirv.h: scripts/build-spirv backends/hd_bind_vk_glsl.h hybriddiff.h
 	scripts/build-spirv $@.new && $(call hd_regen_new,scripts/build-spirv)
 dist: $(GEN_FILES)
 
-$(B)/%.o: tests/%.c $(LIB_SRC) $(wildcard examples/*.h) tests/hd_test.h $(B)/hd_suites.h | $(B)
+$(B)/%.o: tests/%.c $(LIB_SRC) $(wildcard examples/*.h) $(wildcard tests/*.h) $(B)/hd_suites.h | $(B)
 	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(CFLAGS) -c $< -o $@
 
 # Every tests/*.c that defines `const hd_test_case hd_tests_NAME[]` is a suite of build/hdtest.

@@ -68,7 +68,7 @@ fuzz-long: $(FUZZ_TARGETS:%=$(FZ)/fuzz_%) $(FZ)/seeds.stamp
 	done
 
 # ---- ASan + UBSan (+ LSan) ----
-$(SAN)/hdtest-asan: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+$(SAN)/hdtest-asan: $(TEST_SRC) $(LIB_SRC) $(wildcard tests/*.h) $(B)/hd_suites.h | $(SAN)
 	$(SAN_CC) $(CPPFLAGS) -I$(B) $(WARN) $(ASAN_FLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
 $(SAN)/conf_impl_cpu.o: $(CONF_DIR)/impl_cpu.c $(CONF_DEPS) | $(SAN)
 	$(SAN_CC) $(CPPFLAGS) $(WARN) $(ASAN_FLAGS) -c $< -o $@
@@ -87,13 +87,13 @@ asan: $(SAN)/hdtest-asan $(SAN)/conformance-asan
 		$(SAN)/conformance-asan --quick
 
 # ---- TSan: every test that runs the CPU backend's worker threads ----
-$(SAN)/hdtest-tsan: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+$(SAN)/hdtest-tsan: $(TEST_SRC) $(LIB_SRC) $(wildcard tests/*.h) $(B)/hd_suites.h | $(SAN)
 	$(SAN_CC) $(CPPFLAGS) -I$(B) $(WARN) $(TSAN_FLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
 tsan: $(SAN)/hdtest-tsan
 	$(TSAN_ENV) $(SAN)/hdtest-tsan $(TSAN_FILTER)
 
 # ---- valgrind memcheck (no AVX-512 in valgrind) ----
-$(SAN)/hdtest-vg: $(TEST_SRC) $(LIB_SRC) tests/hd_test.h $(B)/hd_suites.h | $(SAN)
+$(SAN)/hdtest-vg: $(TEST_SRC) $(LIB_SRC) $(wildcard tests/*.h) $(B)/hd_suites.h | $(SAN)
 	$(CC) $(CPPFLAGS) -I$(B) $(WARN) $(VG_CFLAGS) $(TEST_SRC) -o $@ $(LDLIBS)
 # The suites that exercise the API, the loaders and the error paths; the numeric suites
 # (kernels_, methods_) take >10 min under memcheck and run under ASan instead. A filter that

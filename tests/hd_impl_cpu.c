@@ -51,17 +51,7 @@ unsigned hdt_slot_generation(int slot, unsigned generation)
 int hdt_slots(void);
 int hdt_slots(void) { return HD_MAX_CONTEXTS; }
 
-/* The core's view of the volume for test_living.c: a checksum-free copy of what hd_update_volume
-   must keep equal to a fresh context's (voxels, cell ranges, majorants, the largest extinction,
-   the direct light's mask and list), after hd__prepare (run by hd_read_illumination's bracket). */
-typedef struct hdt_volume_state {
-    size_t nvox, ncell, gvox, dl_count;
-    float *vol, *cell_range, *majorant, max_sigma;
-    unsigned char *bits;
-    uint32_t *dl_idx;
-    uint64_t dl_n;
-} hdt_volume_state;
-int hdt_volume_state_get(hd_context h, hdt_volume_state *s);
+#include "hdt_volume_state.h"
 int hdt_volume_state_get(hd_context h, hdt_volume_state *s)
 {
     hd__ctx *ctx = hd__lookup(h);

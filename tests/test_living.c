@@ -92,14 +92,7 @@ static void test_no_frame(void)
 }
 
 /* ---- hd_update_volume ------------------------------------------------------------------------ */
-typedef struct hdt_volume_state {
-    size_t nvox, ncell, gvox, dl_count;
-    float *vol, *cell_range, *majorant, max_sigma;
-    unsigned char *bits;
-    uint32_t *dl_idx;
-    uint64_t dl_n;
-} hdt_volume_state;
-int hdt_volume_state_get(hd_context h, hdt_volume_state *s);
+#include "hdt_volume_state.h"
 
 static float vox2[N * N * N];
 static uint8_t vox8[N * N * N], vox8b[N * N * N];
