@@ -377,36 +377,27 @@ HDDEF hd_result hd_render(hd_context h)
 }
 
 /* The optional features' entry points, for every backend (hd__be_features). */
-static hd_result hd__api_gl_render_to_texture(hd__ctx *ctx, unsigned int texture)
+/* hd_gl_render_to_texture (exact: GL_RGBA8 of the camera's size, output NULL) and its _ex. */
+static hd_result hd__api_output_texture(hd__ctx *ctx, unsigned int texture, const hd_output *output, int exact,
+                                        const char *what)
 {
     hd_result r;
     hd_output o;
     if (!(hd__be_features() & HD__BE_TEXTURE))
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture: this is the %s backend", hd__be_name());
-    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture: texture 0");
-    if ((r = hd__output_check(ctx, NULL, &o, "hd_gl_render_to_texture")) != HD_SUCCESS) return r;
-    HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 1));
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", what, hd__be_name());
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "%s: texture 0", what);
+    if ((r = hd__output_check(ctx, output, &o, what)) != HD_SUCCESS) return r;
+    HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, exact));
     return r;
 }
 HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
 {
-    HD__GUARDED(h, "hd_gl_render_to_texture", hd__api_gl_render_to_texture(ctx, texture));
-}
-
-static hd_result hd__api_gl_render_to_texture_ex(hd__ctx *ctx, unsigned int texture, const hd_output *output)
-{
-    hd_result r;
-    hd_output o;
-    if (!(hd__be_features() & HD__BE_TEXTURE))
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_gl_render_to_texture_ex: this is the %s backend", hd__be_name());
-    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "hd_gl_render_to_texture_ex: texture 0");
-    if ((r = hd__output_check(ctx, output, &o, "hd_gl_render_to_texture_ex")) != HD_SUCCESS) return r;
-    HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, 0));
-    return r;
+    HD__GUARDED(h, "hd_gl_render_to_texture", hd__api_output_texture(ctx, texture, NULL, 1, "hd_gl_render_to_texture"));
 }
 HDDEF hd_result hd_gl_render_to_texture_ex(hd_context h, unsigned int texture, const hd_output *output)
 {
-    HD__GUARDED(h, "hd_gl_render_to_texture_ex", hd__api_gl_render_to_texture_ex(ctx, texture, output));
+    HD__GUARDED(h, "hd_gl_render_to_texture_ex",
+                hd__api_output_texture(ctx, texture, output, 0, "hd_gl_render_to_texture_ex"));
 }
 
 /* The checks of hd_vulkan_record and _record_render that come before the device: the feature,
