@@ -55,6 +55,7 @@ help:
 	@echo "  make integrate                      T examples/integrate_*: built (C99/C++17, both include orders) and run"
 	@echo "  make integrate-compile              T the integration programs' other language and include order, compiled"
 	@echo "  make readme-check                   T every code block of README.md compiled (C99, C++17) and run"
+	@echo "  make test-vdb                       T OpenVDB grids (head CT, a sparse cloud) load, place and render as their NRRDs"
 	@echo "  make test-dicom-hostile             T hdrender on hostile DICOM folders: links, FIFOs, junk, mutated slices"
 	@echo "  make test-hdrender-cli              T hdrender's command line: FIFOs, /dev/full, numbers out of range, TF files"
 	@echo "  make valgrind-opencl                the quick OpenCL conformance subset under valgrind"
@@ -165,4 +166,9 @@ clean:
 	rm -rf $(B)
 
 # Backends, tools and test programs that bring their own rules (one fragment each).
+# what every tool (hdrender, hdview) links beside its own object: the DICOM and OpenVDB readers
+# (mk/hdrender.mk); set before the includes, which use it in prerequisites
+TOOL_OBJS := $(B)/hd_dicom.o $(B)/hd_vdb.o
+TOOL_LDLIBS = $(DICOM_LDLIBS) $(VDB_LDLIBS)
+VDB_LDLIBS := -lopenvdb -lImath-3_1 -ltbb
 -include $(wildcard mk/*.mk)

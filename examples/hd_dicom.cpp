@@ -4,6 +4,7 @@
 // and CPU time are limited: GDCM asserts, aborts or allocates what a length claims on some damaged
 // files, which would take the tool down with them.
 #include "hd_dicom.h"
+#include "hd_pipe.h"
 
 #include <gdcmDict.h>
 #include <gdcmDicts.h>
@@ -43,6 +44,9 @@
 #include <vector>
 
 namespace {
+
+using hdx::now_s;
+using hdx::write_all;
 
 // ---- limits --------------------------------------------------------------------------------------
 const size_t kMaxEntries = 100000;            // directory entries listed
@@ -686,18 +690,6 @@ struct reply {
 };
 const uint32_t kMagic = 0x4d434448;
 
-bool write_all(int fd, const void *p, size_t n)
-{
-    const char *c = (const char *)p;
-    while (n) {
-        const ssize_t w = write(fd, c, n);
-        if (w < 0 && errno == EINTR) continue;
-        if (w <= 0) return false;
-        c += w, n -= (size_t)w;
-    }
-    return true;
-}
-
 bool read_all(int fd, void *p, size_t n)
 {
     char *c = (char *)p;
@@ -842,13 +834,6 @@ void work_one(const candidate &f, std::vector<unsigned char> &bytes, reply &r, s
             _exit(4);
     }
     _exit(0); // no destructors, no atexit handlers, no flush of the parent's stdio buffers
-}
-
-double now_s()
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 // The last line the worker wrote to stderr (GDCM's assertion or error) for a message: an

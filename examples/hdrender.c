@@ -42,7 +42,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "hd_dicom.h"
+#include "hd_input.h"
 #include "hd_png.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
@@ -54,7 +54,8 @@ static const char *usage_text =
     "usage: hdrender [options] [FILE|DIR]           (default input: " DEFAULT_INPUT ")\n"
     "       hdrender [options] --raw FILE --dims X,Y,Z --type TYPE\n"
     "\n"
-    "Renders a volume with global illumination (hybriddiff) and writes a PNG.\n"
+    "Renders a volume with global illumination (hybriddiff) and writes a PNG. FILE: NRRD,\n"
+    "MetaImage, NIfTI, or OpenVDB (FILE.vdb, FILE.vdb:GRID: a float grid); DIR: a DICOM series.\n"
     "\n"
     "backend\n"
     "  --backend B             cpu (default), opencl, vulkan or gl: runs build/hdrender-B\n"
@@ -960,12 +961,8 @@ int main(int argc, char **argv)
         if (r != HD_SUCCESS) fail_lib(2, &ls, r, NULL, NULL);
     } else {
         if (!input) input = DEFAULT_INPUT;
-        if (hdx_is_directory(input)) {
-            if (!hdx_dicom_load_series(input, &vol, err, sizeof err)) fail(2, "DICOM: %s", err);
-            r = HD_SUCCESS;
-        } else {
-            r = hd_volume_load(input, &vol, &logger);
-        }
+        r = hdx_load_input(input, &vol, &logger, err, sizeof err);
+        if (r != HD_SUCCESS && err[0]) fail(2, "%s", err);
         if (r != HD_SUCCESS)
             fail_lib(2, &ls, r, NULL,
                      r == HD_ERROR_FILE_IO && strcmp(input, DEFAULT_INPUT) == 0

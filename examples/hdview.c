@@ -60,7 +60,7 @@
 #include <time.h>
 
 #include "hd_crop.h"
-#include "hd_dicom.h"
+#include "hd_input.h"
 #include "hd_png.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
@@ -568,6 +568,7 @@ int main(int argc, char **argv)
     hd_desc desc;
     hd_logger logger = {hd_log_stderr, NULL};
     hd_result r;
+    char err[512];
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = atoi(argv[++i]);
         else if (strcmp(argv[i], "--screenshot") == 0 && i + 1 < argc) shot = argv[++i];
@@ -576,19 +577,16 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc && sscanf(argv[i + 1], "%dx%d", &w, &h) == 2) ++i;
         else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
             printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE] [FILE|DIR]\n"
-                   "(DIR: a DICOM series; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n"
+                   "(DIR: a DICOM series; FILE.vdb[:GRID]: an OpenVDB float grid; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n"
                    "crop box: O / shift+O select a face, I / shift+I move it in / out, U whole volume / default box\n");
             return 0;
         } else if (argv[i][0] == '-') { fprintf(stderr, "hdview: unknown option %s (--help)\n", argv[i]); return 2; }
         else input = argv[i];
     }
-    if (hdx_is_directory(input)) { /* a DICOM series (examples/hd_dicom.cpp, GDCM) */
-        char err[512];
-        if (!hdx_dicom_load_series(input, &vol, err, sizeof err)) {
-            fprintf(stderr, "hdview: DICOM: %s\n", err);
-            return 2;
-        }
-    } else if ((r = hd_volume_load(input, &vol, &logger)) != HD_SUCCESS) {
+    if ((r = hdx_load_input(input, &vol, &logger, err, sizeof err)) != HD_SUCCESS && err[0]) {
+        fprintf(stderr, "hdview: %s\n", err);
+        return 2;
+    } else if (r != HD_SUCCESS) {
         fprintf(stderr, "hdview: cannot load %s: %s%s\n", input, hd_result_string(r),
                 strcmp(input, DEFAULT_INPUT) == 0 ? " (make data fetches the head CT)" : "");
         return 2;

@@ -45,8 +45,8 @@ test: conformance-gl test-gl compile-gl-cxx physics-gl
 
 # ---- the viewer -------------------------------------------------------------------------------
 VIEW_LDLIBS := -lglfw -lOpenGL -lEGL
-$(B)/hdview: examples/hdview.c $(wildcard examples/*.h) $(LIB_SRC) $(B)/hd_dicom.o | $(B)
-	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< $(B)/hd_dicom.o -o $@ $(LDLIBS) $(VIEW_LDLIBS) $(DICOM_LDLIBS)
+$(B)/hdview: examples/hdview.c $(wildcard examples/*.h) $(LIB_SRC) $(TOOL_OBJS) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< $(TOOL_OBJS) -o $@ $(LDLIBS) $(VIEW_LDLIBS) $(TOOL_LDLIBS)
 hdview: $(B)/hdview
 
 $(B)/pngcmp: tests/gl/pngcmp.c | $(B)

@@ -8,6 +8,10 @@
 #   make test-dicom             a DICOM series written from the head CT renders as the NRRD in
 #                               hdrender and hdview; malformed series give their own errors
 #                               (part of `make test`)
+#   make test-vdb               OpenVDB grids written by scripts/vdb-from-nrrd (the head CT, a
+#                               sparse cloud) load and render as the same voxels in NRRD, placed
+#                               by their transforms; damaged files give their own errors (part of
+#                               `make test`)
 #   make test-dicom-hostile     hostile DICOM folders (scripts/dicom-corpus): each case's exit and
 #                               message, 60 junk files and 30 mutated slices beside a series, the
 #                               files that abort GDCM contained; 5 s and 256 MiB per run (part of
@@ -17,7 +21,7 @@
 #   make dicom-dcmtk-probe      DCMTK alone on that corpus (needs libdcmtk-dev; docs/DICOM.md)
 #   make test-hdrender-cli      FIFOs, /dev/full, numbers out of range, TF files at 1 MiB, NUL
 #                               bytes (part of `make test`)
-.PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom test-dicom-hostile \
+.PHONY: hdrender-backends test-hdrender-backends test-hdrender-defaults test-dicom test-vdb test-dicom-hostile \
         dicom-hostile-long dicom-dcmtk-probe test-hdrender-cli
 
 HDR_DEPS := examples/hdrender.c $(wildcard examples/*.h) $(LIB_SRC)
@@ -26,8 +30,11 @@ HDR_BACKENDS := $(B)/hdrender $(B)/hdrender-opencl $(B)/hdrender-vulkan $(B)/hdr
 DICOM_CXXFLAGS := -std=c++17 -Wall -Wextra -Werror -Wpedantic -I/usr/include/gdcm-3.0
 DICOM_LDLIBS := -lgdcmMSFF -lgdcmDICT -lgdcmDSED -lgdcmCommon -lstdc++
 
-$(B)/hd_dicom.o: examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
+$(B)/hd_dicom.o: examples/hd_dicom.cpp examples/hd_dicom.h examples/hd_pipe.h hybriddiff.h | $(B)
 	$(CXX) $(CPPFLAGS) $(DICOM_CXXFLAGS) $(CFLAGS) -c $< -o $@
+# OpenVDB grids (FILE.vdb) through libopenvdb-dev, in another C++ file of the tools
+$(B)/hd_vdb.o: examples/hd_vdb.cpp examples/hd_vdb.h examples/hd_pipe.h hybriddiff.h | $(B)
+	$(CXX) $(CPPFLAGS) -std=c++17 -Wall -Wextra -Werror -Wpedantic $(CFLAGS) -c $< -o $@
 
 # each backend's object (the library's implementation is most of the compile), then the link
 $(B)/hdrender.o: $(HDR_DEPS) | $(B)
@@ -38,22 +45,22 @@ $(B)/hdrender-vulkan.o: $(HDR_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_VULKAN $(WARN) $(CFLAGS) -c $< -o $@
 $(B)/hdrender-gl.o: $(HDR_DEPS) | $(B)
 	$(CC) $(CPPFLAGS) -DHYBRIDDIFF_BACKEND_GL $(WARN) $(CFLAGS) -c $< -o $@
-$(B)/hdrender: $(B)/hdrender.o $(B)/hd_dicom.o
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(DICOM_LDLIBS)
-$(B)/hdrender-opencl: $(B)/hdrender-opencl.o $(B)/hd_dicom.o
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lOpenCL $(DICOM_LDLIBS)
-$(B)/hdrender-vulkan: $(B)/hdrender-vulkan.o $(B)/hd_dicom.o
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lvulkan $(DICOM_LDLIBS)
-$(B)/hdrender-gl: $(B)/hdrender-gl.o $(B)/hd_dicom.o
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lEGL $(DICOM_LDLIBS)
+$(B)/hdrender: $(B)/hdrender.o $(TOOL_OBJS)
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(TOOL_LDLIBS)
+$(B)/hdrender-opencl: $(B)/hdrender-opencl.o $(TOOL_OBJS)
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lOpenCL $(TOOL_LDLIBS)
+$(B)/hdrender-vulkan: $(B)/hdrender-vulkan.o $(TOOL_OBJS)
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lvulkan $(TOOL_LDLIBS)
+$(B)/hdrender-gl: $(B)/hdrender-gl.o $(TOOL_OBJS)
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) -lEGL $(TOOL_LDLIBS)
 
 # the DICOM reader's tests: hdrender with the VR check off, so that GDCM's asserts on the files
 # of tests/dicom/gdcm-aborts reach the worker; gdcm_probe, GDCM alone on a corpus
-$(B)/hd_dicom_novrcheck.o: examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
+$(B)/hd_dicom_novrcheck.o: examples/hd_dicom.cpp examples/hd_dicom.h examples/hd_pipe.h hybriddiff.h | $(B)
 	$(CXX) $(CPPFLAGS) -DHDX_DICOM_TEST_NO_VR_CHECK $(DICOM_CXXFLAGS) $(CFLAGS) -c $< -o $@
-$(B)/hdrender_novrcheck: $(B)/hdrender.o $(B)/hd_dicom_novrcheck.o
-	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(DICOM_LDLIBS)
-$(B)/gdcm_probe: tests/dicom/gdcm_probe.cpp examples/hd_dicom.cpp examples/hd_dicom.h hybriddiff.h | $(B)
+$(B)/hdrender_novrcheck: $(B)/hdrender.o $(B)/hd_dicom_novrcheck.o $(B)/hd_vdb.o
+	$(CC) $(CFLAGS) $^ -o $@ $(LDLIBS) $(TOOL_LDLIBS)
+$(B)/gdcm_probe: tests/dicom/gdcm_probe.cpp examples/hd_dicom.cpp examples/hd_dicom.h examples/hd_pipe.h hybriddiff.h | $(B)
 	$(CXX) $(CPPFLAGS) $(DICOM_CXXFLAGS) $(CFLAGS) $< -o $@ $(DICOM_LDLIBS)
 
 hdrender-backends: $(HDR_BACKENDS)
@@ -68,6 +75,12 @@ test-hdrender-defaults: $(B)/hdrender $(B)/pngcmp data
 
 test-dicom: $(B)/hdrender $(B)/hdview $(B)/pngcmp data
 	scripts/test-dicom $(B)
+
+# the OpenVDB reader alone (tests/vdb/test_vdb.c), then through hdrender and hdview
+$(B)/test_vdb: tests/vdb/test_vdb.c $(B)/hd_vdb.o $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< $(B)/hd_vdb.o -o $@ $(LDLIBS) $(VDB_LDLIBS) -lstdc++
+test-vdb: $(B)/hdrender $(B)/hdview $(B)/pngcmp $(B)/test_vdb data
+	scripts/test-vdb $(B)
 
 test-dicom-hostile: $(B)/hdrender $(B)/hdrender_novrcheck
 	scripts/test-dicom-hostile $(B)
@@ -87,4 +100,4 @@ dicom-dcmtk-probe: $(B)/dcmtk_probe
 test-hdrender-cli: $(B)/hdrender
 	scripts/test-hdrender-cli $(B)
 
-test: test-hdrender-backends test-hdrender-defaults test-dicom test-dicom-hostile test-hdrender-cli
+test: test-hdrender-backends test-hdrender-defaults test-dicom test-vdb test-dicom-hostile test-hdrender-cli
