@@ -79,6 +79,7 @@ help:
 	@echo "  make bench-peer                     one orbit frame against VTK's ray casters (needs pvpython; docs/peer/)"
 	@echo "  make eval                           the reduced evaluation of the paper's claims (docs/eval/, ~15 min)"
 	@echo "  make eval-paper                     the evaluation at the paper's scale (out/eval-paper)"
+	@echo "  make eval-refine                    a resting view refined toward PT_MS: PSNR per budget (docs/DESIGN-REFINE.md)"
 	@echo "  make eval-multigrid                 the multigrid study: PSNR against PT_MS over time (docs/eval/multigrid/)"
 	@echo "  make bench-energy                   HD's mean radiance and PSNR against PT_MS per scene (docs/DESIGN-ENERGY.md)"
 	@echo "  make compile-time                   CPU seconds to compile each backend's implementation against stb_image.h"

@@ -210,6 +210,17 @@ typedef enum hd_boundary {
     HD_BOUNDARY_COUNT
 } hd_boundary;
 
+/* What hd_render does for HD and CD once the view rests (the light has converged and the image
+   holds its frame_window frames; params.rest). */
+typedef enum hd_rest {
+    HD_REST_DEFAULT = 0, /* = HOLD */
+    HD_REST_HOLD,        /* nothing: HD's image stays as it is */
+    HD_REST_REFINE,      /* every call adds paths per pixel that start at the camera and end into
+                            HD's converged light at vertex params.refine_bounces: the image moves
+                            from HD's frame toward the path-traced solution (docs/DESIGN-REFINE.md) */
+    HD_REST_COUNT
+} hd_rest;
+
 typedef enum hd_precision {
     HD_PRECISION_FLOAT32 = 0, /* 4 bytes per voxel and channel (default) */
     HD_PRECISION_FLOAT16,     /* IEEE binary16 storage, float32 arithmetic: half the bytes */
@@ -468,6 +479,16 @@ typedef struct hd_params {
                                and the old light fades as the new one's samples come in. Smaller
                                follows a changing volume with less lag and more noise. 0 -> 8;
                                1..1000000 */
+    hd_rest rest;           /* HD and CD, once the view rests: HD_REST_HOLD (default) keeps HD's
+                               image; HD_REST_REFINE refines it toward PT_MS with paths that read
+                               HD's light, as many per call as render_budget allows (at least
+                               one). The first call after any change (camera, setter) still shows
+                               HD's frame, as with HOLD. hd_stats.refine_paths counts them */
+    int refine_bounces;     /* HD_REST_REFINE: the vertex at which a refinement path ends into HD's
+                               light ((E + phi) / 4 pi there); the vertices before it track toward
+                               the lights and scatter as PT_MS's do. 0 -> 2 (one bounce, then HD's
+                               light: a final gather); -1: never, the paths are PT_MS's (unbiased,
+                               slower to converge); else 1..100000 */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -547,6 +568,8 @@ typedef struct hd_stats {
     int light_converged;      /* light_error < params.light_tolerance twice in a row */
     int render_scale;         /* the divisor of the current image's frames (params.render_scale);
                                  1 for full-resolution frames and for the path tracers */
+    uint64_t refine_paths;    /* paths per pixel a resting view's refinement (HD_REST_REFINE) has
+                                 added to the current image; 0 while it shows HD's frames */
 } hd_stats;
 
 typedef struct hd_context {

@@ -51,6 +51,7 @@ layout(location = 0) uniform ivec4 hd_pc;
    date before every projection. */
 #define HD_PRELUDE_LIGHT_SUM 1
 #define HD_LIGHT_SUM_READY true
+#define HD_LIGHT_SUM_ONLY 1 /* hdk_sample_light reads lsum alone: the path stage, which has no r16f twin, never loads E or phi */
 #define HD_PRELUDE_PROJECT_TABLE 1
 #define HD_PROJECT_TABLE_READY true
 #define HD_PTAB_N hd_pc.x

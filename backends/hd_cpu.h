@@ -1208,7 +1208,9 @@ static void hd__cpu_sum_light_row(hd__backend *be, int r)
 static void hd__cpu_path_row(hd__backend *be, int py)
 {
     int px, w = be->vw->kp.image.x;
-    for (px = 0; px < w; ++px) hdk_path_pixel(&be->k, px, py);
+    hd__kctx k = be->k;
+    k.lsum = be->lsum_ok ? be->lsum : NULL; /* HD's light, for a resting view's refinement */
+    for (px = 0; px < w; ++px) hdk_path_pixel(&k, px, py);
 }
 
 /* One convection step of light `light` (hdk_convect_voxel on every voxel of the illumination

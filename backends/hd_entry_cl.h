@@ -122,11 +122,13 @@ HD__CL_SUM_LIGHT(hd_k_sum_light, 0)
 HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
 
 /* PT_SS / PT_MS: one path per pixel (x, y); dep: the host's depth buffer (a placeholder while
-   depth_dims.z is 0). */
-__kernel void hd_k_path(HD__CL_BUFFERS, __global const float *restrict dep)
+   depth_dims.z is 0); lsum: HD's summed light, read by a resting view's refinement (image.w > 0,
+   hd_k_path.h; unread, and possibly null, otherwise). */
+__kernel void hd_k_path(HD__CL_BUFFERS, __global const float *restrict dep, __global const float *restrict lsum)
 {
     HD__CL_KCTX;
     k.dep = dep;
+    k.lsum = lsum;
     hdk_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
 

@@ -873,7 +873,7 @@ static hd_result hd__be_sum_lights(const hd__view *vw)
 /* One path per pixel, folded into the image with weight march.y. */
 static hd_result hd__be_path(const hd__view *vw)
 {
-    hd_result r = hd__cl_mems(vw, HD__CL_PATH, 9, 1, vw->be->dep);
+    hd_result r = hd__cl_mems(vw, HD__CL_PATH, 9, 2, vw->be->dep, vw->be->lsum);
     if (r == HD_SUCCESS) r = hd__cl_bind_run(vw, HD__CL_PATH, 2, (size_t)vw->kp.image.x, (size_t)vw->kp.image.y, 1);
     return r != HD_SUCCESS ? r : hd__cl_finish(vw);
 }

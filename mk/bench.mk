@@ -87,3 +87,17 @@ $(B)/hdbench_guard: bench/hdbench_guard.c $(B)/hdbench_guard_on.o $(B)/hdbench_g
 	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< $(B)/hdbench_guard_on.o $(B)/hdbench_guard_off.o -o $@ $(LDLIBS)
 bench-guard: $(B)/hdbench_guard
 	$(B)/hdbench_guard
+
+# make eval-refine: bench/hdbench_refine.c on the CPU backend: PSNR against a PT_MS reference
+# per time budget for HD, PT_MS and HD with params.rest = HD_REST_REFINE (several
+# refine_bounces) on one view of the head CT at 128^2, ct-skin and ct-bone, HD from scratch and
+# with converged light (docs/DESIGN-REFINE.md). The references are cached in build/refine-cache.
+# REFINE_ARGS are added to each run.
+.PHONY: eval-refine
+REFINE_ARGS ?=
+$(B)/hdbench_refine: bench/hdbench_refine.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_tonemap.h $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -DHYBRIDDIFF_BACKEND_CPU
+eval-refine: $(B)/hdbench_refine
+	@test -f data/head.nrrd || scripts/fetch-data
+	@for tf in ct-skin ct-bone; do for w in "" --warm; do \
+	    $(B)/hdbench_refine --tf $$tf $$w --csv $(B)/refine-$$tf$$w.csv $(REFINE_ARGS) || exit 1; done; done

@@ -107,6 +107,8 @@ typedef struct hd__ctx {
     hd__conv conv;
     double light_error;
     uint64_t converged_frames; /* projection frames since the light converged */
+    uint64_t refined;        /* refinement paths per pixel in the resting view's image (HD_REST_REFINE,
+                                src/hd_schedule.h); 0: the image is HD's frames */
     int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
                                 was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
     hd__cost cost;

@@ -87,7 +87,7 @@ static hd_result hd__image_room(hd__ctx *ctx)
     if (ctx->image_room) return HD_SUCCESS;
     if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height, 1)) != HD_SUCCESS) return r;
     ctx->image_room = 1;
-    ctx->frames = ctx->converged_frames = 0;
+    ctx->frames = ctx->converged_frames = ctx->refined = 0;
     return hd__be_clear(&ctx->vw, HD__DIRTY_IMAGE);
 }
 

@@ -207,6 +207,7 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     if (hd__method_is_pt(ctx->vw.params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;
+    out->refine_paths = ctx->refined;
     /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
        plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
 #ifdef HD__BE_SPLIT_LAYOUT /* the colour layout: one padding slot per row when gx is odd */

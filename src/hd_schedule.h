@@ -59,7 +59,7 @@ static hd_result hd__prepare(hd__ctx *ctx)
        (the iteration count, the random numbers' key, runs on) */
     if ((dirty & HD__DIRTY_WARM_E) && ctx->dl_n > (uint64_t)ctx->vw.params.light_window) ctx->dl_n = (uint64_t)ctx->vw.params.light_window;
     if (dirty & HD__DIRTY_IMAGE) {
-        ctx->frames = ctx->converged_frames = 0;
+        ctx->frames = ctx->converged_frames = ctx->refined = 0;
         ctx->frame_scale = 0;
         ctx->image_empty = 1;
     }
@@ -175,6 +175,7 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     t1 = hd__now(); /* the frame cost starts after a first reduced frame's allocation */
     s = ctx->frame_scale;
     ctx->frames++;
+    ctx->refined = 0; /* the image is HD's frames again */
     hd__fill_kparams(ctx);
     if (s > 1) {
         int w = ctx->vw.kp.image.x, h = ctx->vw.kp.image.y;
@@ -223,6 +224,31 @@ static hd_result hd__iterate_pt(hd__ctx *ctx)
     ctx->image_empty = 0;
     ctx->seconds[0] += hd__now() - t0;
     return HD_SUCCESS;
+}
+
+/* HD's frame as refine_prior paths' worth of the resting view's image: the k-th refinement path
+   per pixel enters the mean with weight 1 / (HD__REFINE_PRIOR + k), so the image moves from HD's
+   frame toward the paths' mean as the rest lasts (docs/DESIGN-REFINE.md has the measurements). */
+#define HD__REFINE_PRIOR 8.0
+
+/* One refinement pass of a resting HD or CD view (HD_REST_REFINE): one path per pixel that ends
+   into the converged E + phi at vertex refine_bounces (hd_k_path.h, image.w), into the image's
+   mean. The view rests only after a projection of the current light, so the backends' summed
+   light (lsum) the paths read is up to date. Its time counts as the projection's. */
+static hd_result hd__refine_paths(hd__ctx *ctx)
+{
+    hd_result r;
+    double t0 = hd__now();
+    int k = ctx->vw.params.refine_bounces;
+    ctx->refined++;
+    hd__fill_kparams(ctx);
+    ctx->vw.kp.image.w = k < 0 ? 0 : k;
+    ctx->vw.kp.frame.x = (int32_t)ctx->refined;
+    ctx->vw.kp.march.y = (float)(1.0 / (HD__REFINE_PRIOR + (double)ctx->refined));
+    r = hd__be_path(&ctx->vw);
+    hd__fill_kparams(ctx);
+    ctx->seconds[2] += hd__now() - t0;
+    return r;
 }
 
 /* One iteration of the current method (docs/METHOD.md: what an iteration is, per method). */
@@ -309,9 +335,20 @@ static hd_result hd__render(hd__ctx *ctx)
         if (hd__now() - t0 + last > budget) break;
     }
     if (hd__light_converged(ctx)) {
-        /* the image is done once frame_window frames at its final scale are in */
+        /* the image is done once frame_window frames at its final scale are in; then the view
+           rests: HD_REST_REFINE adds refinement paths, at least one pass, while the budget has
+           room for another */
         int s = hd__next_scale(ctx);
-        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) return HD_SUCCESS;
+        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) {
+            if (ctx->vw.params.rest != HD_REST_REFINE) return HD_SUCCESS;
+            do {
+                double ti = hd__now();
+                if (ctx->refined >= 0x7fffffffu) break;
+                if ((r = hd__refine_paths(ctx)) != HD_SUCCESS) return r;
+                last = hd__now() - ti;
+            } while (hd__now() - t0 + last <= budget);
+            return HD_SUCCESS;
+        }
         if ((r = hd__use_scale(ctx, s)) != HD_SUCCESS) return r;
         ctx->converged_frames++;
     }
@@ -382,8 +419,10 @@ static hd_result hd__record_render(hd__ctx *ctx, void *cb, const hd_vulkan_targe
         r = hd__light_iteration(ctx);
     } else if (hd__light_converged(ctx)) {
         int s = hd__next_scale(ctx);
-        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) frame = 0;
-        else if ((r = hd__use_scale(ctx, s)) == HD_SUCCESS) ctx->converged_frames++;
+        if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) {
+            frame = 0;
+            if (ctx->vw.params.rest == HD_REST_REFINE && ctx->refined < 0x7fffffffu) r = hd__refine_paths(ctx);
+        } else if ((r = hd__use_scale(ctx, s)) == HD_SUCCESS) ctx->converged_frames++;
     }
     if (r == HD_SUCCESS && frame) {
         hd__be_record_mark(&ctx->vw, 0);

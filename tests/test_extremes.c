@@ -1072,6 +1072,7 @@ static const xt_enum xt_param_enums[] = {
     {"params.tracking", offsetof(hd_params, tracking), HD_TRACKING_COUNT},
     {"params.diffusion_boundary", offsetof(hd_params, diffusion_boundary), HD_BOUNDARY_COUNT},
     {"params.illumination_precision", offsetof(hd_params, illumination_precision), HD_PRECISION_COUNT},
+    {"params.rest", offsetof(hd_params, rest), HD_REST_COUNT},
 };
 
 static void test_enums(void)

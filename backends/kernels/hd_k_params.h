@@ -7,7 +7,7 @@ HD_PARAM_I4(gdims)      /* illumination grid dims x, y, z; w = channels (1 or 3)
 HD_PARAM_I4(mdims)      /* majorant grid dims x, y, z; w = voxels per cell edge */
 HD_PARAM_I4(counts)     /* x = lights, y = tracking (1 ratio, 2 delta), z = flags, w = bounces */
 HD_PARAM_I4(frame)      /* x = iteration (1-based), y = frame (1-based), z = seed, w = half-sweep parity */
-HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = 0 (unused) */
+HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = the path vertex that reads HD's light (0: none, hd_k_path.h) */
 HD_PARAM_I4(region)     /* x = the first pixel of the frame's region of the image buffer (0; a
                            reduced frame's: the full image's width * height, hd_k_upsample.h),
                            y = the upsample pass's render scale (0 in every other pass), z, w = 0 */

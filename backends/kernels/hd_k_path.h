@@ -22,6 +22,12 @@
    (hdk_depth_t) the first free flight ends at the scene's surface: a path that reaches it ends
    there with nothing (the geometry is opaque and black for the volume's image) and sees no
    background; scattered rays do not see the geometry (the light ignores it, as HD's does).
+   Refinement of a resting HD view (params.refine_on_rest, src/hd_schedule.h) runs this kernel
+   on HD's converged light with image.w = k >= 1: at the k-th vertex the path ends into HD's
+   cache instead of tracking toward a light, adding w * (E + phi)(x) / (4 pi) (the in-scattered
+   radiance HD's projection uses there, isotropic), so vertices 1..k-1 carry what the diffusion
+   lacks (light across air, exact shadows) and the cache the rest. k = 1 is HD's own estimator
+   traced; image.w = 0 never reads it: PT_MS.
    Random numbers: key (pixel, iteration, seed, HD_STREAM_PATH); dims 0, 1 jitter the pixel,
    then every decision takes the next dims in order. Frames go into the image's running mean with
    weight march.y, which the host sets to 1/n for these methods (a plain progressive mean). */
@@ -78,6 +84,15 @@ HD_FN float hdk_light_rgb(HD_KARGS int l, int c)
     return c == 0 ? lb.x : (c == 1 ? lb.y : lb.z);
 }
 
+/* The in-scattered radiance HD's light gives at texture coordinate u, per colour channel:
+   (E + phi) / (4 pi), with 1 illumination channel times the lights' common colour. */
+HD_FN float hdk_cache_rgb(HD_KARGS hd_v3 u, int c)
+{
+    float cc = c == 0 ? HD_PRM(chan_color).x : (c == 1 ? HD_PRM(chan_color).y : HD_PRM(chan_color).z);
+    if (HD_PRM(gdims).w == 1) return hdk_sample_light(HD_KPASS u, 0) * HD_PRM(box).w * cc;
+    return hdk_sample_light(HD_KPASS u, c) * HD_PRM(box).w;
+}
+
 HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
 {
     int i = py * HD_PRM(image).x + px;
@@ -120,6 +135,13 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         p = hdk_madd(p, d, t);
         c = hdk_tf(HD_KPASS hdk_sample_value(HD_KPASS hdk_world_to_tex(HD_KPASS p)));
         wr *= albedo * c.x; wg *= albedo * c.y; wb *= albedo * c.z;
+        if (vertices + 1 == HD_PRM(image).w) { /* the path ends into HD's light */
+            hd_v3 u = hdk_world_to_tex(HD_KPASS p);
+            lr += wr * hdk_cache_rgb(HD_KPASS u, 0);
+            lg += wg * hdk_cache_rgb(HD_KPASS u, 1);
+            lb += wb * hdk_cache_rgb(HD_KPASS u, 2);
+            break;
+        }
         /* next-event estimation toward one light */
         l = hdk_mini(HD_I(hdk_rand(key, dim) * HD_F(nl)), nl - 1);
         dim += 1u;

@@ -31,6 +31,9 @@ HD_FN float hdk_sample_light(HD_KARGS hd_v3 u, int c)
         return d0 + wz * (d1 - d0);
     }
 #endif
+#ifdef HD_LIGHT_SUM_ONLY
+    return 0.0f; /* not reached: the backend's summed light is always there, and no stage loads E or phi here */
+#else
     float v000 = HD_GET(E, r00 + x0, x0, y0, za) + HD_GET(phi, r00 + x0, x0, y0, za);
     float v100 = HD_GET(E, r00 + x1, x1, y0, za) + HD_GET(phi, r00 + x1, x1, y0, za);
     float v010 = HD_GET(E, r10 + x0, x0, y1, za) + HD_GET(phi, r10 + x0, x0, y1, za);
@@ -43,6 +46,7 @@ HD_FN float hdk_sample_light(HD_KARGS hd_v3 u, int c)
     float c01 = v001 + wx * (v101 - v001), c11 = v011 + wx * (v111 - v011);
     float c0 = c00 + wy * (c10 - c00), c1 = c01 + wy * (c11 - c01);
     return c0 + wz * (c1 - c0);
+#endif
 }
 #endif
 
