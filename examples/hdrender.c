@@ -116,6 +116,12 @@ static const char *usage_text_method =
     "                          " HDR_MAX_LIGHT " iterations, CD at least 200, then project\n"
     "                          --frame-window frames);\n"
     "                          pt_ss, pt_ms: paths per pixel (default 256)\n"
+    "  --budget SECONDS        render for this wall time (0.01..86400) instead: hd_render\n"
+    "                          calls with hd, cd the light, HD's frames, then the resting\n"
+    "                          view's refinement toward PT_MS (params.rest HD_REST_REFINE);\n"
+    "                          pt_ss, pt_ms: paths until the time is spent\n"
+    "  --refine-bounces K      --budget: the vertex at which refinement paths read HD's light\n"
+    "                          (default 2; -1: never, unbiased PT_MS paths)\n"
     "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
     "                          as converged (default 0.1)\n"
     "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"
@@ -592,6 +598,30 @@ static void render_frames(hd_context ctx, log_state *ls, int window_given, hd_st
     free(cur);
 }
 
+/* --budget: hd_render until `seconds` of wall time since t0 are spent, each call given the time
+   left (params.render_budget, at most the library's 10 s) so that it refines the light, projects
+   or traces within it; the library's schedule picks the work (light, HD's frames, then the
+   resting view's refinement, params.rest). A call that would end past the time is not made. */
+static void render_budget(hd_context ctx, log_state *ls, double seconds, double t0, hd_stats *stats)
+{
+    hd_desc desc;
+    hd_result r;
+    double last = 0.0;
+    if ((r = hd_query_desc(ctx, &desc)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_query_desc", NULL);
+    for (;;) {
+        double ts = now_seconds(), left = seconds - (ts - t0);
+        if (left <= 0.0 || (last > 0.0 && last > left)) break;
+        desc.params.render_budget = (float)(left > 10.0 ? 10.0 : left);
+        ls->last[0] = 0;
+        if ((r = hd_set_params(ctx, &desc.params)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_set_params", NULL);
+        if ((r = hd_render(ctx)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_render", NULL);
+        last = now_seconds() - ts;
+        if (!g_quiet && isatty(2)) fprintf(stderr, "\r  %.1f / %.1f s ", now_seconds() - t0, seconds);
+    }
+    if (!g_quiet && isatty(2)) fputc('\n', stderr);
+    hd_get_stats(ctx, stats);
+}
+
 /* ---- backends -------------------------------------------------------------------------------- */
 static const char *const backend_names[] = {"cpu", "opencl", "vulkan", "gl"};
 
@@ -707,6 +737,7 @@ int main(int argc, char **argv)
     const char *input = NULL, *raw = NULL, *out_path = DEFAULT_OUTPUT, *tf_arg = NULL;
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
     int print_tf = 0, i, k, have_spacing = 0, camera_given = 0, min_light = 0, crop_given = 0, window_given = 0;
+    double budget = 0.0; /* --budget: seconds of wall time, 0: the iteration schedule */
     double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -853,6 +884,11 @@ int main(int argc, char **argv)
             desc.params.light_tolerance = parse_float(a, VAL(), 0.0f, 10.0f, 1, 0);
         } else if (IS("--iterations")) {
             iterations = (int)parse_int(a, VAL(), 1, 1000000);
+        } else if (IS("--budget")) {
+            budget = parse_float(a, VAL(), 0.01f, 86400.0f, 0, 0);
+        } else if (IS("--refine-bounces")) {
+            desc.params.refine_bounces = (int)parse_int(a, VAL(), -1, 100000);
+            if (desc.params.refine_bounces == 0) fail(2, "--refine-bounces: 0 is not -1 or 1..100000");
         } else if (IS("--extinction")) {
             desc.params.extinction = parse_float(a, VAL(), 0.0f, 1e6f, 1, 0);
         } else if (IS("--albedo")) {
@@ -932,7 +968,9 @@ int main(int argc, char **argv)
     if (light_count && lights_n) fail(2, "give either --light (one or more) or --lights N");
 
     pt = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS;
-    if (!iterations && pt) iterations = 256;
+    if (budget > 0.0 && iterations) fail(2, "give either --budget or --iterations, not both");
+    if (budget > 0.0) desc.params.rest = HD_REST_REFINE;
+    if (!iterations && pt && budget <= 0.0) iterations = 256;
     /* CD's multiple scattering spreads one cell per sweep: its convergence estimate settles
        (about 100 iterations on the head CT) long before the light has reached the far side,
        and the image is nearly black below about 200 */
@@ -1019,7 +1057,10 @@ int main(int argc, char **argv)
     hd_volume_free(&vol);
 
     t0 = now_seconds();
-    if (!iterations) {
+    if (budget > 0.0) {
+        render_budget(ctx, &ls, budget, t0, &stats);
+        done = iterations = (int)stats.iterations;
+    } else if (!iterations) {
         /* the single-view schedule: light without frames until it converges, then the frames */
         int max_light = atoi(HDR_MAX_LIGHT);
         while (done < max_light) {
@@ -1081,12 +1122,16 @@ int main(int argc, char **argv)
     if (!hdx_png_write(out_path, desc.camera.width, desc.camera.height, 3, rgb, desc.camera.width * 3, err,
                        sizeof err))
         fail(1, "cannot write %s: %s", out_path, err);
-    if (!g_quiet && hd_get_stats(ctx, &stats) == HD_SUCCESS)
-        fprintf(stderr, "hdrender: %d iteration%s, %d frame%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
+    if (!g_quiet && hd_get_stats(ctx, &stats) == HD_SUCCESS) {
+        char refined[64] = "";
+        if (stats.refine_paths)
+            snprintf(refined, sizeof refined, ", %llu refinement paths/pixel", (unsigned long long)stats.refine_paths);
+        fprintf(stderr, "hdrender: %d iteration%s, %d frame%s%s in %.2f s (%.2f it/s; direct %.2f s, diffusion "
                 "%.2f s, projection %.2f s) -> %s\n", iterations, iterations == 1 ? "" : "s",
-                (int)stats.frames, stats.frames == 1 ? "" : "s", t_end - t0,
+                (int)stats.frames, stats.frames == 1 ? "" : "s", refined, t_end - t0,
                 iterations / (t_end - t0), stats.seconds_direct, stats.seconds_diffusion,
                 stats.seconds_projection, out_path);
+    }
     free(rgba);
     free(rgb);
     hd_destroy(ctx);
