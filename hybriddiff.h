@@ -486,9 +486,11 @@ typedef struct hd_params {
                                HD's frame, as with HOLD. hd_stats.refine_paths counts them */
     int refine_bounces;     /* HD_REST_REFINE: the vertex at which a refinement path ends into HD's
                                light ((E + phi) / 4 pi there); the vertices before it track toward
-                               the lights and scatter as PT_MS's do. 0 -> 2 (one bounce, then HD's
-                               light: a final gather); -1: never, the paths are PT_MS's (unbiased,
-                               slower to converge); else 1..100000 */
+                               the lights and scatter as PT_MS's do. 0 -> -1: never, the paths are
+                               PT_MS's and the image tends to PT_MS's (unbiased); K in 1..100000
+                               (2: a final gather) converges faster to an image that keeps part of
+                               HD's bias (on the head CT 2 and 3 lose to -1 from 1 s on:
+                               docs/DESIGN-REFINE.md) */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -618,7 +620,7 @@ HDDEF hd_result hd_query_desc(hd_context ctx, hd_desc *out_desc);
      hd_update_volume                          -> the box's majorant cells; E, phi warm; image
      volume transform                          -> E, phi reset, image
      camera, depth, step, background,
-     frame_window                              -> image only (E and phi are kept)
+     frame_window, rest, refine_bounces        -> image only (E and phi are kept)
      method                                    -> the new method starts from scratch
      illumination_downsample, rgb_scattering,
      illumination_precision                    -> E, phi, image (new grids)
@@ -687,7 +689,9 @@ HDDEF hd_result hd_refine(hd_context ctx, int n);
              params.render_budget seconds allow), then one projection frame from the current E
              and phi into the image's running mean. Once the light has converged, no light work:
              the projection alone, and when the frame_window frames since the convergence are in
-             the image (it is done), nothing at all until a setter invalidates something.
+             the image (it is done), nothing at all until a setter invalidates something; with
+             params.rest HD_REST_REFINE, refinement passes toward PT_MS instead (one, or as many
+             as render_budget allows), until the next change.
      PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
    A camera move (hd_set_camera) keeps converged light: the next call projects at once. For a
    frame budget below one projection's time, params.render_scale projects at reduced resolution

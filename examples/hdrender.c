@@ -121,7 +121,7 @@ static const char *usage_text_method =
     "                          view's refinement toward PT_MS (params.rest HD_REST_REFINE);\n"
     "                          pt_ss, pt_ms: paths until the time is spent\n"
     "  --refine-bounces K      --budget: the vertex at which refinement paths read HD's light\n"
-    "                          (default 2; -1: never, unbiased PT_MS paths)\n"
+    "                          (default -1: never, unbiased PT_MS paths; 2: a final gather)\n"
     "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
     "                          as converged (default 0.1)\n"
     "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"

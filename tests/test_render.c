@@ -665,7 +665,7 @@ static void test_render_refine_rest(void)
     CHECK(hd_get_stats(ref, &c) == HD_SUCCESS && c.refine_paths == 5);
     CHECK(hd_query_desc(ref, &d) == HD_SUCCESS);
     p = d.params;
-    CHECK(p.rest == HD_REST_REFINE && p.refine_bounces == 2); /* the defaults filled in */
+    CHECK(p.rest == HD_REST_REFINE && p.refine_bounces == -1); /* the default filled in */
     p.refine_bounces = 3;
     CHECK(hd_set_params(ref, &p) == HD_SUCCESS && hd_render(ref) == HD_SUCCESS);
     CHECK(hd_get_stats(ref, &c) == HD_SUCCESS && c.refine_paths == 0 && c.frames == 1);
@@ -763,7 +763,7 @@ static void test_render_refine_bad_input(void)
         p.rest = (hd_rest)bad_rest[i];
         CHECK(hd_set_params(ctx, &p) == HD_ERROR_INVALID_ENUM && log.errors == 4 + i && strstr(log.last, "params.rest"));
     }
-    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS && d.params.rest == HD_REST_HOLD && d.params.refine_bounces == 2);
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS && d.params.rest == HD_REST_HOLD && d.params.refine_bounces == -1);
     make_desc(&d, &log); /* a fresh log */
     d.params.refine_bounces = -2;
     {
