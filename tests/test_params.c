@@ -44,6 +44,8 @@ static int param_change(const char *name, hd_params *p)
     F(crop_max, p->crop_max[2] = 0.7f)
     F(render_scale, p->render_scale = 2)
     F(light_window, p->light_window = 3)
+    F(rest, p->rest = HD_REST_REFINE)
+    F(refine_bounces, p->refine_bounces = 2)
 #undef F
     return 0;
 }
