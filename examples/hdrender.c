@@ -601,21 +601,20 @@ static void render_frames(hd_context ctx, log_state *ls, int window_given, hd_st
 /* --budget: hd_render until `seconds` of wall time since t0 are spent, each call given the time
    left (params.render_budget, at most the library's 10 s) so that it refines the light, projects
    or traces within it; the library's schedule picks the work (light, HD's frames, then the
-   resting view's refinement, params.rest). A call that would end past the time is not made. */
+   resting view's refinement, params.rest). Each call does at least one pass of its work, so the
+   time may be passed by one light iteration, frame or refinement pass. */
 static void render_budget(hd_context ctx, log_state *ls, double seconds, double t0, hd_stats *stats)
 {
     hd_desc desc;
     hd_result r;
-    double last = 0.0;
     if ((r = hd_query_desc(ctx, &desc)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_query_desc", NULL);
     for (;;) {
         double ts = now_seconds(), left = seconds - (ts - t0);
-        if (left <= 0.0 || (last > 0.0 && last > left)) break;
+        if (left <= 0.005) break;
         desc.params.render_budget = (float)(left > 10.0 ? 10.0 : left);
         ls->last[0] = 0;
         if ((r = hd_set_params(ctx, &desc.params)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_set_params", NULL);
         if ((r = hd_render(ctx)) != HD_SUCCESS) fail_lib(1, ls, r, "hd_render", NULL);
-        last = now_seconds() - ts;
         if (!g_quiet && isatty(2)) fprintf(stderr, "\r  %.1f / %.1f s ", now_seconds() - t0, seconds);
     }
     if (!g_quiet && isatty(2)) fputc('\n', stderr);
