@@ -149,7 +149,8 @@ extern "C" {
     X(HD_ERROR_OUTPUT_OUTSIDE_TARGET, "the output region does not lie inside the target") \
     X(HD_ERROR_OUTPUT_SIZE, "the output region's size is not the camera's (the image is written 1:1)") \
     X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format") \
-    X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)")
+    X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)") \
+    X(HD_ERROR_INVALID_ENVIRONMENT, "an environment map texel, rotation or intensity is invalid")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -261,6 +262,7 @@ typedef enum hd_illumination {
 #define HD_LOAD_OPTIONS_INIT HD_ZERO_INIT
 #define HD_DEPTH_DESC_INIT HD_ZERO_INIT
 #define HD_VOLUME_UPDATE_INIT HD_ZERO_INIT
+#define HD_ENVIRONMENT_INIT HD_ZERO_INIT
 
 /* ---- callbacks ------------------------------------------------------------------------------ */
 /* Silent unless a logger is given. hd_log_stderr is a ready one. */
@@ -344,6 +346,24 @@ typedef struct hd_light {
                            HD_MAX_LIGHT_POWER */
     int inverse_square; /* POINT: 1 = intensity / r^2 falloff (r in world units), 0 = none */
 } hd_light;
+
+/* An environment: light arriving from every direction at infinity, given as an equirectangular
+   (latitude-longitude) map of linear RGB radiance. Set by its own call (hd_set_environment), not
+   as a hd_light type: the map is a large image copied once and turned into sampling tables
+   once, where hd_set_lights is cheap enough to call every frame, and a context holds at most
+   one. Map texel (i, j), row j from the top, is the radiance arriving from the map direction
+   theta = pi (j + 0.5) / height from +y (the top row looks up), phi = 2 pi (i + 0.5) / width,
+   dir = (sin theta cos phi, cos theta, sin theta sin phi): the left edge looks along +x, a
+   quarter of the width along +z, the centre along -x. */
+typedef struct hd_environment {
+    int width, height;   /* 1..HD_MAX_ENVIRONMENT_DIM each */
+    const float *rgb;    /* width * height * 3 floats, rows top first, each finite and >= 0; copied */
+    float rotation[9];   /* map to world directions, row-major 3x3 (world = R * map): a rotation
+                            (orthonormal within 1e-3, determinant +1); all zero: the identity */
+    float intensity;     /* >= 0; 0 -> 1. intensity * the largest texel component counts toward
+                            HD_MAX_LIGHT_POWER with the lights */
+} hd_environment;
+#define HD_MAX_ENVIRONMENT_DIM 8192
 
 /* How a projection's NDC z maps to the depth buffer's values (hd_set_depth) and which end is
    near: the convention the host renders its scene with. */
@@ -654,6 +674,24 @@ HDDEF hd_result hd_set_volume_transform(hd_context ctx, const float transform[16
    a nonzero size), HD_ERROR_INVALID_DEPTH (a NaN, infinite or out-of-[0, 1] value); each logs
    one line and changes nothing. Invalidates the image only (the light is kept). */
 HDDEF hd_result hd_set_depth(hd_context ctx, const hd_depth_desc *depth);
+
+/* The environment light (hd_environment; NULL: none), copied; with it the scene's lights are
+   the hd_set_lights list plus the environment, and hd_set_lights may then give count 0 (the
+   environment alone). Each HD iteration samples, per voxel, one of them uniformly; the
+   environment's direction is drawn from a piecewise-constant distribution over the map
+   (texel radiance times sin theta, built once here, 16 bytes of tables and radiance per map
+   texel on the device), the transmittance tracked to the box's edge, the sample weighted by
+   radiance over pdf. PT_SS and PT_MS sample it by next-event estimation, and PT_MS's scattered
+   paths that leave the box see it, the two combined by multiple importance sampling (balance
+   heuristic). HD_METHOD_CD, one light volume per light, cannot hold it (HD_ERROR_UNSUPPORTED,
+   also from hd_set_params choosing CD while one is set). Errors, each with one logged line and
+   nothing changed: HD_ERROR_INVALID_DIMENSIONS (a size outside 1..HD_MAX_ENVIRONMENT_DIM),
+   HD_ERROR_NULL_POINTER (rgb NULL), HD_ERROR_INVALID_ENVIRONMENT (a NaN, infinite or negative
+   texel, a rotation that is not one, a NaN, infinite or negative intensity),
+   HD_ERROR_INVALID_LIGHT (the power above HD_MAX_LIGHT_POWER), HD_ERROR_NO_LIGHTS (clearing the
+   environment while the light list is empty), HD_ERROR_OUT_OF_MEMORY. Invalidates E and phi
+   (warm start, as hd_set_lights) and the image. */
+HDDEF hd_result hd_set_environment(hd_context ctx, const hd_environment *env);
 
 /* New voxels for the whole volume or a box of it, same type and dims, without a new context (an
    animated or simulated volume, a time series). The core's copy, the majorant grid and the

@@ -10,7 +10,8 @@
    projection's E + phi (always r32f); storage buffers 0 TF, 1 majorants, 2 image accumulation,
    4 the direct light's list of voxels (src/hd_direct_mask.h, hd__direct_mask; hd_pc.x its length in the
    direct stage), 5 the projection's TF table (hd_pc.x its entries in the projection stage), 6 the
-   host's depth buffer (hd_set_depth; the projection and the path tracers). GL has no push
+   host's depth buffer (hd_set_depth; the projection and the path tracers), 7 the environment's
+   tables (hd_set_environment; the direct light and the path tracers). GL has no push
    constants: hd_pc (x = red-black parity, y = Jacobi, z = light, w = first) is the plain
    uniform at location 0. HD_ILLUM_R16F (hd_gl.h's prefix for params.illumination_precision
    FLOAT16): E, phi and phi2 are r16f (GL_R16F textures, core in GL 4.3), converted by imageLoad /
@@ -37,6 +38,7 @@ layout(binding = 6, r32f) uniform image3D hd_i_lv2;
 layout(binding = 7, r32f) uniform image3D hd_i_lsum;
 layout(std430, binding = 5) readonly buffer hd_b_ptab { float ptab[]; };
 layout(std430, binding = 6) readonly buffer hd_b_dep { float dep[]; };
+layout(std430, binding = 7) readonly buffer hd_b_env { float env[]; };
 layout(location = 0) uniform ivec4 hd_pc;
 #define HD_GET(buf, i, px, py, pz) imageLoad(hd_i_##buf, ivec3((px), (py), (pz))).r
 #define HD_SET(buf, i, px, py, pz, v) imageStore(hd_i_##buf, ivec3((px), (py), (pz)), vec4(HD_STV_##buf(v), 0.0f, 0.0f, 0.0f))

@@ -25,7 +25,8 @@
    Binding 12: the direct light's list of voxels (src/hd_direct_mask.h, hd__direct_mask); the direct
    stage's push constant x is its length. Binding 13: the projection's TF table (the projection
    stage's push constant x is its entries); 14: the projection's E + phi, r32f at any precision;
-   15: the host's depth buffer (hd_set_depth; the projection and the path tracers). */
+   15: the host's depth buffer (hd_set_depth; the projection and the path tracers); 16: the
+   environment's tables (hd_set_environment; the direct light and the path tracers). */
 #define HD_GLSL_CUSTOM_BUFFERS 1
 #extension GL_EXT_control_flow_attributes : require
 #define HD_UNROLL [[unroll]] /* loops over a block (hd_entry_glsl.h): unrolled, their arrays registers */
@@ -50,6 +51,7 @@ layout(std430, binding = 12) readonly buffer hd_b_dl { uint dl[]; };
 layout(std430, binding = 13) readonly buffer hd_b_ptab { float ptab[]; };
 layout(binding = 14, r32f) uniform image3D hd_i_lsum;
 layout(std430, binding = 15) readonly buffer hd_b_dep { float dep[]; };
+layout(std430, binding = 16) readonly buffer hd_b_env { float env[]; };
 layout(push_constant) uniform hd_push_block { ivec4 hd_pc; };
 layout(constant_id = 0) const int hd_sc_flags = 0;
 layout(constant_id = 1) const int hd_sc_zk = 1;

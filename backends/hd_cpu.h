@@ -260,6 +260,13 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* The direct light and the path tracers read the core's environment tables in place. */
+static hd_result hd__be_upload_env(const hd__view *vw)
+{
+    vw->be->k.env = vw->env;
+    return HD_SUCCESS;
+}
+
 /* hd_update_volume: the kernels read vw->vol and vw->majorant in place, so the core's copy is
    already the backend's. */
 static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)

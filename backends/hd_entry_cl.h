@@ -9,7 +9,7 @@
     __global float *restrict img
 #define HD__CL_KCTX hd__kctx k; \
     k.p = p; k.vol = vol; k.tf = tf; k.maj = maj; k.sig = sig; k.E = E; k.phi = phi; \
-    k.phi2 = phi2; k.img = img; k.lsum = 0; k.ptab = 0; k.ptab_n = 0; k.dep = 0; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
+    k.phi2 = phi2; k.img = img; k.lsum = 0; k.ptab = 0; k.ptab_n = 0; k.dep = 0; k.env = 0; k.lv = 0; k.lv2 = 0; k.flags = p->counts.z; \
     k.hx = (p->gdims.x + 1) >> 1; k.gy = p->gdims.y; k.cx = 0; k.cp = 0; k.cid = 0; \
     k.Eh = (__global half *)E; k.phih = (__global half *)phi; k.phi2h = (__global half *)phi2; k.f16 = 0
 
@@ -28,10 +28,11 @@ __kernel void hd_k_classify(HD__CL_BUFFERS)
 /* Each stage that touches E or phi has a twin with a _half suffix whose k.f16 is the literal 1:
    binary16 storage (params.illumination_precision), float32 arithmetic. */
 #define HD__CL_DIRECT(name, is16) \
-    __kernel void name(HD__CL_BUFFERS, __global const uint *restrict list, int count) \
+    __kernel void name(HD__CL_BUFFERS, __global const uint *restrict list, int count, __global const float *restrict env) \
     { \
         HD__CL_KCTX; \
         k.f16 = (is16); \
+        k.env = env; \
         if ((int)get_global_id(0) < count) hdk_direct_index(&k, (int)list[get_global_id(0)]); \
     }
 HD__CL_DIRECT(hd_k_direct, 0)
@@ -123,12 +124,15 @@ HD__CL_SUM_LIGHT(hd_k_sum_light_half, 1)
 
 /* PT_SS / PT_MS: one path per pixel (x, y); dep: the host's depth buffer (a placeholder while
    depth_dims.z is 0); lsum: HD's summed light, read by a resting view's refinement (image.w > 0,
-   hd_k_path.h; unread, and possibly null, otherwise). */
-__kernel void hd_k_path(HD__CL_BUFFERS, __global const float *restrict dep, __global const float *restrict lsum)
+   hd_k_path.h; unread, and possibly null, otherwise); env the environment's tables (a
+   placeholder while env.x is 0). */
+__kernel void hd_k_path(HD__CL_BUFFERS, __global const float *restrict dep, __global const float *restrict lsum,
+                        __global const float *restrict env)
 {
     HD__CL_KCTX;
     k.dep = dep;
     k.lsum = lsum;
+    k.env = env;
     hdk_path_pixel(&k, (int)get_global_id(0), (int)get_global_id(1));
 }
 

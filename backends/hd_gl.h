@@ -129,8 +129,9 @@ static int hd__gl_diffuse_slot(int counts_z)
 #define HD__GL_DIFFUSE_ZK 4
 #define HD__GL_DIFFUSE_YK 2
 #define HD__GL_IMAGE_UNITS 8 /* hd_bind_gl_glsl.h: image units 0..7, GL 4.3's minimum */
-#define HD__GL_SSBOS 7       /* storage buffers 0..6 (3: multigrid's row sums, 4: the direct light's list,
-                                5: the projection's TF table, 6: the host's depth buffer) */
+#define HD__GL_SSBOS 8       /* storage buffers 0..7 (3: multigrid's row sums, 4: the direct light's list,
+                                5: the projection's TF table, 6: the host's depth buffer, 7: the
+                                environment's tables), GL 4.3's minimum */
 
 typedef struct hd__gl_tex {
     GLuint name;
@@ -188,6 +189,7 @@ struct hd__backend {
     GLuint tf, maj, img, dummy_buffer;
     GLuint dl;                  /* the direct light's list of voxels (vw->dl_idx), storage buffer 4 */
     GLuint dep;                 /* the host's depth buffer (vw->depth), storage buffer 6; 0: none */
+    GLuint env;                 /* the environment's tables (vw->env), storage buffer 7; 0: none */
     hd__gl_tex vol, sig, E, phi, phi2, dummy, dummy16;
     hd__gl_tex lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + a spare at lv[gg.nlv] */
     /* the projection's own inputs (hd__gl_project_prepare): E + phi (image unit 7), valid while
@@ -610,6 +612,7 @@ static hd_result hd__gl_run(const hd__view *vw, GLuint prog, const char *what, c
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, be->dl ? be->dl : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 5, be->ptab ? be->ptab : be->dummy_buffer);
     be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, be->dep ? be->dep : be->dummy_buffer);
+    be->gl.BindBufferBase(GL_SHADER_STORAGE_BUFFER, 7, be->env ? be->env : be->dummy_buffer);
     for (i = 0; i < HD__GL_IMAGE_UNITS; ++i)
         hd__gl_bind_image(be, (GLuint)i, b->img[i], i == 0 || i == 5 ? GL_READ_ONLY : GL_READ_WRITE, b->half && i >= 2 && i <= 4);
     be->gl.DispatchCompute((GLuint)((nx + HD__GL_LOCAL_X - 1) / HD__GL_LOCAL_X), (GLuint)ny, (GLuint)nz);
@@ -736,6 +739,7 @@ static void hd__be_destroy(hd__view *vw)
         hd__gl_free_buffer(be, &be->params); hd__gl_free_buffer(be, &be->tf); hd__gl_free_buffer(be, &be->maj);
         hd__gl_free_buffer(be, &be->img); hd__gl_free_buffer(be, &be->dummy_buffer);
         hd__gl_free_buffer(be, &be->dl); hd__gl_free_buffer(be, &be->ptab); hd__gl_free_buffer(be, &be->dep);
+        hd__gl_free_buffer(be, &be->env);
         hd__gl_free_buffer(be, &be->otab); hd__gl_free_buffer(be, &be->obuf);
         hd__gl_free_tex(be, &be->vol); hd__gl_free_tex(be, &be->dummy); hd__gl_free_tex(be, &be->dummy16);
         hd__be_end(vw, HD_SUCCESS);
@@ -911,6 +915,16 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     }
     return hd__gl_buffer_data(vw, &vw->be->dep, (size_t)vw->depth_w * vw->depth_h * sizeof(float), vw->depth, GL_DYNAMIC_DRAW,
                               "the depth buffer");
+}
+
+/* The environment's tables into storage buffer 7 (freed without them). */
+static hd_result hd__be_upload_env(const hd__view *vw)
+{
+    if (!vw->env) {
+        hd__gl_free_buffer(vw->be, &vw->be->env);
+        return HD_SUCCESS;
+    }
+    return hd__gl_buffer_data(vw, &vw->be->env, vw->env_floats * sizeof(float), vw->env, GL_STATIC_DRAW, "the environment's tables");
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */

@@ -10,7 +10,7 @@
 #define HD__NULL_PRIMITIVES(X) \
     X(upload_inputs) X(update_volume) X(alloc_illumination) X(alloc_jacobi) X(alloc_image) X(alloc_lights) X(clear) \
     X(classify) X(direct) X(direct_list) X(diffuse) X(diffuse_sweeps) X(convect) X(sum_lights) \
-    X(project) X(upsample) X(path) X(upload_depth) X(read_image) X(read_illumination) X(mg_begin) X(mg_end) \
+    X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
     X(mg_extrapolate) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
@@ -78,6 +78,7 @@ static hd_result hd__be_end(const hd__view *vw, hd_result r)
 
 static hd_result hd__be_upload_inputs(const hd__view *vw) { hd__null_call(vw, HD__NULL_upload_inputs); return HD_SUCCESS; }
 static hd_result hd__be_upload_depth(const hd__view *vw) { hd__null_call(vw, HD__NULL_upload_depth); return HD_SUCCESS; }
+static hd_result hd__be_upload_env(const hd__view *vw) { hd__null_call(vw, HD__NULL_upload_env); return HD_SUCCESS; }
 static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
 {
     (void)vox; (void)cells;

@@ -84,6 +84,8 @@ struct hd__backend {
     cl_mem dep;              /* the host's depth buffer (vw->depth; a placeholder without one): the
                                 projection's argument 12, the path kernel's 9 */
     size_t dep_floats;       /* what dep holds (0: the placeholder) */
+    cl_mem env;              /* the environment's tables (vw->env; a placeholder without one): the
+                                direct kernels' argument 11, the path kernel's 10 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
        gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (ptab_n
@@ -388,6 +390,7 @@ static void hd__be_destroy(hd__view *vw)
     hd__gpu_free(vw, &be->gg);
     hd__cl_release(&be->params); hd__cl_release(&be->vol); hd__cl_release(&be->tf); hd__cl_release(&be->maj);
     hd__cl_release(&be->img); hd__cl_release(&be->dl); hd__cl_release(&be->ptab); hd__cl_release(&be->dep);
+    hd__cl_release(&be->env);
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k)
         if (be->kernels[k]) clReleaseKernel(be->kernels[k]);
     if (be->program) clReleaseProgram(be->program);
@@ -659,6 +662,13 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* The environment's tables into env, made anew (a 16-byte placeholder without them). */
+static hd_result hd__be_upload_env(const hd__view *vw)
+{
+    hd__cl_release(&vw->be->env);
+    return hd__cl_buffer(vw, &vw->be->env, vw->env_floats * sizeof(float), vw->env, "the environment's tables");
+}
+
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {
@@ -673,7 +683,8 @@ static hd_result hd__be_direct(const hd__view *vw)
     cl_int count = (cl_int)vw->dl_count;
     vw->be->gg.lsum_ok = 0;
     HD__CL_ARG(vw, k, 10, count);
-    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(vw, k, 1, vw->dl_count, 1, 1)) != HD_SUCCESS)
+    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 11, 1, vw->be->env)) != HD_SUCCESS ||
+        (r = hd__cl_bind_run(vw, k, 1, vw->dl_count, 1, 1)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);
 }
@@ -873,7 +884,7 @@ static hd_result hd__be_sum_lights(const hd__view *vw)
 /* One path per pixel, folded into the image with weight march.y. */
 static hd_result hd__be_path(const hd__view *vw)
 {
-    hd_result r = hd__cl_mems(vw, HD__CL_PATH, 9, 2, vw->be->dep, vw->be->lsum);
+    hd_result r = hd__cl_mems(vw, HD__CL_PATH, 9, 3, vw->be->dep, vw->be->lsum, vw->be->env);
     if (r == HD_SUCCESS) r = hd__cl_bind_run(vw, HD__CL_PATH, 2, (size_t)vw->kp.image.x, (size_t)vw->kp.image.y, 1);
     return r != HD_SUCCESS ? r : hd__cl_finish(vw);
 }

@@ -158,6 +158,7 @@ typedef struct hd__kctx {
     const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries (NULL: TF and exp) */
     int ptab_n;
     const float *dep;  /* the host's depth buffer, depth_dims.x * y window depths (hd_set_depth) */
+    const float *env;  /* the environment's tables (hd_set_environment, hd_k_light.h) */
     const float *lv;   /* CD: the light volume being read (one light's rho) */
     float *lv2;        /* CD: the light volume being written (ping-pong) */
 } hd__kctx;

@@ -116,6 +116,7 @@ typedef struct hd__kctx {
     __global const float *ptab; /* projection: the step's TF table, ptab_n RGBA entries */
     int ptab_n;
     __global const float *dep;  /* the host's depth buffer (hd_set_depth; projection and paths) */
+    __global const float *env;  /* the environment's tables (hd_set_environment; direct light and paths) */
     __global const float *lv;   /* CD: the light volume being read */
     __global float *lv2;        /* CD: the light volume being written */
     int flags;                  /* what the diffusion reads as HD_DIFFUSE_FLAGS */

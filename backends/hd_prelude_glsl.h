@@ -99,6 +99,7 @@ layout(std430, binding = 9) readonly buffer hd_b_lv { float lv[]; };
 layout(std430, binding = 10) buffer hd_b_lv2 { float lv2[]; };
 layout(std430, binding = 12) readonly buffer hd_b_dl { uint dl[]; };
 layout(std430, binding = 15) readonly buffer hd_b_dep { float dep[]; };
+layout(std430, binding = 16) readonly buffer hd_b_env { float env[]; };
 #define HD_GET(buf, i, x, y, z) buf[(i)]
 #define HD_SET(buf, i, x, y, z, v) buf[(i)] = (v)
 #define HD_GET1(buf, i) buf[(i)]

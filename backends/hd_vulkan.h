@@ -107,7 +107,7 @@ enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CO
                                      (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
 #define HD__VK_DIFFUSE_ZK 4 /* slices of the block each diffusion invocation relaxes (hd_sc_zk; docs/DESIGN-VULKAN.md) */
 #define HD__VK_DIFFUSE_YK 2 /* its rows (hd_sc_yk) */
-#define HD__VK_BINDINGS 16
+#define HD__VK_BINDINGS 17
 
 typedef struct hd__vk_buffer {
     VkBuffer buffer;
@@ -196,6 +196,7 @@ struct hd__backend {
     hd__vk_buffer dl;             /* the direct light's list of voxels (vw->dl_idx), binding 12 */
     hd__vk_buffer dep;            /* the host's depth buffer (vw->depth), binding 15; none: the placeholder */
     size_t dep_floats;            /* what dep holds */
+    hd__vk_buffer env;            /* the environment's tables (vw->env), binding 16; none: the placeholder */
     hd__vk_image vol, sig, E, phi, phi2, dummy, dummy16;
     const char *no_half;          /* why r16f storage images are missing, or NULL */
     const char *no_f64;           /* why shaderFloat64 (HD_SOLVER_MULTIGRID) is missing, or NULL */
@@ -1053,7 +1054,7 @@ static hd_result hd__vk_layouts(const hd__view *vw, const VkDescriptorType *type
 }
 
 /* A descriptor pool for `sets` sets of the backend's set layout (hd__vk_pipelines' types: per set
-   1 dynamic uniform buffer, 8 storage images, 7 storage buffers): the backend's sets and the
+   1 dynamic uniform buffer, 8 storage images, 8 storage buffers): the backend's sets and the
    multigrid's (HD_SOLVER_MULTIGRID) each have one. */
 static hd_result hd__vk_pool(const hd__view *vw, uint32_t sets, VkDescriptorPool *pool)
 {
@@ -1062,7 +1063,7 @@ static hd_result hd__vk_pool(const hd__view *vw, uint32_t sets, VkDescriptorPool
     VkDescriptorPoolCreateInfo dpci;
     ps[0].type = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER_DYNAMIC; ps[0].descriptorCount = sets;
     ps[1].type = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE; ps[1].descriptorCount = 8 * sets;
-    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 7 * sets;
+    ps[2].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER; ps[2].descriptorCount = 8 * sets;
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpci.maxSets = sets;
@@ -1106,16 +1107,16 @@ static hd_result hd__vk_pipelines(const hd__view *vw)
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER};
     hd_result r;
     int i;
     /* the set's storage buffers (TF, majorants, image, row sums, direct light's list, the
-       projection's TF table, the depth buffer) and storage images (volume, sigma_t, E, phi, phi2,
+       projection's TF table, the depth buffer, the environment's tables) and storage images (volume, sigma_t, E, phi, phi2,
        two light volumes, the projection's E + phi): above Vulkan's guaranteed minimum of 4 per
        stage each */
-    if (be->limits.maxPerStageDescriptorStorageBuffers < 7 || be->limits.maxPerStageDescriptorStorageImages < 8)
+    if (be->limits.maxPerStageDescriptorStorageBuffers < 8 || be->limits.maxPerStageDescriptorStorageImages < 8)
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED,
-                       "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 7 and 8 needed",
+                       "vulkan: the device binds %u storage buffers and %u storage images per shader stage; 8 and 8 needed",
                        be->limits.maxPerStageDescriptorStorageBuffers, be->limits.maxPerStageDescriptorStorageImages);
     if ((r = hd__vk_layouts(vw, types, HD__VK_BINDINGS, 4 * sizeof(int32_t), &be->set_layout, &be->layout)) != HD_SUCCESS)
         return r;
@@ -1162,11 +1163,11 @@ static void hd__vk_write_set(const hd__view *vw, VkDescriptorSet set, const hd__
 
 /* The buffers every set binds (TF, majorants, image; binding 11, multigrid's row sums, a
    placeholder unless given; 12, the direct light's list; 13, the projection's TF table; 15, the
-   depth buffer's placeholder, which hd__vk_sets replaces) into bu. */
+   depth buffer's placeholder, which hd__vk_sets replaces; 16, the environment's tables) into bu. */
 static void hd__vk_common_buffers(hd__backend *be, const hd__vk_buffer **bu, const hd__vk_buffer *dot)
 {
     bu[2] = &be->tf; bu[3] = &be->maj; bu[8] = &be->img; bu[11] = dot ? dot : &be->dummy_buffer;
-    bu[12] = &be->dl; bu[13] = &be->ptab; bu[15] = &be->dummy_buffer;
+    bu[12] = &be->dl; bu[13] = &be->ptab; bu[15] = &be->dummy_buffer; bu[16] = &be->env;
 }
 
 /* The descriptor sets, rebuilt after any resource changed: set l binds CD's light l (and the
@@ -1301,6 +1302,7 @@ static void hd__be_destroy(hd__view *vw)
         hd__vk_free_buffer(vw, &be->params); hd__vk_free_buffer(vw, &be->tf); hd__vk_free_buffer(vw, &be->maj);
         hd__vk_free_buffer(vw, &be->img); hd__vk_free_buffer(vw, &be->staging); hd__vk_free_buffer(vw, &be->dummy_buffer);
         hd__vk_free_buffer(vw, &be->dl); hd__vk_free_buffer(vw, &be->ptab); hd__vk_free_buffer(vw, &be->dep);
+        hd__vk_free_buffer(vw, &be->env);
         hd__vk_free_buffer(vw, &be->otab); hd__vk_free_buffer(vw, &be->obuf);
         if (be->out_pipe) be->fn.vkDestroyPipeline(be->device, be->out_pipe, NULL);
         if (be->out_pool) be->fn.vkDestroyDescriptorPool(be->device, be->out_pool, NULL);
@@ -1643,6 +1645,23 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
         be->dep_floats = n;
     }
     memcpy(be->dep.map, vw->depth, n * sizeof(float));
+    return HD_SUCCESS;
+}
+
+/* The environment's tables (host-visible, binding 16), made anew; freed without them (the sets
+   then bind the placeholder). */
+static hd_result hd__be_upload_env(const hd__view *vw)
+{
+    hd__backend *be = vw->be;
+    hd_result r;
+    HD__VK_IDLE(vw);
+    hd__vk_free_buffer(vw, &be->env);
+    be->sets_valid = 0;
+    if (!vw->env) return HD_SUCCESS;
+    if ((r = hd__vk_buffer_create(vw, &be->env, vw->env_floats * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1,
+                                  "the environment's tables")) != HD_SUCCESS)
+        return r;
+    memcpy(be->env.map, vw->env, vw->env_floats * sizeof(float));
     return HD_SUCCESS;
 }
 

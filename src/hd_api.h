@@ -50,6 +50,7 @@ static void hd__ctx_free(hd__ctx *ctx)
     hd__free(&ctx->vw, ctx->vw.tf);
     hd__free(&ctx->vw, ctx->srgb);
     hd__free(&ctx->vw, ctx->vw.depth);
+    hd__free(&ctx->vw, ctx->vw.env);
     hd__free(&ctx->vw, ctx);
 }
 
@@ -76,7 +77,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     memset(&default_light, 0, sizeof default_light);
     default_light.direction[2] = -1.0f;
     if (!d.lights && d.light_count == 0) { d.lights = &default_light; d.light_count = 1; }
-    if ((r = hd__check_lights(d.lights, d.light_count, log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_lights(d.lights, d.light_count, -1.0, log)) != HD_SUCCESS) return r;
     hd__volume_box(&d.volume, box);
     if ((r = hd__xform_make(d.volume.transform, box, d.volume.dims, &xf, log)) != HD_SUCCESS) return r;
     hd__xform_box(&xf, box, kbox);
@@ -111,7 +112,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     hd__build_majorants(ctx);
     if ((r = hd__check_majorant(ctx, &ctx->vw.params)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
     hd__set_grid(ctx);
-    ctx->dirty = HD__DIRTY_ALL;
+    ctx->dirty = HD__DIRTY_ALL | HD__DIRTY_ENV; /* the environment's placeholder */
     if ((r = hd__be_create(&ctx->vw)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
 
     *out_ctx = hd__slot_take(ctx);
@@ -182,7 +183,7 @@ static hd_result hd__api_set_lights(hd__ctx *ctx, const hd_light *lights, int co
 {
     hd_result r;
     int channels_before;
-    if ((r = hd__check_lights(lights, count, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_lights(lights, count, ctx->env_on ? ctx->env_power : -1.0, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_lights_frame(lights, count, &ctx->xf, &ctx->vw.log)) != HD_SUCCESS) return r;
     channels_before = ctx->vw.channels;
     /* CD keeps one light volume per light: another count makes them anew */
@@ -195,6 +196,10 @@ static hd_result hd__api_set_lights(hd__ctx *ctx, const hd_light *lights, int co
 HDDEF hd_result hd_set_lights(hd_context h, const hd_light *lights, int count)
 {
     HD__GUARDED(h, "hd_set_lights", hd__api_set_lights(ctx, lights, count));
+}
+HDDEF hd_result hd_set_environment(hd_context h, const hd_environment *env)
+{
+    HD__GUARDED(h, "hd_set_environment", hd__api_set_environment(ctx, env));
 }
 
 static hd_result hd__api_set_camera(hd__ctx *ctx, const hd_camera *camera)
@@ -293,6 +298,8 @@ static hd_result hd__api_set_params(hd__ctx *ctx, const hd_params *params)
     hd__params_defaults(&p);
     if ((r = hd__check_params(&p, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
+    if (ctx->env_on && p.method == HD_METHOD_CD)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_params: method CD cannot hold the environment (one light volume per light); clear it first");
     ctx->dirty |= hd__params_dirty(&ctx->vw.params, &p);
     ctx->vw.params = p;
     hd__set_channels(ctx);

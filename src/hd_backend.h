@@ -102,6 +102,10 @@ static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
    NULL (free what the backend holds). The projection and the path tracers read it as hdk_depth_t
    (hd_k_project.h) does, through their buffer `dep`, while vw->kp.depth_dims.z is 1. */
 static hd_result hd__be_upload_depth(const hd__view *vw);
+/* The environment's tables changed (hd_set_environment): vw->env, vw->env_floats floats, or NULL
+   (free what the backend holds). The direct light and the path tracers read them as buffer
+   `env` (hd_k_light.h) while vw->kp.env.x > 0. */
+static hd_result hd__be_upload_env(const hd__view *vw);
 /* Zeroes what the HD__DIRTY_* bits in what name: DIRECT (E and CD's light volumes), PHI (phi,
    phi2), IMAGE (the image). */
 static hd_result hd__be_clear(const hd__view *vw, unsigned what);

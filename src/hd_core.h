@@ -99,6 +99,12 @@ typedef struct hd__ctx {
     int light_count;
     int lights_one_colour;   /* every light has the same colour */
     float chan_color[3];
+    /* the environment (hd_set_environment): on, its desc (rgb not kept: the tables in vw.env
+       hold its radiance), every texel grey (r = g = b), and intensity * its largest component */
+    int env_on;
+    hd_environment env;
+    int env_grey;
+    double env_power;
     /* method state */
     unsigned dirty;
     uint64_t iterations;
@@ -151,6 +157,7 @@ static hd_result hd__prepare(hd__ctx *ctx);
 #include "hd_params.h"
 #include "hd_volume.h"
 #include "hd_scene.h"
+#include "hd_environment.h"
 #include "hd_kparams.h"
 #include "hd_multigrid.h"
 #include "hd_direct_mask.h"

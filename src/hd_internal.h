@@ -77,6 +77,10 @@ typedef struct hd__view {
        NULL: none (kp.depth_dims.z = 0) */
     float *depth;
     int depth_w, depth_h;
+    /* the environment's tables (hd_set_environment, src/hd_environment.h; the kernels' buffer
+       env, hd_k_light.h): env_floats floats, NULL: none (kp.env.x = 0) */
+    float *env;
+    size_t env_floats;
 } hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */

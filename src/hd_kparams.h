@@ -77,6 +77,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
         (&k->crop_hi.x)[i] = ctx->vw.params.crop_max[i] < 1.0f ? ctx->vw.params.crop_max[i] : 2.0f;
         if (ctx->vw.params.crop_min[i] > 0.0f || ctx->vw.params.crop_max[i] < 1.0f) k->crop_lo.w = 1.0f;
     }
+    hd__env_kparams(ctx, k);
     for (i = 0; i < ctx->light_count; ++i) {
         const hd_light *l = &ctx->lights[i];
         hd_f4 *a = &k->light_a[i], *b = &k->light_b[i];

@@ -16,6 +16,7 @@
                                      uploaded, reclassified and the direct light's mask redone there */
 #define HD__DIRTY_TF 0x1000u      /* the TF's colours changed and nothing the light depends on: the
                                      TF is uploaded again, nothing reclassified */
+#define HD__DIRTY_ENV 0x2000u     /* the environment's tables (vw.env) changed: upload them or free them */
 #define HD__INV_NONE 0u        /* the same solution, estimator or encoding */
 #define HD__INV_IMAGE ((unsigned)HD__DIRTY_IMAGE)
 #define HD__INV_PHI ((unsigned)(HD__DIRTY_PHI | HD__DIRTY_IMAGE))

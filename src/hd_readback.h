@@ -222,6 +222,7 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     out->method_bytes += hd__be_solver_bytes(&ctx->vw); /* the solver's own state (multigrid levels) */
     out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
     if (hd__method_is_pt(ctx->vw.params.method)) out->method_bytes = 0;
+    out->method_bytes += ctx->vw.env_floats * sizeof(float); /* the environment's tables, any method */
     /* the buffer held, or the one the next call makes for a new camera size */
     out->image_bytes = hd__image_floats(ctx->vw.camera.width, ctx->vw.camera.height,
                                         (ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) *

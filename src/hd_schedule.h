@@ -54,6 +54,10 @@ static hd_result hd__prepare(hd__ctx *ctx)
         if ((r = hd__be_upload_depth(&ctx->vw)) != HD_SUCCESS) return r;
         ctx->dirty &= ~(unsigned)HD__DIRTY_DEPTH;
     }
+    if (dirty & HD__DIRTY_ENV) {
+        if ((r = hd__be_upload_env(&ctx->vw)) != HD_SUCCESS) return r;
+        ctx->dirty &= ~(unsigned)HD__DIRTY_ENV;
+    }
     if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = 0;
     /* a warm start: E's mean keeps at most light_window samples of the light before the change
        (the iteration count, the random numbers' key, runs on) */

@@ -90,15 +90,16 @@ static int hd__unit3(const float v[3], float out[3])
            out[0] * out[0] + out[1] * out[1] + out[2] * out[2] > 0.5f;
 }
 
-/* Lights as given, before the defaults (zero colour -> white, zero intensity -> 1), which the
+/* Lights as given (env_power: an environment's power, -1 without one), before the defaults (zero colour -> white, zero intensity -> 1), which the
    power limit applies after: sum of intensity * max(colour) <= HD_MAX_LIGHT_POWER keeps E, phi
    and the image finite (a sample is at most HD_MAX_LIGHTS * power * 1e12, the point lights'
    1/r^2 floor; README "Guarantees"). */
-static hd_result hd__check_lights(const hd_light *lights, int count, const hd_logger *log)
+static hd_result hd__check_lights(const hd_light *lights, int count, double env_power, const hd_logger *log)
 {
     int i;
-    double power = 0.0;
-    if (count == 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "no lights: give at least one");
+    double power = env_power > 0.0 ? env_power : 0.0; /* an environment's (src/hd_environment.h), which may stand alone */
+    if (count == 0 && env_power >= 0.0) return HD_SUCCESS;
+    if (count == 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "no lights: give at least one, or set an environment");
     if (count < 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "light count %d is negative", count);
     if (count > HD_MAX_LIGHTS) return HD__ERR(log, HD_ERROR_TOO_MANY_LIGHTS, "%d lights, at most %d", count, HD_MAX_LIGHTS);
     if (!lights) return HD__ERR(log, HD_ERROR_NULL_POINTER, "lights is NULL with count %d", count);
@@ -127,8 +128,8 @@ static hd_result hd__check_lights(const hd_light *lights, int count, const hd_lo
         power += inten * cmax;
         if (!(power <= (double)HD_MAX_LIGHT_POWER))
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT,
-                           "light %d: intensity * colour summed over lights 0..%d is %g, above HD_MAX_LIGHT_POWER %g",
-                           i, i, power, (double)HD_MAX_LIGHT_POWER);
+                           "light %d: intensity * colour summed over lights 0..%d%s is %g, above HD_MAX_LIGHT_POWER %g",
+                           i, i, env_power > 0.0 ? " and the environment" : "", power, (double)HD_MAX_LIGHT_POWER);
     }
     return HD_SUCCESS;
 }

@@ -211,13 +211,17 @@ static int hd__tf_change(const hd__ctx *ctx, const hd_transfer_function *tf)
 static float hd__max3(const float v[3]) { return v[0] > v[1] ? (v[0] > v[2] ? v[0] : v[2]) : (v[1] > v[2] ? v[1] : v[2]); }
 static void hd__set_channels(hd__ctx *ctx)
 {
-    int i, grey = ctx->lights_one_colour && !ctx->vw.params.rgb_scattering;
+    static const float white[3] = {1.0f, 1.0f, 1.0f};
+    /* an environment alone is white; with lights, a grey one needs them grey too */
+    const float *col = ctx->light_count > 0 ? ctx->lights[0].color : white;
+    int i, grey = ctx->lights_one_colour && !ctx->vw.params.rgb_scattering &&
+                  (!ctx->env_on || (ctx->env_grey && col[0] == col[1] && col[1] == col[2]));
     /* one channel: E carries intensity * max colour (the quantity hd__check_lights limits) and the
        projection the colour over its maximum, so neither factor alone can overflow */
-    float cmax = hd__max3(ctx->lights[0].color);
+    float cmax = hd__max3(col);
     ctx->vw.channels = grey ? 1 : 3;
     ctx->vw.sig_channels = ctx->vw.params.rgb_scattering ? 4 : 1;
-    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? ctx->lights[0].color[i] / cmax : 1.0f;
+    for (i = 0; i < 3; ++i) ctx->chan_color[i] = grey ? col[i] / cmax : 1.0f;
 }
 
 static void hd__set_lights(hd__ctx *ctx, const hd_light *lights, int count)

@@ -32,6 +32,11 @@ HD_PARAM_F4(background) /* rgb radiance behind the volume */
 HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */
 HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates; w = 1: on */
 HD_PARAM_F4(crop_hi)    /* xyz = its high corner */
+HD_PARAM_I4(env)        /* the environment (hd_k_light.h): x = width, y = height (0: none), z, w = where
+                           its marginal and conditional CDFs start in the env buffer */
+HD_PARAM_F4(env_r0)     /* rows of the rotation from the volume's frame into the map's */
+HD_PARAM_F4(env_r1)
+HD_PARAM_F4(env_r2)
 HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position, w = type */
 HD_PARAM_F4_ARRAY(light_b, HD_MAX_LIGHTS) /* rgb = colour * intensity (x only with 1 channel), w = 1/r^2 */
 HD_PARAMS_END

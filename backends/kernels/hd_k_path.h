@@ -6,23 +6,29 @@
      - the path weight w *= albedo * c(x): the TF colour is the per-channel scattering albedo, so
        the expected weight is exactly the chance the path survives as scattering in each channel
        (absorption is not sampled, it is carried in w: no bias, less variance);
-     - next-event estimation: one light l chosen uniformly (weight L), its transmittance by the
-       selected tracking estimator (ratio tracking by default), so the vertex adds
-           w * L * I_l * falloff * T(x -> l) * p(mu),   mu = d . omega_l,
-       p the phase function (isotropic 1/(4 pi), or Henyey-Greenstein with g = medium.z);
+     - next-event estimation: one light l chosen uniformly among L (the list and the
+       environment, hd_k_light.h), its transmittance by the selected tracking estimator (ratio
+       tracking by default), so the vertex adds
+           w * L * I_l * falloff * T(x -> l) * p(mu) * m,   mu = d . omega_l,
+       p the phase function (isotropic 1/(4 pi), or Henyey-Greenstein with g = medium.z), I_l
+       the environment's radiance over its direction's density q, and m the multiple importance
+       sampling weight (balance heuristic) q / L / (q / L + p) for the environment at a vertex
+       whose path goes on, 1 otherwise;
      - then the path scatters in a direction drawn from p (importance sampled, so w is unchanged),
        after Russian roulette from HD_PT_RR_BOUNCES vertices on, until counts.w vertices.
    PT_SS is this kernel with counts.w = 1 and g = 0 (set by the host): one collision, one shadow
    ray, isotropic phase; so PT_MS with max_bounces = 1 and g = 0 is the same estimator.
    Every loop is bounded: at most counts.w (max_bounces <= 100000) vertices per path, each
    free flight and shadow ray at most HD_MAX_TRACK_STEPS (hdk_track).
-   A camera ray that leaves the box unscattered sees the background; scattered rays that leave
-   add nothing (the background is a backdrop, not a light, as in HD's projection). Alpha is 1 if
+   A camera ray that leaves the box unscattered sees the background; a scattered ray that leaves
+   sees the environment (if one is set) with the other weight of the pair, p / (q / L + p), so
+   each direction is counted once; the background is a backdrop, not a light, as in HD's
+   projection. Alpha is 1 if
    the camera ray collides, so its mean is 1 - T_cam as in the projection. With the host's depth
    (hdk_depth_t) the first free flight ends at the scene's surface: a path that reaches it ends
    there with nothing (the geometry is opaque and black for the volume's image) and sees no
    background; scattered rays do not see the geometry (the light ignores it, as HD's does).
-   Refinement of a resting HD view (params.refine_on_rest, src/hd_schedule.h) runs this kernel
+   Refinement of a resting HD view (params.rest, src/hd_schedule.h) runs this kernel
    on HD's converged light with image.w = k >= 1: at the k-th vertex the path ends into HD's
    cache instead of tracking toward a light, adding w * (E + phi)(x) / (4 pi) (the in-scattered
    radiance HD's projection uses there, isotropic), so vertices 1..k-1 carry what the diffusion
@@ -33,11 +39,6 @@
    weight march.y, which the host sets to 1/n for these methods (a plain progressive mean). */
 
 #define HD_PT_RR_BOUNCES 3 /* Russian roulette from this many vertices on */
-
-#ifndef HD_PRELUDE_HAS_TRIG
-#define hdk_cos(x) cos(x)
-#define hdk_sin(x) sin(x)
-#endif
 
 HD_FN hd_v3 hdk_cross(hd_v3 a, hd_v3 b)
 {
@@ -73,17 +74,6 @@ HD_FN hd_v3 hdk_sample_phase_hg(hd_v3 d, float g, float xi0, float xi1)
     return hdk_normalize(hdk_add(hdk_scale(d, mu), hdk_add(hdk_scale(b1, st * hdk_cos(ph)), hdk_scale(b2, st * hdk_sin(ph)))));
 }
 
-/* Light l's radiance in colour channel c (0..2) for a path: with 1 illumination channel the
-   light_b.x weight times the lights' common colour. */
-HD_FN float hdk_light_rgb(HD_KARGS int l, int c)
-{
-    hd_v4 lb = HD_PRM(light_b)[l];
-    if (HD_PRM(gdims).w == 1) {
-        return lb.x * (c == 0 ? HD_PRM(chan_color).x : (c == 1 ? HD_PRM(chan_color).y : HD_PRM(chan_color).z));
-    }
-    return c == 0 ? lb.x : (c == 1 ? lb.y : lb.z);
-}
-
 /* The in-scattered radiance HD's light gives at texture coordinate u, per colour channel:
    (E + phi) / (4 pi), with 1 illumination channel times the lights' common colour. */
 HD_FN float hdk_cache_rgb(HD_KARGS hd_v3 u, int c)
@@ -105,10 +95,11 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
     float t0 = hdk_box_entry(HD_KPASS o, d, HD_REF(t1));
     int geo = 0;
     float td = hdk_depth_t(HD_KPASS px, py, fx, fy, sx, sy, o, d, HD_REF(geo));
-    int nl = HD_PRM(counts).x, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
+    int nl = HDK_LIGHTS, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
     float albedo = HD_PRM(medium).y, g = HD_PRM(medium).z;
     float lr = 0.0f, lg = 0.0f, lb = 0.0f, alpha = 0.0f;
     float wr = 1.0f, wg = 1.0f, wb = 1.0f;
+    float pphase = 0.0f; /* the phase function's density of d, once d is a scattered direction */
     hd_u32 dim = 2u;
     int vertices = 0;
     hd_v3 p = hdk_madd(o, d, t0);
@@ -124,11 +115,21 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         float t = hdk_free_flight(HD_KPASS p, d, tmax, key, dim, HD_REF(nd));
         hd_v4 c;
         int l;
-        float lt = 0.0f, falloff = 0.0f, tr, f;
-        hd_v3 ld;
+        float lt = 0.0f, lpdf = 0.0f, tr, f, ph, xe0 = 0.0f, xe1 = 0.0f;
+        hd_v3 ld, lw = HD_V3(0.0f, 0.0f, 0.0f);
         dim = nd;
         if (!(t < tmax)) {
             if (vertices == 0 && geo == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
+            if (vertices > 0 && HD_PRM(env).x > 0) { /* a scattered ray that leaves sees the environment */
+                float st = 0.0f;
+                int et = hdk_env_texel(HD_KPASS d, HD_REF(st));
+                float q = hdk_env_pdf(HD_KPASS et, st) / HD_F(nl);
+                hd_v3 le = hdk_env_rgb(HD_KPASS et);
+                float m = pphase / (pphase + q);
+                lr += wr * m * hdk_light_colour(HD_KPASS le, 0);
+                lg += wg * m * hdk_light_colour(HD_KPASS le, 1);
+                lb += wb * m * hdk_light_colour(HD_KPASS le, 2);
+            }
             break;
         }
         alpha = 1.0f;
@@ -145,13 +146,17 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         /* next-event estimation toward one light */
         l = hdk_mini(HD_I(hdk_rand(key, dim) * HD_F(nl)), nl - 1);
         dim += 1u;
-        ld = hdk_light_dir(HD_KPASS l, p, HD_REF(lt), HD_REF(falloff));
+        if (l >= HD_PRM(counts).x) { xe0 = hdk_rand(key, dim); xe1 = hdk_rand(key, dim + 1u); dim += 2u; }
+        ld = hdk_light_pick(HD_KPASS l, p, xe0, xe1, HD_REF(lt), HD_REF(lw), HD_REF(lpdf));
         tr = hdk_transmittance(HD_KPASS p, ld, lt, key, dim, mode, HD_REF(nd));
         dim = nd;
-        f = HD_F(nl) * falloff * tr * hdk_phase_hg(g, hdk_dot(d, ld));
-        lr += wr * f * hdk_light_rgb(HD_KPASS l, 0);
-        lg += wg * f * hdk_light_rgb(HD_KPASS l, 1);
-        lb += wb * f * hdk_light_rgb(HD_KPASS l, 2);
+        ph = hdk_phase_hg(g, hdk_dot(d, ld));
+        f = HD_F(nl) * tr * ph;
+        /* the environment's share of a direction a scattered ray may also reach */
+        if (lpdf > 0.0f && vertices + 1 < max_vertices) f *= lpdf / (lpdf + HD_F(nl) * ph);
+        lr += wr * f * hdk_light_colour(HD_KPASS lw, 0);
+        lg += wg * f * hdk_light_colour(HD_KPASS lw, 1);
+        lb += wb * f * hdk_light_colour(HD_KPASS lw, 2);
         vertices += 1;
         if (vertices >= max_vertices) break;
         if (vertices >= HD_PT_RR_BOUNCES) {
@@ -161,7 +166,11 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
             if (!(xi < q)) break;
             wr /= q; wg /= q; wb /= q;
         }
-        d = hdk_sample_phase_hg(d, g, hdk_rand(key, dim), hdk_rand(key, dim + 1u));
+        {
+            hd_v3 dn = hdk_sample_phase_hg(d, g, hdk_rand(key, dim), hdk_rand(key, dim + 1u));
+            pphase = hdk_phase_hg(g, hdk_dot(d, dn));
+            d = dn;
+        }
         dim += 2u;
         tmax = hdk_box_exit(HD_KPASS p, d);
     }
