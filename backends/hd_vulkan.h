@@ -1016,7 +1016,7 @@ static hd_result hd__vk_diffuse_pipeline(const hd__view *vw, int32_t jacobi, VkP
 /* A compute descriptor-set layout of n bindings (binding i of types[i], one descriptor each)
    and the pipeline layout of that one set with push_bytes of push constants (the library's
    layouts and the benchmarks' share this). */
-#define HD__VK_MAX_SET_BINDINGS 16
+#define HD__VK_MAX_SET_BINDINGS 17
 static hd_result hd__vk_layouts(const hd__view *vw, const VkDescriptorType *types, uint32_t n, uint32_t push_bytes,
                                 VkDescriptorSetLayout *set_layout, VkPipelineLayout *layout)
 {

@@ -64,6 +64,9 @@ typedef struct scene {
     int light_count;
     hd_camera camera;
     hd_params params;
+    const hd_environment *env; /* set on both after hd_create (NULL: none) */
+    int env_only;              /* then the lights are cleared: the environment alone */
+    double env_bound;          /* the largest radiance over pdf one of its samples can weigh */
 } scene;
 
 /* A smooth blob with a shell and some noise, so the TF makes dense, thin and empty regions. */
@@ -233,7 +236,9 @@ static int pair_create(pair *p, const scene *s)
     p->s = s;
     if ((r = hd_api_cpu.create(&d, &p->ref)) != HD_SUCCESS) { pair_fail(p, "reference create", r); return 0; }
     if ((r = hd_api_backend.create(&d, &p->dut)) != HD_SUCCESS) { pair_fail(p, "backend create", r); hd_api_cpu.destroy(p->ref); return 0; }
-    return 1;
+    if (s->env) BOTH(p, set_environment, (p->ref, s->env), (p->dut, s->env));
+    if (s->env && s->env_only) BOTH(p, set_lights, (p->ref, NULL, 0), (p->dut, NULL, 0));
+    return p->ok;
 }
 static void pair_destroy(pair *p)
 {
@@ -282,7 +287,8 @@ static double sample_ratio(const pair *p, const hd_stats *st, const float *ref, 
                         }
                         if (col * L->intensity * f > w) w = col * L->intensity * f;
                     }
-                    w *= (double)q.light_count / (double)st->iterations;
+                    if (p->s->env && p->s->env_bound > w) w = p->s->env_bound;
+                    w *= (double)(q.light_count + (p->s->env ? 1 : 0)) / (double)st->iterations;
                     if (got[i] != got[i]) d = 1e30;
                     if (d > 0.0 && d / (w > 0.0 ? w : 1e-30) > worst) worst = d / (w > 0.0 ? w : 1e-30);
                 }
@@ -820,6 +826,59 @@ static void case_method(hd_method method, hd_voxel_type type, const int *d, int 
     scene_free(&s);
 }
 
+/* An environment (hd_set_environment): a sky with a sun on a w x h map, grey or coloured; its
+   sample bound for sample_ratio: radiance over pdf is at most 4 pi^2 S / (w h) for S the sum of
+   max(rgb) sin(theta) over the texels (hd_k_light.h: sin theta over the texel centre's is at
+   most 2). */
+static double env_sky(float *rgb, int w, int h, int grey)
+{
+    int i, j;
+    double sum = 0.0;
+    for (j = 0; j < h; ++j)
+        for (i = 0; i < w; ++i) {
+            float *px = rgb + 3 * (j * w + i), up = 1.0f - ((float)j + 0.5f) / (float)h;
+            px[0] = 0.3f + 0.4f * up; px[1] = 0.4f + 0.3f * up; px[2] = 0.6f + 0.3f * up;
+            if (j > h / 2) px[0] = px[1] = px[2] = 0.1f;
+            if (i == w / 3 && j == h / 4) { px[0] = 40.0f; px[1] = 36.0f; px[2] = 30.0f; }
+            if (grey) px[0] = px[2] = px[1];
+            sum += fmax(px[0], fmax(px[1], px[2])) * sin(3.14159265358979 * ((double)j + 0.5) / h);
+        }
+    return 4.0 * 3.14159265358979 * 3.14159265358979 * sum / ((double)w * h);
+}
+
+/* HD (E, phi and the image), PT_SS or PT_MS (the image) with an environment, beside lights or
+   alone; rotated a quarter turn about +y when rotate. */
+static void case_env(hd_method method, hd_voxel_type type, const int *d, int lights, int grey, int rotate, int n)
+{
+    static float rgb[24 * 12 * 3];
+    hd_environment env;
+    scene s;
+    guard g;
+    char name[128];
+    memset(&env, 0, sizeof env);
+    env.width = 24; env.height = 12; env.rgb = rgb; env.intensity = 0.8f;
+    if (rotate) { env.rotation[2] = 1.0f; env.rotation[4] = 1.0f; env.rotation[6] = -1.0f; }
+    scene_init(&s, type, d[0], d[1], d[2], lights > 0 ? lights : 1, 1, 1);
+    s.params.method = method;
+    s.env = &env;
+    s.env_only = lights == 0;
+    s.env_bound = env_sky(rgb, env.width, env.height, grey) * env.intensity;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s x%d %s %dx%dx%d environment%s%s + %dL", hd_api_cpu.method_name(method), n, type_name(type), d[0], d[1],
+             d[2], grey ? " grey" : "", rotate ? " rotated" : "", lights);
+    iterate_case(name, &s, &g, n, method_is_pt(method) ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, 0);
+    guard_free(&g);
+    scene_free(&s);
+}
+static void env_cases(const int *odd, const int *other)
+{
+    case_env(HD_METHOD_HD, HD_VOXEL_U8, odd, 3, 0, 0, 8);
+    case_env(HD_METHOD_HD, HD_VOXEL_F32, other, 0, 1, 1, 8);
+    case_env(HD_METHOD_PT_SS, HD_VOXEL_U16, odd, 1, 0, 1, 8);
+    case_env(HD_METHOD_PT_MS, HD_VOXEL_U8, other, 0, 0, 0, 8);
+    case_env(HD_METHOD_PT_MS, HD_VOXEL_F32, odd, 2, 1, 0, 8);
+}
+
 /* The per-frame API: light refined without frames (hd_refine) until it converges, then frames
    from the converged light (hd_render) before and after a camera move; both sides must agree on
    the light, the image, and the iteration and frame counts. With scale != 0 (params.render_scale)
@@ -1249,7 +1308,7 @@ int main(int argc, char **argv)
     static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     int render = argc > 1 && strcmp(argv[1], "--render") == 0, direct = argc > 1 && strcmp(argv[1], "--direct") == 0;
-    int scenes = argc > 1 && strcmp(argv[1], "--scene") == 0;
+    int scenes = argc > 1 && strcmp(argv[1], "--scene") == 0, envs = argc > 1 && strcmp(argv[1], "--env") == 0;
     int hard = 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available(&hard)) {
@@ -1260,10 +1319,12 @@ int main(int argc, char **argv)
                     require ? "; HD_CONFORMANCE_REQUIRE=1: a skip fails" : "");
         return hard || require ? 1 : 0;
     }
-    if (quick || crop || render || direct || scenes) { /* quick: one case per stage, for valgrind; crop: the
+    if (quick || crop || render || direct || scenes || envs) { /* quick: one case per stage, for valgrind; crop: the
                                       crop box cases; render: the per-frame API's; direct: the
                                       direct light's and the rule's self-check */
-        if (direct) {
+        if (envs) {
+            env_cases(odd, other);
+        } else if (direct) {
             direct_cases(odd, other);
         } else if (render) {
             render_cases(odd, other);
@@ -1325,6 +1386,8 @@ int main(int argc, char **argv)
     render_cases(odd, other);
     /* inside a host's scene: matrices, a placed volume, depth */
     scene_cases();
+    /* an environment map, beside lights and alone */
+    env_cases(odd, other);
     /* binary16 illumination storage */
     case_half(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 0, HD_SOLVER_RED_BLACK, 8);
     case_half(HD_METHOD_HD, HD_VOXEL_U16, odd, 3, 1, 0, HD_SOLVER_RED_BLACK, 8);

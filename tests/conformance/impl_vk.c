@@ -72,6 +72,7 @@ VK_WRAP(iterate, (hd_context c, int n), (c, n))
 VK_WRAP(refine, (hd_context c, int n), (c, n))
 VK_WRAP(render, (hd_context c), (c))
 VK_WRAP(set_depth, (hd_context c, const hd_depth_desc *dd), (c, dd))
+VK_WRAP(set_environment, (hd_context c, const hd_environment *e), (c, e))
 VK_WRAP(set_volume_transform, (hd_context c, const float *m), (c, m))
 VK_WRAP(read_image_rgba8, (hd_context c, uint8_t *dst, size_t n), (c, dst, n))
 VK_WRAP(read_image_f32, (hd_context c, float *dst, size_t n), (c, dst, n))
@@ -91,4 +92,5 @@ const hd_api hd_api_backend = {hd_backend_name, hd_result_string, hd_method_name
                                vk_read_illumination, hd_get_stats, hd_volume_load_nrrd, hd_volume_load_raw,
                                hd_volume_parse_nrrd, hd_volume_free, vk_test_prepare, vk_test_direct,
                                vk_test_diffuse, vk_test_project, vk_test_write_illumination, vk_test_finish,
-                               vk_test_direct_all, vk_refine, vk_render, vk_set_depth, vk_set_volume_transform, vk_update_volume};
+                               vk_test_direct_all, vk_refine, vk_render, vk_set_depth, vk_set_volume_transform, vk_update_volume,
+                               vk_set_environment};
