@@ -44,6 +44,7 @@
 
 #include "hd_input.h"
 #include "hd_png.h"
+#include "hd_env.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
 #define DEFAULT_OUTPUT "out/head.png"
@@ -91,6 +92,10 @@ static const char *usage_text =
     "                          point light at X,Y,Z; falloff: intensity / r^2\n"
     "  --lights N              N preset directional lights placed around the camera\n"
     "                          (1: key light, 3: key, fill and rim; default 1)\n"
+    "  --env FILE.hdr[:ROTATION][:INTENSITY]\n"
+    "                          environment light from a Radiance .hdr lat-long map, its\n"
+    "                          top toward --up, turned ROTATION degrees about it; alone,\n"
+    "                          or beside --light / --lights (scripts/make-env writes one)\n"
     "\n"
     "camera (default: in front of the face, for the head CT's axes: face +y, top +z;\n"
     "        data/brainsmall.nrrd: its left side, from the front and above)\n"
@@ -246,6 +251,37 @@ static float parse_float(const char *flag, const char *s, float lo, float hi, in
         fail(2, "%s: %s is outside %s%g, %g%s", flag, s, lo_open ? "(" : "[", (double)lo,
              (double)hi, hi_open ? ")" : "]");
     return (float)v;
+}
+
+/* --env FILE[:ROTATION][:INTENSITY]: up to two numeric fields after the last ':'s of the path. */
+static const char *parse_env(const char *s, float *rot, float *inten, char *path, size_t path_size)
+{
+    const char *c[2] = {NULL, NULL};
+    char *end;
+    size_t n = strlen(s);
+    int k = 0, m;
+    *rot = 0.0f;
+    *inten = 1.0f;
+    if (n >= path_size) fail(2, "--env: '%s' is too long", s);
+    memcpy(path, s, n + 1);
+    while (k < 2) {
+        char *colon = strrchr(path, ':');
+        double v;
+        if (!colon) break;
+        errno = 0;
+        v = strtod(colon + 1, &end);
+        if (end == colon + 1 || *end || errno == ERANGE || !isfinite(v)) break;
+        c[k++] = colon + 1;
+        *colon = 0;
+    }
+    /* the fields were found right to left */
+    for (m = 0; m < k; ++m) {
+        const char *f = c[k - 1 - m];
+        if (m == 0) *rot = parse_float("--env rotation", f, -3600.0f, 3600.0f, 0, 0);
+        else *inten = parse_float("--env intensity", f, 0.0f, 1e9f, 1, 0);
+    }
+    if (!path[0]) fail(2, "--env: '%s' names no file", s);
+    return path;
 }
 
 static long parse_int(const char *flag, const char *s, long lo, long hi)
@@ -743,6 +779,10 @@ int main(int argc, char **argv)
     float spacing[3] = {0, 0, 0};
     hd_light lights[HD_MAX_LIGHTS];
     int light_count = 0;
+    const char *env_arg = NULL;
+    char env_path[4096];
+    float env_rot = 0.0f, env_intensity = 1.0f;
+    hd_environment env;
     hd_desc desc;
     hd_volume_file vol;
     hd_context ctx;
@@ -846,6 +886,9 @@ int main(int argc, char **argv)
             lights[light_count++] = parse_light(v);
         } else if (IS("--lights")) {
             lights_n = (int)parse_int(a, VAL(), 1, HD_MAX_LIGHTS);
+        } else if (IS("--env")) {
+            if (env_arg) fail(2, "--env: given twice");
+            env_arg = parse_env(VAL(), &env_rot, &env_intensity, env_path, sizeof env_path);
         } else if (IS("--eye")) {
             parse_floats_in(a, VAL(), desc.camera.eye, 3, HD_MAX_CAMERA_DISTANCE);
             camera_given = 1;
@@ -1025,8 +1068,16 @@ int main(int argc, char **argv)
     if (have_spacing) memcpy(desc.volume.spacing, spacing, sizeof spacing);
 
     /* ---- lights, the rest ---- */
-    if (!light_count) light_count = preset_lights(lights_n ? lights_n : 1, &desc.camera, lights);
-    desc.lights = lights;
+    memset(&env, 0, sizeof env);
+    if (env_arg) {
+        if (!hdx_env_load(env_arg, &env, err, sizeof err)) fail(2, "--env: %s", err);
+        env.intensity = env_intensity;
+        static const float y_up[3] = {0.0f, 1.0f, 0.0f}; /* the library's default camera up */
+        int zero_up = desc.camera.up[0] == 0.0f && desc.camera.up[1] == 0.0f && desc.camera.up[2] == 0.0f;
+        hdx_env_rotation(zero_up ? y_up : desc.camera.up, env_rot, env.rotation);
+    }
+    if (!light_count && (!env_arg || lights_n)) light_count = preset_lights(lights_n ? lights_n : 1, &desc.camera, lights);
+    desc.lights = light_count ? lights : NULL; /* none: the environment alone, set after hd_create */
     desc.light_count = light_count;
     desc.logger = logger;
     make_parent_dirs(out_path);
@@ -1038,6 +1089,14 @@ int main(int argc, char **argv)
         int usage_error = r == HD_ERROR_UNSUPPORTED || (r >= HD_ERROR_NULL_POINTER &&
                                                         r <= HD_ERROR_TOO_MANY_LIGHTS);
         fail_lib(usage_error ? 2 : 1, &ls, r, "cannot create the renderer", NULL);
+    }
+    if (env_arg) {
+        ls.last[0] = 0;
+        if ((r = hd_set_environment(ctx, &env)) != HD_SUCCESS) fail_lib(2, &ls, r, "--env", NULL);
+        if (!light_count && (r = hd_set_lights(ctx, NULL, 0)) != HD_SUCCESS) fail_lib(1, &ls, r, "--env", NULL);
+        free((void *)env.rgb);
+        if (!g_quiet) fprintf(stderr, "hdrender: environment %s, %dx%d, turned %g degrees, intensity %g\n", env_arg, env.width, env.height,
+                              (double)env_rot, (double)env.intensity);
     }
     if (!g_quiet)
         fprintf(stderr, "hdrender: %s %dx%dx%d %s, values %g..%g, tf %s, %d light%s, %s on %s, "

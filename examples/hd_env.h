@@ -1,0 +1,84 @@
+/* hd_env.h - environment maps for the examples: a Radiance .hdr (RGBE) file read by stb_image
+   (Debian: libstb-dev; its HDR reader alone, implementation once per program, its warnings
+   silenced here only) into a hd_environment, and the map's rotation from an angle about the
+   scene's up axis. The library itself reads no image files: it takes the linear RGB floats. */
+#ifndef HD_ENV_H
+#define HD_ENV_H
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#endif
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_HDR
+#include <stb/stb_image.h>
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The map's rotation (row-major, world = R map) that stands the map's up (+y) on up (need not be
+   unit, nonzero) and turns it by deg degrees about it: the map's +x goes to a, a unit vector
+   perpendicular to up, turned; its +z to a x up. */
+static void hdx_env_rotation(const float up[3], float deg, float r[9])
+{
+    double u[3] = {up[0], up[1], up[2]}, a[3], b[3], n, c = cos(deg * 3.14159265358979 / 180.0), s = sin(deg * 3.14159265358979 / 180.0);
+    int i;
+    n = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (i = 0; i < 3; ++i) u[i] /= n;
+    /* a: the world axis least along up, made perpendicular to it */
+    i = fabs(u[0]) <= fabs(u[1]) && fabs(u[0]) <= fabs(u[2]) ? 0 : fabs(u[1]) <= fabs(u[2]) ? 1 : 2;
+    a[0] = a[1] = a[2] = 0.0;
+    a[i] = 1.0;
+    n = a[0] * u[0] + a[1] * u[1] + a[2] * u[2];
+    for (i = 0; i < 3; ++i) a[i] -= n * u[i];
+    n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (i = 0; i < 3; ++i) a[i] /= n;
+    /* turned by deg about up: a c + (up x a) s */
+    b[0] = u[1] * a[2] - u[2] * a[1]; b[1] = u[2] * a[0] - u[0] * a[2]; b[2] = u[0] * a[1] - u[1] * a[0];
+    for (i = 0; i < 3; ++i) a[i] = a[i] * c + b[i] * s;
+    /* b = a x up, the map's +z */
+    b[0] = a[1] * u[2] - a[2] * u[1]; b[1] = a[2] * u[0] - a[0] * u[2]; b[2] = a[0] * u[1] - a[1] * u[0];
+    for (i = 0; i < 3; ++i) {
+        r[3 * i] = (float)a[i];
+        r[3 * i + 1] = (float)u[i];
+        r[3 * i + 2] = (float)b[i];
+    }
+}
+
+/* Reads a Radiance .hdr file into env (env->rgb malloc'd: free it). 1, or 0 with the reason in err. */
+static int hdx_env_load(const char *path, hd_environment *env, char *err, size_t err_size)
+{
+    int w = 0, h = 0, comp = 0;
+    float *px;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        snprintf(err, err_size, "cannot open '%s'", path);
+        return 0;
+    }
+    if (!stbi_is_hdr_from_file(f)) {
+        fclose(f);
+        snprintf(err, err_size, "'%s' is not a Radiance .hdr file", path);
+        return 0;
+    }
+    px = stbi_loadf_from_file(f, &w, &h, &comp, 3);
+    fclose(f);
+    if (!px) {
+        const char *why = stbi_failure_reason();
+        snprintf(err, err_size, "'%s': %s", path, why ? why : "cannot be decoded");
+        return 0;
+    }
+    memset(env, 0, sizeof *env);
+    env->width = w;
+    env->height = h;
+    env->rgb = px;
+    return 1;
+}
+#endif
