@@ -53,6 +53,31 @@ static void hdx_env_rotation(const float up[3], float deg, float r[9])
     }
 }
 
+/* FILE[:ROTATION][:INTENSITY]: the path into path (path_size bytes) and up to two numbers after
+   its last ':'s (defaults 0 and 1). 1, or 0 when the path does not fit or a number is out of
+   range (ROTATION within +-3600 degrees, INTENSITY in (0, 1e9]). */
+static int hdx_env_arg(const char *s, char *path, size_t path_size, float *rot, float *inten)
+{
+    double v[2];
+    int k = 0;
+    size_t n = strlen(s);
+    *rot = 0.0f;
+    *inten = 1.0f;
+    if (n + 1 > path_size || n == 0) return 0;
+    memcpy(path, s, n + 1);
+    while (k < 2) {
+        char *colon = strrchr(path, ':'), *end;
+        if (!colon) break;
+        v[k] = strtod(colon + 1, &end);
+        if (end == colon + 1 || *end || !(v[k] == v[k]) || fabs(v[k]) > 1e30) break;
+        *colon = 0;
+        ++k;
+    }
+    if (k == 2) { *rot = (float)v[1]; *inten = (float)v[0]; }
+    else if (k == 1) *rot = (float)v[0];
+    return path[0] != 0 && fabs(*rot) <= 3600.0f && *inten > 0.0f && *inten <= 1e9f;
+}
+
 /* Reads a Radiance .hdr file into env (env->rgb malloc'd: free it). 1, or 0 with the reason in err. */
 static int hdx_env_load(const char *path, hd_environment *env, char *err, size_t err_size)
 {
@@ -60,19 +85,19 @@ static int hdx_env_load(const char *path, hd_environment *env, char *err, size_t
     float *px;
     FILE *f = fopen(path, "rb");
     if (!f) {
-        snprintf(err, err_size, "cannot open '%s'", path);
+        snprintf(err, err_size, "cannot open '%.400s'", path);
         return 0;
     }
     if (!stbi_is_hdr_from_file(f)) {
         fclose(f);
-        snprintf(err, err_size, "'%s' is not a Radiance .hdr file", path);
+        snprintf(err, err_size, "'%.400s' is not a Radiance .hdr file", path);
         return 0;
     }
     px = stbi_loadf_from_file(f, &w, &h, &comp, 3);
     fclose(f);
     if (!px) {
         const char *why = stbi_failure_reason();
-        snprintf(err, err_size, "'%s': %s", path, why ? why : "cannot be decoded");
+        snprintf(err, err_size, "'%.400s': %s", path, why ? why : "cannot be decoded");
         return 0;
     }
     memset(env, 0, sizeof *env);

@@ -22,6 +22,7 @@
      O / shift+O  select the next / previous face of the crop box (x-, x+, y-, y+, z-, z+)
      I / shift+I  move the selected face 0.02 of the volume in / out (the box shrinks / grows)
      U         crop box: the whole volume / the volume's default (data/head.nrrd: no head rest)
+     V / shift+V  turn the environment (--env FILE.hdr[:ROTATION][:INTENSITY]) 15 degrees about +z
      P         preview on / off: while the camera moves, frames at reduced resolution (render_scale
                HD_RENDER_SCALE_AUTO, the scale whose frame time fits 50 ms), refined to full
                resolution when it stops; on by default in the window, off in scripted runs
@@ -62,6 +63,7 @@
 #include "hd_crop.h"
 #include "hd_input.h"
 #include "hd_png.h"
+#include "hd_env.h"
 
 #define DEFAULT_INPUT "data/head.nrrd"
 
@@ -87,6 +89,8 @@ typedef struct viewer {
     int shots;
     int crop_face;            /* the face I moves: 2 * axis + (0 low, 1 high) */
     float crop_min[3], crop_max[3]; /* the volume's default crop box (U toggles to it) */
+    hd_environment env;       /* --env: the map (rgb NULL: none), turned env_deg about the up axis */
+    float env_deg;
 } viewer;
 
 static void die(const char *what, hd_result r)
@@ -314,6 +318,15 @@ static void key_char(viewer *v, int c)
     switch (c) {
     case '1': case '2': case '3': case '4': v->params.method = methods[c - '1']; apply_params(v); break;
     case 't': case 'T': set_tf(v, (v->tf_preset + 1) % HDX_TF_PRESET_COUNT); break;
+    case 'v': case 'V': /* the environment 15 degrees further about the up axis (shift: back) */
+        if (v->env.rgb) {
+            static const float up[3] = {0.0f, 0.0f, 1.0f};
+            v->env_deg += c == 'v' ? 15.0f : -15.0f;
+            hdx_env_rotation(up, v->env_deg, v->env.rotation);
+            if ((r = hd_set_environment(v->ctx, &v->env)) != HD_SUCCESS) die("hd_set_environment", r);
+            fprintf(stderr, "hdview: environment turned %g degrees\n", (double)v->env_deg);
+        }
+        break;
     case 'l': case 'L':
         set_lights(v, v->light_count == 1 ? 3 : 1);
         if ((r = hd_set_lights(v->ctx, v->lights, v->light_count)) != HD_SUCCESS) die("hd_set_lights", r);
@@ -569,14 +582,17 @@ int main(int argc, char **argv)
     hd_logger logger = {hd_log_stderr, NULL};
     hd_result r;
     char err[512];
+    const char *env_arg = NULL;
     for (i = 1; i < argc; ++i) {
         if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = atoi(argv[++i]);
+        else if (strcmp(argv[i], "--env") == 0 && i + 1 < argc) env_arg = argv[++i];
         else if (strcmp(argv[i], "--screenshot") == 0 && i + 1 < argc) shot = argv[++i];
         else if (strcmp(argv[i], "--script") == 0 && i + 1 < argc) script = argv[++i];
         else if (strcmp(argv[i], "--seed") == 0 && i + 1 < argc) seed = (unsigned)strtoul(argv[++i], NULL, 10);
         else if (strcmp(argv[i], "--size") == 0 && i + 1 < argc && sscanf(argv[i + 1], "%dx%d", &w, &h) == 2) ++i;
         else if (strcmp(argv[i], "-h") == 0 || strcmp(argv[i], "--help") == 0) {
-            printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE] [FILE|DIR]\n"
+            printf("usage: hdview [--size WxH] [--seed N] [--frames N] [--screenshot FILE] [--script FILE]\n"
+                   "              [--env FILE.hdr[:ROTATION][:INTENSITY]] [FILE|DIR]\n"
                    "(DIR: a DICOM series; FILE.vdb[:GRID]: an OpenVDB float grid; default FILE: " DEFAULT_INPUT "); keys and mouse: see the top of examples/hdview.c\n"
                    "crop box: O / shift+O select a face, I / shift+I move it in / out, U whole volume / default box\n");
             return 0;
@@ -628,6 +644,17 @@ int main(int argc, char **argv)
     desc.gl.get_proc_address = glfwGetProcAddress;
     if ((r = hd_create(&desc, &v.ctx)) != HD_SUCCESS) die("hd_create", r);
     hd_volume_free(&vol);
+    if (env_arg) { /* the environment alone (L adds the lights beside it), its top on +z */
+        static const float up[3] = {0.0f, 0.0f, 1.0f};
+        char path[4096];
+        float inten = 1.0f;
+        if (!hdx_env_arg(env_arg, path, sizeof path, &v.env_deg, &inten)) { fprintf(stderr, "hdview: --env '%s' is not FILE[:ROTATION][:INTENSITY]\n", env_arg); return 2; }
+        if (!hdx_env_load(path, &v.env, err, sizeof err)) { fprintf(stderr, "hdview: --env: %s\n", err); return 2; }
+        v.env.intensity = inten;
+        hdx_env_rotation(up, v.env_deg, v.env.rotation);
+        if ((r = hd_set_environment(v.ctx, &v.env)) != HD_SUCCESS) die("hd_set_environment", r);
+        if ((r = hd_set_lights(v.ctx, NULL, 0)) != HD_SUCCESS) die("hd_set_lights", r);
+    }
     hd_query_desc(v.ctx, &desc);
     v.params = desc.params;
     v.camera_dirty = 0;
