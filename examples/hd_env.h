@@ -19,6 +19,11 @@
 #pragma GCC diagnostic pop
 #endif
 
+#if defined(__GNUC__) || defined(__clang__)
+#define HDX_ENV_FN static __attribute__((unused))
+#else
+#define HDX_ENV_FN static
+#endif
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,7 +32,7 @@
 /* The map's rotation (row-major, world = R map) that stands the map's up (+y) on up (need not be
    unit, nonzero) and turns it by deg degrees about it: the map's +x goes to a, a unit vector
    perpendicular to up, turned; its +z to a x up. */
-static void hdx_env_rotation(const float up[3], float deg, float r[9])
+HDX_ENV_FN void hdx_env_rotation(const float up[3], float deg, float r[9])
 {
     double u[3] = {up[0], up[1], up[2]}, a[3], b[3], n, c = cos(deg * 3.14159265358979 / 180.0), s = sin(deg * 3.14159265358979 / 180.0);
     int i;
@@ -56,7 +61,7 @@ static void hdx_env_rotation(const float up[3], float deg, float r[9])
 /* FILE[:ROTATION][:INTENSITY]: the path into path (path_size bytes) and up to two numbers after
    its last ':'s (defaults 0 and 1). 1, or 0 when the path does not fit or a number is out of
    range (ROTATION within +-3600 degrees, INTENSITY in (0, 1e9]). */
-static int hdx_env_arg(const char *s, char *path, size_t path_size, float *rot, float *inten)
+HDX_ENV_FN int hdx_env_arg(const char *s, char *path, size_t path_size, float *rot, float *inten)
 {
     double v[2];
     int k = 0;
@@ -79,7 +84,7 @@ static int hdx_env_arg(const char *s, char *path, size_t path_size, float *rot, 
 }
 
 /* Reads a Radiance .hdr file into env (env->rgb malloc'd: free it). 1, or 0 with the reason in err. */
-static int hdx_env_load(const char *path, hd_environment *env, char *err, size_t err_size)
+HDX_ENV_FN int hdx_env_load(const char *path, hd_environment *env, char *err, size_t err_size)
 {
     int w = 0, h = 0, comp = 0;
     float *px;
