@@ -944,7 +944,7 @@ static const char *const hd__gl_source[] = {
 "                    ((HD_F(z) + 0.5f) / HD_F(gz) - 0.5f) * HD_PRM(box).z);\n",
 "    float tmax = 0.0f, pdf = 0.0f, T, w;\n",
 "    hd_u32 next_dim = 0u;\n",
-"    hd_u32 ekey = hdk_rng_key(HD_U(i) >> 3u, HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_ENV);\n",
+"    hd_u32 ekey = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_ENV);\n",
 "    hd_v3 lw = HD_V3(0.0f, 0.0f, 0.0f);\n",
 "    int c;\n",
 "    hd_v3 d = hdk_light_pick(HD_KPASS l, p, hdk_rand(ekey, 0u), hdk_rand(ekey, 1u), HD_REF(tmax), HD_REF(lw), HD_REF(pdf));\n",
