@@ -491,6 +491,9 @@ typedef struct hd_params {
                                (2: a final gather) converges faster to an image that keeps part of
                                HD's bias (on the head CT 2 and 3 lose to -1 from 1 s on:
                                docs/DESIGN-REFINE.md) */
+    float depth_threshold;  /* the volume's depth (hd_read_depth) is where a camera ray's
+                               accumulated opacity 1 - T first reaches this: 0 -> 0.5; (0, 1]
+                               (1: where the march stops, T below 1e-4) */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -716,6 +719,17 @@ HDDEF hd_result hd_read_image_f32(hd_context ctx, float *dst, size_t dst_floats)
    ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. */
 HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, float *dst,
                                      size_t dst_floats);
+/* The volume's depth for the host's later passes (HD, CD; a matrix camera): width x height
+   floats, rows top first (hd_set_depth's order), each the window depth under camera.depth_range
+   of the nearest point where a ray of the pixel's accumulated opacity reached
+   params.depth_threshold, over the frames in the image since it last restarted (full-resolution
+   frames only: a reduced frame, params.render_scale, adds none); the far plane's value (1, or 0
+   reversed) where none did. The crossing is the first march sample at or past the threshold
+   (within one params.step of it), placed on the ray through the pixel's centre. Where the
+   host's depth (hd_set_depth) ends the rays first there is none. Errors, one log line each:
+   HD_ERROR_NULL_POINTER, HD_ERROR_BUFFER_TOO_SMALL, HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at
+   camera), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS), HD_ERROR_NO_FRAME (as the image's). */
+HDDEF hd_result hd_read_depth(hd_context ctx, float *dst, size_t dst_floats);
 HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
 
 /* ---- output into the renderer's target ------------------------------------------------------

@@ -1109,6 +1109,11 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
     memcpy(dst, vw->be->img, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float));
     return HD_SUCCESS;
 }
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    memcpy(dst, vw->be->img + vw->kp.region.z, (size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float));
+    return HD_SUCCESS;
+}
 /* Copies E or phi between the colour layout and the API's x-fastest channel-planar order, one
    direction per call: into dst (src NULL; binary16 widened exactly) or from src (dst NULL; rounded
    to nearest even), as the OpenCL backend's hd__cl_copy_illumination. Padding slots are not

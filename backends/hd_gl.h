@@ -998,6 +998,14 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
     be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float)), dst);
     return hd__gl_check(vw, "reading the image", __LINE__);
 }
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    hd__backend *be = vw->be;
+    be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
+    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, (GLintptr)((size_t)vw->kp.region.z * sizeof(float)),
+                            (GLsizeiptr)((size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float)), dst);
+    return hd__gl_check(vw, "reading the depth plane", __LINE__);
+}
 
 /* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
    glGetTextureSubImage each, or without GL 4.5 the whole grid read and the slices copied out of

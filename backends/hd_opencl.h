@@ -768,6 +768,14 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
                "clEnqueueReadBuffer(image)");
     return HD_SUCCESS;
 }
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    hd__backend *be = vw->be;
+    HD__CL_TRY(vw, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, (size_t)vw->kp.region.z * sizeof(float),
+                                       (size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float), dst, 0, NULL, NULL),
+               "clEnqueueReadBuffer(depth plane)");
+    return HD_SUCCESS;
+}
 
 /* Maps E or phi (which) for reading or writing; *out is NULL on failure (logged). */
 static hd_result hd__cl_map_illumination(const hd__view *vw, hd_illumination which, cl_map_flags flags, void **out)

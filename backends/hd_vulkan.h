@@ -1735,24 +1735,34 @@ static hd_result hd__be_project(const hd__view *vw)
 static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
-static hd_result hd__be_read_image(const hd__view *vw, float *dst)
+/* Floats [first, first + n) of the image buffer into dst. */
+static hd_result hd__vk_read_img(const hd__view *vw, size_t first, size_t n, float *dst)
 {
     hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkBufferCopy bc;
-    size_t bytes = (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float);
+    size_t bytes = n * sizeof(float);
     hd_result r;
     HD__VK_IDLE(vw);
     if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
     if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
     hd__vk_barrier(be, cb);
     memset(&bc, 0, sizeof bc);
+    bc.srcOffset = first * sizeof(float);
     bc.size = bytes;
     be->fn.vkCmdCopyBuffer(cb, be->img.buffer, be->staging.buffer, 1, &bc);
     hd__vk_barrier(be, cb);
     if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
     memcpy(dst, be->staging.map, bytes);
     return HD_SUCCESS;
+}
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
+{
+    return hd__vk_read_img(vw, 0, (size_t)vw->kp.image.x * vw->kp.image.y * 4, dst);
+}
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    return hd__vk_read_img(vw, (size_t)vw->kp.region.z, (size_t)vw->kp.image.x * vw->kp.image.y, dst);
 }
 
 static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)

@@ -91,10 +91,16 @@ static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable);
    old one is released, so on failure the image held before is kept as it was. */
 static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced);
 /* The image buffer's floats: width x height RGBA, then with reduced the room for a frame at render
-   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use. */
-HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
+   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use, then the
+   depth plane (width x height floats from hd__image_depth_first: hd_k_project.h's
+   hdk_project_depth, read by hd__be_read_depth). */
+HD__MAYBE_UNUSED static size_t hd__image_depth_first(int width, int height, int reduced)
 {
     return ((size_t)width * height + (reduced ? (size_t)((width + 1) / 2) * ((height + 1) / 2) : 0)) * 4;
+}
+HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
+{
+    return hd__image_depth_first(width, height, reduced) + (size_t)width * height;
 }
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
@@ -138,6 +144,9 @@ static hd_result hd__be_path(const hd__view *vw);
 /* ---- read-back (blocking: every earlier primitive's result) ------------------------------------ */
 /* The image as RGBA floats, vw->camera.width x height, rows top to bottom. */
 static hd_result hd__be_read_image(const hd__view *vw, float *dst);
+/* The image buffer's depth plane (hd__image_floats), vw->camera.width x height floats from float
+   vw->kp.region.z of the buffer: what hdk_project_depth wrote. */
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst);
 /* E (HD_ILLUMINATION_DIRECT) or phi (SCATTERED) as floats, x fastest, channels stacked in z:
    with zz NULL the whole grid; else the z slices zz[0..count) of that stacking (slice zz: channel
    zz / gdims[2], z zz % gdims[2]) in that order, each gdims[0] * gdims[1] floats, one after
