@@ -242,6 +242,8 @@ typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_l
 typedef enum hd_illumination {
     HD_ILLUMINATION_DIRECT = 0, /* E: direct light, progressive mean */
     HD_ILLUMINATION_SCATTERED,  /* phi: fluence of scattered light from the diffusion solve */
+    HD_ILLUMINATION_TOTAL,      /* E + phi, summed in float per voxel and channel: what the
+                                   projection samples (docs/INTEGRATION.md, "Light out") */
     HD_ILLUMINATION_COUNT
 } hd_illumination;
 
@@ -716,7 +718,11 @@ HDDEF hd_result hd_render(hd_context ctx);
 HDDEF hd_result hd_read_image_rgba8(hd_context ctx, uint8_t *dst, size_t dst_bytes);
 HDDEF hd_result hd_read_image_f32(hd_context ctx, float *dst, size_t dst_floats);
 /* An illumination volume, channel-planar: channel c of voxel (x,y,z) at
-   ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. */
+   ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. Voxel (x, y, z)'s
+   centre is the volume's box coordinate ((x + 0.5) / dx, ...) (0 and 1 at the box's faces, as
+   params.crop_min), where the projection samples it trilinearly, clamped at the faces: a 3D
+   texture's texel centres with GL_LINEAR and CLAMP_TO_EDGE. The PT methods keep none:
+   HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, float *dst,
                                      size_t dst_floats);
 /* The volume's depth for the host's later passes (HD, CD; a matrix camera): width x height
@@ -860,6 +866,15 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
    glTexSubImage2D copies it in from there (a pixel unpack buffer), so the bytes are exactly
    hd_read_image_ex's. Not a 2D texture: HD_ERROR_INVALID_TEXTURE. */
 HDDEF hd_result hd_gl_render_to_texture_ex(hd_context ctx, unsigned int texture, const hd_output *output);
+/* GL backend only (the others return HD_ERROR_UNSUPPORTED): channel `channel` (0 .. hd_stats.
+   illumination_channels - 1) of HD_ILLUMINATION_TOTAL (E + phi, as the projection samples it)
+   copied on the device (glCopyImageSubData) into texels (0, 0, 0) .. illumination_dims - 1 of
+   level 0 of the caller's GL_TEXTURE_3D `texture`, internal format GL_R32F, at least
+   illumination_dims large (texels beyond are not touched); x, y, z as hd_read_illumination's.
+   Errors, one log line each: HD_ERROR_INVALID_TEXTURE (0, or not a 3D texture),
+   HD_ERROR_OUTPUT_FORMAT (not GL_R32F), HD_ERROR_OUTPUT_OUTSIDE_TARGET (smaller than the grid),
+   HD_ERROR_INVALID_PARAMETER (channel), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS). */
+HDDEF hd_result hd_gl_illumination_texture(hd_context ctx, unsigned int texture, int channel);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer

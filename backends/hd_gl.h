@@ -74,7 +74,8 @@
     X(_HD_GENTEXTURES, GenTextures) X(_HD_DELETETEXTURES, DeleteTextures) X(_HD_BINDTEXTURE, BindTexture) \
     X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
     X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
-    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei) X(_HD_TEXSUBIMAGE2D, TexSubImage2D)
+    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei) X(_HD_TEXSUBIMAGE2D, TexSubImage2D) \
+    X(COPYIMAGESUBDATA, CopyImageSubData)
 /* optional: GL 4.4 / ARB_clear_texture, KHR_debug, GL 4.5 / ARB_get_texture_sub_image */
 #define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
     X(DEBUGMESSAGECONTROL, DebugMessageControl) X(GETTEXTURESUBIMAGE, GetTextureSubImage)
@@ -1326,6 +1327,38 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
     be->gl.TexSubImage2D(GL_TEXTURE_2D, 0, out->x, out->y, cw, ch, GL_RGBA, type, NULL);
     be->gl.BindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
     return hd__gl_check(vw, "the output into the texture", __LINE__);
+}
+
+/* E + phi's channel from lsum (the projection's summed copy, rebuilt first when stale) into the
+   caller's GL_R32F 3D texture: one glCopyImageSubData of slices [c gz, (c + 1) gz). */
+static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)
+{
+    const char *fn = "hd_gl_illumination_texture";
+    hd__backend *be = vw->be;
+    GLint w = 0, h = 0, d = 0, internal = 0;
+    hd_result r;
+    be->gl.BindTexture(GL_TEXTURE_3D, (GLuint)texture);
+    if (be->gl.GetError() != GL_NO_ERROR)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 3D texture name in the current context", fn, texture);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_WIDTH, &w);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_HEIGHT, &h);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_DEPTH, &d);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if (internal != GL_R32F)
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "%s: texture %u has internal format 0x%04x; the light needs GL_R32F", fn, texture,
+                       (unsigned)internal);
+    if (w < vw->gdims[0] || h < vw->gdims[1] || d < vw->gdims[2])
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "%s: texture %u is %dx%dx%d, the illumination grid %dx%dx%d", fn, texture,
+                       (int)w, (int)h, (int)d, vw->gdims[0], vw->gdims[1], vw->gdims[2]);
+    if (!be->gg.lsum_ok) {
+        if ((r = hd__gl_dispatch(vw, HD__GL_LIGHT_SUM, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0)) != HD_SUCCESS)
+            return r;
+        be->gg.lsum_ok = 1;
+    }
+    be->gl.MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    be->gl.CopyImageSubData(be->lsum.name, GL_TEXTURE_3D, 0, 0, 0, channel * vw->gdims[2], (GLuint)texture, GL_TEXTURE_3D, 0, 0, 0, 0,
+                            vw->gdims[0], vw->gdims[1], vw->gdims[2]);
+    return hd__gl_check(vw, "copying the light into the texture", __LINE__);
 }
 
 static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }

@@ -390,6 +390,24 @@ static hd_result hd__api_output_texture(hd__ctx *ctx, unsigned int texture, cons
     HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, exact));
     return r;
 }
+/* hd_gl_illumination_texture: the checks that need no device, then the backend's copy. */
+static hd_result hd__api_illumination_texture(hd__ctx *ctx, unsigned int texture, int channel)
+{
+    hd_result r;
+    const char *fn = "hd_gl_illumination_texture";
+    if (!(hd__be_features() & HD__BE_TEXTURE)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: method %s keeps no illumination volume", fn, hd_method_name(ctx->vw.params.method));
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "%s: texture 0", fn);
+    if (channel < 0 || channel >= ctx->vw.channels)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: channel %d, the grid has %d", fn, channel, ctx->vw.channels);
+    HD__BE_CALL(r, ctx, hd__be_illumination_texture(&ctx->vw, texture, channel));
+    return r;
+}
+HDDEF hd_result hd_gl_illumination_texture(hd_context h, unsigned int texture, int channel)
+{
+    HD__GUARDED(h, "hd_gl_illumination_texture", hd__api_illumination_texture(ctx, texture, channel));
+}
 HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
 {
     HD__GUARDED(h, "hd_gl_render_to_texture", hd__api_output_texture(ctx, texture, NULL, 1, "hd_gl_render_to_texture"));

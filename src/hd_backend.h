@@ -241,6 +241,12 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
    out->y), rows bottom first. The core has checked out (format, size: the camera's, x and y
    >= 0). Runs in a bracket after the core's preparation. */
 static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact);
+/* HD__BE_TEXTURE: channel `channel` of E + phi (as the projection samples it) into texels from
+   (0, 0, 0) of level 0 of the caller's 3D texture (GL_R32F, at least vw->gdims; checked here,
+   each with its own result and log line: HD_ERROR_INVALID_TEXTURE, _OUTPUT_FORMAT,
+   _OUTPUT_OUTSIDE_TARGET), on the device. The core has checked the method (HD, CD), the name
+   (not 0) and the channel. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel);
 /* The primitives of a feature a backend lacks, in one line each: they log and refuse, though the
    core never calls them (hd__be_features). NAME is the backend's name in the log line. */
 #define HD__BE_NO_RECORDING(NAME)                                                                       \
@@ -267,6 +273,11 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
     static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact) \
     {                                                                                                   \
         (void)texture; (void)out; (void)exact;                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
+    }                                                                                                   \
+    static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)     \
+    {                                                                                                   \
+        (void)texture; (void)channel;                                                                   \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
     }
 

@@ -222,6 +222,19 @@ static hd_result hd__api_read_illumination(hd__ctx *ctx, hd_illumination which, 
                        hd_method_name(ctx->vw.params.method));
     need = hd__illum_floats(ctx);
     if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
+    if (which == HD_ILLUMINATION_TOTAL) {
+        /* E into dst, phi beside it, summed as the projection's hdk_sample_light sums them */
+        float *phi = (float *)hd__alloc(&ctx->vw, need * sizeof(float));
+        size_t i;
+        if (!phi) return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_read_illumination: no memory for phi beside E (%zu floats)", need);
+        HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_DIRECT, NULL, 0, dst));
+        if (r == HD_SUCCESS) {
+            HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_SCATTERED, NULL, 0, phi));
+            for (i = 0; r == HD_SUCCESS && i < need; ++i) dst[i] += phi[i];
+        }
+        hd__free(&ctx->vw, phi);
+        return r;
+    }
     HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, which, NULL, 0, dst));
     return r;
 }

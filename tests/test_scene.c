@@ -758,6 +758,49 @@ static void test_depth_out_slab(void)
     free(wall);
 }
 
+/* ---- the light out ------------------------------------------------------------------------------ */
+/* HD_ILLUMINATION_TOTAL is E + phi of the other two read-backs, bit for bit, for one channel and
+   three (lights of different colours); the GL-only copy is HD_ERROR_UNSUPPORTED here with one
+   logged line, the path tracers' read HD_ERROR_UNSUPPORTED. */
+static void test_light_out(void)
+{
+    hd_desc d = scene_desc(vox_blob, tf_blob, 3);
+    hd_test_log log;
+    hd_context ctx;
+    hd_stats st;
+    int rgb;
+    make_volumes();
+    d.logger = hd_test_logger(&log);
+    for (rgb = 0; rgb < 2; ++rgb) {
+        size_t n, i, bad = 0, lit = 0;
+        float *t, *e, *p;
+        d.light_count = rgb ? 2 : 1;
+        CHECK(hd_create(&d, &ctx) == HD_SUCCESS && hd_iterate(ctx, 3) == HD_SUCCESS && hd_get_stats(ctx, &st) == HD_SUCCESS);
+        CHECK(st.illumination_channels == (rgb ? 3 : 1));
+        n = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels;
+        t = (float *)malloc(n * sizeof(float)); e = (float *)malloc(n * sizeof(float)); p = (float *)malloc(n * sizeof(float));
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, t, n) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e, n) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_SCATTERED, p, n) == HD_SUCCESS);
+        for (i = 0; i < n; ++i) { bad += t[i] != e[i] + p[i]; lit += p[i] > 0.0f && e[i] > 0.0f; }
+        CHECK_MSG(bad == 0 && lit > n / 10, "%d channels: %zu voxels not E + phi, %zu lit by both", st.illumination_channels, bad, lit);
+        log.errors = 0;
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, t, n - 1) == HD_ERROR_BUFFER_TOO_SMALL && log.errors == 1);
+        log.errors = 0;
+        CHECK(hd_gl_illumination_texture(ctx, 1u, 0) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        free(t); free(e); free(p);
+        hd_destroy(ctx);
+    }
+    d.params.method = HD_METHOD_PT_SS;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS && hd_iterate(ctx, 1) == HD_SUCCESS);
+    {
+        float one[4];
+        log.errors = 0;
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, one, 4) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+    }
+    hd_destroy(ctx);
+}
+
 /* ---- bad input --------------------------------------------------------------------------------- */
 static hd_test_log g_log;
 /* `call`'s result is `code`, with exactly one logged error. */
@@ -856,6 +899,7 @@ const hd_test_case hd_tests_scene[] = {
     {"scene_depth_post_cuts", test_depth_post_cuts},
     {"scene_depth_lifetime", test_depth_lifetime},
     {"scene_depth_out_slab", test_depth_out_slab},
+    {"scene_light_out", test_light_out},
     {"scene_bad_input", test_bad_input},
 };
 const int hd_tests_scene_count = (int)(sizeof hd_tests_scene / sizeof hd_tests_scene[0]);
