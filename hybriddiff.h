@@ -149,7 +149,8 @@ extern "C" {
     X(HD_ERROR_OUTPUT_OUTSIDE_TARGET, "the output region does not lie inside the target") \
     X(HD_ERROR_OUTPUT_SIZE, "the output region's size is not the camera's (the image is written 1:1)") \
     X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format") \
-    X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)")
+    X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)") \
+    X(HD_ERROR_DEPTH_FORMAT, "the depth texture's internal format is not a depth format")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -875,6 +876,16 @@ HDDEF hd_result hd_gl_render_to_texture_ex(hd_context ctx, unsigned int texture,
    HD_ERROR_OUTPUT_FORMAT (not GL_R32F), HD_ERROR_OUTPUT_OUTSIDE_TARGET (smaller than the grid),
    HD_ERROR_INVALID_PARAMETER (channel), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS). */
 HDDEF hd_result hd_gl_illumination_texture(hd_context ctx, unsigned int texture, int channel);
+/* GL backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's depth
+   texture, with no CPU round trip: level 0 of the 2D texture `texture` (internal format
+   GL_DEPTH_COMPONENT16, 24, 32F, GL_DEPTH24_STENCIL8 or GL_DEPTH32F_STENCIL8, the camera's size;
+   GL's rows, bottom first) is copied on the device at the call into the backend's depth buffer
+   and used as hd_set_depth's values (the same image as hd_set_depth of the same values, rows
+   top first), with its lifetime (replaced by either call, cleared by hd_set_depth(NULL),
+   dropped with the camera's size). Errors, one log line each, the depth held before kept:
+   HD_ERROR_INVALID_TEXTURE (0, not a 2D texture), HD_ERROR_DEPTH_FORMAT, HD_ERROR_DEPTH_SIZE,
+   HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
+HDDEF hd_result hd_gl_set_depth_texture(hd_context ctx, unsigned int texture);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer

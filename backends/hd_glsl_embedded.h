@@ -232,7 +232,8 @@ static const char *const hd__gl_source[] = {
 "HD_PARAM_F4(cam_w)      /* the direction at the image centre (look-at: forward, unit) */\n",
 "HD_PARAM_F4(cam_ou)     /* the origin's change per NDC x (orthographic; 0 for a perspective camera) */\n",
 "HD_PARAM_F4(cam_ov)     /* the origin's change per NDC y */\n",
-"HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on */\n",
+"HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on,\n",
+"                           w = 1: its rows bottom first (a GL depth texture's) */\n",
 "HD_PARAM_F4(depth_z)    /* NDC z = x * depth + y; z = the far plane's depth (no geometry there);\n",
 "                           w = 1 - params.depth_threshold (the volume's depth out, hdk_project_depth) */\n",
 "HD_PARAM_F4(depth_m0)   /* rows 0..3 of the inverse of projection * view, clip to the volume's frame */\n",
@@ -1656,7 +1657,7 @@ static const char *const hd__gl_source[] = {
 "        x = hdk_clampi(HD_I(fx * HD_F(dd.x) / HD_F(HD_PRM(image).x)), 0, dd.x - 1);\n",
 "        y = hdk_clampi(HD_I(fy * HD_F(dd.y) / HD_F(HD_PRM(image).y)), 0, dd.y - 1);\n",
 "    }\n",
-"    w = HD_GET1(dep, y * dd.x + x);\n",
+"    w = HD_GET1(dep, (dd.w != 0 ? dd.y - 1 - y : y) * dd.x + x);\n",
 "    if (w == HD_PRM(depth_z).z) return 3.0e38f;\n",
 "    z = w * HD_PRM(depth_z).x + HD_PRM(depth_z).y;\n",
 "    hx = m0.x * sx + m0.y * sy + m0.z * z + m0.w;\n",
@@ -2614,7 +2615,7 @@ static const char *const hd__gl_source_output[] = {
 "    }\n",
 "}\n",
 };
-#define HD__GL_COMMON_LINES 2201 /* hd__gl_source's lines before hd_entry_glsl.h */
+#define HD__GL_COMMON_LINES 2202 /* hd__gl_source's lines before hd_entry_glsl.h */
 #define HD__GL_SOURCE_MG_LINES (sizeof hd__gl_source_mg / sizeof hd__gl_source_mg[0])
 #define HD__GL_SOURCE_LINES (sizeof hd__gl_source / sizeof hd__gl_source[0])
 #define HD__GL_SOURCE_OUTPUT_LINES (sizeof hd__gl_source_output / sizeof hd__gl_source_output[0])

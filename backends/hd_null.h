@@ -259,6 +259,11 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
     (void)texture; (void)out; (void)exact;
     return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
 }
+static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)
+{
+    (void)texture;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
+}
 static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)
 {
     (void)texture; (void)channel;

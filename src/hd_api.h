@@ -211,12 +211,13 @@ static hd_result hd__api_set_camera(hd__ctx *ctx, const hd_camera *camera)
     resized = c.width != ctx->vw.camera.width || c.height != ctx->vw.camera.height;
     if (resized) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
     /* the depth belongs to a matrix camera of its size */
-    if (ctx->vw.depth && (resized || !cf.matrix)) {
+    if ((ctx->vw.depth || ctx->vw.depth_device) && (resized || !cf.matrix)) {
         HD__INFO(&ctx->vw.log, "hd_set_camera: the depth buffer (%dx%d) is dropped: the camera is %s", ctx->vw.depth_w, ctx->vw.depth_h,
                  resized ? "resized" : "a look-at camera");
         hd__free(&ctx->vw, ctx->vw.depth);
         ctx->vw.depth = NULL;
         ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        ctx->vw.depth_device = 0;
         ctx->dirty |= HD__DIRTY_DEPTH;
     }
     ctx->vw.camera = c;
@@ -258,10 +259,11 @@ static hd_result hd__api_set_depth(hd__ctx *ctx, const hd_depth_desc *depth)
     size_t n;
     float *buf;
     if (!depth || (!depth->data && depth->width == 0 && depth->height == 0)) {
-        if (ctx->vw.depth) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
+        if (ctx->vw.depth || ctx->vw.depth_device) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
         hd__free(&ctx->vw, ctx->vw.depth);
         ctx->vw.depth = NULL;
         ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        ctx->vw.depth_device = 0;
         return HD_SUCCESS;
     }
     if (!depth->data)
@@ -276,8 +278,35 @@ static hd_result hd__api_set_depth(hd__ctx *ctx, const hd_depth_desc *depth)
     ctx->vw.depth = buf;
     ctx->vw.depth_w = depth->width;
     ctx->vw.depth_h = depth->height;
+    ctx->vw.depth_device = 0;
     ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
+}
+
+/* hd_gl_set_depth_texture: the checks that need no device, the backend's copy in a bracket, then
+   the depth is the backend's (the host copy, if any, released). */
+static hd_result hd__api_depth_texture(hd__ctx *ctx, unsigned int texture)
+{
+    const char *fn = "hd_gl_set_depth_texture";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_TEXTURE)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "%s: texture 0", fn);
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    HD__BE_CALL(r, ctx, hd__be_depth_texture(&ctx->vw, texture));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 1;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+HDDEF hd_result hd_gl_set_depth_texture(hd_context h, unsigned int texture)
+{
+    HD__GUARDED(h, "hd_gl_set_depth_texture", hd__api_depth_texture(ctx, texture));
 }
 HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
 {

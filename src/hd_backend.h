@@ -105,7 +105,8 @@ HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduc
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
 /* The host's depth buffer changed (hd_set_depth): vw->depth, vw->depth_w x depth_h floats, or
-   NULL (free what the backend holds). The projection and the path tracers read it as hdk_depth_t
+   NULL (free what the backend holds, unless vw->depth_device: then keep the buffer
+   hd__be_depth_texture filled). The projection and the path tracers read it as hdk_depth_t
    (hd_k_project.h) does, through their buffer `dep`, while vw->kp.depth_dims.z is 1. */
 static hd_result hd__be_upload_depth(const hd__view *vw);
 /* Zeroes what the HD__DIRTY_* bits in what name: DIRECT (E and CD's light volumes), PHI (phi,
@@ -247,6 +248,12 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
    _OUTPUT_OUTSIDE_TARGET), on the device. The core has checked the method (HD, CD), the name
    (not 0) and the channel. Runs in a bracket after the core's preparation. */
 static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel);
+/* HD__BE_TEXTURE: the host's depth texture (level 0 of a 2D texture of a depth format and the
+   camera's size; checked here: HD_ERROR_INVALID_TEXTURE, _DEPTH_FORMAT, _DEPTH_SIZE, each with
+   one log line, the buffer held before untouched) copied on the device into the buffer the
+   kernels read as `dep`, GL's rows (bottom first, which kp.depth_dims.w = 1 tells them). The core
+   then sets vw->depth_device. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture);
 /* The primitives of a feature a backend lacks, in one line each: they log and refuse, though the
    core never calls them (hd__be_features). NAME is the backend's name in the log line. */
 #define HD__BE_NO_RECORDING(NAME)                                                                       \
@@ -278,6 +285,11 @@ static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned textur
     static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)     \
     {                                                                                                   \
         (void)texture; (void)channel;                                                                   \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
+    }                                                                                                   \
+    static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)                         \
+    {                                                                                                   \
+        (void)texture;                                                                                  \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
     }
 

@@ -77,6 +77,8 @@ typedef struct hd__view {
        NULL: none (kp.depth_dims.z = 0) */
     float *depth;
     int depth_w, depth_h;
+    int depth_device;        /* 1: the backend's buffer holds the host's depth, copied from its GL
+                                texture (hd_gl_set_depth_texture), rows bottom first; depth NULL */
 } hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */

@@ -760,8 +760,9 @@ static void test_depth_out_slab(void)
 
 /* ---- the light out ------------------------------------------------------------------------------ */
 /* HD_ILLUMINATION_TOTAL is E + phi of the other two read-backs, bit for bit, for one channel and
-   three (lights of different colours); the GL-only copy is HD_ERROR_UNSUPPORTED here with one
-   logged line, the path tracers' read HD_ERROR_UNSUPPORTED. */
+   three (lights of different colours); the GL-only calls (hd_gl_illumination_texture,
+   hd_gl_set_depth_texture) are HD_ERROR_UNSUPPORTED here with one logged line, the path tracers'
+   read HD_ERROR_UNSUPPORTED. */
 static void test_light_out(void)
 {
     hd_desc d = scene_desc(vox_blob, tf_blob, 3);
@@ -788,6 +789,8 @@ static void test_light_out(void)
         CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, t, n - 1) == HD_ERROR_BUFFER_TOO_SMALL && log.errors == 1);
         log.errors = 0;
         CHECK(hd_gl_illumination_texture(ctx, 1u, 0) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        log.errors = 0;
+        CHECK(hd_gl_set_depth_texture(ctx, 1u) == HD_ERROR_UNSUPPORTED && log.errors == 1);
         free(t); free(e); free(p);
         hd_destroy(ctx);
     }

@@ -23,7 +23,8 @@ HD_PARAM_F4(cam_v)      /* its change per NDC y (look-at: image up * tan(fov/2))
 HD_PARAM_F4(cam_w)      /* the direction at the image centre (look-at: forward, unit) */
 HD_PARAM_F4(cam_ou)     /* the origin's change per NDC x (orthographic; 0 for a perspective camera) */
 HD_PARAM_F4(cam_ov)     /* the origin's change per NDC y */
-HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on */
+HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on,
+                           w = 1: its rows bottom first (a GL depth texture's) */
 HD_PARAM_F4(depth_z)    /* NDC z = x * depth + y; z = the far plane's depth (no geometry there);
                            w = 1 - params.depth_threshold (the volume's depth out, hdk_project_depth) */
 HD_PARAM_F4(depth_m0)   /* rows 0..3 of the inverse of projection * view, clip to the volume's frame */

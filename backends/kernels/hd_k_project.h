@@ -97,7 +97,7 @@ HD_FN float hdk_depth_t(HD_KARGS int px, int py, float fx, float fy, float sx, f
         x = hdk_clampi(HD_I(fx * HD_F(dd.x) / HD_F(HD_PRM(image).x)), 0, dd.x - 1);
         y = hdk_clampi(HD_I(fy * HD_F(dd.y) / HD_F(HD_PRM(image).y)), 0, dd.y - 1);
     }
-    w = HD_GET1(dep, y * dd.x + x);
+    w = HD_GET1(dep, (dd.w != 0 ? dd.y - 1 - y : y) * dd.x + x);
     if (w == HD_PRM(depth_z).z) return 3.0e38f;
     z = w * HD_PRM(depth_z).x + HD_PRM(depth_z).y;
     hx = m0.x * sx + m0.y * sy + m0.z * z + m0.w;

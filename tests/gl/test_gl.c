@@ -45,6 +45,13 @@
       channel of a 3-channel grid. A 2D texture, a GL_R16F one, one smaller than the grid, a
       channel past the grid's, texture 0: each its own hd_result and one logged error, nothing
       written, and the context goes on.
+   11. hd_gl_set_depth_texture: the host's GL_DEPTH_COMPONENT32F and GL_DEPTH_COMPONENT24 textures
+      (a wall over the left third and the bottom half, a post through the middle; GL's rows,
+      bottom first) give bit for bit the image
+      of hd_set_depth with the same values (rows flipped to top first), which differs from the
+      image without depth; hd_set_depth(NULL) then gives the image without depth. An RGBA8
+      texture, one of another size, a 3D texture, texture 0 and a look-at camera: each its own
+      hd_result and one logged error, and the depth held before stays.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -920,6 +927,126 @@ static void check_light_texture(void)
     }
 }
 
+/* Check 11: the host's depth texture as the depth input. */
+static float *render_depth(hd_context c, const float *top_first, GLuint tex, int w, int h)
+{
+    float *img = (float *)malloc((size_t)w * h * 4 * sizeof(float));
+    hd_result r = HD_SUCCESS;
+    if (top_first) {
+        hd_depth_desc dd;
+        dd.data = top_first; dd.width = w; dd.height = h;
+        r = hd_set_depth(c, &dd);
+    } else if (tex) {
+        r = hd_gl_set_depth_texture(c, tex);
+    }
+    CHECK(r == HD_SUCCESS, "depth texture: setting the depth: %s", hd_result_string(r));
+    CHECK(hd_iterate(c, 2) == HD_SUCCESS && hd_read_image_f32(c, img, (size_t)w * h * 4) == HD_SUCCESS, "depth texture: render");
+    return img;
+}
+static void check_depth_texture(void)
+{
+    static uint8_t vox[24 * 24 * 24];
+    static const GLenum fmts[2] = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT24};
+    hd_desc d;
+    int w, h, x, y, k;
+    double n = 0.1, f = 10.0, th = tan(20.0 * 3.14159265358979 / 180.0);
+    float *gl_rows, *top, *back;
+    make_desc(&d, vox, 24);
+    d.gl.use_current_context = 1;
+    d.logger.func = out_log;
+    w = d.camera.width; h = d.camera.height;
+    memset(d.camera.view, 0, sizeof d.camera.view);
+    d.camera.view[0] = d.camera.view[5] = d.camera.view[10] = d.camera.view[15] = 1.0f;
+    d.camera.view[14] = -2.5f; /* the default look-at camera, (0, 0, 2.5) toward the origin */
+    d.camera.projection[0] = (float)(1.0 / (th * w / h));
+    d.camera.projection[5] = (float)(1.0 / th);
+    d.camera.projection[10] = (float)(-(f + n) / (f - n));
+    d.camera.projection[11] = -1.0f;
+    d.camera.projection[14] = (float)(-2.0 * f * n / (f - n));
+    gl_rows = (float *)malloc((size_t)w * h * sizeof(float));
+    top = (float *)malloc((size_t)w * h * sizeof(float));
+    back = (float *)malloc((size_t)w * h * sizeof(float));
+    for (y = 0; y < h; ++y) /* GL's row y (bottom first) */
+        for (x = 0; x < w; ++x) {
+            double z = x < w / 3 || y < h / 2 ? -2.2 : (x >= w / 2 - 2 && x < w / 2 + 2) ? -2.5 : 0.0;
+            gl_rows[y * w + x] = z == 0.0 ? 1.0f : (float)(0.5 * ((-(f + n) / (f - n) * z - 2.0 * f * n / (f - n)) / -z + 1.0));
+        }
+    for (k = 0; k < 2; ++k) {
+        hd_context a, b, none;
+        GLuint t, prev;
+        float *ia, *ib, *in, *ic;
+        size_t np = (size_t)w * h * 4;
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, (GLint *)&prev);
+        glGenTextures(1, &t);
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexStorage2D(GL_TEXTURE_2D, 1, fmts[k], w, h);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, gl_rows);
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+        glGetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, back); /* the values it holds */
+        glBindTexture(GL_TEXTURE_2D, prev);
+        for (y = 0; y < h; ++y) memcpy(top + (size_t)y * w, back + (size_t)(h - 1 - y) * w, (size_t)w * sizeof(float));
+        CHECK(hd_create(&d, &a) == HD_SUCCESS && hd_create(&d, &b) == HD_SUCCESS && hd_create(&d, &none) == HD_SUCCESS,
+              "depth texture: hd_create");
+        ia = render_depth(a, top, 0, w, h);
+        ib = render_depth(b, NULL, t, w, h);
+        in = render_depth(none, NULL, 0, w, h);
+        CHECK(memcmp(ia, ib, np * sizeof(float)) == 0, "depth texture 0x%04x: the image is not hd_set_depth's of the same values", fmts[k]);
+        CHECK(memcmp(ia, in, np * sizeof(float)) != 0, "depth texture 0x%04x: the depth changed nothing", fmts[k]);
+        if (k == 0) { /* refusals keep the depth held */
+            GLuint rgba, small, t3;
+            hd_context look;
+            hd_desc dl = d;
+            hd_result r;
+            float *iz;
+            glGenTextures(1, &rgba); glBindTexture(GL_TEXTURE_2D, rgba); glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, w, h);
+            glGenTextures(1, &small); glBindTexture(GL_TEXTURE_2D, small); glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, w, h - 1);
+            glBindTexture(GL_TEXTURE_2D, prev);
+            t3 = tex3d(GL_R32F, 4, 4, 4, 0.0f);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, rgba);
+            CHECK(r == HD_ERROR_DEPTH_FORMAT && out_errors == 1, "depth texture: RGBA8: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, small);
+            CHECK(r == HD_ERROR_DEPTH_SIZE && out_errors == 1, "depth texture: another size: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, t3);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE && out_errors == 1, "depth texture: a 3D texture: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, 0);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE && out_errors == 1, "depth texture: 0: %s, %d errors", hd_result_string(r), out_errors);
+            CHECK(glGetError() == GL_NO_ERROR, "depth texture: a refusal left a GL error pending");
+            memset(dl.camera.view, 0, sizeof dl.camera.view);
+            memset(dl.camera.projection, 0, sizeof dl.camera.projection);
+            CHECK(hd_create(&dl, &look) == HD_SUCCESS, "depth texture: look-at context");
+            out_errors = 0; r = hd_gl_set_depth_texture(look, t);
+            CHECK(r == HD_ERROR_DEPTH_NEEDS_PROJECTION && out_errors == 1, "depth texture: look-at camera: %s", hd_result_string(r));
+            hd_destroy(look);
+            /* the depth held: a and b go on alike (a method change re-uploads a host buffer, keeps the texture's) */
+            {
+                hd_params p = d.params;
+                p.method = HD_METHOD_CD;
+                CHECK(hd_set_params(a, &p) == HD_SUCCESS && hd_set_params(b, &p) == HD_SUCCESS, "depth texture: method CD");
+            }
+            free(ia); free(ib);
+            ia = render_depth(a, NULL, 0, w, h);
+            ib = render_depth(b, NULL, 0, w, h);
+            CHECK(memcmp(ia, ib, np * sizeof(float)) == 0, "depth texture: after the refusals and a method change b is not a's");
+            CHECK(hd_set_depth(b, NULL) == HD_SUCCESS && hd_set_depth(a, NULL) == HD_SUCCESS, "depth texture: cleared");
+            iz = render_depth(b, NULL, 0, w, h);
+            ic = render_depth(a, NULL, 0, w, h);
+            CHECK(memcmp(iz, ic, np * sizeof(float)) == 0, "depth texture: hd_set_depth(NULL) did not clear the texture's depth");
+            free(iz); free(ic);
+            glDeleteTextures(1, &rgba); glDeleteTextures(1, &small); glDeleteTextures(1, &t3);
+        }
+        free(ia); free(ib); free(in);
+        hd_destroy(a); hd_destroy(b); hd_destroy(none);
+        glDeleteTextures(1, &t);
+        printf("PASS depth texture 0x%04x: the image of hd_set_depth with the same values, bit for bit\n", fmts[k]);
+    }
+    free(gl_rows); free(top); free(back);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -949,6 +1076,7 @@ int main(void)
     check_output_formats();
     check_output_encoding();
     check_light_texture();
+    check_depth_texture();
     check_shader_warnings();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
