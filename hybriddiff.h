@@ -852,6 +852,40 @@ typedef struct hd_vulkan_target {
 HDDEF hd_result hd_vulkan_record_render(hd_context ctx, void *command_buffer, const hd_vulkan_target *target,
                                         const hd_output *output);
 
+/* The host's depth on the device for hd_vulkan_record_depth: an image or a buffer (one of them),
+   the camera's size (the library cannot query it: the validation layer reports a wrong one).
+   Image: a 2D depth image, VK_FORMAT_D32_SFLOAT or D32_SFLOAT_S8_UINT (its depth aspect), mip 0
+   layer 0, made with VK_IMAGE_USAGE_TRANSFER_SRC_BIT, owned by desc.vulkan.queue_family, in
+   `layout` when the command buffer reaches the copy (GENERAL, TRANSFER_SRC_OPTIMAL,
+   SHADER_READ_ONLY_OPTIMAL or a depth attachment or read-only layout) and left in it. Rows top
+   first (Vulkan's y down, as hd_set_depth's). Buffer: width x height floats, rows top first,
+   `offset` bytes from its start, inside buffer_size, made with VK_BUFFER_USAGE_TRANSFER_SRC_BIT.
+   Barriers (the library records them): source stage ALL_COMMANDS, access MEMORY_READ |
+   MEMORY_WRITE before the copy (and the image's transition to TRANSFER_SRC_OPTIMAL), its
+   transition back and an ALL_COMMANDS barrier after. */
+typedef struct hd_vulkan_depth {
+    uint64_t image;       /* VkImage, or 0 with a buffer */
+    int format;           /* the image's VkFormat */
+    int layout;           /* the VkImageLayout it is in at the copy, and is left in */
+    uint64_t buffer;      /* VkBuffer, or 0 with an image */
+    uint64_t offset;      /* buffer: bytes to the first value (a multiple of 4) */
+    uint64_t buffer_size; /* buffer: its size in bytes */
+} hd_vulkan_depth;
+#define HD_VULKAN_DEPTH_INIT HD_ZERO_INIT
+
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's
+   depth image or buffer, recorded into the caller's command buffer (in the recording state, as
+   hd_vulkan_record's): a copy into the library's depth buffer, with no CPU round trip, which the
+   frames recorded after it (hd_vulkan_record_render in the same command buffer, or any later
+   call once it has run) read: the same image as hd_set_depth of the same values, with its
+   lifetime (replaced by either call, cleared by hd_set_depth(NULL), dropped with the camera's
+   size). Submit and wait before the next call, as for hd_vulkan_record. Errors, one log line
+   each, nothing recorded and the depth held before kept: HD_ERROR_NULL_POINTER (command buffer,
+   depth), HD_ERROR_INVALID_PARAMETER (not one of image and buffer, a layout, an offset),
+   HD_ERROR_DEPTH_FORMAT, HD_ERROR_BUFFER_TOO_SMALL (the values past buffer_size),
+   HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
+HDDEF hd_result hd_vulkan_record_depth(hd_context ctx, void *command_buffer, const hd_vulkan_depth *depth);
+
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
    hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must
    be the camera's: else HD_ERROR_INVALID_TEXTURE) with no CPU round trip; rows bottom first,

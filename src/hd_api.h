@@ -304,6 +304,43 @@ static hd_result hd__api_depth_texture(hd__ctx *ctx, unsigned int texture)
     ctx->dirty |= HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+
+/* hd_vulkan_record_depth: the checks that need no device, the backend's recording of the copy
+   (its own checks first), then the depth is the backend's. */
+static hd_result hd__api_vulkan_record_depth(hd__ctx *ctx, void *command_buffer, const hd_vulkan_depth *d)
+{
+    const char *fn = "hd_vulkan_record_depth";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_RECORD)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (!command_buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: command_buffer is NULL", fn);
+    if (!d) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: depth is NULL", fn);
+    if ((d->image != 0) == (d->buffer != 0))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: the depth names %s; give an image or a buffer", fn,
+                       d->image ? "an image and a buffer" : "neither an image nor a buffer");
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    if (d->buffer) {
+        uint64_t bytes = (uint64_t)ctx->vw.camera.width * (uint64_t)ctx->vw.camera.height * 4u;
+        if (d->offset % 4u != 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: offset %llu is not a multiple of 4", fn, (unsigned long long)d->offset);
+        if (d->offset > d->buffer_size || d->buffer_size - d->offset < bytes)
+            return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "%s: %llu bytes from offset %llu past the buffer's %llu", fn,
+                           (unsigned long long)bytes, (unsigned long long)d->offset, (unsigned long long)d->buffer_size);
+    }
+    HD__BE_CALL(r, ctx, hd__be_record_depth(&ctx->vw, command_buffer, d));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 2;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+HDDEF hd_result hd_vulkan_record_depth(hd_context h, void *command_buffer, const hd_vulkan_depth *depth)
+{
+    HD__GUARDED(h, "hd_vulkan_record_depth", hd__api_vulkan_record_depth(ctx, command_buffer, depth));
+}
 HDDEF hd_result hd_gl_set_depth_texture(hd_context h, unsigned int texture)
 {
     HD__GUARDED(h, "hd_gl_set_depth_texture", hd__api_depth_texture(ctx, texture));

@@ -234,6 +234,13 @@ static int hd__be_record_seconds(const hd__view *vw, double *seconds);
    hd__be_record_begin, so a refused target leaves the command buffer untouched. */
 static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
 static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
+/* HD__BE_RECORD: records into the caller's command buffer `cb` the copy of the host's depth
+   (hybriddiff.h's hd_vulkan_depth, the camera's size) into the buffer the kernels read as `dep`,
+   with its barriers, after checking what the core has not (the image's format: HD_ERROR_DEPTH_FORMAT,
+   its layout: HD_ERROR_INVALID_PARAMETER; each with one log line, nothing recorded). The core has
+   checked the pointers, one of image and buffer, the buffer's range and the camera, and sets
+   vw->depth_device after. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth);
 /* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line:
    HD_ERROR_INVALID_TEXTURE not a 2D texture, HD_ERROR_OUTPUT_FORMAT its internal format,
    HD_ERROR_OUTPUT_OUTSIDE_TARGET the region past its size; exact: hd_gl_render_to_texture's
@@ -274,6 +281,11 @@ static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture);
     static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out) \
     {                                                                                                   \
         (void)target; (void)out;                                                                        \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth)    \
+    {                                                                                                   \
+        (void)cb; (void)depth;                                                                          \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
     }
 #define HD__BE_NO_TEXTURE(NAME)                                                                         \

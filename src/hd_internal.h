@@ -77,8 +77,10 @@ typedef struct hd__view {
        NULL: none (kp.depth_dims.z = 0) */
     float *depth;
     int depth_w, depth_h;
-    int depth_device;        /* 1: the backend's buffer holds the host's depth, copied from its GL
-                                texture (hd_gl_set_depth_texture), rows bottom first; depth NULL */
+    int depth_device;        /* the backend's buffer holds the host's depth (depth NULL), copied on
+                                the device: 1 from a GL texture (hd_gl_set_depth_texture), rows
+                                bottom first; 2 from a Vulkan image or buffer (hd_vulkan_record_depth),
+                                rows top first */
 } hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */

@@ -63,7 +63,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->depth_w.x = cf->dw[0]; k->depth_w.y = cf->dw[1]; k->depth_w.z = cf->dw[2]; k->depth_w.w = cf->dw[3];
     if ((ctx->vw.depth || ctx->vw.depth_device) && cf->matrix) {
         k->depth_dims.x = ctx->vw.depth_w; k->depth_dims.y = ctx->vw.depth_h; k->depth_dims.z = 1;
-        k->depth_dims.w = ctx->vw.depth_device; /* rows bottom first */
+        k->depth_dims.w = ctx->vw.depth_device == 1; /* rows bottom first */
         k->depth_z.x = cf->depth_z[0]; k->depth_z.y = cf->depth_z[1]; k->depth_z.z = cf->depth_z[2];
         for (i = 0; i < 4; ++i) {
             (&k->depth_m0.x)[i] = cf->dm[i]; (&k->depth_m1.x)[i] = cf->dm[4 + i];
