@@ -920,6 +920,14 @@ HDDEF hd_result hd_gl_illumination_texture(hd_context ctx, unsigned int texture,
    HD_ERROR_INVALID_TEXTURE (0, not a 2D texture), HD_ERROR_DEPTH_FORMAT, HD_ERROR_DEPTH_SIZE,
    HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
 HDDEF hd_result hd_gl_set_depth_texture(hd_context ctx, unsigned int texture);
+/* OpenCL backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's
+   cl_mem buffer (passed as void*) of the backend's context (desc.opencl.context): width x height
+   floats, rows top first, from byte `offset` (a multiple of 4), copied on the device
+   (clEnqueueCopyBuffer on the backend's queue: the caller's writes must be finished or on that
+   queue) at the call, with hd_set_depth's lifetime and image. Errors, one log line each, the
+   depth held before kept: HD_ERROR_NULL_POINTER, HD_ERROR_INVALID_PARAMETER (the offset, not a
+   buffer, another context), HD_ERROR_BUFFER_TOO_SMALL, HD_ERROR_DEPTH_NEEDS_PROJECTION. */
+HDDEF hd_result hd_opencl_set_depth_buffer(hd_context ctx, void *buffer, size_t offset);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer

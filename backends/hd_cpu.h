@@ -1103,6 +1103,7 @@ static hd_result hd__be_upsample(const hd__view *vw)
 static unsigned hd__be_features(void) { return 0; }
 HD__BE_NO_RECORDING("cpu")
 HD__BE_NO_TEXTURE("cpu")
+HD__BE_NO_CL_BUFFER("cpu")
 
 static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {

@@ -1397,3 +1397,4 @@ static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }
 
 /* No recording (a Vulkan feature): the core never calls these. */
 HD__BE_NO_RECORDING("gl")
+HD__BE_NO_CL_BUFFER("gl")

@@ -265,6 +265,11 @@ static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulk
     hd__null_call(vw, HD__NULL_record_depth);
     return HD_SUCCESS;
 }
+static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)
+{
+    (void)buffer; (void)offset;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no OpenCL buffer");
+}
 static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)
 {
     (void)texture;

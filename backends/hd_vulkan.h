@@ -2419,3 +2419,4 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
 
 /* No GL texture: the core never calls it. */
 HD__BE_NO_TEXTURE("vulkan")
+HD__BE_NO_CL_BUFFER("vulkan")

@@ -337,6 +337,32 @@ static hd_result hd__api_vulkan_record_depth(hd__ctx *ctx, void *command_buffer,
     ctx->dirty |= HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+/* hd_opencl_set_depth_buffer: the checks that need no device, the backend's copy, then the depth
+   is the backend's. */
+static hd_result hd__api_cl_depth(hd__ctx *ctx, void *buffer, size_t offset)
+{
+    const char *fn = "hd_opencl_set_depth_buffer";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_CL_BUFFER)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (!buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: buffer is NULL", fn);
+    if (offset % 4u != 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: offset %zu is not a multiple of 4", fn, offset);
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    HD__BE_CALL(r, ctx, hd__be_depth_cl_buffer(&ctx->vw, buffer, offset));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 3;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+HDDEF hd_result hd_opencl_set_depth_buffer(hd_context h, void *buffer, size_t offset)
+{
+    HD__GUARDED(h, "hd_opencl_set_depth_buffer", hd__api_cl_depth(ctx, buffer, offset));
+}
 HDDEF hd_result hd_vulkan_record_depth(hd_context h, void *command_buffer, const hd_vulkan_depth *depth)
 {
     HD__GUARDED(h, "hd_vulkan_record_depth", hd__api_vulkan_record_depth(ctx, command_buffer, depth));

@@ -211,6 +211,7 @@ static size_t hd__be_solver_bytes(const hd__view *vw);
    A backend without a feature still defines its primitives; the core never calls them then. */
 #define HD__BE_RECORD 1  /* hd_vulkan_record, _record_render: work recorded into the caller's command buffer */
 #define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture(_ex): the image encoded into the caller's texture */
+#define HD__BE_CL_BUFFER 4 /* hd_opencl_set_depth_buffer: the host's depth from its cl_mem */
 static unsigned hd__be_features(void);
 /* Recording (HD__BE_RECORD). The core's hd_vulkan_record and hd_vulkan_record_render run their
    preparation, then hd__be_record_begin, then the method's primitives, which the backend
@@ -261,6 +262,12 @@ static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned textur
    kernels read as `dep`, GL's rows (bottom first, which kp.depth_dims.w = 1 tells them). The core
    then sets vw->depth_device. Runs in a bracket after the core's preparation. */
 static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture);
+/* HD__BE_CL_BUFFER: the host's cl_mem buffer (of the backend's context, width x height floats
+   from byte offset; checked here: HD_ERROR_INVALID_PARAMETER not a buffer or another context,
+   HD_ERROR_BUFFER_TOO_SMALL, each with one log line, the buffer held before untouched) copied
+   on the device into `dep`, rows top first. The core has checked the pointer, the offset's
+   alignment and the camera, and sets vw->depth_device after. */
+static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset);
 /* The primitives of a feature a backend lacks, in one line each: they log and refuse, though the
    core never calls them (hd__be_features). NAME is the backend's name in the log line. */
 #define HD__BE_NO_RECORDING(NAME)                                                                       \
@@ -287,6 +294,12 @@ static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture);
     {                                                                                                   \
         (void)cb; (void)depth;                                                                          \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }
+#define HD__BE_NO_CL_BUFFER(NAME)                                                                       \
+    static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)            \
+    {                                                                                                   \
+        (void)buffer; (void)offset;                                                                     \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no OpenCL buffer");                      \
     }
 #define HD__BE_NO_TEXTURE(NAME)                                                                         \
     static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact) \
