@@ -320,6 +320,8 @@ static void fz_params_defaults(hd_params *p)
     if (p->render_scale == 0) p->render_scale = 1;
     if (p->light_window == 0) p->light_window = 8;
     if (p->depth_threshold == 0.0f) p->depth_threshold = 0.5f;
+    if (p->refine_bounces == 0) p->refine_bounces = -1;
+    if (p->rest == HD_REST_DEFAULT) p->rest = HD_REST_HOLD;
     for (i = 0; i < 3; ++i)
         if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
     /* a float whose default is 0 is stored as +0 (src/hd_params.h: a zero field gets its default) */
@@ -360,6 +362,8 @@ static fz_set fz_params_want(const hd_params *p)
     if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > 8)) bad |= FZ_R(IP);
     if (p->light_window < 1 || p->light_window > 1000000) bad |= FZ_R(IP);
     if (!fz_finite(p->depth_threshold) || !(p->depth_threshold >= 0.0f && p->depth_threshold <= 1.0f)) bad |= FZ_R(IP);
+    if (fz_bad_enum((int)p->rest, HD_REST_COUNT)) bad |= FZ_R(IE);
+    if (p->refine_bounces < -1 || p->refine_bounces > 100000) bad |= FZ_R(IP);
     for (i = 0; i < 3; ++i)
         if (!fz_finite(p->crop_min[i]) || !fz_finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
             !(p->crop_max[i] <= 1.0f) || !(p->crop_min[i] < p->crop_max[i]))
@@ -933,7 +937,8 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
     light_bits = FZ_BITS(extinction) || FZ_BITS(majorant) || FZ_BITS(crop_min) || FZ_BITS(crop_max) || light;
     phi = FZ_NE(disable_diffusion) || FZ_NE(diffusion_boundary);
     phi_bits = FZ_BITS(albedo) || FZ_BITS(anisotropy) || phi || warm;
-    image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || FZ_NE(depth_threshold) || bg;
+    image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || FZ_NE(depth_threshold) || FZ_NE(rest) ||
+            FZ_NE(refine_bounces) || bg;
     /* "solver, sweeps, tracking, exposure, light_tolerance, render_budget, light_window -> nothing" */
     t.solver = p->solver;
     t.diffusion_sweeps = p->diffusion_sweeps;
