@@ -39,6 +39,7 @@ help:
 	@echo "  make compile-vulkan-cxx             T the Vulkan implementation as C++17, warnings as errors"
 	@echo "  make compile-gl-cxx                 T the GL implementation as C++17, warnings as errors"
 	@echo "  make test-gl                        T GL host state restored, render to texture, caller's context checks"
+	@echo "  make test-opencl                    T OpenCL: the host's cl_mem depth buffer gives hd_set_depth's image"
 	@echo "  make test-null                      T the public API over the null backend (computes nothing, counts primitives)"
 	@echo "  make test-vulkan                    T caller's device and hd_vulkan_record, device memory and device-lost paths"
 	@echo "  make test-hdview                    T the viewer under Xvfb against hdrender's image"

@@ -150,7 +150,8 @@ extern "C" {
     X(HD_ERROR_OUTPUT_SIZE, "the output region's size is not the camera's (the image is written 1:1)") \
     X(HD_ERROR_OUTPUT_FORMAT, "the target's format does not take the output format") \
     X(HD_ERROR_BUSY, "another call on this context is in progress (calls on one context must not overlap)") \
-    X(HD_ERROR_INVALID_ENVIRONMENT, "an environment map texel, rotation or intensity is invalid")
+    X(HD_ERROR_INVALID_ENVIRONMENT, "an environment map texel, rotation or intensity is invalid") \
+    X(HD_ERROR_DEPTH_FORMAT, "the depth texture's internal format is not a depth format")
 
 typedef enum hd_result {
 #define HD__X(name, text) name,
@@ -243,6 +244,8 @@ typedef enum hd_log_level { HD_LOG_ERROR = 0, HD_LOG_WARNING, HD_LOG_INFO } hd_l
 typedef enum hd_illumination {
     HD_ILLUMINATION_DIRECT = 0, /* E: direct light, progressive mean */
     HD_ILLUMINATION_SCATTERED,  /* phi: fluence of scattered light from the diffusion solve */
+    HD_ILLUMINATION_TOTAL,      /* E + phi, summed in float per voxel and channel: what the
+                                   projection samples (docs/INTEGRATION.md, "Light out") */
     HD_ILLUMINATION_COUNT
 } hd_illumination;
 
@@ -511,6 +514,9 @@ typedef struct hd_params {
                                (2: a final gather) converges faster to an image that keeps part of
                                HD's bias (on the head CT 2 and 3 lose to -1 from 1 s on:
                                docs/DESIGN-REFINE.md) */
+    float depth_threshold;  /* the volume's depth (hd_read_depth) is where a camera ray's
+                               accumulated opacity 1 - T first reaches this: 0 -> 0.5; (0, 1]
+                               (1: where the march stops, T below 1e-4) */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -751,9 +757,24 @@ HDDEF hd_result hd_render(hd_context ctx);
 HDDEF hd_result hd_read_image_rgba8(hd_context ctx, uint8_t *dst, size_t dst_bytes);
 HDDEF hd_result hd_read_image_f32(hd_context ctx, float *dst, size_t dst_floats);
 /* An illumination volume, channel-planar: channel c of voxel (x,y,z) at
-   ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. */
+   ((c * dz + z) * dy + y) * dx + x, with the dims and channels of hd_stats. Voxel (x, y, z)'s
+   centre is the volume's box coordinate ((x + 0.5) / dx, ...) (0 and 1 at the box's faces, as
+   params.crop_min), where the projection samples it trilinearly, clamped at the faces: a 3D
+   texture's texel centres with GL_LINEAR and CLAMP_TO_EDGE. The PT methods keep none:
+   HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_read_illumination(hd_context ctx, hd_illumination which, float *dst,
                                      size_t dst_floats);
+/* The volume's depth for the host's later passes (HD, CD; a matrix camera): width x height
+   floats, rows top first (hd_set_depth's order), each the window depth under camera.depth_range
+   of the nearest point where a ray of the pixel's accumulated opacity reached
+   params.depth_threshold, over the frames in the image since it last restarted (full-resolution
+   frames only: a reduced frame, params.render_scale, adds none); the far plane's value (1, or 0
+   reversed) where none did. The crossing is the first march sample at or past the threshold
+   (within one params.step of it), placed on the ray through the pixel's centre. Where the
+   host's depth (hd_set_depth) ends the rays first there is none. Errors, one log line each:
+   HD_ERROR_NULL_POINTER, HD_ERROR_BUFFER_TOO_SMALL, HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at
+   camera), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS), HD_ERROR_NO_FRAME (as the image's). */
+HDDEF hd_result hd_read_depth(hd_context ctx, float *dst, size_t dst_floats);
 HDDEF hd_result hd_get_stats(hd_context ctx, hd_stats *out_stats);
 
 /* ---- output into the renderer's target ------------------------------------------------------
@@ -869,6 +890,40 @@ typedef struct hd_vulkan_target {
 HDDEF hd_result hd_vulkan_record_render(hd_context ctx, void *command_buffer, const hd_vulkan_target *target,
                                         const hd_output *output);
 
+/* The host's depth on the device for hd_vulkan_record_depth: an image or a buffer (one of them),
+   the camera's size (the library cannot query it: the validation layer reports a wrong one).
+   Image: a 2D depth image, VK_FORMAT_D32_SFLOAT or D32_SFLOAT_S8_UINT (its depth aspect), mip 0
+   layer 0, made with VK_IMAGE_USAGE_TRANSFER_SRC_BIT, owned by desc.vulkan.queue_family, in
+   `layout` when the command buffer reaches the copy (GENERAL, TRANSFER_SRC_OPTIMAL,
+   SHADER_READ_ONLY_OPTIMAL or a depth attachment or read-only layout) and left in it. Rows top
+   first (Vulkan's y down, as hd_set_depth's). Buffer: width x height floats, rows top first,
+   `offset` bytes from its start, inside buffer_size, made with VK_BUFFER_USAGE_TRANSFER_SRC_BIT.
+   Barriers (the library records them): source stage ALL_COMMANDS, access MEMORY_READ |
+   MEMORY_WRITE before the copy (and the image's transition to TRANSFER_SRC_OPTIMAL), its
+   transition back and an ALL_COMMANDS barrier after. */
+typedef struct hd_vulkan_depth {
+    uint64_t image;       /* VkImage, or 0 with a buffer */
+    int format;           /* the image's VkFormat */
+    int layout;           /* the VkImageLayout it is in at the copy, and is left in */
+    uint64_t buffer;      /* VkBuffer, or 0 with an image */
+    uint64_t offset;      /* buffer: bytes to the first value (a multiple of 4) */
+    uint64_t buffer_size; /* buffer: its size in bytes */
+} hd_vulkan_depth;
+#define HD_VULKAN_DEPTH_INIT HD_ZERO_INIT
+
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's
+   depth image or buffer, recorded into the caller's command buffer (in the recording state, as
+   hd_vulkan_record's): a copy into the library's depth buffer, with no CPU round trip, which the
+   frames recorded after it (hd_vulkan_record_render in the same command buffer, or any later
+   call once it has run) read: the same image as hd_set_depth of the same values, with its
+   lifetime (replaced by either call, cleared by hd_set_depth(NULL), dropped with the camera's
+   size). Submit and wait before the next call, as for hd_vulkan_record. Errors, one log line
+   each, nothing recorded and the depth held before kept: HD_ERROR_NULL_POINTER (command buffer,
+   depth), HD_ERROR_INVALID_PARAMETER (not one of image and buffer, a layout, an offset),
+   HD_ERROR_DEPTH_FORMAT, HD_ERROR_BUFFER_TOO_SMALL (the values past buffer_size),
+   HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
+HDDEF hd_result hd_vulkan_record_depth(hd_context ctx, void *command_buffer, const hd_vulkan_depth *depth);
+
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
    hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must
    be the camera's: else HD_ERROR_INVALID_TEXTURE) with no CPU round trip; rows bottom first,
@@ -884,6 +939,33 @@ HDDEF hd_result hd_gl_render_to_texture(hd_context ctx, unsigned int texture);
    glTexSubImage2D copies it in from there (a pixel unpack buffer), so the bytes are exactly
    hd_read_image_ex's. Not a 2D texture: HD_ERROR_INVALID_TEXTURE. */
 HDDEF hd_result hd_gl_render_to_texture_ex(hd_context ctx, unsigned int texture, const hd_output *output);
+/* GL backend only (the others return HD_ERROR_UNSUPPORTED): channel `channel` (0 .. hd_stats.
+   illumination_channels - 1) of HD_ILLUMINATION_TOTAL (E + phi, as the projection samples it)
+   copied on the device (glCopyImageSubData) into texels (0, 0, 0) .. illumination_dims - 1 of
+   level 0 of the caller's GL_TEXTURE_3D `texture`, internal format GL_R32F, at least
+   illumination_dims large (texels beyond are not touched); x, y, z as hd_read_illumination's.
+   Errors, one log line each: HD_ERROR_INVALID_TEXTURE (0, or not a 3D texture),
+   HD_ERROR_OUTPUT_FORMAT (not GL_R32F), HD_ERROR_OUTPUT_OUTSIDE_TARGET (smaller than the grid),
+   HD_ERROR_INVALID_PARAMETER (channel), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS). */
+HDDEF hd_result hd_gl_illumination_texture(hd_context ctx, unsigned int texture, int channel);
+/* GL backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's depth
+   texture, with no CPU round trip: level 0 of the 2D texture `texture` (internal format
+   GL_DEPTH_COMPONENT16, 24, 32F, GL_DEPTH24_STENCIL8 or GL_DEPTH32F_STENCIL8, the camera's size;
+   GL's rows, bottom first) is copied on the device at the call into the backend's depth buffer
+   and used as hd_set_depth's values (the same image as hd_set_depth of the same values, rows
+   top first), with its lifetime (replaced by either call, cleared by hd_set_depth(NULL),
+   dropped with the camera's size). Errors, one log line each, the depth held before kept:
+   HD_ERROR_INVALID_TEXTURE (0, not a 2D texture), HD_ERROR_DEPTH_FORMAT, HD_ERROR_DEPTH_SIZE,
+   HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
+HDDEF hd_result hd_gl_set_depth_texture(hd_context ctx, unsigned int texture);
+/* OpenCL backend only (the others return HD_ERROR_UNSUPPORTED): hd_set_depth from the host's
+   cl_mem buffer (passed as void*) of the backend's context (desc.opencl.context): width x height
+   floats, rows top first, from byte `offset` (a multiple of 4), copied on the device
+   (clEnqueueCopyBuffer on the backend's queue: the caller's writes must be finished or on that
+   queue) at the call, with hd_set_depth's lifetime and image. Errors, one log line each, the
+   depth held before kept: HD_ERROR_NULL_POINTER, HD_ERROR_INVALID_PARAMETER (the offset, not a
+   buffer, another context), HD_ERROR_BUFFER_TOO_SMALL, HD_ERROR_DEPTH_NEEDS_PROJECTION. */
+HDDEF hd_result hd_opencl_set_depth_buffer(hd_context ctx, void *buffer, size_t offset);
 
 /* ---- file loaders ----------------------------------------------------------------------------- */
 /* A loaded volume owns its voxels; free it with hd_volume_free. Signed and 32/64-bit integer

@@ -1110,10 +1110,16 @@ static hd_result hd__be_upsample(const hd__view *vw)
 static unsigned hd__be_features(void) { return 0; }
 HD__BE_NO_RECORDING("cpu")
 HD__BE_NO_TEXTURE("cpu")
+HD__BE_NO_CL_BUFFER("cpu")
 
 static hd_result hd__be_read_image(const hd__view *vw, float *dst)
 {
     memcpy(dst, vw->be->img, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float));
+    return HD_SUCCESS;
+}
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    memcpy(dst, vw->be->img + vw->kp.region.z, (size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float));
     return HD_SUCCESS;
 }
 /* Copies E or phi between the colour layout and the API's x-fastest channel-planar order, one

@@ -74,7 +74,8 @@
     X(_HD_GENTEXTURES, GenTextures) X(_HD_DELETETEXTURES, DeleteTextures) X(_HD_BINDTEXTURE, BindTexture) \
     X(ACTIVETEXTURE, ActiveTexture) X(TEXSTORAGE3D, TexStorage3D) X(TEXSUBIMAGE3D, TexSubImage3D) \
     X(GETTEXIMAGE, GetTexImage) X(GETTEXLEVELPARAMETERIV, GetTexLevelParameteriv) \
-    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei) X(_HD_TEXSUBIMAGE2D, TexSubImage2D)
+    X(BINDIMAGETEXTURE, BindImageTexture) X(PIXELSTOREI, PixelStorei) X(_HD_TEXSUBIMAGE2D, TexSubImage2D) \
+    X(COPYIMAGESUBDATA, CopyImageSubData)
 /* optional: GL 4.4 / ARB_clear_texture, KHR_debug, GL 4.5 / ARB_get_texture_sub_image */
 #define HD__GL_OPT_FNS(X) X(CLEARTEXIMAGE, ClearTexImage) X(DEBUGMESSAGECALLBACK, DebugMessageCallback) \
     X(DEBUGMESSAGECONTROL, DebugMessageControl) X(GETTEXTURESUBIMAGE, GetTextureSubImage)
@@ -909,8 +910,8 @@ static hd_result hd__be_classify(const hd__view *vw)
 /* The host's depth buffer into storage buffer 6 (freed without one). */
 static hd_result hd__be_upload_depth(const hd__view *vw)
 {
-    if (!vw->depth) {
-        hd__gl_free_buffer(vw->be, &vw->be->dep);
+    if (!vw->depth) { /* none, or the one hd__be_depth_texture copied in (depth_device), kept */
+        if (!vw->depth_device) hd__gl_free_buffer(vw->be, &vw->be->dep);
         return HD_SUCCESS;
     }
     return hd__gl_buffer_data(vw, &vw->be->dep, (size_t)vw->depth_w * vw->depth_h * sizeof(float), vw->depth, GL_DYNAMIC_DRAW,
@@ -1011,6 +1012,14 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
     be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
     be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, 0, (GLsizeiptr)((size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float)), dst);
     return hd__gl_check(vw, "reading the image", __LINE__);
+}
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    hd__backend *be = vw->be;
+    be->gl.BindBuffer(GL_COPY_READ_BUFFER, be->img);
+    be->gl.GetBufferSubData(GL_COPY_READ_BUFFER, (GLintptr)((size_t)vw->kp.region.z * sizeof(float)),
+                            (GLsizeiptr)((size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float)), dst);
+    return hd__gl_check(vw, "reading the depth plane", __LINE__);
 }
 
 /* A grid into dst, whole (list NULL) or the z slices list[0..count) one after another: one
@@ -1334,7 +1343,72 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
     return hd__gl_check(vw, "the output into the texture", __LINE__);
 }
 
+/* E + phi's channel from lsum (the projection's summed copy, rebuilt first when stale) into the
+   caller's GL_R32F 3D texture: one glCopyImageSubData of slices [c gz, (c + 1) gz). */
+static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)
+{
+    const char *fn = "hd_gl_illumination_texture";
+    hd__backend *be = vw->be;
+    GLint w = 0, h = 0, d = 0, internal = 0;
+    hd_result r;
+    be->gl.BindTexture(GL_TEXTURE_3D, (GLuint)texture);
+    if (be->gl.GetError() != GL_NO_ERROR)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 3D texture name in the current context", fn, texture);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_WIDTH, &w);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_HEIGHT, &h);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_DEPTH, &d);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if (internal != GL_R32F)
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "%s: texture %u has internal format 0x%04x; the light needs GL_R32F", fn, texture,
+                       (unsigned)internal);
+    if (w < vw->gdims[0] || h < vw->gdims[1] || d < vw->gdims[2])
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "%s: texture %u is %dx%dx%d, the illumination grid %dx%dx%d", fn, texture,
+                       (int)w, (int)h, (int)d, vw->gdims[0], vw->gdims[1], vw->gdims[2]);
+    if (!be->gg.lsum_ok) {
+        if ((r = hd__gl_dispatch(vw, HD__GL_LIGHT_SUM, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0)) != HD_SUCCESS)
+            return r;
+        be->gg.lsum_ok = 1;
+    }
+    be->gl.MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    be->gl.CopyImageSubData(be->lsum.name, GL_TEXTURE_3D, 0, 0, 0, channel * vw->gdims[2], (GLuint)texture, GL_TEXTURE_3D, 0, 0, 0, 0,
+                            vw->gdims[0], vw->gdims[1], vw->gdims[2]);
+    return hd__gl_check(vw, "copying the light into the texture", __LINE__);
+}
+
+/* The host's depth texture into dep: glGetTexImage into dep bound as the pixel pack buffer (a
+   copy on the device), GL's rows as they are (kp.depth_dims.w says bottom first). A depth-stencil
+   texture gives its depth with GL_DEPTH_COMPONENT. */
+static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)
+{
+    const char *fn = "hd_gl_set_depth_texture";
+    hd__backend *be = vw->be;
+    GLint w = 0, h = 0, internal = 0;
+    size_t bytes = (size_t)vw->camera.width * vw->camera.height * sizeof(float);
+    hd_result r;
+    be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)texture);
+    if (be->gl.GetError() != GL_NO_ERROR)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 2D texture name in the current context", fn, texture);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
+    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if (internal != GL_DEPTH_COMPONENT16 && internal != GL_DEPTH_COMPONENT24 && internal != GL_DEPTH_COMPONENT32F &&
+        internal != GL_DEPTH24_STENCIL8 && internal != GL_DEPTH32F_STENCIL8)
+        return HD__ERR(&vw->log, HD_ERROR_DEPTH_FORMAT, "%s: texture %u has internal format 0x%04x, not GL_DEPTH_COMPONENT16, 24, 32F, "
+                       "GL_DEPTH24_STENCIL8 or GL_DEPTH32F_STENCIL8", fn, texture, (unsigned)internal);
+    if (w != vw->camera.width || h != vw->camera.height)
+        return HD__ERR(&vw->log, HD_ERROR_DEPTH_SIZE, "%s: texture %u is %dx%d, the camera %dx%d", fn, texture, (int)w, (int)h,
+                       vw->camera.width, vw->camera.height);
+    if ((r = hd__gl_buffer_data(vw, &be->dep, bytes, NULL, GL_DYNAMIC_COPY, "the depth buffer")) != HD_SUCCESS) return r;
+    be->gl.MemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_FRAMEBUFFER_BARRIER_BIT);
+    be->gl.BindBuffer(GL_PIXEL_PACK_BUFFER, be->dep);
+    be->gl.GetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    be->gl.BindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    be->gl.MemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    return hd__gl_check(vw, "copying the depth texture", __LINE__);
+}
+
 static unsigned hd__be_features(void) { return HD__BE_TEXTURE; }
 
 /* No recording (a Vulkan feature): the core never calls these. */
 HD__BE_NO_RECORDING("gl")
+HD__BE_NO_CL_BUFFER("gl")

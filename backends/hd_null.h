@@ -10,7 +10,7 @@
 #define HD__NULL_PRIMITIVES(X) \
     X(upload_inputs) X(update_volume) X(alloc_illumination) X(alloc_jacobi) X(alloc_image) X(alloc_lights) X(clear) \
     X(classify) X(direct) X(direct_list) X(diffuse) X(diffuse_sweeps) X(convect) X(sum_lights) \
-    X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_illumination) X(mg_begin) X(mg_end) \
+    X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_depth) X(record_depth) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
     X(mg_extrapolate) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
@@ -149,6 +149,12 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
     memset(dst, 0, (size_t)vw->camera.width * vw->camera.height * 4 * sizeof(float));
     return HD_SUCCESS;
 }
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    hd__null_call(vw, HD__NULL_read_depth);
+    memset(dst, 0, (size_t)vw->camera.width * vw->camera.height * sizeof(float));
+    return HD_SUCCESS;
+}
 static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
 {
     size_t slice = (size_t)vw->gdims[0] * vw->gdims[1];
@@ -252,6 +258,27 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
 static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
 {
     (void)texture; (void)out; (void)exact;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
+}
+static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth)
+{
+    (void)cb; (void)depth;
+    hd__null_call(vw, HD__NULL_record_depth);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)
+{
+    (void)buffer; (void)offset;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no OpenCL buffer");
+}
+static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)
+{
+    (void)texture;
+    return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
+}
+static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)
+{
+    (void)texture; (void)channel;
     return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "null: no GL texture");
 }
 

@@ -652,6 +652,7 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     hd__backend *be = vw->be;
     size_t n = vw->depth ? (size_t)vw->depth_w * vw->depth_h : 0;
     hd_result r;
+    if (!vw->depth && vw->depth_device && be->dep) return HD_SUCCESS; /* hd__be_depth_cl_buffer's copy, kept */
     if (!be->dep || n != be->dep_floats) {
         hd__cl_release(&be->dep);
         be->dep_floats = 0;
@@ -667,6 +668,34 @@ static hd_result hd__be_upload_env(const hd__view *vw)
 {
     hd__cl_release(&vw->be->env);
     return hd__cl_buffer(vw, &vw->be->env, vw->env_floats * sizeof(float), vw->env, "the environment's tables");
+}
+
+/* The host's cl_mem into dep, on the queue (in order before every later kernel). */
+static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)
+{
+    const char *fn = "hd_opencl_set_depth_buffer";
+    hd__backend *be = vw->be;
+    cl_mem src = (cl_mem)buffer;
+    cl_mem_object_type type = 0;
+    cl_context c = NULL;
+    size_t size = 0, n = (size_t)vw->camera.width * vw->camera.height;
+    hd_result r;
+    if (clGetMemObjectInfo(src, CL_MEM_TYPE, sizeof type, &type, NULL) != CL_SUCCESS || type != CL_MEM_OBJECT_BUFFER ||
+        clGetMemObjectInfo(src, CL_MEM_CONTEXT, sizeof c, &c, NULL) != CL_SUCCESS ||
+        clGetMemObjectInfo(src, CL_MEM_SIZE, sizeof size, &size, NULL) != CL_SUCCESS)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_PARAMETER, "%s: not a cl_mem buffer", fn);
+    if (c != be->context) return HD__ERR(&vw->log, HD_ERROR_INVALID_PARAMETER, "%s: the buffer belongs to another cl_context", fn);
+    if (offset > size || size - offset < n * sizeof(float))
+        return HD__ERR(&vw->log, HD_ERROR_BUFFER_TOO_SMALL, "%s: %zu bytes from offset %zu past the buffer's %zu", fn, n * sizeof(float), offset,
+                       size);
+    if (!be->dep || n != be->dep_floats) {
+        hd__cl_release(&be->dep);
+        be->dep_floats = 0;
+        if ((r = hd__cl_buffer(vw, &be->dep, n * sizeof(float), NULL, "the depth buffer")) != HD_SUCCESS) return r;
+        be->dep_floats = n;
+    }
+    HD__CL_TRY(vw, clEnqueueCopyBuffer(be->queue, src, be->dep, offset, 0, n * sizeof(float), 0, NULL, NULL), "clEnqueueCopyBuffer(depth)");
+    return HD_SUCCESS;
 }
 
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
@@ -767,7 +796,7 @@ static hd_result hd__be_project(const hd__view *vw)
 static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
 
 /* No recording and no GL texture: the core never calls these (hd__be_features). */
-static unsigned hd__be_features(void) { return 0; }
+static unsigned hd__be_features(void) { return HD__BE_CL_BUFFER; }
 HD__BE_NO_RECORDING("opencl")
 HD__BE_NO_TEXTURE("opencl")
 
@@ -777,6 +806,14 @@ static hd_result hd__be_read_image(const hd__view *vw, float *dst)
     hd__backend *be = vw->be;
     HD__CL_TRY(vw, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, 0, (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float), dst, 0, NULL, NULL),
                "clEnqueueReadBuffer(image)");
+    return HD_SUCCESS;
+}
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    hd__backend *be = vw->be;
+    HD__CL_TRY(vw, clEnqueueReadBuffer(be->queue, be->img, CL_TRUE, (size_t)vw->kp.region.z * sizeof(float),
+                                       (size_t)vw->kp.image.x * vw->kp.image.y * sizeof(float), dst, 0, NULL, NULL),
+               "clEnqueueReadBuffer(depth plane)");
     return HD_SUCCESS;
 }
 

@@ -1633,14 +1633,15 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
     hd__backend *be = vw->be;
     size_t n = vw->depth ? (size_t)vw->depth_w * vw->depth_h : 0;
     hd_result r;
+    if (!vw->depth && vw->depth_device) return HD_SUCCESS; /* hd__be_record_depth's copy, kept */
     HD__VK_IDLE(vw);
     if (!vw->depth || !be->dep.buffer || be->dep_floats != n) {
         hd__vk_free_buffer(vw, &be->dep);
         be->dep_floats = 0;
         be->sets_valid = 0;
         if (!vw->depth) return HD_SUCCESS;
-        if ((r = hd__vk_buffer_create(vw, &be->dep, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the depth buffer")) !=
-            HD_SUCCESS)
+        if ((r = hd__vk_buffer_create(vw, &be->dep, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      1, "the depth buffer")) != HD_SUCCESS)
             return r;
         be->dep_floats = n;
     }
@@ -1662,6 +1663,88 @@ static hd_result hd__be_upload_env(const hd__view *vw)
                                   "the environment's tables")) != HD_SUCCESS)
         return r;
     memcpy(be->env.map, vw->env, vw->env_floats * sizeof(float));
+    return HD_SUCCESS;
+}
+
+/* The depth layouts a copy may start from (hd_vulkan_depth.layout). */
+static int hd__vk_depth_layout(int l)
+{
+    return l == VK_IMAGE_LAYOUT_GENERAL || l == VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL || l == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL ||
+           l == VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL || l == VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL ||
+           l == VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_STENCIL_ATTACHMENT_OPTIMAL || l == VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_STENCIL_READ_ONLY_OPTIMAL;
+}
+
+/* The host's depth image or buffer copied into dep inside the caller's command buffer: dep made
+   first (the camera's size, host-visible as hd__be_upload_depth's, a transfer's destination),
+   then barrier, [transition,] copy, [transition back,] barrier. */
+static hd_result hd__be_record_depth(const hd__view *vw, void *cbp, const hd_vulkan_depth *d)
+{
+    const char *fn = "hd_vulkan_record_depth";
+    hd__backend *be = vw->be;
+    VkCommandBuffer cb = (VkCommandBuffer)cbp;
+    size_t n = (size_t)vw->camera.width * vw->camera.height;
+    VkMemoryBarrier mb;
+    hd_result r;
+    int stencil = d->format == VK_FORMAT_D32_SFLOAT_S8_UINT;
+    if (d->image && d->format != VK_FORMAT_D32_SFLOAT && !stencil)
+        return HD__ERR(&vw->log, HD_ERROR_DEPTH_FORMAT, "%s: image format %d; needs VK_FORMAT_D32_SFLOAT or D32_SFLOAT_S8_UINT (float depth)", fn,
+                       d->format);
+    if (d->image && !hd__vk_depth_layout(d->layout))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_PARAMETER, "%s: layout %d is not one a depth image is copied from", fn, d->layout);
+    if (!be->dep.buffer || be->dep_floats != n) {
+        HD__VK_IDLE(vw);
+        hd__vk_free_buffer(vw, &be->dep);
+        be->dep_floats = 0;
+        be->sets_valid = 0;
+        if ((r = hd__vk_buffer_create(vw, &be->dep, n * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                      1, "the depth buffer")) != HD_SUCCESS)
+            return r;
+        be->dep_floats = n;
+    }
+    memset(&mb, 0, sizeof mb);
+    mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    mb.srcAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    if (d->image) {
+        VkImageMemoryBarrier ib;
+        VkBufferImageCopy reg;
+        memset(&ib, 0, sizeof ib);
+        ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        ib.srcAccessMask = mb.srcAccessMask;
+        ib.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        ib.oldLayout = (VkImageLayout)d->layout;
+        ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        ib.image = (VkImage)d->image;
+        ib.subresourceRange.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT | (stencil ? VK_IMAGE_ASPECT_STENCIL_BIT : 0);
+        ib.subresourceRange.levelCount = 1;
+        ib.subresourceRange.layerCount = 1;
+        be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, NULL, 1, &ib);
+        memset(&reg, 0, sizeof reg);
+        reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+        reg.imageSubresource.layerCount = 1;
+        reg.imageExtent.width = (uint32_t)vw->camera.width;
+        reg.imageExtent.height = (uint32_t)vw->camera.height;
+        reg.imageExtent.depth = 1;
+        be->fn.vkCmdCopyImageToBuffer(cb, ib.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, be->dep.buffer, 1, &reg);
+        ib.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+        ib.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        ib.newLayout = (VkImageLayout)d->layout;
+        mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        mb.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &mb, 0, NULL, 1, &ib);
+    } else {
+        VkBufferCopy bc;
+        be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+        memset(&bc, 0, sizeof bc);
+        bc.srcOffset = (VkDeviceSize)d->offset;
+        bc.size = (VkDeviceSize)(n * sizeof(float));
+        be->fn.vkCmdCopyBuffer(cb, (VkBuffer)d->buffer, be->dep.buffer, 1, &bc);
+        mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+        mb.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+        be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+    }
     return HD_SUCCESS;
 }
 
@@ -1754,24 +1837,34 @@ static hd_result hd__be_project(const hd__view *vw)
 static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
 
 /* ---- read-back ------------------------------------------------------------------------------- */
-static hd_result hd__be_read_image(const hd__view *vw, float *dst)
+/* Floats [first, first + n) of the image buffer into dst. */
+static hd_result hd__vk_read_img(const hd__view *vw, size_t first, size_t n, float *dst)
 {
     hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
     VkBufferCopy bc;
-    size_t bytes = (size_t)vw->kp.image.x * vw->kp.image.y * 4 * sizeof(float);
+    size_t bytes = n * sizeof(float);
     hd_result r;
     HD__VK_IDLE(vw);
     if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
     if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
     hd__vk_barrier(be, cb);
     memset(&bc, 0, sizeof bc);
+    bc.srcOffset = first * sizeof(float);
     bc.size = bytes;
     be->fn.vkCmdCopyBuffer(cb, be->img.buffer, be->staging.buffer, 1, &bc);
     hd__vk_barrier(be, cb);
     if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
     memcpy(dst, be->staging.map, bytes);
     return HD_SUCCESS;
+}
+static hd_result hd__be_read_image(const hd__view *vw, float *dst)
+{
+    return hd__vk_read_img(vw, 0, (size_t)vw->kp.image.x * vw->kp.image.y * 4, dst);
+}
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst)
+{
+    return hd__vk_read_img(vw, (size_t)vw->kp.region.z, (size_t)vw->kp.image.x * vw->kp.image.y, dst);
 }
 
 static hd_result hd__be_read_illumination(const hd__view *vw, hd_illumination which, const int *zz, int count, float *dst)
@@ -2345,3 +2438,4 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
 
 /* No GL texture: the core never calls it. */
 HD__BE_NO_TEXTURE("vulkan")
+HD__BE_NO_CL_BUFFER("vulkan")

@@ -7,6 +7,7 @@
 #   make bench-opencl         build/hdbench_opencl: OpenCL vs CPU figures in one run
 #   make valgrind-opencl      the quick conformance subset under valgrind (PoCL suppressed)
 #   make physics-opencl       tests/physics on OpenCL (part of `make test`; mk/physics.mk)
+#   make test-opencl          tests/opencl: the backend's own checks (the host's cl_mem depth; part of `make test`)
 CL_LDLIBS := -lOpenCL
 CONF_DIR := tests/conformance
 CONF_DEPS := $(CONF_DIR)/hd_api.h $(CONF_DIR)/hd_probe_vk.h src/hd_test_hooks.h $(LIB_SRC)
@@ -52,5 +53,11 @@ valgrind-opencl: $(B)/conformance-opencl
 bench-opencl: $(B)/hdbench_opencl
 	$(B)/hdbench_opencl
 
-TEST_PROGRAMS += $(B)/conformance-opencl $(B)/physics-opencl
-test: conformance-opencl compile-opencl-cxx physics-opencl
+$(B)/test_opencl: tests/opencl/test_opencl.c $(LIB_SRC) | $(B)
+	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(CL_LDLIBS)
+.PHONY: test-opencl
+test-opencl: $(B)/test_opencl
+	$(B)/test_opencl
+
+TEST_PROGRAMS += $(B)/conformance-opencl $(B)/physics-opencl $(B)/test_opencl
+test: conformance-opencl compile-opencl-cxx physics-opencl test-opencl

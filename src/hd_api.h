@@ -216,12 +216,13 @@ static hd_result hd__api_set_camera(hd__ctx *ctx, const hd_camera *camera)
     resized = c.width != ctx->vw.camera.width || c.height != ctx->vw.camera.height;
     if (resized) ctx->dirty |= HD__DIRTY_IMAGE_ALLOC;
     /* the depth belongs to a matrix camera of its size */
-    if (ctx->vw.depth && (resized || !cf.matrix)) {
+    if ((ctx->vw.depth || ctx->vw.depth_device) && (resized || !cf.matrix)) {
         HD__INFO(&ctx->vw.log, "hd_set_camera: the depth buffer (%dx%d) is dropped: the camera is %s", ctx->vw.depth_w, ctx->vw.depth_h,
                  resized ? "resized" : "a look-at camera");
         hd__free(&ctx->vw, ctx->vw.depth);
         ctx->vw.depth = NULL;
         ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        ctx->vw.depth_device = 0;
         ctx->dirty |= HD__DIRTY_DEPTH;
     }
     ctx->vw.camera = c;
@@ -263,10 +264,11 @@ static hd_result hd__api_set_depth(hd__ctx *ctx, const hd_depth_desc *depth)
     size_t n;
     float *buf;
     if (!depth || (!depth->data && depth->width == 0 && depth->height == 0)) {
-        if (ctx->vw.depth) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
+        if (ctx->vw.depth || ctx->vw.depth_device) ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
         hd__free(&ctx->vw, ctx->vw.depth);
         ctx->vw.depth = NULL;
         ctx->vw.depth_w = ctx->vw.depth_h = 0;
+        ctx->vw.depth_device = 0;
         return HD_SUCCESS;
     }
     if (!depth->data)
@@ -281,8 +283,98 @@ static hd_result hd__api_set_depth(hd__ctx *ctx, const hd_depth_desc *depth)
     ctx->vw.depth = buf;
     ctx->vw.depth_w = depth->width;
     ctx->vw.depth_h = depth->height;
+    ctx->vw.depth_device = 0;
     ctx->dirty |= HD__DIRTY_DEPTH | HD__DIRTY_IMAGE;
     return HD_SUCCESS;
+}
+
+/* hd_gl_set_depth_texture: the checks that need no device, the backend's copy in a bracket, then
+   the depth is the backend's (the host copy, if any, released). */
+static hd_result hd__api_depth_texture(hd__ctx *ctx, unsigned int texture)
+{
+    const char *fn = "hd_gl_set_depth_texture";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_TEXTURE)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "%s: texture 0", fn);
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    HD__BE_CALL(r, ctx, hd__be_depth_texture(&ctx->vw, texture));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 1;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+
+/* hd_vulkan_record_depth: the checks that need no device, the backend's recording of the copy
+   (its own checks first), then the depth is the backend's. */
+static hd_result hd__api_vulkan_record_depth(hd__ctx *ctx, void *command_buffer, const hd_vulkan_depth *d)
+{
+    const char *fn = "hd_vulkan_record_depth";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_RECORD)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (!command_buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: command_buffer is NULL", fn);
+    if (!d) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: depth is NULL", fn);
+    if ((d->image != 0) == (d->buffer != 0))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: the depth names %s; give an image or a buffer", fn,
+                       d->image ? "an image and a buffer" : "neither an image nor a buffer");
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    if (d->buffer) {
+        uint64_t bytes = (uint64_t)ctx->vw.camera.width * (uint64_t)ctx->vw.camera.height * 4u;
+        if (d->offset % 4u != 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: offset %llu is not a multiple of 4", fn, (unsigned long long)d->offset);
+        if (d->offset > d->buffer_size || d->buffer_size - d->offset < bytes)
+            return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "%s: %llu bytes from offset %llu past the buffer's %llu", fn,
+                           (unsigned long long)bytes, (unsigned long long)d->offset, (unsigned long long)d->buffer_size);
+    }
+    HD__BE_CALL(r, ctx, hd__be_record_depth(&ctx->vw, command_buffer, d));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 2;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+/* hd_opencl_set_depth_buffer: the checks that need no device, the backend's copy, then the depth
+   is the backend's. */
+static hd_result hd__api_cl_depth(hd__ctx *ctx, void *buffer, size_t offset)
+{
+    const char *fn = "hd_opencl_set_depth_buffer";
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_CL_BUFFER)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (!buffer) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "%s: buffer is NULL", fn);
+    if (offset % 4u != 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: offset %zu is not a multiple of 4", fn, offset);
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "%s: the camera is a look-at camera; depth is read through the host's projection (camera.projection)", fn);
+    HD__BE_CALL(r, ctx, hd__be_depth_cl_buffer(&ctx->vw, buffer, offset));
+    if (r != HD_SUCCESS) return r;
+    hd__free(&ctx->vw, ctx->vw.depth);
+    ctx->vw.depth = NULL;
+    ctx->vw.depth_w = ctx->vw.camera.width;
+    ctx->vw.depth_h = ctx->vw.camera.height;
+    ctx->vw.depth_device = 3;
+    ctx->dirty |= HD__DIRTY_IMAGE;
+    return HD_SUCCESS;
+}
+HDDEF hd_result hd_opencl_set_depth_buffer(hd_context h, void *buffer, size_t offset)
+{
+    HD__GUARDED(h, "hd_opencl_set_depth_buffer", hd__api_cl_depth(ctx, buffer, offset));
+}
+HDDEF hd_result hd_vulkan_record_depth(hd_context h, void *command_buffer, const hd_vulkan_depth *depth)
+{
+    HD__GUARDED(h, "hd_vulkan_record_depth", hd__api_vulkan_record_depth(ctx, command_buffer, depth));
+}
+HDDEF hd_result hd_gl_set_depth_texture(hd_context h, unsigned int texture)
+{
+    HD__GUARDED(h, "hd_gl_set_depth_texture", hd__api_depth_texture(ctx, texture));
 }
 HDDEF hd_result hd_set_depth(hd_context h, const hd_depth_desc *depth)
 {
@@ -396,6 +488,24 @@ static hd_result hd__api_output_texture(hd__ctx *ctx, unsigned int texture, cons
     if ((r = hd__output_check(ctx, output, &o, what)) != HD_SUCCESS) return r;
     HD__BE_CALL(r, ctx, hd__be_output_texture(&ctx->vw, texture, &o, exact));
     return r;
+}
+/* hd_gl_illumination_texture: the checks that need no device, then the backend's copy. */
+static hd_result hd__api_illumination_texture(hd__ctx *ctx, unsigned int texture, int channel)
+{
+    hd_result r;
+    const char *fn = "hd_gl_illumination_texture";
+    if (!(hd__be_features() & HD__BE_TEXTURE)) return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: method %s keeps no illumination volume", fn, hd_method_name(ctx->vw.params.method));
+    if (texture == 0) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_TEXTURE, "%s: texture 0", fn);
+    if (channel < 0 || channel >= ctx->vw.channels)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: channel %d, the grid has %d", fn, channel, ctx->vw.channels);
+    HD__BE_CALL(r, ctx, hd__be_illumination_texture(&ctx->vw, texture, channel));
+    return r;
+}
+HDDEF hd_result hd_gl_illumination_texture(hd_context h, unsigned int texture, int channel)
+{
+    HD__GUARDED(h, "hd_gl_illumination_texture", hd__api_illumination_texture(ctx, texture, channel));
 }
 HDDEF hd_result hd_gl_render_to_texture(hd_context h, unsigned int texture)
 {

@@ -91,15 +91,22 @@ static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable);
    old one is released, so on failure the image held before is kept as it was. */
 static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced);
 /* The image buffer's floats: width x height RGBA, then with reduced the room for a frame at render
-   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use. */
-HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
+   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use, then the
+   depth plane (width x height floats from hd__image_depth_first: hd_k_project.h's
+   hdk_project_depth, read by hd__be_read_depth). */
+HD__MAYBE_UNUSED static size_t hd__image_depth_first(int width, int height, int reduced)
 {
     return ((size_t)width * height + (reduced ? (size_t)((width + 1) / 2) * ((height + 1) / 2) : 0)) * 4;
+}
+HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
+{
+    return hd__image_depth_first(width, height, reduced) + (size_t)width * height;
 }
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
 /* The host's depth buffer changed (hd_set_depth): vw->depth, vw->depth_w x depth_h floats, or
-   NULL (free what the backend holds). The projection and the path tracers read it as hdk_depth_t
+   NULL (free what the backend holds, unless vw->depth_device: then keep the buffer
+   hd__be_depth_texture filled). The projection and the path tracers read it as hdk_depth_t
    (hd_k_project.h) does, through their buffer `dep`, while vw->kp.depth_dims.z is 1. */
 static hd_result hd__be_upload_depth(const hd__view *vw);
 /* The environment's tables changed (hd_set_environment): vw->env, vw->env_floats floats, or NULL
@@ -142,6 +149,9 @@ static hd_result hd__be_path(const hd__view *vw);
 /* ---- read-back (blocking: every earlier primitive's result) ------------------------------------ */
 /* The image as RGBA floats, vw->camera.width x height, rows top to bottom. */
 static hd_result hd__be_read_image(const hd__view *vw, float *dst);
+/* The image buffer's depth plane (hd__image_floats), vw->camera.width x height floats from float
+   vw->kp.region.z of the buffer: what hdk_project_depth wrote. */
+static hd_result hd__be_read_depth(const hd__view *vw, float *dst);
 /* E (HD_ILLUMINATION_DIRECT) or phi (SCATTERED) as floats, x fastest, channels stacked in z:
    with zz NULL the whole grid; else the z slices zz[0..count) of that stacking (slice zz: channel
    zz / gdims[2], z zz % gdims[2]) in that order, each gdims[0] * gdims[1] floats, one after
@@ -205,6 +215,7 @@ static size_t hd__be_solver_bytes(const hd__view *vw);
    A backend without a feature still defines its primitives; the core never calls them then. */
 #define HD__BE_RECORD 1  /* hd_vulkan_record, _record_render: work recorded into the caller's command buffer */
 #define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture(_ex): the image encoded into the caller's texture */
+#define HD__BE_CL_BUFFER 4 /* hd_opencl_set_depth_buffer: the host's depth from its cl_mem */
 static unsigned hd__be_features(void);
 /* Recording (HD__BE_RECORD). The core's hd_vulkan_record and hd_vulkan_record_render run their
    preparation, then hd__be_record_begin, then the method's primitives, which the backend
@@ -228,6 +239,13 @@ static int hd__be_record_seconds(const hd__view *vw, double *seconds);
    hd__be_record_begin, so a refused target leaves the command buffer untouched. */
 static hd_result hd__be_output_target_check(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
 static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target *target, const hd_output *out);
+/* HD__BE_RECORD: records into the caller's command buffer `cb` the copy of the host's depth
+   (hybriddiff.h's hd_vulkan_depth, the camera's size) into the buffer the kernels read as `dep`,
+   with its barriers, after checking what the core has not (the image's format: HD_ERROR_DEPTH_FORMAT,
+   its layout: HD_ERROR_INVALID_PARAMETER; each with one log line, nothing recorded). The core has
+   checked the pointers, one of image and buffer, the buffer's range and the camera, and sets
+   vw->depth_device after. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth);
 /* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line:
    HD_ERROR_INVALID_TEXTURE not a 2D texture, HD_ERROR_OUTPUT_FORMAT its internal format,
    HD_ERROR_OUTPUT_OUTSIDE_TARGET the region past its size; exact: hd_gl_render_to_texture's
@@ -236,6 +254,24 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
    out->y), rows bottom first. The core has checked out (format, size: the camera's, x and y
    >= 0). Runs in a bracket after the core's preparation. */
 static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact);
+/* HD__BE_TEXTURE: channel `channel` of E + phi (as the projection samples it) into texels from
+   (0, 0, 0) of level 0 of the caller's 3D texture (GL_R32F, at least vw->gdims; checked here,
+   each with its own result and log line: HD_ERROR_INVALID_TEXTURE, _OUTPUT_FORMAT,
+   _OUTPUT_OUTSIDE_TARGET), on the device. The core has checked the method (HD, CD), the name
+   (not 0) and the channel. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel);
+/* HD__BE_TEXTURE: the host's depth texture (level 0 of a 2D texture of a depth format and the
+   camera's size; checked here: HD_ERROR_INVALID_TEXTURE, _DEPTH_FORMAT, _DEPTH_SIZE, each with
+   one log line, the buffer held before untouched) copied on the device into the buffer the
+   kernels read as `dep`, GL's rows (bottom first, which kp.depth_dims.w = 1 tells them). The core
+   then sets vw->depth_device. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture);
+/* HD__BE_CL_BUFFER: the host's cl_mem buffer (of the backend's context, width x height floats
+   from byte offset; checked here: HD_ERROR_INVALID_PARAMETER not a buffer or another context,
+   HD_ERROR_BUFFER_TOO_SMALL, each with one log line, the buffer held before untouched) copied
+   on the device into `dep`, rows top first. The core has checked the pointer, the offset's
+   alignment and the camera, and sets vw->depth_device after. */
+static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset);
 /* The primitives of a feature a backend lacks, in one line each: they log and refuse, though the
    core never calls them (hd__be_features). NAME is the backend's name in the log line. */
 #define HD__BE_NO_RECORDING(NAME)                                                                       \
@@ -257,11 +293,32 @@ static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, con
     {                                                                                                   \
         (void)target; (void)out;                                                                        \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth)    \
+    {                                                                                                   \
+        (void)cb; (void)depth;                                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }
+#define HD__BE_NO_CL_BUFFER(NAME)                                                                       \
+    static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)            \
+    {                                                                                                   \
+        (void)buffer; (void)offset;                                                                     \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no OpenCL buffer");                      \
     }
 #define HD__BE_NO_TEXTURE(NAME)                                                                         \
     static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact) \
     {                                                                                                   \
         (void)texture; (void)out; (void)exact;                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
+    }                                                                                                   \
+    static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned texture, int channel)     \
+    {                                                                                                   \
+        (void)texture; (void)channel;                                                                   \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
+    }                                                                                                   \
+    static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)                         \
+    {                                                                                                   \
+        (void)texture;                                                                                  \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no GL texture");                         \
     }
 

@@ -82,6 +82,7 @@ typedef struct hd__camframe {
     float pos[3], ou[3], ov[3], u[3], v[3], w[3];
     float dm[16];    /* the inverse of projection * view into the volume's frame, row-major */
     float depth_z[3]; /* NDC z = [0] * depth + [1]; [2]: the far plane's depth */
+    float dq[4], dw[4]; /* the volume's depth out: q = dq . (k, 1) / dw . (k, 1) (hdk_depth_q) */
 } hd__camframe;
 
 typedef struct hd__ctx {

@@ -81,6 +81,10 @@ typedef struct hd__view {
        env, hd_k_light.h): env_floats floats, NULL: none (kp.env.x = 0) */
     float *env;
     size_t env_floats;
+    int depth_device;        /* the backend's buffer holds the host's depth (depth NULL), copied on
+                                the device: 1 from a GL texture (hd_gl_set_depth_texture), rows
+                                bottom first; 2 from a Vulkan image or buffer (hd_vulkan_record_depth),
+                                3 from an OpenCL buffer (hd_opencl_set_depth_buffer), rows top first */
 } hd__view;
 
 /* ---- logging ---------------------------------------------------------------------------- */

@@ -24,6 +24,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->frame.y = (int32_t)ctx->frames;
     k->frame.z = (int32_t)ctx->vw.params.seed;
     k->image.x = c->width; k->image.y = c->height; k->image.z = (int32_t)ctx->vw.params.method;
+    k->region.z = (int32_t)hd__image_depth_first(c->width, c->height, ctx->image_room); /* the depth plane */
     k->box.x = box[0]; k->box.y = box[1]; k->box.z = box[2]; k->box.w = 0.0795774715f;
     k->medium.x = ctx->vw.params.extinction; k->medium.y = ctx->vw.params.albedo;
     k->medium.z = ctx->vw.params.method == HD_METHOD_PT_SS ? 0.0f : ctx->vw.params.anisotropy;
@@ -57,8 +58,12 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->cam_w.x = cf->w[0]; k->cam_w.y = cf->w[1]; k->cam_w.z = cf->w[2];
     k->cam_ou.x = cf->ou[0]; k->cam_ou.y = cf->ou[1]; k->cam_ou.z = cf->ou[2];
     k->cam_ov.x = cf->ov[0]; k->cam_ov.y = cf->ov[1]; k->cam_ov.z = cf->ov[2];
-    if (ctx->vw.depth && cf->matrix) {
+    k->depth_z.w = 1.0f - ctx->vw.params.depth_threshold; /* the volume's depth: T at the crossing */
+    k->depth_q.x = cf->dq[0]; k->depth_q.y = cf->dq[1]; k->depth_q.z = cf->dq[2]; k->depth_q.w = cf->dq[3];
+    k->depth_w.x = cf->dw[0]; k->depth_w.y = cf->dw[1]; k->depth_w.z = cf->dw[2]; k->depth_w.w = cf->dw[3];
+    if ((ctx->vw.depth || ctx->vw.depth_device) && cf->matrix) {
         k->depth_dims.x = ctx->vw.depth_w; k->depth_dims.y = ctx->vw.depth_h; k->depth_dims.z = 1;
+        k->depth_dims.w = ctx->vw.depth_device == 1; /* rows bottom first */
         k->depth_z.x = cf->depth_z[0]; k->depth_z.y = cf->depth_z[1]; k->depth_z.z = cf->depth_z[2];
         for (i = 0; i < 4; ++i) {
             (&k->depth_m0.x)[i] = cf->dm[i]; (&k->depth_m1.x)[i] = cf->dm[4 + i];

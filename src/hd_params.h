@@ -75,7 +75,8 @@
     INT(render_scale, 1, -1, HD__MAX_RENDER_SCALE, "1..8 or HD_RENDER_SCALE_AUTO (-1)", HD__INV_IMAGE) \
     INT(light_window, 8, 1, 1000000, "in 1..1000000", HD__INV_NONE) \
     ENUM(rest, hd_rest, HD_REST_HOLD, HD_REST_COUNT, HD__INV_IMAGE) \
-    INT(refine_bounces, -1, -1, 100000, "-1 or 1..100000", HD__INV_IMAGE)
+    INT(refine_bounces, -1, -1, 100000, "-1 or 1..100000", HD__INV_IMAGE) \
+    FLOAT(depth_threshold, 0.5f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_IMAGE)
 
 /* ---- defaults: a zero field gets the row's default --------------------------------------------- */
 #define HD__PD_ENUM(n, t, def, count, inv) if ((int)p->n == 0) p->n = def;

@@ -176,6 +176,40 @@ HDDEF hd_result hd_read_image_ex(hd_context h, const hd_output *output, void *ds
     HD__GUARDED(h, "hd_read_image_ex", hd__api_read_image_ex(ctx, output, dst, dst_bytes, row_pitch));
 }
 
+/* The volume's depth (hd_read_depth) from the depth plane's q (hdk_depth_q: the window depth's
+   distance from the far plane's value; 0 there and where no frame crossed): depth = 1 - q, or q
+   reversed. */
+static void hd__depth_from_plane(const hd__ctx *ctx, float *dst)
+{
+    size_t i, n = (size_t)ctx->vw.camera.width * ctx->vw.camera.height;
+    if (ctx->vw.camera.depth_range != HD_DEPTH_REVERSED)
+        for (i = 0; i < n; ++i) dst[i] = 1.0f - dst[i];
+}
+
+static hd_result hd__api_read_depth(hd__ctx *ctx, float *dst, size_t dst_floats)
+{
+    hd_result r;
+    size_t need;
+    if (!dst) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_read_depth: dst is NULL");
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_read_depth: method %s has no projection frames to take a depth from",
+                       hd_method_name(ctx->vw.params.method));
+    if (!ctx->cf.matrix)
+        return HD__ERR(&ctx->vw.log, HD_ERROR_DEPTH_NEEDS_PROJECTION,
+                       "hd_read_depth: the camera is a look-at camera; the depth is written through the host's projection (camera.projection)");
+    need = (size_t)ctx->vw.camera.width * ctx->vw.camera.height;
+    if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_depth: %zu floats given, %zu needed", dst_floats, need);
+    HD__BE_CALL(r, ctx, ctx->image_empty ? HD__ERR(&ctx->vw.log, HD_ERROR_NO_FRAME, "hd_read_depth: the %dx%d image holds no frame yet (render one first)",
+                                                   ctx->vw.camera.width, ctx->vw.camera.height)
+                                         : hd__be_read_depth(&ctx->vw, dst));
+    if (r == HD_SUCCESS) hd__depth_from_plane(ctx, dst);
+    return r;
+}
+HDDEF hd_result hd_read_depth(hd_context h, float *dst, size_t dst_floats)
+{
+    HD__GUARDED(h, "hd_read_depth", hd__api_read_depth(ctx, dst, dst_floats));
+}
+
 static hd_result hd__api_read_illumination(hd__ctx *ctx, hd_illumination which, float *dst, size_t dst_floats)
 {
     hd_result r;
@@ -188,6 +222,19 @@ static hd_result hd__api_read_illumination(hd__ctx *ctx, hd_illumination which, 
                        hd_method_name(ctx->vw.params.method));
     need = hd__illum_floats(ctx);
     if (dst_floats < need) return HD__ERR(&ctx->vw.log, HD_ERROR_BUFFER_TOO_SMALL, "hd_read_illumination: %zu floats given, %zu needed", dst_floats, need);
+    if (which == HD_ILLUMINATION_TOTAL) {
+        /* E into dst, phi beside it, summed as the projection's hdk_sample_light sums them */
+        float *phi = (float *)hd__alloc(&ctx->vw, need * sizeof(float));
+        size_t i;
+        if (!phi) return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "hd_read_illumination: no memory for phi beside E (%zu floats)", need);
+        HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_DIRECT, NULL, 0, dst));
+        if (r == HD_SUCCESS) {
+            HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_SCATTERED, NULL, 0, phi));
+            for (i = 0; r == HD_SUCCESS && i < need; ++i) dst[i] += phi[i];
+        }
+        hd__free(&ctx->vw, phi);
+        return r;
+    }
     HD__BE_CALL(r, ctx, hd__be_read_illumination(&ctx->vw, which, NULL, 0, dst));
     return r;
 }

@@ -338,6 +338,22 @@ static hd_result hd__camframe_matrix(const hd_camera *c, const hd__xform *x, hd_
     cf->depth_z[0] = c->depth_range == HD_DEPTH_NEG_ONE_TO_ONE ? 2.0f : 1.0f;
     cf->depth_z[1] = c->depth_range == HD_DEPTH_NEG_ONE_TO_ONE ? -1.0f : 0.0f;
     cf->depth_z[2] = (float)zf;
+    {
+        /* the volume's depth out: G = P V [Q, t] (the volume's frame to clip); window depth * w =
+           (G2 - b G3) / a for NDC z = a depth + b; q = 1 - depth (depth when reversed) times w */
+        double Wm[16], G[16], a = (double)cf->depth_z[0], b = (double)cf->depth_z[1];
+        memset(Wm, 0, sizeof Wm);
+        for (i = 0; i < 3; ++i)
+            for (r = 0; r < 3; ++r) Wm[i * 4 + r] = x->q[r][i];
+        for (r = 0; r < 3; ++r) Wm[12 + r] = x->t[r];
+        Wm[15] = 1.0;
+        hd__mat_mul(M, Wm, G);
+        for (i = 0; i < 4; ++i) {
+            double dz = (G[i * 4 + 2] - b * G[i * 4 + 3]) / a;
+            cf->dq[i] = (float)(c->depth_range == HD_DEPTH_REVERSED ? dz : G[i * 4 + 3] - dz);
+            cf->dw[i] = (float)G[i * 4 + 3];
+        }
+    }
     for (i = 0; i < 3; ++i)
         if (!hd__finite(cf->pos[i]) || !hd__finite(cf->u[i]) || !hd__finite(cf->v[i]) || !hd__finite(cf->w[i]) ||
             !hd__finite(cf->ou[i]) || !hd__finite(cf->ov[i]))

@@ -927,6 +927,12 @@ XT_EDIT(rb_hd_short, d->params.render_budget = 0.05f; d->params.light_tolerance 
 XT_EDIT(rb_cd_short, d->params.render_budget = 0.05f; d->params.light_tolerance = xt_denorm(); d->params.method = HD_METHOD_CD)
 XT_EDIT(rb_ss_short, d->params.render_budget = 0.05f; d->params.method = HD_METHOD_PT_SS)
 XT_EDIT(rb_ms_short, d->params.render_budget = 0.05f; d->params.method = HD_METHOD_PT_MS)
+XT_EDIT(dt_one, d->params.depth_threshold = 1.0f)
+XT_EDIT(dt_one_up, d->params.depth_threshold = xt_up(1.0f))
+XT_EDIT(dt_denorm, d->params.depth_threshold = xt_denorm())
+XT_EDIT(dt_neg0, d->params.depth_threshold = xt_neg0())
+XT_EDIT(dt_neg_denorm, d->params.depth_threshold = -xt_denorm())
+XT_EDIT(dt_max, d->params.depth_threshold = FLT_MAX)
 static const xt_row xt_tolerance_rows[] = {
     {"light tolerance FLT_MAX", lt_max, HD_SUCCESS, 0},
     {"light tolerance 1e30", lt_1e30, HD_SUCCESS, 0},
@@ -941,6 +947,12 @@ static const xt_row xt_tolerance_rows[] = {
     {"render budget -0 (the default)", rb_neg0, HD_SUCCESS, 0},
     {"render budget -denormal", rb_neg_denorm, IP, 0},
     {"render budget -FLT_MAX", rb_neg_max, IP, 0},
+    {"depth threshold 1 (the bound)", dt_one, HD_SUCCESS, 0},
+    {"depth threshold 1 + ulp", dt_one_up, IP, 0},
+    {"depth threshold denormal", dt_denorm, HD_SUCCESS, 0},
+    {"depth threshold -0 (the default)", dt_neg0, HD_SUCCESS, 0},
+    {"depth threshold -denormal", dt_neg_denorm, IP, 0},
+    {"depth threshold FLT_MAX", dt_max, IP, 0},
 };
 /* The budget's bound (10 s): above it rejected; at it, with light that converges, and with short
    budgets the light never meets, every hd_render call returns within its budget and a few seconds. */
@@ -975,7 +987,7 @@ typedef struct xt_field { const char *name; int part; size_t off; hd_result want
                {"point light." #f, XF_POINT, offsetof(hd_light, f), IL}
 static const xt_field xt_fields[] = {
     XFP(extinction), XFP(albedo), XFP(anisotropy), XFP(majorant), XFP(background[0]), XFP(background[1]),
-    XFP(background[2]), XFP(step), XFP(exposure), XFP(light_tolerance), XFP(render_budget), XFP(crop_min[0]),
+    XFP(background[2]), XFP(step), XFP(exposure), XFP(light_tolerance), XFP(render_budget), XFP(depth_threshold), XFP(crop_min[0]),
     XFP(crop_min[1]), XFP(crop_min[2]), XFP(crop_max[0]), XFP(crop_max[1]), XFP(crop_max[2]),
     XFC(eye[0]), XFC(eye[1]), XFC(eye[2]), XFC(target[0]), XFC(target[1]), XFC(target[2]), XFC(up[0]),
     XFC(up[1]), XFC(up[2]), XFC(fov_y),

@@ -421,10 +421,12 @@ static void proj_fixture(kfix *f, int n, int w)
 static void project_pixel_span(const hd__kctx *k, int x, int y, int spans)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
-    float len = 0.0f, s0 = 0.0f;
+    float len = 0.0f, s0 = 0.0f, xs = -1.0f;
     int geo = 0;
+    hd_v4 m;
     hdk_project_ray(k, x, y, &pe, &d, &len, &s0, &geo);
-    hdk_project_finish(k, y * k->p->image.x + x, hdk_project_march_span(k, pe, d, len, s0, spans), geo);
+    m = hdk_project_march_span(k, pe, d, len, s0, spans, &xs);
+    hdk_project_finish(k, y * k->p->image.x + x, m, geo, xs >= 0.0f ? hdk_depth_q(k, hdk_madd(pe, d, xs)) : 0.0f);
 }
 
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true

@@ -46,6 +46,7 @@ static int param_change(const char *name, hd_params *p)
     F(light_window, p->light_window = 3)
     F(rest, p->rest = HD_REST_REFINE)
     F(refine_bounces, p->refine_bounces = 2)
+    F(depth_threshold, p->depth_threshold = 0.8f)
 #undef F
     return 0;
 }

@@ -334,7 +334,7 @@ static void test_render_scale_upsample(void)
     for (f = 0; f < 3; ++f) /* three jittered frames into each running mean */
         CHECK(hd_render(a) == HD_SUCCESS && hd_render(b) == HD_SUCCESS && hd_render(c) == HD_SUCCESS);
     CHECK(hd_get_stats(a, &s) == HD_SUCCESS && s.frames == 3 && s.render_scale == 2);
-    CHECK(s.image_bytes == (size_t)(W * W + H * H) * 16); /* the image and the half-size frame */
+    CHECK(s.image_bytes == (size_t)(W * W + H * H) * 16 + (size_t)W * W * 4); /* the image, the half-size frame, the depth plane */
     CHECK(hd_read_image_f32(a, full, W * W * 4) == HD_SUCCESS);
     CHECK(hd_read_image_f32(b, half, H * H * 4) == HD_SUCCESS);
     CHECK(hd_read_image_f32(c, plain, W * W * 4) == HD_SUCCESS);
@@ -516,14 +516,14 @@ static void test_render_scale_auto_stale(void)
 }
 
 /* The image buffer holds the reduced frames' region only once a scale > 1 is used: full frames
-   cost the w x h image alone (hd_stats.image_bytes says what is held). A new camera size keeps
+   cost the w x h image and its depth plane alone (hd_stats.image_bytes says what is held). A new camera size keeps
    the region while the parameters may still ask for reduced frames. When the region cannot be
    allocated, the frame fails with HD_ERROR_OUT_OF_MEMORY and one log line, and the context goes
    on rendering full frames. */
 static void test_render_scale_image_room(void)
 {
     enum { H = W / 2, W2 = 2 * W };
-    const size_t full = (size_t)W * W * 16, room = (size_t)H * H * 16;
+    const size_t full = (size_t)W * W * 16, room = (size_t)H * H * 16, held = full + (size_t)W * W * 4;
     float *img = (float *)malloc(full), *before = (float *)malloc(full);
     hd_test_alloc al;
     hd_test_log log;
@@ -537,7 +537,7 @@ static void test_render_scale_image_room(void)
     hd_test_allocator(&d, &al);
     CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
     CHECK(hd_refine(ctx, 3) == HD_SUCCESS && hd_render(ctx) == HD_SUCCESS);
-    CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full, "scale 1: %zu image bytes, want %zu", s.image_bytes, full);
+    CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == held, "scale 1: %zu image bytes, want %zu", s.image_bytes, held);
     /* the region cannot be had: the frame fails, logged once; full frames go on */
     CHECK(hd_read_image_f32(ctx, before, full / 4) == HD_SUCCESS);
     CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
@@ -547,29 +547,29 @@ static void test_render_scale_image_room(void)
     al.fail_at = al.calls + 1;
     CHECK(hd_render(ctx) == HD_ERROR_OUT_OF_MEMORY && log.errors == 1 && log.last_code == HD_ERROR_OUT_OF_MEMORY && al.failed == 1);
     CHECK_MSG(strstr(log.last, "reduced") != NULL, "log: %s", log.last);
-    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full && s.frames == 0);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == held && s.frames == 0);
     p.render_scale = 1;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     CHECK(hd_render(ctx) == HD_SUCCESS && hd_read_image_f32(ctx, img, full / 4) == HD_SUCCESS);
-    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.frames == 1 && s.render_scale == 1 && s.image_bytes == full);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.frames == 1 && s.render_scale == 1 && s.image_bytes == held);
     CHECK(memcmp(img, before, full) == 0); /* the same first frame of the same view and light */
     /* reduced frames: the region comes with the first one */
     p.render_scale = HD_RENDER_SCALE_AUTO;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     CHECK(hd_render(ctx) == HD_SUCCESS);
-    CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 4 && s.image_bytes == full + room, "auto: scale %d, %zu bytes",
+    CHECK_MSG(hd_get_stats(ctx, &s) == HD_SUCCESS && s.render_scale == 4 && s.image_bytes == held + room, "auto: scale %d, %zu bytes",
               s.render_scale, s.image_bytes);
     /* a new size keeps it while reduced frames may come, and drops it at render_scale 1 */
     cam = d.camera;
     cam.width = cam.height = W2;
     CHECK(hd_set_camera(ctx, &cam) == HD_SUCCESS);
-    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == (size_t)(W2 * W2 + W * W) * 16);
-    CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == (size_t)(W2 * W2 + W * W) * 16);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == (size_t)(W2 * W2 + W * W) * 16 + (size_t)W2 * W2 * 4);
+    CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == (size_t)(W2 * W2 + W * W) * 16 + (size_t)W2 * W2 * 4);
     p.render_scale = 1;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     cam.width = cam.height = W;
     CHECK(hd_set_camera(ctx, &cam) == HD_SUCCESS);
-    CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full);
+    CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == held);
     CHECK(log.errors == 1);
     hd_destroy(ctx);
     CHECK(al.live == 0);

@@ -672,6 +672,138 @@ static void test_depth_lifetime(void)
     free(ref);
 }
 
+/* ---- the volume's depth out ----------------------------------------------------------------------- */
+/* A slab of uniform medium (the whole 32 x 32 x 8 volume, 1 x 1 x 0.25 world units) translated to
+   z = -1, seen down -z from the origin through a 90-degree perspective: a ray's opacity reaches
+   1/2 at ln 2 / sigma_t past the front face at z = -0.875 along the ray, so hd_read_depth is the
+   window depth of eye z -(0.875 + cos(theta) ln 2 / sigma_t) (theta: the pixel's ray's angle to
+   the axis), within one step (the crossing sample's jitter); where a ray misses the slab, the
+   far plane's value; threshold 0.9: ln 10 instead of ln 2. Under GL's, zero-to-one and reversed-Z
+   conventions. A wall of host depth in front: the far value everywhere. */
+static uint8_t vox_slab[N * N * 8];
+static void test_depth_out_slab(void)
+{
+    static const float tf_one[8] = {0, 0, 0, 1, 1, 1, 1, 1};
+    hd_desc d = HD_DESC_INIT;
+    hd_light l;
+    hd_context ctx;
+    float *dep = (float *)malloc(W * H * sizeof(float)), *wall = (float *)malloc(W * H * sizeof(float));
+    const double sigma = 20.0, dt = 0.5 / N, zface = 0.875;
+    int conv, i, x, y;
+    memset(vox_slab, 255, sizeof vox_slab);
+    memset(&l, 0, sizeof l);
+    l.direction[2] = -1.0f;
+    d.volume.type = HD_VOXEL_U8;
+    d.volume.dims[0] = d.volume.dims[1] = N; d.volume.dims[2] = 8;
+    d.volume.data = vox_slab;
+    d.volume.transform[0] = d.volume.transform[5] = d.volume.transform[10] = d.volume.transform[15] = 1.0f;
+    d.volume.transform[14] = -1.0f;
+    d.transfer_function.rgba = tf_one;
+    d.transfer_function.count = 2;
+    d.lights = &l;
+    d.light_count = 1;
+    d.camera.width = W; d.camera.height = H;
+    d.params.extinction = (float)sigma;
+    for (conv = 0; conv < 3; ++conv) {
+        hd_depth_range range = (hd_depth_range)conv;
+        mat4 p = m4_perspective(90.0, (double)W / H, 0.1, 10.0, range), pv;
+        float far = range == HD_DEPTH_REVERSED ? 0.0f : 1.0f;
+        int thr;
+        memset(d.camera.view, 0, sizeof d.camera.view);
+        m4_store(p, d.camera.projection);
+        d.camera.depth_range = range;
+        pv = p; /* view: identity */
+        for (thr = 0; thr < 2; ++thr) {
+            double len = (thr ? log(10.0) : log(2.0)) / sigma;
+            int hit = 0, miss = 0, bad = 0;
+            d.params.depth_threshold = thr ? 0.9f : 0.0f;
+            CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+            CHECK(hd_iterate(ctx, 4) == HD_SUCCESS);
+            CHECK(hd_read_depth(ctx, dep, W * H) == HD_SUCCESS);
+            for (y = 0; y < H; ++y)
+                for (x = 0; x < W; ++x) {
+                    /* the centre ray's point on the front face's plane */
+                    double sx = 2.0 * (x + 0.5) / W - 1.0, sy = 1.0 - 2.0 * (y + 0.5) / H;
+                    double fx = fabs(sx * zface / M4(p, 0, 0)), fy = fabs(sy * zface / M4(p, 1, 1));
+                    double ct = 1.0 / sqrt(1.0 + (fx * fx + fy * fy) / (zface * zface)), zc = zface + ct * len;
+                    double pn[3] = {0.0, 0.0, -(zc - 1.01 * dt)}, pf[3] = {0.0, 0.0, -(zc + 1.01 * dt)};
+                    float dn = window_depth(pv, pn, range), df = window_depth(pv, pf, range), lo = dn < df ? dn : df, hi = dn < df ? df : dn;
+                    float v = dep[y * W + x];
+                    if (fx < 0.5 - 3.0 / N && fy < 0.5 - 3.0 / N) {
+                        ++hit;
+                        bad += !(v >= lo - 1e-6f && v <= hi + 1e-6f);
+                        if (!(v >= lo - 1e-6f && v <= hi + 1e-6f) && bad < 4)
+                            fprintf(stderr, "  conv %d thr %d (%d, %d): %.7f not in [%.7f, %.7f]\n", conv, thr, x, y, (double)v, (double)lo, (double)hi);
+                    } else if (fx > 0.5 + 1.0 / N || fy > 0.5 + 1.0 / N) {
+                        ++miss;
+                        bad += v != far;
+                    }
+                }
+            CHECK_MSG(hit > 300 && miss > 100 && bad == 0, "convention %d, threshold %d: %d of %d + %d pixels off", conv, thr, bad, hit, miss);
+            if (thr == 0) { /* the host's wall in front of the slab: no volume depth anywhere */
+                hd_depth_desc dd = HD_DEPTH_DESC_INIT;
+                double pw[3] = {0.0, 0.0, -0.5};
+                float wv = window_depth(pv, pw, range);
+                for (i = 0; i < W * H; ++i) wall[i] = wv;
+                dd.data = wall; dd.width = W; dd.height = H;
+                CHECK(hd_set_depth(ctx, &dd) == HD_SUCCESS && hd_iterate(ctx, 2) == HD_SUCCESS);
+                CHECK(hd_read_depth(ctx, dep, W * H) == HD_SUCCESS);
+                for (i = 0; i < W * H && dep[i] == far; ++i) {}
+                CHECK_MSG(i == W * H, "convention %d: behind the host's wall pixel %d has depth %g", conv, i, (double)dep[i]);
+            }
+            hd_destroy(ctx);
+        }
+    }
+    free(dep);
+    free(wall);
+}
+
+/* ---- the light out ------------------------------------------------------------------------------ */
+/* HD_ILLUMINATION_TOTAL is E + phi of the other two read-backs, bit for bit, for one channel and
+   three (lights of different colours); the GL-only calls (hd_gl_illumination_texture,
+   hd_gl_set_depth_texture) are HD_ERROR_UNSUPPORTED here with one logged line, the path tracers'
+   read HD_ERROR_UNSUPPORTED. */
+static void test_light_out(void)
+{
+    hd_desc d = scene_desc(vox_blob, tf_blob, 3);
+    hd_test_log log;
+    hd_context ctx;
+    hd_stats st;
+    int rgb;
+    make_volumes();
+    d.logger = hd_test_logger(&log);
+    for (rgb = 0; rgb < 2; ++rgb) {
+        size_t n, i, bad = 0, lit = 0;
+        float *t, *e, *p;
+        d.light_count = rgb ? 2 : 1;
+        CHECK(hd_create(&d, &ctx) == HD_SUCCESS && hd_iterate(ctx, 3) == HD_SUCCESS && hd_get_stats(ctx, &st) == HD_SUCCESS);
+        CHECK(st.illumination_channels == (rgb ? 3 : 1));
+        n = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * st.illumination_channels;
+        t = (float *)malloc(n * sizeof(float)); e = (float *)malloc(n * sizeof(float)); p = (float *)malloc(n * sizeof(float));
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, t, n) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_DIRECT, e, n) == HD_SUCCESS);
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_SCATTERED, p, n) == HD_SUCCESS);
+        for (i = 0; i < n; ++i) { bad += t[i] != e[i] + p[i]; lit += p[i] > 0.0f && e[i] > 0.0f; }
+        CHECK_MSG(bad == 0 && lit > n / 10, "%d channels: %zu voxels not E + phi, %zu lit by both", st.illumination_channels, bad, lit);
+        log.errors = 0;
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, t, n - 1) == HD_ERROR_BUFFER_TOO_SMALL && log.errors == 1);
+        log.errors = 0;
+        CHECK(hd_gl_illumination_texture(ctx, 1u, 0) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        log.errors = 0;
+        CHECK(hd_gl_set_depth_texture(ctx, 1u) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        free(t); free(e); free(p);
+        hd_destroy(ctx);
+    }
+    d.params.method = HD_METHOD_PT_SS;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS && hd_iterate(ctx, 1) == HD_SUCCESS);
+    {
+        float one[4];
+        log.errors = 0;
+        CHECK(hd_read_illumination(ctx, HD_ILLUMINATION_TOTAL, one, 4) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+    }
+    hd_destroy(ctx);
+}
+
 /* ---- bad input --------------------------------------------------------------------------------- */
 static hd_test_log g_log;
 /* `call`'s result is `code`, with exactly one logged error. */
@@ -736,7 +868,21 @@ static void test_bad_input(void)
     bad.logger = d.logger;
     CHECK(hd_create(&bad, &tmp) == HD_SUCCESS);
     EXPECT_ONE(hd_set_depth(tmp, &dd), HD_ERROR_DEPTH_NEEDS_PROJECTION);
+    CHECK(hd_iterate(tmp, 1) == HD_SUCCESS);
+    EXPECT_ONE(hd_read_depth(tmp, depth, W * H), HD_ERROR_DEPTH_NEEDS_PROJECTION);
     hd_destroy(tmp);
+    /* the volume's depth out */
+    EXPECT_ONE(hd_read_depth(ctx, depth, W * H), HD_ERROR_NO_FRAME);
+    EXPECT_ONE(hd_read_depth(ctx, NULL, W * H), HD_ERROR_NULL_POINTER);
+    EXPECT_ONE(hd_read_depth(ctx, depth, W * H - 1), HD_ERROR_BUFFER_TOO_SMALL);
+    bad = d;
+    bad.params.method = HD_METHOD_PT_SS;
+    CHECK(hd_create(&bad, &tmp) == HD_SUCCESS && hd_iterate(tmp, 1) == HD_SUCCESS);
+    EXPECT_ONE(hd_read_depth(tmp, depth, W * H), HD_ERROR_UNSUPPORTED);
+    hd_destroy(tmp);
+    bad.params.method = HD_METHOD_HD;
+    bad.params.depth_threshold = 1.5f;
+    EXPECT_ONE(hd_create(&bad, &tmp), HD_ERROR_INVALID_PARAMETER);
     /* nothing changed */
     g_log.errors = 0;
     CHECK(hd_iterate(ctx, 2) == HD_SUCCESS && hd_read_image_f32(ctx, img, n) == HD_SUCCESS);
@@ -755,6 +901,8 @@ const hd_test_case hd_tests_scene[] = {
     {"scene_depth_box_in_front", test_depth_box_in_front},
     {"scene_depth_post_cuts", test_depth_post_cuts},
     {"scene_depth_lifetime", test_depth_lifetime},
+    {"scene_depth_out_slab", test_depth_out_slab},
+    {"scene_light_out", test_light_out},
     {"scene_bad_input", test_bad_input},
 };
 const int hd_tests_scene_count = (int)(sizeof hd_tests_scene / sizeof hd_tests_scene[0]);

@@ -10,7 +10,8 @@ HD_PARAM_I4(frame)      /* x = iteration (1-based), y = frame (1-based), z = see
 HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = the path vertex that reads HD's light (0: none, hd_k_path.h) */
 HD_PARAM_I4(region)     /* x = the first pixel of the frame's region of the image buffer (0; a
                            reduced frame's: the full image's width * height, hd_k_upsample.h),
-                           y = the upsample pass's render scale (0 in every other pass), z, w = 0 */
+                           y = the upsample pass's render scale (0 in every other pass), z = the
+                           depth plane's first float in the image buffer (hdk_project_depth), w = 0 */
 HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / (4 pi) */
 HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
 HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */
@@ -22,12 +23,16 @@ HD_PARAM_F4(cam_v)      /* its change per NDC y (look-at: image up * tan(fov/2))
 HD_PARAM_F4(cam_w)      /* the direction at the image centre (look-at: forward, unit) */
 HD_PARAM_F4(cam_ou)     /* the origin's change per NDC x (orthographic; 0 for a perspective camera) */
 HD_PARAM_F4(cam_ov)     /* the origin's change per NDC y */
-HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on */
-HD_PARAM_F4(depth_z)    /* NDC z = x * depth + y; z = the far plane's depth (no geometry there) */
+HD_PARAM_I4(depth_dims) /* the host's depth buffer: x = width, y = height (the full image's), z = 1: on,
+                           w = 1: its rows bottom first (a GL depth texture's) */
+HD_PARAM_F4(depth_z)    /* NDC z = x * depth + y; z = the far plane's depth (no geometry there);
+                           w = 1 - params.depth_threshold (the volume's depth out, hdk_project_depth) */
 HD_PARAM_F4(depth_m0)   /* rows 0..3 of the inverse of projection * view, clip to the volume's frame */
 HD_PARAM_F4(depth_m1)
 HD_PARAM_F4(depth_m2)
 HD_PARAM_F4(depth_m3)
+HD_PARAM_F4(depth_q)    /* the volume's depth out (hdk_depth_q): the numerator's row over the volume's frame */
+HD_PARAM_F4(depth_w)    /* its denominator's row (clip w); all 0 without a matrix camera */
 HD_PARAM_F4(background) /* rgb radiance behind the volume */
 HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */
 HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates; w = 1: on */

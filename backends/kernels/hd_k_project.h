@@ -97,7 +97,7 @@ HD_FN float hdk_depth_t(HD_KARGS int px, int py, float fx, float fy, float sx, f
         x = hdk_clampi(HD_I(fx * HD_F(dd.x) / HD_F(HD_PRM(image).x)), 0, dd.x - 1);
         y = hdk_clampi(HD_I(fy * HD_F(dd.y) / HD_F(HD_PRM(image).y)), 0, dd.y - 1);
     }
-    w = HD_GET1(dep, y * dd.x + x);
+    w = HD_GET1(dep, (dd.w != 0 ? dd.y - 1 - y : y) * dd.x + x);
     if (w == HD_PRM(depth_z).z) return 3.0e38f;
     z = w * HD_PRM(depth_z).x + HD_PRM(depth_z).y;
     hx = m0.x * sx + m0.y * sy + m0.z * z + m0.w;
@@ -232,13 +232,17 @@ HD_FN void hdk_project_ray(HD_KARGS int px, int py, HD_INOUT(hd_v3) pe, HD_INOUT
    difference at a cell face stays inside the halo). Where rays run in the lanes of one SIMD
    instruction stream and the compiler runs both sides of every branch under a mask (llvmpipe and
    lavapipe do), every iteration of one loop that both walks and samples pays for both; here the
-   walk's iterations pay for a step and the march's for a sample. */
+   walk's iterations pay for a step and the march's for a sample.
+
+   Both set *xs to the position s of the first sample after which T is at or below depth_z.w
+   (1 - params.depth_threshold) or below the cutoff march.z: where the accumulated opacity first
+   reaches the threshold (the volume's depth, hdk_project_depth); -1 where it never does. */
 #ifndef HD_MARCH_SPANS
 #define HD_MARCH_SPANS 6 /* spans the span march keeps apart: 6 measured best of 1, 4, 6, 8 on llvmpipe */
 #endif
-HD_FN hd_v4 hdk_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0)
+HD_FN hd_v4 hdk_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, HD_INOUT(float) xs)
 {
-    float dt = HD_PRM(march).x, idt = 1.0f / dt;
+    float dt = HD_PRM(march).x, idt = 1.0f / dt, tth = HD_PRM(depth_z).w;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
     hd_cell_walk w = hdk_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
@@ -257,6 +261,7 @@ HD_FN hd_v4 hdk_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float
             while (s < sc && n < HD_MAX_MARCH_STEPS) {
                 hdk_project_sample(HD_KPASS hdk_world_to_tex(HD_KPASS hdk_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r),
                                   HD_REF(g), HD_REF(b));
+                if (HD_DEREF(xs) < 0.0f && (T <= tth || T < HD_PRM(march).z)) HD_DEREF(xs) = s;
                 if (T < HD_PRM(march).z) break;
                 ++n;
                 s = s0 + HD_F(n) * dt;
@@ -273,9 +278,9 @@ HD_FN hd_v4 hdk_project_march_cells(HD_KARGS hd_v3 pe, hd_v3 d, float len, float
     return HD_V4(r, g, b, T);
 }
 
-HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, int spans)
+HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float s0, int spans, HD_INOUT(float) xs)
 {
-    float dt = HD_PRM(march).x, idt = 1.0f / dt;
+    float dt = HD_PRM(march).x, idt = 1.0f / dt, tth = HD_PRM(depth_z).w;
     float T = 1.0f, r = 0.0f, g = 0.0f, b = 0.0f;
     hd_cell_walk w = hdk_cell_walk_begin(HD_KPASS pe, d);
     hd_i4 md = HD_PRM(mdims);
@@ -306,6 +311,7 @@ HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
         if (s < sb[j]) { /* a sample of span j, else on to the next span */
             hdk_project_sample(HD_KPASS hdk_world_to_tex(HD_KPASS hdk_madd(pe, d, s)), dt, HD_REF(T), HD_REF(r), HD_REF(g),
                               HD_REF(b));
+            if (HD_DEREF(xs) < 0.0f && (T <= tth || T < HD_PRM(march).z)) HD_DEREF(xs) = s;
             if (T < HD_PRM(march).z) break;
             ++n;
         } else {
@@ -317,25 +323,54 @@ HD_FN hd_v4 hdk_project_march_span(HD_KARGS hd_v3 pe, hd_v3 d, float len, float 
     return HD_V4(r, g, b, T);
 }
 
+/* The volume's depth at point p of the volume's frame, as the depth plane holds it: q = (depth_q .
+   (p, 1)) / (depth_w . (p, 1)), the host's projection * view * volume-to-world folded into two
+   rows (src/hd_kparams.h) so that q is the window depth's distance from the far plane's value
+   (1 - depth, or depth when reversed), in [0, 1]: larger is nearer, 0 the far plane's (also
+   beyond it, behind the camera and without a matrix camera, depth_w = 0). */
+HD_FN float hdk_depth_q(HD_KARGS hd_v3 p)
+{
+    hd_v4 a = HD_PRM(depth_q), b = HD_PRM(depth_w);
+    float w = b.x * p.x + b.y * p.y + b.z * p.z + b.w;
+    if (!(w > 0.0f)) return 0.0f;
+    return hdk_clampf((a.x * p.x + a.y * p.y + a.z * p.z + a.w) / w, 0.0f, 1.0f);
+}
+
+/* The volume's depth of full-resolution pixel i (a reduced frame, region.x > 0, writes none; nor
+   a block without a plane, region.z = 0): the image buffer's depth plane (region.z floats from its
+   start, width x height floats) holds, per pixel, the largest q (hdk_depth_q: the nearest) of
+   the crossings (where the opacity reached the threshold, hdk_project_march_*) over the frames
+   since the running mean restarted (march.y = 1: the frame's own value), 0 where none crossed. */
+HD_FN void hdk_project_depth(HD_KARGS int i, float q)
+{
+    int j = HD_PRM(region).z + i;
+    if (HD_PRM(region).x != 0 || HD_PRM(region).z == 0) return;
+    HD_SET1(img, j, HD_PRM(march).y == 1.0f ? q : hdk_maxf(HD_GET1(img, j), q));
+}
+
 /* Folds the march's (r, g, b, T) into pixel i: the background behind it (none where the host's
-   geometry is, geo = 1), and T = 0 where the march stopped on it. */
-HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m, int geo)
+   geometry is, geo = 1), and T = 0 where the march stopped on it; and the crossing's q (0: none)
+   into the depth plane. */
+HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m, int geo, float q)
 {
     float T = m.w < HD_PRM(march).z ? 0.0f : m.w;
     float bg = geo != 0 ? 0.0f : T;
     hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + bg * HD_PRM(background).x, m.y + bg * HD_PRM(background).y,
                                           m.z + bg * HD_PRM(background).z, 1.0f - T));
+    hdk_project_depth(HD_KPASS i, q);
 }
 
 HD_FN void hdk_project_pixel(HD_KARGS int px, int py)
 {
     hd_v3 pe = HD_V3(0.0f, 0.0f, 0.0f), d = HD_V3(0.0f, 0.0f, 1.0f);
-    float len = 0.0f, s0 = 0.0f;
+    float len = 0.0f, s0 = 0.0f, xs = -1.0f;
     int geo = 0;
+    hd_v4 m;
     hdk_project_ray(HD_KPASS px, py, HD_REF(pe), HD_REF(d), HD_REF(len), HD_REF(s0), HD_REF(geo));
 #ifdef HD_PROJECT_MARCH_SPAN
-    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS), geo);
+    m = hdk_project_march_span(HD_KPASS pe, d, len, s0, HD_MARCH_SPANS, HD_REF(xs));
 #else
-    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, hdk_project_march_cells(HD_KPASS pe, d, len, s0), geo);
+    m = hdk_project_march_cells(HD_KPASS pe, d, len, s0, HD_REF(xs));
 #endif
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, m, geo, xs >= 0.0f ? hdk_depth_q(HD_KPASS hdk_madd(pe, d, xs)) : 0.0f);
 }

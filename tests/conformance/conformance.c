@@ -1094,7 +1094,10 @@ static void direct_cases(const int *odd, const int *other)
    the volume over the image's left third, a post through its middle (a strip at the volume
    centre's eye depth), nothing elsewhere. Whole iterations against the reference; besides, on
    the backend every wall pixel is exactly empty (rgb and alpha 0) and every pixel without
-   geometry equals the backend's own image without depth within the stochastic bound. */
+   geometry equals the backend's own image without depth within the stochastic bound. HD: the
+   volume's depth (hd_read_depth) is the reference's at all but 2 % of the pixels where either
+   has one (a crossing sample's transmittance within float rounding of the threshold can move
+   it by a step), which are at least a tenth of the image; the wall's pixels have none. */
 static void case_scene(hd_method method, hd_depth_range range, int placed, int n)
 {
     scene s;
@@ -1174,6 +1177,26 @@ static void case_scene(hd_method method, hd_depth_range range, int placed, int n
         BOTH(&p, set_depth, (p.ref, &dd), (p.dut, &dd));
         BOTH(&p, iterate, (p.ref, n), (p.dut, n));
         pair_compare(&p, method_is_pt(method) ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, &e);
+        if (p.ok && !method_is_pt(method)) {
+            float *za = (float *)malloc(sizeof(float) * (size_t)w * h), *zb = (float *)malloc(sizeof(float) * (size_t)w * h);
+            float zfar = range == HD_DEPTH_REVERSED ? 0.0f : 1.0f;
+            int with = 0, off = 0, wall = 0;
+            if ((r = hd_api_cpu.read_depth(p.ref, za, (size_t)w * h)) != HD_SUCCESS) pair_fail(&p, "reference read_depth", r);
+            else if ((r = hd_api_backend.read_depth(p.dut, zb, (size_t)w * h)) != HD_SUCCESS) pair_fail(&p, "backend read_depth", r);
+            else {
+                for (i = 0; i < w * h; ++i) {
+                    if (za[i] == zfar && zb[i] == zfar) continue;
+                    ++with;
+                    off += !(fabsf(za[i] - zb[i]) <= 1e-5f);
+                    wall += i % w < w / 3;
+                }
+                printf("  depth: %d of %d pixels with depth, %d differ, %d on the wall\n", with, w * h, off, wall);
+                if (wall || !(with >= w * h / 10) || off > with / 50)
+                    pair_fail(&p, "the volume's depth differs from the reference's", HD_SUCCESS);
+            }
+            free(za);
+            free(zb);
+        }
         if (p.ok && (r = hd_api_backend.create(&d, &plain)) == HD_SUCCESS) {
             size_t np = (size_t)w * h * 4, j;
             float *a = (float *)calloc(np, sizeof(float)), *b = (float *)calloc(np, sizeof(float));

@@ -41,6 +41,7 @@ typedef struct hd_api {
     hd_result (*set_volume_transform)(hd_context, const float *);
     hd_result (*update_volume)(hd_context, const hd_volume_update *);
     hd_result (*set_environment)(hd_context, const hd_environment *);
+    hd_result (*read_depth)(hd_context, float *, size_t);
 } hd_api;
 
 extern const hd_api hd_api_cpu;
@@ -69,5 +70,6 @@ int hd_backend_runtime_present(char *why, size_t why_size);
                         hd_volume_parse_nrrd, hd_volume_free, hd__test_prepare, hd__test_direct, \
                         hd__test_diffuse, hd__test_project, hd__test_write_illumination, hd__test_finish, \
                         hd__test_direct_all, hd_refine, hd_render, hd_set_depth, hd_set_volume_transform, hd_update_volume, \
-                        hd_set_environment}
+                        hd_set_environment,
+                        hd_read_depth}
 #endif

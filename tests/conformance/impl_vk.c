@@ -78,6 +78,7 @@ VK_WRAP(read_image_rgba8, (hd_context c, uint8_t *dst, size_t n), (c, dst, n))
 VK_WRAP(read_image_f32, (hd_context c, float *dst, size_t n), (c, dst, n))
 VK_WRAP(read_illumination, (hd_context c, hd_illumination w, float *dst, size_t n), (c, w, dst, n))
 VK_WRAP(update_volume, (hd_context c, const hd_volume_update *u), (c, u))
+VK_WRAP(read_depth, (hd_context c, float *dst, size_t n), (c, dst, n))
 VK_WRAP_HOOK(test_prepare, (hd_context c), (c))
 VK_WRAP_HOOK(test_direct, (hd_context c, int n), (c, n))
 VK_WRAP_HOOK(test_diffuse, (hd_context c, int n), (c, n))
@@ -93,4 +94,5 @@ const hd_api hd_api_backend = {hd_backend_name, hd_result_string, hd_method_name
                                hd_volume_parse_nrrd, hd_volume_free, vk_test_prepare, vk_test_direct,
                                vk_test_diffuse, vk_test_project, vk_test_write_illumination, vk_test_finish,
                                vk_test_direct_all, vk_refine, vk_render, vk_set_depth, vk_set_volume_transform, vk_update_volume,
-                               vk_set_environment};
+                               vk_set_environment,
+                               vk_read_depth};

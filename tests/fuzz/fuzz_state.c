@@ -176,7 +176,7 @@ static void fz_tr_params(const char *p, const hd_params *q)
     FZ_TRF(background, 3); FZ_TRF(step, 1); FZ_TRI(frame_window); FZ_TRF(exposure, 1); FZ_TRI(max_bounces);
     FZ_TRI(illumination_downsample); FZ_TRI(rgb_scattering); FZ_TRI(diffusion_boundary);
     FZ_TRI(illumination_precision); FZ_TRF(light_tolerance, 1); FZ_TRF(render_budget, 1); FZ_TRF(crop_min, 3);
-    FZ_TRF(crop_max, 3); FZ_TRI(render_scale);
+    FZ_TRF(crop_max, 3); FZ_TRI(render_scale); FZ_TRF(depth_threshold, 1);
 #undef FZ_TRF
 #undef FZ_TRI
 }
@@ -319,6 +319,9 @@ static void fz_params_defaults(hd_params *p)
     if (p->light_tolerance == 0.0f) p->light_tolerance = 0.1f;
     if (p->render_scale == 0) p->render_scale = 1;
     if (p->light_window == 0) p->light_window = 8;
+    if (p->depth_threshold == 0.0f) p->depth_threshold = 0.5f;
+    if (p->refine_bounces == 0) p->refine_bounces = -1;
+    if (p->rest == HD_REST_DEFAULT) p->rest = HD_REST_HOLD;
     for (i = 0; i < 3; ++i)
         if (p->crop_max[i] == 0.0f) p->crop_max[i] = 1.0f;
     /* a float whose default is 0 is stored as +0 (src/hd_params.h: a zero field gets its default) */
@@ -358,6 +361,9 @@ static fz_set fz_params_want(const hd_params *p)
     if (!fz_finite(p->render_budget) || !(p->render_budget >= 0.0f && p->render_budget <= FZ_BUDGET_MAX)) bad |= FZ_R(IP);
     if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > 8)) bad |= FZ_R(IP);
     if (p->light_window < 1 || p->light_window > 1000000) bad |= FZ_R(IP);
+    if (!fz_finite(p->depth_threshold) || !(p->depth_threshold >= 0.0f && p->depth_threshold <= 1.0f)) bad |= FZ_R(IP);
+    if (fz_bad_enum((int)p->rest, HD_REST_COUNT)) bad |= FZ_R(IE);
+    if (p->refine_bounces < -1 || p->refine_bounces > 100000) bad |= FZ_R(IP);
     for (i = 0; i < 3; ++i)
         if (!fz_finite(p->crop_min[i]) || !fz_finite(p->crop_max[i]) || !(p->crop_min[i] >= 0.0f) ||
             !(p->crop_max[i] <= 1.0f) || !(p->crop_min[i] < p->crop_max[i]))
@@ -931,7 +937,8 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
     light_bits = FZ_BITS(extinction) || FZ_BITS(majorant) || FZ_BITS(crop_min) || FZ_BITS(crop_max) || light;
     phi = FZ_NE(disable_diffusion) || FZ_NE(diffusion_boundary);
     phi_bits = FZ_BITS(albedo) || FZ_BITS(anisotropy) || phi || warm;
-    image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || bg;
+    image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || FZ_NE(depth_threshold) || FZ_NE(rest) ||
+            FZ_NE(refine_bounces) || bg;
     /* "solver, sweeps, tracking, exposure, light_tolerance, render_budget, light_window -> nothing" */
     t.solver = p->solver;
     t.diffusion_sweeps = p->diffusion_sweeps;
@@ -1352,15 +1359,54 @@ static void fz_op_preset(int ci)
     }
 }
 
+/* The GL and Vulkan backends' calls (bit 0: which; bits 6-7: which call of it): unsupported
+   here, before any other check. */
 static void fz_op_backend(int ci)
 {
+    static const char *const names[2][3] = {{"hd_vulkan_record(c, NULL, 1)", "hd_vulkan_record_depth(c, NULL, NULL)",
+                                             "hd_vulkan_record_render(c, NULL, NULL, NULL)"},
+                                            {"hd_gl_render_to_texture(c, 1)", "hd_gl_illumination_texture(c, 1, 0)",
+                                             "hd_gl_set_depth_texture(c, 1)"}};
     fz_pre pre;
     hd_result r;
-    int gl = fz_u8() & 1;
-    fz_tr("    r = %s;\n", gl ? "hd_gl_render_to_texture(c, 1)" : "hd_vulkan_record(c, NULL, 1)");
-    fz_begin(ci, &pre, gl ? "hd_gl_render_to_texture" : "hd_vulkan_record");
-    r = gl ? hd_gl_render_to_texture(fz_c[ci].h, 1u) : hd_vulkan_record(fz_c[ci].h, NULL, 1);
+    int k = fz_u8(), gl = k & 1, v = (k >> 6) % 3;
+    fz_tr("    r = %s;\n", names[gl][v]);
+    fz_begin(ci, &pre, names[gl][v]);
+    if (gl) r = v == 0 ? hd_gl_render_to_texture(fz_c[ci].h, 1u) : v == 1 ? hd_gl_illumination_texture(fz_c[ci].h, 1u, 0)
+                                                                           : hd_gl_set_depth_texture(fz_c[ci].h, 1u);
+    else r = v == 0 ? hd_vulkan_record(fz_c[ci].h, NULL, 1) : v == 1 ? hd_vulkan_record_depth(fz_c[ci].h, NULL, NULL)
+                                                                     : hd_vulkan_record_render(fz_c[ci].h, NULL, NULL, NULL);
     fz_end(&pre, r, FZ_R(HD_ERROR_UNSUPPORTED));
+}
+
+/* hd_read_depth: every refusal that applies (NULL, PT, a look-at camera, a short buffer, no
+   frame yet), else the window depths, each in [0, 1]. */
+static void fz_op_read_depth(int ci)
+{
+    fz_pre pre;
+    fz_snap s;
+    hd_result r;
+    fz_set allowed = 0;
+    int null, i, lookat = 1;
+    size_t need, size, k;
+    fz_snap_take(fz_c[ci].h, &s);
+    for (i = 0; i < 16; ++i) lookat &= s.cam.projection[i] == 0.0f;
+    need = (size_t)s.cam.width * (size_t)s.cam.height;
+    size = fz_size(need, &null);
+    if (need == 0 && size == (size_t)-1) size = 0;
+    if (null) allowed |= FZ_R(HD_ERROR_NULL_POINTER);
+    if (fz_pt(s.p.method)) allowed |= FZ_R(HD_ERROR_UNSUPPORTED);
+    if (lookat) allowed |= FZ_R(HD_ERROR_DEPTH_NEEDS_PROJECTION);
+    if (size < need) allowed |= FZ_R(HD_ERROR_BUFFER_TOO_SMALL);
+    if (!allowed) allowed = FZ_OK | (s.st.frames == 0 ? FZ_R(HD_ERROR_NO_FRAME) : 0);
+    fz_tr("    r = hd_read_depth(c%d, %s, %zu);\n", ci, null ? "NULL" : "buf", size);
+    fz_begin(ci, &pre, "hd_read_depth");
+    r = hd_read_depth(fz_c[ci].h, null ? NULL : fz_img, size);
+    fz_end(&pre, r, allowed);
+    if (r != HD_SUCCESS) return;
+    fz_same(fz_c[ci].h, &pre.s, "a depth read");
+    for (k = 0; k < need; ++k)
+        if (!(fz_img[k] >= 0.0f && fz_img[k] <= 1.0f)) fz_fail("depth value %zu is %g", k, (double)fz_img[k]);
 }
 
 static void fz_op_names(void)
@@ -1671,6 +1717,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         case 27: fz_op_preset(ci); break;
         case 28: fz_op_backend(ci); break;
         case 29: fz_op_names(); break;
+        case 30: fz_op_read_depth(ci); break;
         default: fz_op_render(ci); break;
         }
     }

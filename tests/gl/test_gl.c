@@ -38,6 +38,20 @@
       below it, every finite half, the ties between halves and the floats either side of them),
       written into the image buffer: each format bit for bit hd_read_image_ex's, exposure 1 and
       0.75.
+   10. hd_gl_illumination_texture: E + phi into the caller's GL_R32F 3D texture (the grid's size,
+      and a larger one whose texels beyond the grid keep their pattern), read back with
+      glGetTexImage: bit for bit hd_read_illumination's HD_ILLUMINATION_TOTAL, which is E + phi
+      of the DIRECT and SCATTERED read-backs; after more iterations it follows the light; each
+      channel of a 3-channel grid. A 2D texture, a GL_R16F one, one smaller than the grid, a
+      channel past the grid's, texture 0: each its own hd_result and one logged error, nothing
+      written, and the context goes on.
+   11. hd_gl_set_depth_texture: the host's GL_DEPTH_COMPONENT32F and GL_DEPTH_COMPONENT24 textures
+      (a wall over the left third and the bottom half, a post through the middle; GL's rows,
+      bottom first) give bit for bit the image
+      of hd_set_depth with the same values (rows flipped to top first), which differs from the
+      image without depth; hd_set_depth(NULL) then gives the image without depth. An RGBA8
+      texture, one of another size, a 3D texture, texture 0 and a look-at camera: each its own
+      hd_result and one logged error, and the depth held before stays.
    Not tested here: a shader compile failure (the shaders are fixed strings; the path is the
    driver's info log into HD__ERR) and KHR_debug delivery. */
 #define GL_GLEXT_PROTOTYPES /* before hybriddiff.h, which includes GL/glcorearb.h */
@@ -475,7 +489,7 @@ static void check_image_room(void)
     hd_result r;
     hd__ctx *ctx;
     GLint limit;
-    size_t full = (size_t)48 * 40 * 16, room = (size_t)24 * 20 * 16;
+    size_t full = (size_t)48 * 40 * 20, room = (size_t)24 * 20 * 16; /* the image with its depth plane */
     make_desc(&d, vox, 16);
     d.gl.use_current_context = 1;
     d.logger.func = nc_log;
@@ -776,6 +790,263 @@ static void check_output_encoding(void)
     hd_destroy(c);
 }
 
+/* Check 10: the light out into the caller's 3D texture. */
+static GLuint tex3d(GLenum internal, int w, int h, int d, float fill)
+{
+    GLuint t;
+    GLint prev;
+    size_t i, n = (size_t)w * h * d;
+    float *v = (float *)malloc(n * sizeof(float));
+    for (i = 0; i < n; ++i) v[i] = fill;
+    glGetIntegerv(GL_TEXTURE_BINDING_3D, &prev);
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_3D, t);
+    glTexStorage3D(GL_TEXTURE_3D, 1, internal, w, h, d);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+    glPixelStorei(GL_UNPACK_SKIP_IMAGES, 0);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, v);
+    glBindTexture(GL_TEXTURE_3D, (GLuint)prev);
+    free(v);
+    return t;
+}
+static void read_tex3d(GLuint t, float *dst)
+{
+    GLint prev;
+    glGetIntegerv(GL_TEXTURE_BINDING_3D, &prev);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_PACK_IMAGE_HEIGHT, 0);
+    glBindTexture(GL_TEXTURE_3D, t);
+    glGetTexImage(GL_TEXTURE_3D, 0, GL_RED, GL_FLOAT, dst);
+    glBindTexture(GL_TEXTURE_3D, (GLuint)prev);
+}
+static void check_light_texture(void)
+{
+    static uint8_t vox[24 * 24 * 24];
+    hd_desc d;
+    hd_context c;
+    hd_stats st;
+    hd_result r;
+    hd_light l[2];
+    int rgb;
+    make_desc(&d, vox, 24);
+    d.gl.use_current_context = 1;
+    d.logger.func = out_log;
+    d.params.illumination_downsample = 2;
+    memset(l, 0, sizeof l);
+    l[0].direction[1] = -1.0f; l[0].color[0] = 1.0f; l[0].color[1] = 0.5f; l[0].color[2] = 0.2f;
+    l[1].direction[0] = 1.0f; l[1].color[0] = 0.2f; l[1].color[1] = 0.6f; l[1].color[2] = 1.0f;
+    for (rgb = 0; rgb < 2; ++rgb) {
+        int gx, gy, gz, ch, k, pass;
+        size_t n, g;
+        float *tot, *e, *phi, *got, *big;
+        GLuint t, tb, bad2d, bad16, small;
+        d.lights = l;
+        d.light_count = rgb ? 2 : 1;
+        out_errors = 0;
+        r = hd_create(&d, &c);
+        CHECK(r == HD_SUCCESS, "light texture: hd_create: %s", hd_result_string(r));
+        if (r != HD_SUCCESS) return;
+        CHECK(hd_iterate(c, 2) == HD_SUCCESS && hd_get_stats(c, &st) == HD_SUCCESS, "light texture: iterate");
+        gx = st.illumination_dims[0]; gy = st.illumination_dims[1]; gz = st.illumination_dims[2]; ch = st.illumination_channels;
+        CHECK(ch == (rgb ? 3 : 1), "light texture: %d channels", ch);
+        g = (size_t)gx * gy * gz;
+        n = g * ch;
+        tot = (float *)malloc(n * sizeof(float)); e = (float *)malloc(n * sizeof(float)); phi = (float *)malloc(n * sizeof(float));
+        got = (float *)malloc(g * sizeof(float)); big = (float *)malloc((size_t)(gx + 3) * (gy + 2) * (gz + 1) * sizeof(float));
+        t = tex3d(GL_R32F, gx, gy, gz, -7.0f);
+        tb = tex3d(GL_R32F, gx + 3, gy + 2, gz + 1, -7.0f);
+        for (pass = 0; pass < 2; ++pass) {
+            size_t i, bad = 0, nonzero = 0, kept = 0;
+            if (pass) CHECK(hd_iterate(c, 3) == HD_SUCCESS, "light texture: iterate more");
+            CHECK(hd_read_illumination(c, HD_ILLUMINATION_TOTAL, tot, n) == HD_SUCCESS &&
+                      hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e, n) == HD_SUCCESS &&
+                      hd_read_illumination(c, HD_ILLUMINATION_SCATTERED, phi, n) == HD_SUCCESS, "light texture: read-backs");
+            for (i = 0; i < n; ++i) bad += tot[i] != e[i] + phi[i];
+            CHECK(bad == 0, "light texture: HD_ILLUMINATION_TOTAL differs from E + phi at %zu voxels", bad);
+            for (k = 0; k < ch; ++k) {
+                int x, y, z;
+                r = hd_gl_illumination_texture(c, t, k);
+                CHECK(r == HD_SUCCESS, "light texture: channel %d: %s", k, hd_result_string(r));
+                read_tex3d(t, got);
+                for (i = 0, bad = 0; i < g; ++i) { bad += memcmp(&got[i], &tot[k * g + i], sizeof(float)) != 0; nonzero += got[i] > 0.0f; }
+                CHECK(bad == 0, "light texture: channel %d: %zu of %zu texels are not E + phi", k, bad, g);
+                CHECK(hd_gl_illumination_texture(c, tb, k) == HD_SUCCESS, "light texture: larger texture");
+                read_tex3d(tb, big);
+                for (z = 0, bad = 0; z < gz + 1; ++z)
+                    for (y = 0; y < gy + 2; ++y)
+                        for (x = 0; x < gx + 3; ++x) {
+                            float v = big[((size_t)z * (gy + 2) + y) * (gx + 3) + x];
+                            if (x < gx && y < gy && z < gz) bad += v != tot[k * g + ((size_t)z * gy + y) * gx + x];
+                            else kept += v == -7.0f, bad += v != -7.0f;
+                        }
+                CHECK(bad == 0 && kept > 0, "light texture: channel %d into a larger texture: %zu texels wrong", k, bad);
+            }
+            CHECK(nonzero > g / 20, "light texture: only %zu lit texels", nonzero);
+        }
+        /* refusals: one error each, nothing written, the context goes on */
+        {
+            static unsigned char pat[TW * TH * 16];
+            bad2d = pattern_texture(GL_RGBA32F, GL_FLOAT, 16, pat);
+        }
+        bad16 = tex3d(GL_R16F, gx, gy, gz, 0.0f);
+        small = tex3d(GL_R32F, gx, gy, gz - 1, 0.0f);
+        {
+            struct { GLuint tex; int ch; hd_result want; const char *what; } cases[5];
+            int j;
+            size_t i, bad = 0;
+            cases[0].tex = bad2d; cases[0].ch = 0; cases[0].want = HD_ERROR_INVALID_TEXTURE; cases[0].what = "a 2D texture";
+            cases[1].tex = bad16; cases[1].ch = 0; cases[1].want = HD_ERROR_OUTPUT_FORMAT; cases[1].what = "GL_R16F";
+            cases[2].tex = small; cases[2].ch = 0; cases[2].want = HD_ERROR_OUTPUT_OUTSIDE_TARGET; cases[2].what = "smaller than the grid";
+            cases[3].tex = t; cases[3].ch = ch; cases[3].want = HD_ERROR_INVALID_PARAMETER; cases[3].what = "channel past the grid's";
+            cases[4].tex = 0; cases[4].ch = 0; cases[4].want = HD_ERROR_INVALID_TEXTURE; cases[4].what = "texture 0";
+            CHECK(hd_gl_illumination_texture(c, t, 0) == HD_SUCCESS, "light texture: channel 0");
+            for (j = 0; j < 5; ++j) {
+                out_errors = 0;
+                r = hd_gl_illumination_texture(c, cases[j].tex, cases[j].ch);
+                CHECK(r == cases[j].want && out_errors == 1 && out_last == r, "light texture: %s: %s, %d errors logged", cases[j].what,
+                      hd_result_string(r), out_errors);
+            }
+            CHECK(glGetError() == GL_NO_ERROR, "light texture: a refusal left a GL error pending");
+            read_tex3d(t, got);
+            for (i = 0; i < g; ++i) bad += got[i] != tot[i];
+            CHECK(bad == 0, "light texture: a refused call wrote into the texture");
+            out_errors = 0;
+            CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_gl_illumination_texture(c, t, 0) == HD_SUCCESS && out_errors == 0,
+                  "light texture: the context does not go on after the refusals");
+        }
+        glDeleteTextures(1, &bad2d); glDeleteTextures(1, &bad16); glDeleteTextures(1, &small);
+        glDeleteTextures(1, &t); glDeleteTextures(1, &tb);
+        free(tot); free(e); free(phi); free(got); free(big);
+        hd_destroy(c);
+        printf("PASS light texture (%d channel%s): E + phi bit for bit, a larger texture, refusals one error each\n", ch, ch > 1 ? "s" : "");
+    }
+}
+
+/* Check 11: the host's depth texture as the depth input. */
+static float *render_depth(hd_context c, const float *top_first, GLuint tex, int w, int h)
+{
+    float *img = (float *)malloc((size_t)w * h * 4 * sizeof(float));
+    hd_result r = HD_SUCCESS;
+    if (top_first) {
+        hd_depth_desc dd;
+        dd.data = top_first; dd.width = w; dd.height = h;
+        r = hd_set_depth(c, &dd);
+    } else if (tex) {
+        r = hd_gl_set_depth_texture(c, tex);
+    }
+    CHECK(r == HD_SUCCESS, "depth texture: setting the depth: %s", hd_result_string(r));
+    CHECK(hd_iterate(c, 2) == HD_SUCCESS && hd_read_image_f32(c, img, (size_t)w * h * 4) == HD_SUCCESS, "depth texture: render");
+    return img;
+}
+static void check_depth_texture(void)
+{
+    static uint8_t vox[24 * 24 * 24];
+    static const GLenum fmts[2] = {GL_DEPTH_COMPONENT32F, GL_DEPTH_COMPONENT24};
+    hd_desc d;
+    int w, h, x, y, k;
+    double n = 0.1, f = 10.0, th = tan(20.0 * 3.14159265358979 / 180.0);
+    float *gl_rows, *top, *back;
+    make_desc(&d, vox, 24);
+    d.gl.use_current_context = 1;
+    d.logger.func = out_log;
+    w = d.camera.width; h = d.camera.height;
+    memset(d.camera.view, 0, sizeof d.camera.view);
+    d.camera.view[0] = d.camera.view[5] = d.camera.view[10] = d.camera.view[15] = 1.0f;
+    d.camera.view[14] = -2.5f; /* the default look-at camera, (0, 0, 2.5) toward the origin */
+    d.camera.projection[0] = (float)(1.0 / (th * w / h));
+    d.camera.projection[5] = (float)(1.0 / th);
+    d.camera.projection[10] = (float)(-(f + n) / (f - n));
+    d.camera.projection[11] = -1.0f;
+    d.camera.projection[14] = (float)(-2.0 * f * n / (f - n));
+    gl_rows = (float *)malloc((size_t)w * h * sizeof(float));
+    top = (float *)malloc((size_t)w * h * sizeof(float));
+    back = (float *)malloc((size_t)w * h * sizeof(float));
+    for (y = 0; y < h; ++y) /* GL's row y (bottom first) */
+        for (x = 0; x < w; ++x) {
+            double z = x < w / 3 || y < h / 2 ? -2.2 : (x >= w / 2 - 2 && x < w / 2 + 2) ? -2.5 : 0.0;
+            gl_rows[y * w + x] = z == 0.0 ? 1.0f : (float)(0.5 * ((-(f + n) / (f - n) * z - 2.0 * f * n / (f - n)) / -z + 1.0));
+        }
+    for (k = 0; k < 2; ++k) {
+        hd_context a, b, none;
+        GLuint t, prev;
+        float *ia, *ib, *in, *ic;
+        size_t np = (size_t)w * h * 4;
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, (GLint *)&prev);
+        glGenTextures(1, &t);
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexStorage2D(GL_TEXTURE_2D, 1, fmts[k], w, h);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_DEPTH_COMPONENT, GL_FLOAT, gl_rows);
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+        glGetTexImage(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT, GL_FLOAT, back); /* the values it holds */
+        glBindTexture(GL_TEXTURE_2D, prev);
+        for (y = 0; y < h; ++y) memcpy(top + (size_t)y * w, back + (size_t)(h - 1 - y) * w, (size_t)w * sizeof(float));
+        CHECK(hd_create(&d, &a) == HD_SUCCESS && hd_create(&d, &b) == HD_SUCCESS && hd_create(&d, &none) == HD_SUCCESS,
+              "depth texture: hd_create");
+        ia = render_depth(a, top, 0, w, h);
+        ib = render_depth(b, NULL, t, w, h);
+        in = render_depth(none, NULL, 0, w, h);
+        CHECK(memcmp(ia, ib, np * sizeof(float)) == 0, "depth texture 0x%04x: the image is not hd_set_depth's of the same values", fmts[k]);
+        CHECK(memcmp(ia, in, np * sizeof(float)) != 0, "depth texture 0x%04x: the depth changed nothing", fmts[k]);
+        if (k == 0) { /* refusals keep the depth held */
+            GLuint rgba, small, t3;
+            hd_context look;
+            hd_desc dl = d;
+            hd_result r;
+            float *iz;
+            glGenTextures(1, &rgba); glBindTexture(GL_TEXTURE_2D, rgba); glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, w, h);
+            glGenTextures(1, &small); glBindTexture(GL_TEXTURE_2D, small); glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT32F, w, h - 1);
+            glBindTexture(GL_TEXTURE_2D, prev);
+            t3 = tex3d(GL_R32F, 4, 4, 4, 0.0f);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, rgba);
+            CHECK(r == HD_ERROR_DEPTH_FORMAT && out_errors == 1, "depth texture: RGBA8: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, small);
+            CHECK(r == HD_ERROR_DEPTH_SIZE && out_errors == 1, "depth texture: another size: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, t3);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE && out_errors == 1, "depth texture: a 3D texture: %s, %d errors", hd_result_string(r), out_errors);
+            out_errors = 0; r = hd_gl_set_depth_texture(b, 0);
+            CHECK(r == HD_ERROR_INVALID_TEXTURE && out_errors == 1, "depth texture: 0: %s, %d errors", hd_result_string(r), out_errors);
+            CHECK(glGetError() == GL_NO_ERROR, "depth texture: a refusal left a GL error pending");
+            memset(dl.camera.view, 0, sizeof dl.camera.view);
+            memset(dl.camera.projection, 0, sizeof dl.camera.projection);
+            CHECK(hd_create(&dl, &look) == HD_SUCCESS, "depth texture: look-at context");
+            out_errors = 0; r = hd_gl_set_depth_texture(look, t);
+            CHECK(r == HD_ERROR_DEPTH_NEEDS_PROJECTION && out_errors == 1, "depth texture: look-at camera: %s", hd_result_string(r));
+            hd_destroy(look);
+            /* the depth held: a and b go on alike (a method change re-uploads a host buffer, keeps the texture's) */
+            {
+                hd_params p = d.params;
+                p.method = HD_METHOD_CD;
+                CHECK(hd_set_params(a, &p) == HD_SUCCESS && hd_set_params(b, &p) == HD_SUCCESS, "depth texture: method CD");
+            }
+            free(ia); free(ib);
+            ia = render_depth(a, NULL, 0, w, h);
+            ib = render_depth(b, NULL, 0, w, h);
+            CHECK(memcmp(ia, ib, np * sizeof(float)) == 0, "depth texture: after the refusals and a method change b is not a's");
+            CHECK(hd_set_depth(b, NULL) == HD_SUCCESS && hd_set_depth(a, NULL) == HD_SUCCESS, "depth texture: cleared");
+            iz = render_depth(b, NULL, 0, w, h);
+            ic = render_depth(a, NULL, 0, w, h);
+            CHECK(memcmp(iz, ic, np * sizeof(float)) == 0, "depth texture: hd_set_depth(NULL) did not clear the texture's depth");
+            free(iz); free(ic);
+            glDeleteTextures(1, &rgba); glDeleteTextures(1, &small); glDeleteTextures(1, &t3);
+        }
+        free(ia); free(ib); free(in);
+        hd_destroy(a); hd_destroy(b); hd_destroy(none);
+        glDeleteTextures(1, &t);
+        printf("PASS depth texture 0x%04x: the image of hd_set_depth with the same values, bit for bit\n", fmts[k]);
+    }
+    free(gl_rows); free(top); free(back);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -804,6 +1075,8 @@ int main(void)
     check_image_room();
     check_output_formats();
     check_output_encoding();
+    check_light_texture();
+    check_depth_texture();
     check_shader_warnings();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */

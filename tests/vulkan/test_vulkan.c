@@ -633,7 +633,7 @@ static void test_image_room(void)
     hd_stats s;
     hd_params p;
     hd__ctx *ctx;
-    size_t full = (size_t)32 * 24 * 16, room = (size_t)16 * 12 * 16;
+    size_t full = (size_t)32 * 24 * 20, room = (size_t)16 * 12 * 16; /* the image with its depth plane */
     int ok = 1;
     d.vulkan.enable_validation = have_layer;
     messages = 0;
@@ -745,7 +745,8 @@ static int vk_image(hd__backend *be, VkFormat fmt, int w, int h, vk_obj *o)
     ici.arrayLayers = 1;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                (fmt == VK_FORMAT_D32_SFLOAT ? VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT : 0);
     ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     if (be->fn.vkCreateImage(be->device, &ici, NULL, &o->image) != VK_SUCCESS) return 0;
     be->fn.vkGetImageMemoryRequirements(be->device, o->image, &req);
@@ -1095,6 +1096,160 @@ static void test_record_converged(void)
            (unsigned long long)s.iterations, (unsigned long long)fr, (unsigned long long)s.frames, region, messages);
 }
 
+/* 12: hd_vulkan_record_depth: the host's depth as a VkBuffer of floats, and as a D32_SFLOAT
+   image in DEPTH_STENCIL_ATTACHMENT_OPTIMAL (filled by the caller's own copy in the same command
+   buffer), copied inside the caller's command buffer before hd_vulkan_record_render's frame:
+   two frames (the second without a new copy) give bit for bit the image of hd_set_depth with the
+   same values, which differs from the image without depth. Refusals (a colour format, layout
+   UNDEFINED, an image and a buffer, a buffer too small, a NULL command buffer, a look-at camera)
+   each its own hd_result and one logged error, nothing recorded. No validation message. */
+enum { DW = 32, DH = 24 };
+static void depth_values(float *v)
+{
+    double n = 0.1, f = 10.0;
+    int x, y;
+    for (y = 0; y < DH; ++y)
+        for (x = 0; x < DW; ++x) {
+            double z = x < DW / 3 || y < DH / 2 ? -2.2 : (x >= DW / 2 - 2 && x < DW / 2 + 2) ? -2.5 : 0.0;
+            v[y * DW + x] = z == 0.0 ? 1.0f : (float)((f / (n - f) * z + f * n / (n - f)) / -z);
+        }
+}
+static void depth_camera(hd_desc *d)
+{
+    double n = 0.1, f = 10.0, th = tan(20.0 * 3.14159265358979 / 180.0);
+    d->camera.view[0] = d->camera.view[5] = d->camera.view[10] = d->camera.view[15] = 1.0f;
+    d->camera.view[14] = -2.5f;
+    d->camera.projection[0] = (float)(1.0 / (th * DW / DH));
+    d->camera.projection[5] = (float)(1.0 / th);
+    d->camera.projection[10] = (float)(f / (n - f));
+    d->camera.projection[11] = -1.0f;
+    d->camera.projection[14] = (float)(f * n / (n - f));
+    d->camera.depth_range = HD_DEPTH_ZERO_TO_ONE;
+}
+/* The image after two recorded frames with the depth given by `mode`: 0 none, 1 hd_set_depth,
+   2 a buffer, 3 an image (and, mode 3, the refusals first). */
+static int depth_frames(int mode, float *img)
+{
+    hd_desc d = test_desc();
+    hd_context h;
+    hd__backend *be;
+    vk_obj buf, im;
+    float vals[DW * DH];
+    int k, ok = 1;
+    depth_values(vals);
+    depth_camera(&d);
+    d.vulkan.enable_validation = have_layer;
+    if (hd_create(&d, &h) != HD_SUCCESS) return 0;
+    be = hd__lookup(h)->vw.be;
+    memset(&buf, 0, sizeof buf);
+    memset(&im, 0, sizeof im);
+    if (mode == 1) {
+        hd_depth_desc dd;
+        dd.data = vals; dd.width = DW; dd.height = DH;
+        ok &= hd_set_depth(h, &dd) == HD_SUCCESS;
+    }
+    if (mode >= 2) {
+        ok &= vk_buffer(be, 64 + sizeof vals, &buf);
+        if (ok) memcpy((char *)buf.map + 64, vals, sizeof vals);
+    }
+    if (mode == 3) ok &= vk_image(be, VK_FORMAT_D32_SFLOAT, DW, DH, &im);
+    for (k = 0; k < 2 && ok; ++k) {
+        vk_cmd c;
+        if (!cmd_begin(be, &c)) { ok = 0; break; }
+        if (k == 0 && mode >= 2) {
+            hd_vulkan_depth dep = HD_VULKAN_DEPTH_INIT;
+            if (mode == 2) {
+                dep.buffer = (uint64_t)buf.buffer;
+                dep.offset = 64;
+                dep.buffer_size = 64 + sizeof vals;
+            } else {
+                /* the caller's own upload into its depth attachment */
+                VkImageMemoryBarrier ib;
+                VkBufferImageCopy reg;
+                memset(&ib, 0, sizeof ib);
+                ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+                ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+                ib.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+                ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+                ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+                ib.image = im.image;
+                ib.subresourceRange.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+                ib.subresourceRange.levelCount = 1;
+                ib.subresourceRange.layerCount = 1;
+                be->fn.vkCmdPipelineBarrier(c.cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, &ib);
+                memset(&reg, 0, sizeof reg);
+                reg.bufferOffset = 64;
+                reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+                reg.imageSubresource.layerCount = 1;
+                reg.imageExtent.width = DW;
+                reg.imageExtent.height = DH;
+                reg.imageExtent.depth = 1;
+                be->fn.vkCmdCopyBufferToImage(c.cb, buf.buffer, im.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &reg);
+                ib.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+                ib.dstAccessMask = VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+                ib.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+                ib.newLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+                be->fn.vkCmdPipelineBarrier(c.cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT, 0, 0, NULL, 0, NULL,
+                                            1, &ib);
+                dep.image = (uint64_t)im.image;
+                dep.format = VK_FORMAT_D32_SFLOAT;
+                dep.layout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+                { /* refusals: nothing recorded, one error each */
+                    hd_vulkan_depth bad = dep;
+                    unsigned long e0;
+                    hd_result r;
+                    bad.format = VK_FORMAT_R8G8B8A8_UNORM;
+                    e0 = err_count; r = hd_vulkan_record_depth(h, c.cb, &bad);
+                    CHECK(r == HD_ERROR_DEPTH_FORMAT && err_count == e0 + 1);
+                    bad = dep; bad.layout = VK_IMAGE_LAYOUT_UNDEFINED;
+                    e0 = err_count; r = hd_vulkan_record_depth(h, c.cb, &bad);
+                    CHECK(r == HD_ERROR_INVALID_PARAMETER && err_count == e0 + 1);
+                    bad = dep; bad.buffer = (uint64_t)buf.buffer;
+                    e0 = err_count; r = hd_vulkan_record_depth(h, c.cb, &bad);
+                    CHECK(r == HD_ERROR_INVALID_PARAMETER && err_count == e0 + 1);
+                    bad = dep; bad.image = 0; bad.buffer = (uint64_t)buf.buffer; bad.offset = 64; bad.buffer_size = sizeof vals;
+                    e0 = err_count; r = hd_vulkan_record_depth(h, c.cb, &bad);
+                    CHECK(r == HD_ERROR_BUFFER_TOO_SMALL && err_count == e0 + 1);
+                    e0 = err_count; r = hd_vulkan_record_depth(h, NULL, &dep);
+                    CHECK(r == HD_ERROR_NULL_POINTER && err_count == e0 + 1);
+                }
+            }
+            ok &= hd_vulkan_record_depth(h, c.cb, &dep) == HD_SUCCESS;
+        }
+        ok &= hd_vulkan_record_render(h, c.cb, NULL, NULL) == HD_SUCCESS;
+        ok &= cmd_submit(be, &c, 1);
+    }
+    ok &= hd_read_image_f32(h, img, (size_t)DW * DH * 4) == HD_SUCCESS;
+    vk_free(be, &buf);
+    vk_free(be, &im);
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    return ok;
+}
+static void test_record_depth(void)
+{
+    static float img[4][DW * DH * 4];
+    int mode, ok = 1, same, differs;
+    messages = 0;
+    for (mode = 0; mode < 4; ++mode) ok &= depth_frames(mode, img[mode]);
+    same = memcmp(img[1], img[2], sizeof img[1]) == 0 && memcmp(img[1], img[3], sizeof img[1]) == 0;
+    differs = memcmp(img[0], img[1], sizeof img[0]) != 0;
+    { /* a look-at camera cannot take it */
+        hd_desc d = test_desc();
+        hd_context h;
+        hd_vulkan_depth dep = HD_VULKAN_DEPTH_INIT;
+        unsigned long e0;
+        dep.buffer = 1; dep.buffer_size = (uint64_t)DW * DH * 4;
+        CHECK(hd_create(&d, &h) == HD_SUCCESS);
+        e0 = err_count;
+        CHECK(hd_vulkan_record_depth(h, (void *)&dep, &dep) == HD_ERROR_DEPTH_NEEDS_PROJECTION && err_count == e0 + 1);
+        CHECK(hd_destroy(h) == HD_SUCCESS);
+    }
+    CHECK(ok && same && differs && messages == 0);
+    printf("%s depth from the caller's VkBuffer and D32_SFLOAT image inside its command buffer: %s hd_set_depth's image%s; "
+           "refusals one error each; %lu validation messages\n",
+           ok && same && differs && messages == 0 ? "PASS" : "FAIL", same ? "bit for bit" : "NOT", differs ? "" : " (no effect!)", messages);
+}
+
 /* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
    contiguous run of the dispatch's blocks, as a thread pool of T threads splits them, draws about
    a quarter of its blocks from each quarter of the image (blocks in order would give one run the
@@ -1200,6 +1355,7 @@ int main(void)
             test_record_auto_scale();
             test_output_target();
             test_record_converged();
+            test_record_depth();
         }
     }
     if (failures) printf("FAILED\n");
