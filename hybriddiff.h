@@ -549,7 +549,8 @@ typedef struct hd_volume_update {
 /* ---- outputs --------------------------------------------------------------------------------- */
 typedef struct hd_stats {
     hd_method method;
-    uint64_t iterations;      /* iterations of the current method since its state was reset */
+    uint64_t iterations;      /* iterations of the current method since its state was reset
+                                 (complete ones: see light_progress) */
     uint64_t frames;          /* frames accumulated into the current image */
     size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
                                  (illumination grids, the projection's summed light E + phi and
@@ -572,6 +573,9 @@ typedef struct hd_stats {
                                  1 for full-resolution frames and for the path tracers */
     uint64_t refine_paths;    /* paths per pixel a resting view's refinement (HD_REST_REFINE) has
                                  added to the current image; 0 while it shows HD's frames */
+    double light_progress;    /* HD, CD: the part done of a light iteration that render_budget has
+                                 split over hd_render calls, in [0, 1): the direct stage is the
+                                 first half, the diffusion sweeps the second; 0 between iterations */
 } hd_stats;
 
 typedef struct hd_context {

@@ -47,10 +47,11 @@ struct hd__backend {
     int light;               /* the light of the convection / sum pass being run */
     /* the projection's own inputs (hd__cpu_project_prepare): E + phi summed in the API's
        x-fastest layout, valid while lsum_ok, and the TF table for the current step, rebuilt
-       when its inputs change (ptab_key). lsum_ok is cleared by the clears, the test hook's writes and the first pass
-       of every light iteration (direct or the lights' sum), which precedes its diffusion */
+       when its inputs change (ptab_key). lsum_ok is cleared by the clears, the test hook's writes and every pass
+       that writes E or phi (a frame may come between the parts of a split light iteration) */
     float *lsum, *ptab;
     int lsum_ok, ptab_cap, ptab_n;
+    size_t dl_first, dl_end; /* hd__be_direct's range of the list, [dl_first, dl_end) */
     hd__ptab_key ptab_key;
 };
 
@@ -378,8 +379,8 @@ static void hd__cpu_classify_row(hd__backend *be, int r)
 static void hd__cpu_direct_chunk(hd__backend *be, int item)
 {
     const hd__view *vw = be->vw;
-    size_t j = (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
-    if (end > vw->dl_count) end = vw->dl_count;
+    size_t j = be->dl_first + (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
+    if (end > be->dl_end) end = be->dl_end;
     for (; j < end; ++j) hdk_direct_index(&be->k, (int)vw->dl_idx[j]);
 }
 /* ---- diffusion -------------------------------------------------------------------------------
@@ -1008,10 +1009,11 @@ static hd_result hd__be_classify(const hd__view *vw)
     hd__cpu_parallel(vw->be, hd__cpu_classify_row, vw->gdims[1] * vw->gdims[2]);
     return HD_SUCCESS;
 }
-static hd_result hd__be_direct(const hd__view *vw)
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t n)
 {
-    size_t n = vw->dl_count;
     vw->be->lsum_ok = 0;
+    vw->be->dl_first = first;
+    vw->be->dl_end = first + n;
     hd__cpu_parallel(vw->be, hd__cpu_direct_chunk, (int)((n + HD__CPU_DIRECT_CHUNK - 1) / HD__CPU_DIRECT_CHUNK));
     return HD_SUCCESS;
 }

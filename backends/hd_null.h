@@ -118,7 +118,12 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 }
 
 static hd_result hd__be_classify(const hd__view *vw) { hd__null_call(vw, HD__NULL_classify); return HD_SUCCESS; }
-static hd_result hd__be_direct(const hd__view *vw) { hd__null_call(vw, HD__NULL_direct); return HD_SUCCESS; }
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count)
+{
+    hd__null_call(vw, HD__NULL_direct);
+    if (first > vw->dl_count || count > vw->dl_count - first) vw->be->misuse = 1; /* past the list */
+    return HD_SUCCESS;
+}
 static hd_result hd__be_direct_list(const hd__view *vw) { hd__null_call(vw, HD__NULL_direct_list); return HD_SUCCESS; }
 static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
 {

@@ -666,14 +666,16 @@ static hd_result hd__be_direct_list(const hd__view *vw)
     return hd__cl_buffer(vw, &vw->be->dl, vw->dl_count * sizeof(uint32_t), vw->dl_idx, "the direct light's list");
 }
 
-static hd_result hd__be_direct(const hd__view *vw)
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t n)
 {
     hd_result r;
     int k = hd__cl_k(vw, HD__CL_DIRECT);
-    cl_int count = (cl_int)vw->dl_count;
+    cl_int count = (cl_int)n, from = (cl_int)first;
     vw->be->gg.lsum_ok = 0;
+    if (n == 0) return HD_SUCCESS;
     HD__CL_ARG(vw, k, 10, count);
-    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(vw, k, 1, vw->dl_count, 1, 1)) != HD_SUCCESS)
+    HD__CL_ARG(vw, k, 11, from);
+    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_bind_run(vw, k, 1, n, 1, 1)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);
 }

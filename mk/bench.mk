@@ -101,3 +101,26 @@ eval-refine: $(B)/hdbench_refine
 	@test -f data/head.nrrd || scripts/fetch-data
 	@for tf in ct-skin ct-bone; do for w in "" --warm; do \
 	    $(B)/hdbench_refine --tf $$tf $$w --csv $(B)/refine-$$tf$$w.csv $(REFINE_ARGS) || exit 1; done; done
+
+# make bench-budget: bench/hdbench_budget.c on every backend: the head CT orbit (200 frames,
+# HD_RENDER_SCALE_AUTO, the light cold at the start) at 1280x720 and 1920x1080 under rising
+# render_budgets: hd_render's p50 / p99 / max and the frames over each budget, and the smallest
+# budget with none over (docs/PERFORMANCE.md, "A budget that holds"). BUDGET_ARGS are added to
+# each run; BUDGET_BACKENDS picks the GPU backends.
+.PHONY: bench-budget
+BUDGET_SRC := bench/hdbench_budget.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_tonemap.h $(LIB_SRC)
+BUDGET_CC = $(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+$(B)/hdbench_budget: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_CPU
+$(B)/hdbench_budget_opencl: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_OPENCL -lOpenCL
+$(B)/hdbench_budget_vulkan: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_VULKAN -lvulkan
+$(B)/hdbench_budget_gl: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_GL -lEGL
+BUDGET_ARGS ?=
+BUDGET_BACKENDS ?= opencl vulkan gl
+bench-budget: $(B)/hdbench_budget $(patsubst %,$(B)/hdbench_budget_%,$(BUDGET_BACKENDS))
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdbench_budget $(BUDGET_ARGS)
+	@for b in $(BUDGET_BACKENDS); do echo "== $$b"; $(B)/hdbench_budget_$$b $(BUDGET_ARGS) || exit 1; done

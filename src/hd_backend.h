@@ -111,8 +111,11 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what);
    (vw->sig_gen) for the solvers' coarse grids. */
 static hd_result hd__be_classify(const hd__view *vw);
 /* HD: one Monte Carlo sample of the direct light into E's running mean (hd_k_direct.h) at each of
-   the vw->dl_count grid voxels listed in vw->dl_idx; E elsewhere is left as it is (0). */
-static hd_result hd__be_direct(const hd__view *vw);
+   the grid voxels listed in vw->dl_idx[first, first + count) (first + count <= vw->dl_count; the
+   core splits a light iteration's list over hd_render calls under render_budget); E elsewhere
+   is left as it is. A voxel's sample depends on vw->kp and the voxel alone, so the ranges of one
+   iteration give the bits of one call over the whole list. */
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count);
 /* HD: vw->dl_idx (vw->dl_count grid indices, in bricks) changed with sigma_t: make it the list
    hd__be_direct reads (a GPU backend uploads it). */
 static hd_result hd__be_direct_list(const hd__view *vw);
