@@ -998,10 +998,29 @@ static HD__CPU_FLATTEN void hd__cpu_project_row(hd__backend *be, int py)
 }
 
 /* A row of a reduced frame's upsample pass. */
+/* A row of the upsample pass: hdk_upsample_pixel's operations in its order (the same bits), the
+   row's source rows and weight computed once (a frame at 1280x720 upsamples 0.9 M pixels, the
+   largest part of a reduced frame's time). */
 static void hd__cpu_upsample_row(hd__backend *be, int py)
 {
-    int px, w = be->vw->kp.image.x;
-    for (px = 0; px < w; ++px) hdk_upsample_pixel(&be->k, px, py);
+    const hd__view *vw = be->vw;
+    int w = vw->kp.image.x, h = vw->kp.image.y, s = vw->kp.region.y, px, k;
+    int lw = (w + s - 1) / s, lh = (h + s - 1) / s;
+    float fy = hdk_clampf(((float)py + 0.5f) * (float)lh / (float)h - 0.5f, 0.0f, (float)(lh - 1));
+    int y0 = hdk_mini((int)fy, lh - 1), y1 = hdk_mini(y0 + 1, lh - 1);
+    float wy = fy - (float)y0;
+    const float *r0 = be->img + ((size_t)w * h + (size_t)y0 * lw) * 4, *r1 = be->img + ((size_t)w * h + (size_t)y1 * lw) * 4;
+    float *o = be->img + (size_t)py * w * 4;
+    for (px = 0; px < w; ++px) {
+        float fx = hdk_clampf(((float)px + 0.5f) * (float)lw / (float)w - 0.5f, 0.0f, (float)(lw - 1));
+        int x0 = hdk_mini((int)fx, lw - 1), x1 = hdk_mini(x0 + 1, lw - 1);
+        float wx = fx - (float)x0;
+        for (k = 0; k < 4; ++k) {
+            float top = r0[x0 * 4 + k] + wx * (r0[x1 * 4 + k] - r0[x0 * 4 + k]);
+            float bot = r1[x0 * 4 + k] + wx * (r1[x1 * 4 + k] - r1[x0 * 4 + k]);
+            o[px * 4 + k] = top + wy * (bot - top);
+        }
+    }
 }
 
 static hd_result hd__be_classify(const hd__view *vw)

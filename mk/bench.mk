@@ -62,18 +62,33 @@ bench-orbit: $(B)/hdbench_orbit $(patsubst %,$(B)/hdbench_orbit_%,$(ORBIT_BACKEN
 	@for b in $(ORBIT_BACKENDS); do echo "== $$b"; $(B)/hdbench_orbit_$$b --no-psnr $(ORBIT_ARGS) || exit 1; done
 
 # make bench-animated: bench/hdbench_animated.c on the CPU backend: a procedural smoke puff at
-# 64^3 and 128^3 (300 frames, camera orbiting, 512^2): hd_update_volume per frame against
-# destroy + create, and the lag (PSNR against each frame's converged light); then the TF slider
-# on the head CT, warm against cold (hd_reset). ANIMATED_ARGS are added to each run.
+# 64^3 and 128^3 (300 frames, camera orbiting, 512^2) under render_budget 2, 4, 8, 16 and 50 ms:
+# hd_update_volume per frame (p50 / p99, frames over the budget) against destroy + create, and
+# the lag (PSNR against each frame's converged light); then the TF slider on the head CT, warm
+# against cold (hd_reset). Per-frame rows go to $(B)/animated.csv; scripts/plot-animated draws
+# docs/animated/*.png from it (gnuplot). ANIMATED_ARGS are added to each run (e.g.
+# --frames 60); ANIMATED_BACKENDS="gl vulkan" runs the puffs on those backends too.
 .PHONY: bench-animated
+ANIMATED_CC = $(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 $(B)/hdbench_animated: bench/hdbench_animated.c $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+	$(ANIMATED_CC)
+$(B)/hdbench_animated_opencl: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_OPENCL -lOpenCL
+$(B)/hdbench_animated_vulkan: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_VULKAN -lvulkan
+$(B)/hdbench_animated_gl: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_GL -lEGL
 ANIMATED_ARGS ?=
-bench-animated: $(B)/hdbench_animated
+ANIMATED_BACKENDS ?=
+ANIMATED_BUDGETS ?= 2,4,8,16,50
+bench-animated: $(B)/hdbench_animated $(patsubst %,$(B)/hdbench_animated_%,$(ANIMATED_BACKENDS))
 	@test -f data/head.nrrd || scripts/fetch-data
-	$(B)/hdbench_animated --dims 64 --no-tf $(ANIMATED_ARGS)
-	$(B)/hdbench_animated --dims 128 --no-tf $(ANIMATED_ARGS)
-	$(B)/hdbench_animated --no-puff $(ANIMATED_ARGS)
+	rm -f $(B)/animated.csv
+	@for b in cpu $(ANIMATED_BACKENDS); do \
+	    x=$(B)/hdbench_animated; [ $$b = cpu ] || x=$(B)/hdbench_animated_$$b; \
+	    for s in 64 128; do $$x --dims $$s --no-tf --budget $(ANIMATED_BUDGETS) --csv $(B)/animated.csv $(ANIMATED_ARGS) || exit 1; done; \
+	done
+	$(B)/hdbench_animated --no-puff --csv $(B)/animated.csv $(ANIMATED_ARGS)
 
 # bench/hdbench_guard.c: the per-context in-call guard's cost, the library built with it and
 # without it (HD__NO_CALL_GUARD) in one program: ns per hd_get_stats and per hd_render
