@@ -1036,6 +1036,12 @@ static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t n)
     hd__cpu_parallel(vw->be, hd__cpu_direct_chunk, (int)((n + HD__CPU_DIRECT_CHUNK - 1) / HD__CPU_DIRECT_CHUNK));
     return HD_SUCCESS;
 }
+/* Every pass has run when its hd__cpu_parallel returns. */
+static hd_result hd__be_wait(const hd__view *vw)
+{
+    (void)vw;
+    return HD_SUCCESS;
+}
 /* The list of voxels to track lives in the context (vw->dl_idx): nothing to upload. */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {

@@ -913,6 +913,12 @@ static hd_result hd__be_upload_depth(const hd__view *vw)
                               "the depth buffer");
 }
 
+static hd_result hd__be_wait(const hd__view *vw)
+{
+    vw->be->gl.Finish();
+    return hd__gl_check(vw, "glFinish", __LINE__);
+}
+
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {

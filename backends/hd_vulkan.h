@@ -1659,6 +1659,9 @@ static hd_result hd__be_direct_list(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* Every stage is submitted and waited for as it is enqueued (hd__vk_flush), outside a recording. */
+static hd_result hd__be_wait(const hd__view *vw) { return hd__vk_flush(vw); }
+
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
    groups along x are limited to maxComputeWorkGroupCount, at least 65535). */
 #define HD__DIRECT_ROW ((int)HD__VK_LOCAL_X * 32768)

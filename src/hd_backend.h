@@ -138,6 +138,10 @@ static hd_result hd__be_upsample(const hd__view *vw);
 /* PT_SS / PT_MS: one path per pixel into the image's running mean (hd_k_path.h). */
 static hd_result hd__be_path(const hd__view *vw);
 
+/* Waits until the device has run every primitive enqueued so far: hd_render under render_budget
+   times each piece of light work and its frame by the wall clock after it. */
+static hd_result hd__be_wait(const hd__view *vw);
+
 /* ---- read-back (blocking: every earlier primitive's result) ------------------------------------ */
 /* The image as RGBA floats, vw->camera.width x height, rows top to bottom. */
 static hd_result hd__be_read_image(const hd__view *vw, float *dst);

@@ -69,6 +69,9 @@ typedef struct hd__part {
     int open;            /* an iteration is in progress: its counters have advanced */
     size_t dl;           /* its direct stage's units done: HD's list entries, CD's 1 when done */
     int sweeps;          /* its diffusion sweeps done (multigrid: steps) */
+    uint64_t dropped;    /* iterations a change ended before their last part (not counted as
+                            complete by hd_stats; the counter, the random numbers' key, runs on) */
+    size_t last_dl;      /* the last direct piece's units (the next is at most twice as long) */
     double s_entry;      /* seconds per direct unit, smoothed; 0: none measured yet */
     double s_sweep;      /* seconds per sweep */
     double s_measure;    /* seconds of the convergence estimate */

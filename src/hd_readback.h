@@ -203,9 +203,9 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_get_stats: out_stats is NULL");
     memset(out, 0, sizeof *out);
     gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
-    open = ctx->part.open && !(ctx->dirty & HD__PART_ENDS); /* a change ends it: it counts as done */
+    open = ctx->part.open && !(ctx->dirty & HD__PART_ENDS); /* a change ends it (hd__prepare) */
     out->method = ctx->vw.params.method;
-    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations - (open ? 1u : 0u);
+    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations - ctx->part.dropped - (ctx->part.open ? 1u : 0u);
     if (hd__method_is_pt(ctx->vw.params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;

@@ -67,10 +67,13 @@ static hd_result hd__prepare(hd__ctx *ctx)
         if ((r = hd__be_upload_depth(&ctx->vw)) != HD_SUCCESS) return r;
         ctx->dirty &= ~(unsigned)HD__DIRTY_DEPTH;
     }
-    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = 0;
+    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = ctx->part.dropped = 0;
     /* a change of the light's inputs ends a split light iteration where it is (its voxels not yet
        sampled keep their mean; the counters stay, so the random numbers are never reused) */
-    if (dirty & HD__PART_ENDS) hd__part_end(ctx);
+    if (dirty & HD__PART_ENDS) {
+        if (ctx->part.open && !(dirty & HD__DIRTY_DIRECT)) ctx->part.dropped++;
+        hd__part_end(ctx);
+    }
     /* a warm start: E's mean keeps at most light_window samples of the light before the change
        (the iteration count, the random numbers' key, runs on) */
     if ((dirty & HD__DIRTY_WARM_E) && ctx->dl_n > (uint64_t)ctx->vw.params.light_window) ctx->dl_n = (uint64_t)ctx->vw.params.light_window;
@@ -248,12 +251,14 @@ static size_t hd__part_fit(double left, double rate, size_t remaining, size_t le
     return (size_t)n;
 }
 
-/* A unit cost measured over n units: the smoothed estimate moves halfway to it. */
+/* A unit cost measured over n units: a dearer one is taken at once, a cheaper one moves the
+   estimate halfway to it (the direct light's cost per entry varies several times along the list,
+   with the medium's density: the estimate errs on the dear side). */
 static void hd__part_rate(double *rate, double seconds, size_t n)
 {
     double r = seconds / (double)(n ? n : 1);
     if (!(r > 0.0)) return;
-    *rate = *rate > 0.0 ? 0.5 * (*rate + r) : r;
+    *rate = *rate > 0.0 && r < *rate ? 0.5 * (*rate + r) : r;
 }
 
 static void hd__light_settled(hd__ctx *ctx, int before);
@@ -278,9 +283,12 @@ static hd_result hd__light_budget(hd__ctx *ctx, double deadline)
             k = hd__part_fit(left, ctx->part.s_entry, nd - ctx->part.dl, least);
             if (k == 0 && pieces > 0) return HD_SUCCESS;
             if (k == 0) k = least < nd - ctx->part.dl ? least : nd - ctx->part.dl;
+            /* a piece at most twice the last one: the next stretch of the list may cost more */
+            if (ctx->part.last_dl > 0 && k > 2 * ctx->part.last_dl && k > least) k = 2 * ctx->part.last_dl > least ? 2 * ctx->part.last_dl : least;
+            ctx->part.last_dl = k;
             if (!ctx->part.open) hd__light_open(ctx);
             t0 = hd__now();
-            if ((r = hd__direct_part(ctx, k)) != HD_SUCCESS) {
+            if ((r = hd__direct_part(ctx, k)) != HD_SUCCESS || (r = hd__be_wait(&ctx->vw)) != HD_SUCCESS) {
                 hd__part_end(ctx);
                 return r;
             }
@@ -293,7 +301,7 @@ static hd_result hd__light_budget(hd__ctx *ctx, double deadline)
             if (k == 0) k = 1;
             if (!ctx->part.open) hd__light_open(ctx);
             t0 = hd__now();
-            if ((r = hd__sweeps_part(ctx, (int)k)) != HD_SUCCESS) {
+            if ((r = hd__sweeps_part(ctx, (int)k)) != HD_SUCCESS || (r = hd__be_wait(&ctx->vw)) != HD_SUCCESS) {
                 hd__part_end(ctx);
                 return r;
             }
@@ -345,6 +353,8 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     } else {
         r = hd__be_project(&ctx->vw);
     }
+    /* under a budget the frame's time is the device's, not its enqueueing's */
+    if (r == HD_SUCCESS && ctx->vw.params.render_budget > 0.0f && !ctx->no_measure) r = hd__be_wait(&ctx->vw);
     t2 = hd__now();
     ctx->seconds[2] += t2 - t0;
     /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
