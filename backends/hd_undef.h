@@ -83,6 +83,7 @@
 #undef HD__BUDGET_MARGIN
 #undef HD__CLE
 #undef HD__CL_ARG
+#undef HD__CL_DIRECT_LOCAL
 #undef HD__CL_LOST_CHECK
 #undef HD__CL_PROJECT_GROUP_X
 #undef HD__CL_PROJECT_GROUP_Y
