@@ -77,6 +77,7 @@ help:
 	@echo "  make bench-multigrid                time to a 1e-4 residual: red-black sweeps against multigrid CG"
 	@echo "  make bench-project                  projection frame time per backend, this tree against PROJECT_BASE"
 	@echo "  make bench-orbit                    orbit frames per backend and PSNR per time budget (docs/orbit/)"
+	@echo "  make bench-budget                   the smallest render_budget each backend holds on a 1280x720 / 1080p orbit"
 	@echo "  make bench-peer                     one orbit frame against VTK's ray casters (needs pvpython; docs/peer/)"
 	@echo "  make eval                           the reduced evaluation of the paper's claims (docs/eval/, ~15 min)"
 	@echo "  make eval-paper                     the evaluation at the paper's scale (out/eval-paper)"

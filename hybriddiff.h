@@ -469,16 +469,27 @@ typedef struct hd_params {
                                iterations in a row: 0 -> 0.1 (head CT: 10-20 iterations, the
                                image within about 43 dB of one with 8x as many: the projection
                                averages many voxels; docs/DESIGN-RENDER.md); finite and >= 0 */
-    float render_budget;    /* seconds one hd_render call may spend refining light that has not
-                               converged (or tracing paths), before it projects its frame: 0 -> one
-                               light iteration per call; in [0, 10], so every call ends */
+    float render_budget;    /* seconds one hd_render call may take, light work and frame together,
+                               counted from the call's start: 0 -> one whole light iteration per
+                               call, then the frame. HD, CD: the call predicts its frame's time
+                               (the frame cost model of HD_RENDER_SCALE_AUTO; half the budget
+                               before a frame is measured) and fills the rest, less a tenth for
+                               its own overhead, with pieces of light iterations: the direct light
+                               over part of its voxel list, then some diffusion sweeps, each
+                               sized from the measured cost of the last ones; an iteration split
+                               so over calls gives the light of a whole one (the convergence
+                               estimate follows complete iterations; hd_stats.light_progress says
+                               how far the one in progress is). Each call runs at least one piece
+                               (about 1/256 of the list, or one sweep), so the light always
+                               advances, and a volume update's upload and reclassification are
+                               not split. PT_SS, PT_MS: paths while the next fits. In [0, 10] */
     float crop_min[3];      /* the crop box's low corner in box coordinates: 0 at the volume's
                                low face, 1 at its high face, per axis x, y, z; default 0 */
     float crop_max[3];      /* its high corner, 0 -> 1 per axis, so zeroed params crop nothing.
                                Matter outside [crop_min, crop_max] is absent for every method
                                and stage: it casts no shadow, scatters nothing and is not
                                drawn. Per axis 0 <= min < max <= 1, finite */
-    int render_scale;       /* projection frames at 1/s of the camera's resolution per axis: s = 1..8
+    int render_scale;       /* projection frames at 1/s of the camera's resolution per axis: s = 1..16
                                marches ceil(width / s) x ceil(height / s) rays and fills the full
                                image by a bilinear upsample on the device (the image read back stays
                                width x height); 0 -> 1. HD_RENDER_SCALE_AUTO: each new image (camera
@@ -487,8 +498,11 @@ typedef struct hd_params {
                                accumulate as usual (a moving camera gets cheap frames, a still one
                                converges to the full image). The first scale is the smallest power
                                of two whose predicted frame time (a + b * pixels, fitted to the
-                               frames this context has measured at each scale) fits render_budget,
-                               8 if none does, or 4 while render_budget is 0 or nothing is measured.
+                               frames this context has measured at each scale) fits the frame's
+                               share of render_budget (all of it once the light has converged,
+                               half before), 16 if none does, or 4 while render_budget is 0 or
+                               nothing is measured; under a budget the resolution doubles only
+                               while the finer frame's predicted time fits that share.
                                A change of scale restarts the running mean. The first frame at a
                                scale > 1 adds a quarter of the image's memory for the reduced
                                frames (hd_stats.image_bytes); where that fails, the call returns
@@ -575,7 +589,8 @@ typedef struct hd_volume_update {
 /* ---- outputs --------------------------------------------------------------------------------- */
 typedef struct hd_stats {
     hd_method method;
-    uint64_t iterations;      /* iterations of the current method since its state was reset */
+    uint64_t iterations;      /* iterations of the current method since its state was reset
+                                 (complete ones: see light_progress) */
     uint64_t frames;          /* frames accumulated into the current image */
     size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
                                  (illumination grids, the projection's summed light E + phi and
@@ -598,6 +613,9 @@ typedef struct hd_stats {
                                  1 for full-resolution frames and for the path tracers */
     uint64_t refine_paths;    /* paths per pixel a resting view's refinement (HD_REST_REFINE) has
                                  added to the current image; 0 while it shows HD's frames */
+    double light_progress;    /* HD, CD: the part done of a light iteration that render_budget has
+                                 split over hd_render calls, in [0, 1): the direct stage is the
+                                 first half, the diffusion sweeps the second; 0 between iterations */
 } hd_stats;
 
 typedef struct hd_context {
@@ -724,13 +742,15 @@ HDDEF hd_result hd_iterate(hd_context ctx, int n);
 
 /* n >= 1 light iterations (HD: direct light and diffusion; CD: convection and diffusion) with no
    projection: the image is left as it was. For a single view, refine until
-   hd_stats.light_converged, then project with hd_render. The path tracers have no light to
-   refine: HD_ERROR_UNSUPPORTED. */
+   hd_stats.light_converged, then project with hd_render. A light iteration that render_budget
+   split over hd_render calls is finished first, as the first of the n (so is hd_iterate's).
+   The path tracers have no light to refine: HD_ERROR_UNSUPPORTED. */
 HDDEF hd_result hd_refine(hd_context ctx, int n);
 
 /* One frame for a per-frame loop: call it once per displayed frame.
-     HD, CD: while the light has not converged, one light iteration (or as many as
-             params.render_budget seconds allow), then one projection frame from the current E
+     HD, CD: while the light has not converged, one light iteration (under
+             params.render_budget: the pieces of light iterations that fit it), then one
+             projection frame from the current E
              and phi into the image's running mean. Once the light has converged, no light work:
              the projection alone, and when the frame_window frames since the convergence are in
              the image (it is done), nothing at all until a setter invalidates something; with

@@ -24,16 +24,17 @@ __kernel void hd_k_classify(HD__CL_BUFFERS)
 }
 
 /* One work-item per entry of the list of voxels whose E is read (hd__direct_mask), count
-   entries: tracking cost varies per voxel, so fine-grained items balance. */
+   entries from entry first: tracking cost varies per voxel, so fine-grained items balance. */
 /* Each stage that touches E or phi has a twin with a _half suffix whose k.f16 is the literal 1:
    binary16 storage (params.illumination_precision), float32 arithmetic. */
 #define HD__CL_DIRECT(name, is16) \
-    __kernel void name(HD__CL_BUFFERS, __global const uint *restrict list, int count, __global const float *restrict env) \
+    __kernel void name(HD__CL_BUFFERS, __global const uint *restrict list, int count, int first, \
+                       __global const float *restrict env) \
     { \
         HD__CL_KCTX; \
         k.f16 = (is16); \
         k.env = env; \
-        if ((int)get_global_id(0) < count) hdk_direct_index(&k, (int)list[get_global_id(0)]); \
+        if ((int)get_global_id(0) < count) hdk_direct_index(&k, (int)list[first + (int)get_global_id(0)]); \
     }
 HD__CL_DIRECT(hd_k_direct, 0)
 HD__CL_DIRECT(hd_k_direct_half, 1)

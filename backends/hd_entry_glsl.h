@@ -135,9 +135,10 @@ void main()
 #if HD_STAGE == HD_STAGE_CLASSIFY
     if (x < g.x && y < g.y && z < g.z) hdk_classify_voxel(x, y, z);
 #elif HD_STAGE == HD_STAGE_DIRECT
-    /* over the list of voxels whose E is read, hd_pc.x entries, in rows of the dispatch's width */
+    /* over the list of voxels whose E is read, hd_pc.x entries from entry hd_pc.y, in rows of the
+       dispatch's width */
     int j = x + y * int(gl_NumWorkGroups.x * gl_WorkGroupSize.x);
-    if (j < hd_pc.x) hdk_direct_index(int(dl[j]));
+    if (j < hd_pc.x) hdk_direct_index(int(dl[hd_pc.y + j]));
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hdk_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT

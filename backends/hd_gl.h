@@ -928,6 +928,12 @@ static hd_result hd__be_upload_env(const hd__view *vw)
     return hd__gl_buffer_data(vw, &vw->be->env, vw->env_floats * sizeof(float), vw->env, GL_STATIC_DRAW, "the environment's tables");
 }
 
+static hd_result hd__be_wait(const hd__view *vw)
+{
+    vw->be->gl.Finish();
+    return hd__gl_check(vw, "glFinish", __LINE__);
+}
+
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {
@@ -938,11 +944,12 @@ static hd_result hd__be_direct_list(const hd__view *vw)
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
    groups along x are limited to 65535). */
 #define HD__DIRECT_ROW (HD__GL_LOCAL_X * 32768)
-static hd_result hd__be_direct(const hd__view *vw)
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count)
 {
-    int n = (int)vw->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    int n = (int)count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
     vw->be->gg.lsum_ok = 0;
-    return hd__gl_dispatch(vw, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, 0, 0, 0);
+    if (n == 0) return HD_SUCCESS;
+    return hd__gl_dispatch(vw, HD__GL_DIRECT, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, (int)first, 0, 0);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one

@@ -13,7 +13,7 @@
     X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_depth) X(record_depth) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
-    X(mg_extrapolate) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
+    X(mg_extrapolate) X(wait) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
 enum {
 #define HD__NULL_X(name) HD__NULL_##name,
     HD__NULL_PRIMITIVES(HD__NULL_X)
@@ -119,8 +119,14 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what)
 }
 
 static hd_result hd__be_classify(const hd__view *vw) { hd__null_call(vw, HD__NULL_classify); return HD_SUCCESS; }
-static hd_result hd__be_direct(const hd__view *vw) { hd__null_call(vw, HD__NULL_direct); return HD_SUCCESS; }
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count)
+{
+    hd__null_call(vw, HD__NULL_direct);
+    if (first > vw->dl_count || count > vw->dl_count - first) vw->be->misuse = 1; /* past the list */
+    return HD_SUCCESS;
+}
 static hd_result hd__be_direct_list(const hd__view *vw) { hd__null_call(vw, HD__NULL_direct_list); return HD_SUCCESS; }
+static hd_result hd__be_wait(const hd__view *vw) { hd__null_call(vw, HD__NULL_wait); return HD_SUCCESS; }
 static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
 {
     (void)jacobi;

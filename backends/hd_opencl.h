@@ -698,6 +698,8 @@ static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t
     return HD_SUCCESS;
 }
 
+static hd_result hd__be_wait(const hd__view *vw) { return hd__cl_finish(vw); }
+
 /* Uploads the direct light's list of voxels (rebuilt with sigma_t). */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {
@@ -705,15 +707,23 @@ static hd_result hd__be_direct_list(const hd__view *vw)
     return hd__cl_buffer(vw, &vw->be->dl, vw->dl_count * sizeof(uint32_t), vw->dl_idx, "the direct light's list");
 }
 
-static hd_result hd__be_direct(const hd__view *vw)
+/* Work-groups of the direct stage: fixed, so a range of any length (render_budget's pieces) runs
+   the kernel PoCL compiled for the first (its own choice follows the global size, and each new
+   choice compiled a new variant: about 0.5 s per call on this machine's PoCL 3.1). */
+#define HD__CL_DIRECT_LOCAL 64
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t n)
 {
     hd_result r;
     int k = hd__cl_k(vw, HD__CL_DIRECT);
-    cl_int count = (cl_int)vw->dl_count;
+    cl_int count = (cl_int)n, from = (cl_int)first;
+    size_t local = HD__CL_DIRECT_LOCAL;
     vw->be->gg.lsum_ok = 0;
+    if (n == 0) return HD_SUCCESS;
     HD__CL_ARG(vw, k, 10, count);
-    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 11, 1, vw->be->env)) != HD_SUCCESS ||
-        (r = hd__cl_bind_run(vw, k, 1, vw->dl_count, 1, 1)) != HD_SUCCESS)
+    HD__CL_ARG(vw, k, 11, from);
+    if ((r = hd__cl_mems(vw, k, 9, 1, vw->be->dl)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 12, 1, vw->be->env)) != HD_SUCCESS ||
+        (r = hd__cl_bind(vw, k)) != HD_SUCCESS ||
+        (r = hd__cl_run_local(vw, k, 1, (n + local - 1) / local * local, 1, 1, &local)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);
 }

@@ -1761,14 +1761,24 @@ static hd_result hd__be_direct_list(const hd__view *vw)
     return HD_SUCCESS;
 }
 
+/* Every stage is submitted and waited for as it is enqueued (hd__vk_flush), outside a recording. */
+static hd_result hd__be_wait(const hd__view *vw) { return hd__vk_flush(vw); }
+
 /* The direct stage over the list, in rows of at most HD__DIRECT_ROW entries (a dispatch's work
    groups along x are limited to maxComputeWorkGroupCount, at least 65535). */
 #define HD__DIRECT_ROW ((int)HD__VK_LOCAL_X * 32768)
-static hd_result hd__be_direct(const hd__view *vw)
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count)
 {
-    int n = (int)vw->dl_count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    VkPipeline pipe;
+    hd_result r;
+    int n = (int)count, rows = (n + HD__DIRECT_ROW - 1) / HD__DIRECT_ROW;
     vw->be->gg.lsum_ok = 0;
-    return hd__vk_stage(vw, HD__VK_DIRECT, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n);
+    if (n == 0) return HD_SUCCESS;
+    if ((r = hd__vk_stage_pipeline(vw, HD__VK_DIRECT, &pipe)) != HD_SUCCESS || (r = hd__vk_begin(vw, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_dispatch(vw, cb, pipe, 0, rows > 1 ? HD__DIRECT_ROW : n, rows, 1, n, (int)first, 0, 0)) != HD_SUCCESS)
+        return r;
+    return hd__vk_flush(vw);
 }
 
 /* One full sweep: two half-sweeps (red, black; half the voxels of each row per dispatch) or one

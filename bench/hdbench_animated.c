@@ -1,22 +1,28 @@
-/* hdbench_animated.c - living volumes on the CPU backend (make bench-animated).
+/* hdbench_animated.c - living volumes (make bench-animated; built for every backend).
    1. A procedural smoke puff (three Gaussian puffs advected along a loop, modulated by
       time-varying value noise) at S^3, F frames, the camera orbiting, 512^2 (--size):
-      per-frame wall time of hd_update_volume + hd_set_camera + hd_render (render_budget --budget
-      seconds) + hd_read_image_rgba8, against hd_destroy + hd_create + hd_render + read (the
-      only way before hd_update_volume; --cold frames of it). The lag: the PSNR of every
-      --every-th frame's image against the same frame's converged light (a fresh context run to
-      convergence, then frame_window frames, same camera).
+      per-frame wall time of hd_update_volume + hd_set_camera + hd_render (render_budget: each
+      of the --budget list, in ms; 0 is one light iteration per frame) + hd_read_image_rgba8,
+      and the frames over the budget, against hd_destroy + hd_create + hd_render + read (the
+      only way before hd_update_volume; --cold frames of it, with the first budget). The lag:
+      the PSNR of every --every-th frame's image against the same frame's converged light (a
+      fresh context run to convergence, then frame_window frames, same camera; made once for
+      all budgets). --csv appends one row per frame: backend, S, size, budget ms, frame, ms,
+      PSNR (-1 where not measured); and per slider step: "slider", warm or cold, step, mean.
    2. The TF slider on the head CT (data/head.nrrd): the opacity scale moves one way over 61
       steps, one hd_render per step; the brightness (mean of the 8-bit image) should follow
       monotonically: trend reversals are counted; then the renders until hd_stats.light_converged
       after the last step. Run warm (the library's setters) and cold (hd_reset after each step:
       the old behaviour).
-   --scale N|auto sets params.render_scale of the timed frames (both ways; the reference renders
-   full frames).
+   --scale N|auto sets params.render_scale of the timed frames under a budget (default auto; both
+   ways; the reference renders full frames).
    Usage: hdbench_animated [--dims S] [--frames F] [--cold C] [--every K] [--size P]
-                           [--budget s] [--scale N|auto] [--no-puff] [--no-tf] [--head path] */
+                           [--budget ms[,ms...]] [--scale N|auto] [--csv path] [--no-puff]
+                           [--no-tf] [--head path] */
 #define HYBRIDDIFF_IMPLEMENTATION
+#if !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
 #define HYBRIDDIFF_BACKEND_CPU
+#endif
 #include "hybriddiff.h"
 #include <math.h>
 #include <stdio.h>
@@ -97,7 +103,7 @@ static hd_camera orbit(int frame, int frames, int size)
     return c;
 }
 
-static int render_scale; /* --scale: params.render_scale of the timed frames (0: full frames) */
+static int render_scale = HD_RENDER_SCALE_AUTO; /* --scale: params.render_scale of the timed frames */
 
 static hd_desc puff_desc(const float *vol, int s, int size, float budget)
 {
@@ -159,14 +165,35 @@ static void reference(const float *vol, int s, int size, const hd_camera *cam, u
     hd_destroy(c);
 }
 
-static void bench_puff(int s, int frames, int cold, int every, int size, float budget)
+/* The converged images of the frames the lag is measured at (f % every == every - 1), made once
+   and shared by every budget's run. */
+typedef struct refs {
+    int every, count;
+    uint8_t **img;
+} refs;
+
+static const uint8_t *ref_of(refs *rf, const float *vol, int s, int size, int f, const hd_camera *cam)
+{
+    int k = f / rf->every;
+    if (!rf->img[k]) {
+        rf->img[k] = (uint8_t *)malloc((size_t)size * size * 4);
+        reference(vol, s, size, cam, rf->img[k]);
+    }
+    return rf->img[k];
+}
+
+static FILE *csv; /* --csv: one row per timed frame */
+
+/* hd_update_volume per frame under a budget of `budget` seconds: frame time p50 / p99, the frames
+   over the budget, the lag against the converged light; with cold > 0 first destroy + create. */
+static void bench_puff(int s, int frames, int cold, refs *rf, int size, float budget)
 {
     size_t nv = (size_t)s * s * s, np = (size_t)size * size * 4;
     float *vol = (float *)malloc(nv * sizeof(float));
-    uint8_t *img = (uint8_t *)malloc(np), *ref = (uint8_t *)malloc(np);
+    uint8_t *img = (uint8_t *)malloc(np);
     double *tw = (double *)malloc(sizeof(double) * (size_t)frames), *tc = (double *)malloc(sizeof(double) * (size_t)(cold > 0 ? cold : 1));
     double psum = 0.0, pmin = 1e9, t0;
-    int f, np_ = 0;
+    int f, np_ = 0, over = 0;
     hd_context c;
     hd_desc d;
     hd_result r;
@@ -184,15 +211,18 @@ static void bench_puff(int s, int frames, int cold, int every, int size, float b
         hd_destroy(c);
         tc[f] = now() - t0;
     }
-    /* one context, hd_update_volume per frame */
+    /* one context, hd_update_volume per frame; its set-up call (upload, classification, mask)
+       before the first timed frame */
     puff(vol, s, 0, frames);
     d = puff_desc(vol, s, size, budget);
     if ((r = hd_create(&d, &c)) != HD_SUCCESS) die("hd_create", r);
+    if ((r = hd_render(c)) != HD_SUCCESS) die("hd_render (set-up)", r);
     u.type = HD_VOXEL_F32;
     u.dims[0] = u.dims[1] = u.dims[2] = s;
     u.data = vol;
     for (f = 0; f < frames; ++f) {
         hd_camera cam = orbit(f, frames, size);
+        double p = -1.0;
         puff(vol, s, f, frames); /* the simulation's step: not timed */
         t0 = now();
         if ((r = hd_update_volume(c, &u)) != HD_SUCCESS) die("hd_update_volume", r);
@@ -200,23 +230,23 @@ static void bench_puff(int s, int frames, int cold, int every, int size, float b
         if ((r = hd_render(c)) != HD_SUCCESS) die("hd_render", r);
         if ((r = hd_read_image_rgba8(c, img, np)) != HD_SUCCESS) die("read", r);
         tw[f] = now() - t0;
-        if (every > 0 && f % every == every - 1) {
-            double p;
-            reference(vol, s, size, &cam, ref);
-            p = psnr8(img, ref, np);
+        if (budget > 0.0f && tw[f] > budget) ++over;
+        if (rf && f % rf->every == rf->every - 1) {
+            p = psnr8(img, ref_of(rf, vol, s, size, f, &cam), np);
             psum += p;
             if (p < pmin) pmin = p;
             ++np_;
         }
+        if (csv) fprintf(csv, "%s %d %d %.1f %d %.3f %.2f\n", hd_backend_name(), s, size, budget * 1e3, f, tw[f] * 1e3, p);
     }
     hd_destroy(c);
-    printf("puff %d^3, %dx%d, %d frames, render_budget %.0f ms: hd_update_volume frame p50 %.1f ms, p99 %.1f ms",
-           s, size, size, frames, budget * 1e3, 1e3 * pct(tw, frames, 0.5), 1e3 * pct(tw, frames, 0.99));
+    printf("%s puff %d^3, %dx%d, %d frames, render_budget %.0f ms: hd_update_volume frame p50 %.1f ms, p99 %.1f ms, %d over the budget",
+           hd_backend_name(), s, size, size, frames, budget * 1e3, 1e3 * pct(tw, frames, 0.5), 1e3 * pct(tw, frames, 0.99), over);
     if (cold > 0) printf("; destroy + create frame (%d frames) p50 %.1f ms, p99 %.1f ms", cold, 1e3 * pct(tc, cold, 0.5), 1e3 * pct(tc, cold, 0.99));
     if (np_) printf("; lag PSNR against each frame's converged light (%d frames): mean %.1f dB, min %.1f dB", np_, psum / np_, pmin);
     printf("\n");
     fflush(stdout);
-    free(vol); free(img); free(ref); free(tw); free(tc);
+    free(vol); free(img); free(tw); free(tc);
 }
 
 /* ---- the TF slider on the head CT ------------------------------------------------------------------ */
@@ -276,6 +306,7 @@ static void bench_slider(const char *path, int cold)
         if ((r = hd_render(c)) != HD_SUCCESS) die("hd_render", r);
         if ((r = hd_read_image_rgba8(c, img, np)) != HD_SUCCESS) die("read", r);
         m = mean8(img, np);
+        if (csv) fprintf(csv, "slider %s %d %.3f\n", cold ? "cold" : "warm", i, m);
         if (i > 0) {
             dm = m - prev;
             if (fabs(dm) / (prev > 0 ? prev : 1) > maxstep) maxstep = fabs(dm) / (prev > 0 ? prev : 1);
@@ -301,16 +332,19 @@ static void bench_slider(const char *path, int cold)
 
 int main(int argc, char **argv)
 {
-    int s = 64, frames = 300, cold = 20, every = 30, size = 512, puffs = 1, tfs = 1, i;
-    float budget = 0.05f;
-    const char *head = "data/head.nrrd";
+    int s = 64, frames = 300, cold = 20, every = 30, size = 512, puffs = 1, tfs = 1, i, nb = 0;
+    float budgets[16];
+    const char *head = "data/head.nrrd", *list = "50";
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--dims") && i + 1 < argc) s = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--frames") && i + 1 < argc) frames = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--cold") && i + 1 < argc) cold = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--every") && i + 1 < argc) every = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--budget") && i + 1 < argc) budget = (float)atof(argv[++i]);
+        else if (!strcmp(argv[i], "--budget") && i + 1 < argc) list = argv[++i];
+        else if (!strcmp(argv[i], "--csv") && i + 1 < argc) {
+            if (!(csv = fopen(argv[++i], "a"))) { fprintf(stderr, "cannot write %s\n", argv[i]); return 1; }
+        }
         else if (!strcmp(argv[i], "--head") && i + 1 < argc) head = argv[++i];
         else if (!strcmp(argv[i], "--no-puff")) puffs = 0;
         else if (!strcmp(argv[i], "--no-tf")) tfs = 0;
@@ -319,15 +353,33 @@ int main(int argc, char **argv)
             render_scale = !strcmp(argv[i], "auto") ? HD_RENDER_SCALE_AUTO : atoi(argv[i]);
         }
         else {
-            fprintf(stderr, "usage: hdbench_animated [--dims S] [--frames F] [--cold C] [--every K] [--size P] [--budget s] [--no-puff] [--no-tf] [--head path]\n");
+            fprintf(stderr, "usage: hdbench_animated [--dims S] [--frames F] [--cold C] [--every K] [--size P] [--budget ms[,ms...]] "
+                            "[--scale N|auto] [--csv path] [--no-puff] [--no-tf] [--head path]\n");
             return 2;
         }
     }
-    if (s < 8 || frames < 1 || size < 16) return 2;
-    if (puffs) bench_puff(s, frames, cold, every, size, budget);
+    while (*list && nb < 16) { /* --budget ms[,ms...] */
+        char *end;
+        budgets[nb] = (float)(strtod(list, &end) * 1e-3);
+        if (end == list || budgets[nb] < 0.0f) return 2;
+        ++nb;
+        list = *end == ',' ? end + 1 : end;
+    }
+    if (s < 8 || frames < 1 || size < 16 || nb == 0) return 2;
+    if (puffs) {
+        refs rf;
+        int k;
+        rf.every = every;
+        rf.count = every > 0 ? frames / every + 1 : 0;
+        rf.img = rf.count ? (uint8_t **)calloc((size_t)rf.count, sizeof(uint8_t *)) : NULL;
+        for (k = 0; k < nb; ++k) bench_puff(s, frames, k == 0 ? cold : 0, rf.img ? &rf : NULL, size, budgets[k]);
+        for (k = 0; k < rf.count; ++k) free(rf.img[k]);
+        free(rf.img);
+    }
     if (tfs) {
         bench_slider(head, 1);
         bench_slider(head, 0);
     }
+    if (csv) fclose(csv);
     return 0;
 }

@@ -225,7 +225,7 @@ static void experiments(hd_context h, int quick)
     hd__cl_bind(&ctx->vw, HD__CL_DIRECT);
     hd__be_clear(&ctx->vw, HD__DIRTY_DIRECT);
     t0 = hd__now();
-    hd__be_direct(&ctx->vw); clFinish(be->queue);
+    hd__be_direct(&ctx->vw, 0, ctx->vw.dl_count); clFinish(be->queue);
     t_db = hd__now() - t0;
     hd__be_read_illumination(&ctx->vw, HD_ILLUMINATION_DIRECT, NULL, 0, e_b);
     bind9(be, kd);

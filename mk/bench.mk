@@ -62,18 +62,33 @@ bench-orbit: $(B)/hdbench_orbit $(patsubst %,$(B)/hdbench_orbit_%,$(ORBIT_BACKEN
 	@for b in $(ORBIT_BACKENDS); do echo "== $$b"; $(B)/hdbench_orbit_$$b --no-psnr $(ORBIT_ARGS) || exit 1; done
 
 # make bench-animated: bench/hdbench_animated.c on the CPU backend: a procedural smoke puff at
-# 64^3 and 128^3 (300 frames, camera orbiting, 512^2): hd_update_volume per frame against
-# destroy + create, and the lag (PSNR against each frame's converged light); then the TF slider
-# on the head CT, warm against cold (hd_reset). ANIMATED_ARGS are added to each run.
+# 64^3 and 128^3 (300 frames, camera orbiting, 512^2) under render_budget 2, 4, 8, 16 and 50 ms:
+# hd_update_volume per frame (p50 / p99, frames over the budget) against destroy + create, and
+# the lag (PSNR against each frame's converged light); then the TF slider on the head CT, warm
+# against cold (hd_reset). Per-frame rows go to $(B)/animated.csv; scripts/plot-animated draws
+# docs/animated/*.png from it (gnuplot). ANIMATED_ARGS are added to each run (e.g.
+# --frames 60); ANIMATED_BACKENDS="gl vulkan" runs the puffs on those backends too.
 .PHONY: bench-animated
+ANIMATED_CC = $(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
 $(B)/hdbench_animated: bench/hdbench_animated.c $(LIB_SRC) | $(B)
-	$(CC) $(CPPFLAGS) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+	$(ANIMATED_CC)
+$(B)/hdbench_animated_opencl: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_OPENCL -lOpenCL
+$(B)/hdbench_animated_vulkan: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_VULKAN -lvulkan
+$(B)/hdbench_animated_gl: bench/hdbench_animated.c $(LIB_SRC) | $(B)
+	$(ANIMATED_CC) -DHYBRIDDIFF_BACKEND_GL -lEGL
 ANIMATED_ARGS ?=
-bench-animated: $(B)/hdbench_animated
+ANIMATED_BACKENDS ?=
+ANIMATED_BUDGETS ?= 2,4,8,16,50
+bench-animated: $(B)/hdbench_animated $(patsubst %,$(B)/hdbench_animated_%,$(ANIMATED_BACKENDS))
 	@test -f data/head.nrrd || scripts/fetch-data
-	$(B)/hdbench_animated --dims 64 --no-tf $(ANIMATED_ARGS)
-	$(B)/hdbench_animated --dims 128 --no-tf $(ANIMATED_ARGS)
-	$(B)/hdbench_animated --no-puff $(ANIMATED_ARGS)
+	rm -f $(B)/animated.csv
+	@for b in cpu $(ANIMATED_BACKENDS); do \
+	    x=$(B)/hdbench_animated; [ $$b = cpu ] || x=$(B)/hdbench_animated_$$b; \
+	    for s in 64 128; do $$x --dims $$s --no-tf --budget $(ANIMATED_BUDGETS) --csv $(B)/animated.csv $(ANIMATED_ARGS) || exit 1; done; \
+	done
+	$(B)/hdbench_animated --no-puff --csv $(B)/animated.csv $(ANIMATED_ARGS)
 
 # bench/hdbench_guard.c: the per-context in-call guard's cost, the library built with it and
 # without it (HD__NO_CALL_GUARD) in one program: ns per hd_get_stats and per hd_render
@@ -101,3 +116,26 @@ eval-refine: $(B)/hdbench_refine
 	@test -f data/head.nrrd || scripts/fetch-data
 	@for tf in ct-skin ct-bone; do for w in "" --warm; do \
 	    $(B)/hdbench_refine --tf $$tf $$w --csv $(B)/refine-$$tf$$w.csv $(REFINE_ARGS) || exit 1; done; done
+
+# make bench-budget: bench/hdbench_budget.c on every backend: the head CT orbit (200 frames,
+# HD_RENDER_SCALE_AUTO, the light cold at the start) at 1280x720 and 1920x1080 under rising
+# render_budgets: hd_render's p50 / p99 / max and the frames over each budget, and the smallest
+# budget with none over (docs/PERFORMANCE.md, "A budget that holds"). BUDGET_ARGS are added to
+# each run; BUDGET_BACKENDS picks the GPU backends.
+.PHONY: bench-budget
+BUDGET_SRC := bench/hdbench_budget.c bench/hd_orbit_scene.h examples/hd_tf.h examples/hd_tonemap.h $(LIB_SRC)
+BUDGET_CC = $(CC) $(CPPFLAGS) -Iexamples -Ibench $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS)
+$(B)/hdbench_budget: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_CPU
+$(B)/hdbench_budget_opencl: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_OPENCL -lOpenCL
+$(B)/hdbench_budget_vulkan: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_VULKAN -lvulkan
+$(B)/hdbench_budget_gl: $(BUDGET_SRC) | $(B)
+	$(BUDGET_CC) -DHYBRIDDIFF_BACKEND_GL -lEGL
+BUDGET_ARGS ?=
+BUDGET_BACKENDS ?= opencl vulkan gl
+bench-budget: $(B)/hdbench_budget $(patsubst %,$(B)/hdbench_budget_%,$(BUDGET_BACKENDS))
+	@test -f data/head.nrrd || scripts/fetch-data
+	$(B)/hdbench_budget $(BUDGET_ARGS)
+	@for b in $(BUDGET_BACKENDS); do echo "== $$b"; $(B)/hdbench_budget_$$b $(BUDGET_ARGS) || exit 1; done

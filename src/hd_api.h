@@ -467,6 +467,7 @@ HDDEF hd_result hd_refine(hd_context h, int n)
 static hd_result hd__api_render(hd__ctx *ctx)
 {
     hd_result r;
+    ctx->call_t0 = hd__now();
     HD__BE_CALL(r, ctx, hd__render(ctx));
     return r;
 }

@@ -122,8 +122,11 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what);
    (vw->sig_gen) for the solvers' coarse grids. */
 static hd_result hd__be_classify(const hd__view *vw);
 /* HD: one Monte Carlo sample of the direct light into E's running mean (hd_k_direct.h) at each of
-   the vw->dl_count grid voxels listed in vw->dl_idx; E elsewhere is left as it is (0). */
-static hd_result hd__be_direct(const hd__view *vw);
+   the grid voxels listed in vw->dl_idx[first, first + count) (first + count <= vw->dl_count; the
+   core splits a light iteration's list over hd_render calls under render_budget); E elsewhere
+   is left as it is. A voxel's sample depends on vw->kp and the voxel alone, so the ranges of one
+   iteration give the bits of one call over the whole list. */
+static hd_result hd__be_direct(const hd__view *vw, size_t first, size_t count);
 /* HD: vw->dl_idx (vw->dl_count grid indices, in bricks) changed with sigma_t: make it the list
    hd__be_direct reads (a GPU backend uploads it). */
 static hd_result hd__be_direct_list(const hd__view *vw);
@@ -145,6 +148,10 @@ static hd_result hd__be_project(const hd__view *vw);
 static hd_result hd__be_upsample(const hd__view *vw);
 /* PT_SS / PT_MS: one path per pixel into the image's running mean (hd_k_path.h). */
 static hd_result hd__be_path(const hd__view *vw);
+
+/* Waits until the device has run every primitive enqueued so far: hd_render under render_budget
+   times each piece of light work and its frame by the wall clock after it. */
+static hd_result hd__be_wait(const hd__view *vw);
 
 /* ---- read-back (blocking: every earlier primitive's result) ------------------------------------ */
 /* The image as RGBA floats, vw->camera.width x height, rows top to bottom. */

@@ -46,13 +46,14 @@ typedef struct hd__conv {
     double q;                /* the solver's observed contraction of that change */
 } hd__conv;
 
-/* HD_RENDER_SCALE_AUTO's frame cost model (src/hd_frame_cost.h): per render scale 1, 2, 4, 8
+/* HD_RENDER_SCALE_AUTO's frame cost model (src/hd_frame_cost.h): per render scale 1, 2, 4, 8, 16
    (slot log2 s) the pixels its last frame marched (0: none yet), its smoothed seconds and the
    measurement count when it was last measured; the newest measurement's slot; measurements so
    far (0: none). */
+#define HD__COST_SLOTS 5
 typedef struct hd__cost {
-    double pixels[4], seconds[4];
-    unsigned at[4];
+    double pixels[HD__COST_SLOTS], seconds[HD__COST_SLOTS];
+    unsigned at[HD__COST_SLOTS];
     int last;
     unsigned gen;
     /* a frame recorded into a caller's command buffer (hd_vulkan_record), timed on the device and
@@ -61,6 +62,20 @@ typedef struct hd__cost {
     double rec_pixels;
     unsigned rec_gen;
 } hd__cost;
+
+/* The light iteration in progress when render_budget splits one over hd_render calls
+   (src/hd_schedule.h), and the light work's measured costs the budget plans with. */
+typedef struct hd__part {
+    int open;            /* an iteration is in progress: its counters have advanced */
+    size_t dl;           /* its direct stage's units done: HD's list entries, CD's 1 when done */
+    int sweeps;          /* its diffusion sweeps done (multigrid: steps) */
+    uint64_t dropped;    /* iterations a change ended before their last part (not counted as
+                            complete by hd_stats; the counter, the random numbers' key, runs on) */
+    size_t last_dl;      /* the last direct piece's units (the next is at most twice as long) */
+    double s_entry;      /* seconds per direct unit, smoothed; 0: none measured yet */
+    double s_sweep;      /* seconds per sweep */
+    double s_measure;    /* seconds of the convergence estimate */
+} hd__part;
 
 /* The direct light's voxels besides what the backend reads (vw.dl_idx, src/hd_direct_mask.h). */
 typedef struct hd__dl {
@@ -135,6 +150,8 @@ typedef struct hd__ctx {
                                 warm start caps it at params.light_window (src/hd_schedule.h) */
     hd__box upd;             /* the voxels hd_update_volume changed since the last hd__prepare
                                 (HD__DIRTY_VOLUME), [lo, hi) */
+    hd__part part;           /* a light iteration split over hd_render calls (render_budget) */
+    double call_t0;          /* when the current hd_render call began (its budget's start) */
     int busy_logs;           /* HD_ERROR_BUSY lines being logged from other threads (hd__enter; __atomic) */
 } hd__ctx;
 

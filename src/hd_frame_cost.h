@@ -6,7 +6,7 @@ static double hd__scale_pixels(const hd__ctx *ctx, int s)
     return (double)((ctx->vw.camera.width + s - 1) / s) * (double)((ctx->vw.camera.height + s - 1) / s);
 }
 
-static int hd__scale_slot(int s) { return s >= 8 ? 3 : s >= 4 ? 2 : s >= 2 ? 1 : 0; }
+static int hd__scale_slot(int s) { return s >= 16 ? 4 : s >= 8 ? 3 : s >= 4 ? 2 : s >= 2 ? 1 : 0; }
 
 /* Records that a frame at render scale s, marching `pixels` rays, took `seconds` (measured by
    hd__project_frame, or on the device for a recorded one). Each scale keeps its last pixel count
@@ -36,10 +36,10 @@ static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
 {
     double n = 0.0, sp = 0.0, st = 0.0, spp = 0.0, spt = 0.0, a = 0.0, b = 1.0, var, at_last;
     int k, fresh = 0, only_fresh;
-    for (k = 0; k < 4; ++k)
+    for (k = 0; k < HD__COST_SLOTS; ++k)
         if (ctx->cost.pixels[k] > 0.0 && ctx->cost.gen - ctx->cost.at[k] < HD__COST_FRESH) ++fresh;
     only_fresh = fresh >= 2;
-    for (k = 0; k < 4; ++k) {
+    for (k = 0; k < HD__COST_SLOTS; ++k) {
         double p = ctx->cost.pixels[k], t = ctx->cost.seconds[k];
         if (!(p > 0.0) || (only_fresh && ctx->cost.gen - ctx->cost.at[k] >= HD__COST_FRESH)) continue;
         n += 1.0; sp += p; st += t; spp += p * p; spt += p * t;
@@ -54,27 +54,52 @@ static double hd__frame_cost_predict(const hd__ctx *ctx, int s)
     return (a + b * hd__scale_pixels(ctx, s)) * ctx->cost.seconds[ctx->cost.last] / at_last;
 }
 
-/* The scale HD_RENDER_SCALE_AUTO gives a new image's first frame: the smallest whose predicted
-   time fits render_budget (the largest, 8, when none does); 4 without a budget or a measured
-   frame. */
-static int hd__first_scale(const hd__ctx *ctx)
+/* The part of render_budget a frame may take: all of it once the light has converged, else
+   HD__FRAME_SHARE of it (the light's work in the call takes the rest, src/hd_schedule.h). */
+#define HD__FRAME_SHARE 0.5
+static int hd__light_converged(const hd__ctx *ctx);
+static double hd__frame_share(const hd__ctx *ctx)
+{
+    double b = (double)ctx->vw.params.render_budget;
+    return hd__method_is_pt(ctx->vw.params.method) || hd__light_converged(ctx) ? b : b * HD__FRAME_SHARE;
+}
+
+/* The smallest power-of-two scale whose predicted frame time fits `limit` seconds (the largest,
+   HD__MAX_RENDER_SCALE, when none does). */
+static int hd__fit_scale(const hd__ctx *ctx, double limit)
 {
     int s;
-    if (!(ctx->vw.params.render_budget > 0.0f) || ctx->cost.gen == 0) return 4;
     for (s = 1; s < HD__MAX_RENDER_SCALE; s *= 2)
-        if (hd__frame_cost_predict(ctx, s) <= (double)ctx->vw.params.render_budget) break;
+        if (hd__frame_cost_predict(ctx, s) <= limit) break;
     return s;
 }
 
+/* The scale HD_RENDER_SCALE_AUTO gives a new image's first frame: the smallest whose predicted
+   time fits the frame's share of render_budget (hd__frame_share; 16 when none does); 4 without a
+   budget or a measured frame. */
+static int hd__first_scale(const hd__ctx *ctx)
+{
+    if (!(ctx->vw.params.render_budget > 0.0f) || ctx->cost.gen == 0) return 4;
+    return hd__fit_scale(ctx, hd__frame_share(ctx));
+}
+
 /* The render scale of the next projection frame (params.render_scale). HD_RENDER_SCALE_AUTO: a
-   new image's first frame at hd__first_scale, then half the divisor per frame down to 1. */
+   new image's first frame at hd__first_scale, then half the divisor per frame down to 1; under a
+   budget only while the finer frame's predicted time fits the frame's share, and a scale whose
+   frames have come to cost more than 1.5 times the share gives way to a coarser one. */
 static int hd__next_scale(const hd__ctx *ctx)
 {
+    int s = ctx->frame_scale;
     if (hd__method_is_pt(ctx->vw.params.method)) return 1;
     if (ctx->vw.params.render_scale != HD_RENDER_SCALE_AUTO) return ctx->vw.params.render_scale;
-    if (ctx->frame_scale > 0)
-        return ctx->frames > 0 && ctx->frame_scale > 1 ? ctx->frame_scale / 2 : ctx->frame_scale;
-    return hd__first_scale(ctx);
+    if (s <= 0) return hd__first_scale(ctx);
+    if (ctx->vw.params.render_budget > 0.0f && ctx->cost.gen > 0) {
+        double share = hd__frame_share(ctx);
+        if (ctx->frames > 0 && s > 1 && hd__frame_cost_predict(ctx, s / 2) <= share) return s / 2;
+        if (s < HD__MAX_RENDER_SCALE && hd__frame_cost_predict(ctx, s) > 1.5 * share) return hd__fit_scale(ctx, share);
+        return s;
+    }
+    return ctx->frames > 0 && s > 1 ? s / 2 : s;
 }
 
 /* Gives the image buffer the reduced frames' region if it lacks it (the first frame at a scale

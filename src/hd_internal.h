@@ -18,7 +18,7 @@
 #endif
 /* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
 #define HD__MAX_VOXELS (1u << 30)
-#define HD__MAX_RENDER_SCALE 8 /* params.render_scale's largest divisor */
+#define HD__MAX_RENDER_SCALE 16 /* params.render_scale's largest divisor */
 #define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
                                 majorants and few DDA steps (docs/DESIGN-CPU.md) */
 

@@ -72,7 +72,7 @@
     FLOAT(render_budget, 0.0f, 0.0f, HD__MAX_RENDER_BUDGET, 0, "in [0, 10] seconds", HD__INV_NONE) \
     FLOAT3(crop_min, 0.0f, 0.0f, 1.0f, "in [0, 1]", HD__INV_MEDIUM) \
     FLOAT3(crop_max, 1.0f, 0.0f, 1.0f, "in [0, 1]", HD__INV_MEDIUM) \
-    INT(render_scale, 1, -1, HD__MAX_RENDER_SCALE, "1..8 or HD_RENDER_SCALE_AUTO (-1)", HD__INV_IMAGE) \
+    INT(render_scale, 1, -1, HD__MAX_RENDER_SCALE, "1..16 or HD_RENDER_SCALE_AUTO (-1)", HD__INV_IMAGE) \
     INT(light_window, 8, 1, 1000000, "in 1..1000000", HD__INV_NONE) \
     ENUM(rest, hd_rest, HD_REST_HOLD, HD_REST_COUNT, HD__INV_IMAGE) \
     INT(refine_bounces, -1, -1, 100000, "-1 or 1..100000", HD__INV_IMAGE) \

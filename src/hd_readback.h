@@ -246,11 +246,13 @@ HDDEF hd_result hd_read_illumination(hd_context h, hd_illumination which, float 
 static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
 {
     size_t gvox;
+    int open;
     if (!out) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_get_stats: out_stats is NULL");
     memset(out, 0, sizeof *out);
     gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
+    open = ctx->part.open && !(ctx->dirty & HD__PART_ENDS); /* a change ends it (hd__prepare) */
     out->method = ctx->vw.params.method;
-    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations;
+    out->iterations = (ctx->dirty & HD__DIRTY_DIRECT) ? 0 : ctx->iterations - ctx->part.dropped - (ctx->part.open ? 1u : 0u);
     if (hd__method_is_pt(ctx->vw.params.method) && (ctx->dirty & HD__DIRTY_IMAGE)) out->iterations = 0;
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;
@@ -286,6 +288,13 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
         int fresh = (ctx->dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_SIGMA | HD__DIRTY_ALLOC | HD__DIRTY_WARM_E |
                                    HD__DIRTY_WARM_PHI | HD__DIRTY_VOLUME)) != 0;
         out->light_error = fresh ? 1.0 : ctx->light_error;
+        if (open) {
+            size_t nd = hd__direct_units(ctx);
+            int ns = hd__sweep_units(ctx);
+            double d = nd ? (double)ctx->part.dl / (double)nd : 1.0, w = ns ? (double)ctx->part.sweeps / ns : 1.0;
+            out->light_progress = 0.5 * ((d < 1.0 ? d : 1.0) + (w < 1.0 ? w : 1.0));
+            if (out->light_progress >= 1.0) out->light_progress = 0.0;
+        }
         out->light_converged = !fresh && hd__light_converged(ctx);
     }
     return HD_SUCCESS;

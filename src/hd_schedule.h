@@ -22,6 +22,19 @@ static int hd__image_room_kept(const hd__ctx *ctx)
 
 static hd_result hd__record_measure(hd__ctx *ctx);
 
+/* The dirty bits that end a split light iteration (hd__prepare). */
+#define HD__PART_ENDS \
+    (HD__DIRTY_ALLOC | HD__DIRTY_JACOBI | HD__DIRTY_SIGMA | HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI | \
+     HD__DIRTY_VOLUME)
+
+/* No light iteration in progress (ctx->part: src/hd_core.h). */
+static void hd__part_end(hd__ctx *ctx)
+{
+    ctx->part.open = 0;
+    ctx->part.dl = 0;
+    ctx->part.sweeps = 0;
+}
+
 /* Brings the device state up to date with what the setters changed, in dependency order. */
 static hd_result hd__prepare(hd__ctx *ctx)
 {
@@ -58,7 +71,13 @@ static hd_result hd__prepare(hd__ctx *ctx)
         if ((r = hd__be_upload_env(&ctx->vw)) != HD_SUCCESS) return r;
         ctx->dirty &= ~(unsigned)HD__DIRTY_ENV;
     }
-    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = 0;
+    if (dirty & HD__DIRTY_DIRECT) ctx->iterations = ctx->dl_n = ctx->part.dropped = 0;
+    /* a change of the light's inputs ends a split light iteration where it is (its voxels not yet
+       sampled keep their mean; the counters stay, so the random numbers are never reused) */
+    if (dirty & HD__PART_ENDS) {
+        if (ctx->part.open && !(dirty & HD__DIRTY_DIRECT)) ctx->part.dropped++;
+        hd__part_end(ctx);
+    }
     /* a warm start: E's mean keeps at most light_window samples of the light before the change
        (the iteration count, the random numbers' key, runs on) */
     if ((dirty & HD__DIRTY_WARM_E) && ctx->dl_n > (uint64_t)ctx->vw.params.light_window) ctx->dl_n = (uint64_t)ctx->vw.params.light_window;
@@ -123,47 +142,186 @@ static hd_result hd__diffuse_once(hd__ctx *ctx)
     return hd__be_diffuse(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI);
 }
 
-/* The diffusion sweeps of HD and CD (none with disable_diffusion). */
-static hd_result hd__diffuse_sweeps(hd__ctx *ctx)
+/* A light iteration's parts: its direct stage (HD: one unit per entry of the direct light's
+   list; CD: the convection of every light and their sum, one unit) and its diffusion sweeps
+   (none with disable_diffusion; multigrid: conjugate-gradient steps). hd_render under
+   render_budget runs them over several calls (hd__light_budget); every other caller runs what is
+   left of the open iteration at once (hd__light_iteration). The parts run in the order of a
+   whole iteration with the same parameter block, so a split iteration gives the same E and phi. */
+static size_t hd__direct_units(const hd__ctx *ctx)
 {
-    hd_result r;
-    int s;
-    if (ctx->vw.params.disable_diffusion) return HD_SUCCESS;
-    /* all of them in one call: the CPU backend walks memory once for several red-black sweeps */
-    if (ctx->vw.params.solver != HD_SOLVER_MULTIGRID)
-        return hd__be_diffuse_sweeps(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI, ctx->vw.params.diffusion_sweeps);
-    for (s = 0; s < ctx->vw.params.diffusion_sweeps; ++s)
-        if ((r = hd__diffuse_once(ctx)) != HD_SUCCESS) return r;
-    return HD_SUCCESS;
+    return ctx->vw.params.method == HD_METHOD_CD ? 1 : ctx->vw.dl_count;
+}
+static int hd__sweep_units(const hd__ctx *ctx)
+{
+    return ctx->vw.params.disable_diffusion ? 0 : ctx->vw.params.diffusion_sweeps;
 }
 
-/* One light iteration, no projection. HD: a direct-light sample per voxel and the diffusion
-   sweeps; CD: one convection step per light, their sum into E, and the sweeps (convection and
-   sum count as the direct stage). Then the convergence estimate, counted with the diffusion. */
-static hd_result hd__light_iteration(hd__ctx *ctx)
+/* Opens a light iteration: its counters (the random numbers' key, E's sample count) advance. */
+static void hd__light_open(hd__ctx *ctx)
 {
-    hd_result r;
-    double t0 = hd__now(), t1, t2;
     ctx->iterations++;
     ctx->dl_n++;
+    ctx->part.open = 1;
+    ctx->part.dl = 0;
+    ctx->part.sweeps = 0;
+}
+
+/* The open iteration's direct stage over its next n units. */
+static hd_result hd__direct_part(hd__ctx *ctx, size_t n)
+{
+    hd_result r = HD_SUCCESS;
+    double t0 = hd__now();
     hd__fill_kparams(ctx);
     if (ctx->vw.params.method == HD_METHOD_CD) {
         int l;
-        for (l = 0; l < ctx->light_count; ++l)
-            if ((r = hd__be_convect(&ctx->vw, l)) != HD_SUCCESS) return r;
-        if ((r = hd__be_sum_lights(&ctx->vw)) != HD_SUCCESS) return r;
-    } else if ((r = hd__be_direct(&ctx->vw)) != HD_SUCCESS) return r;
-    t1 = hd__now();
-    if ((r = hd__diffuse_sweeps(ctx)) != HD_SUCCESS) return r;
-    /* iterations recorded into a caller's command buffer have not run yet: the next call measures
-       them (hd__record_measure) */
+        for (l = 0; l < ctx->light_count && r == HD_SUCCESS; ++l) r = hd__be_convect(&ctx->vw, l);
+        if (r == HD_SUCCESS) r = hd__be_sum_lights(&ctx->vw);
+    } else {
+        r = hd__be_direct(&ctx->vw, ctx->part.dl, n);
+    }
+    ctx->part.dl += n;
+    ctx->seconds[0] += hd__now() - t0;
+    return r;
+}
+
+/* n more of the open iteration's diffusion sweeps (all of them in one call where the solver
+   allows: the CPU backend walks memory once for several red-black sweeps). */
+static hd_result hd__sweeps_part(hd__ctx *ctx, int n)
+{
+    hd_result r = HD_SUCCESS;
+    double t0 = hd__now();
+    int s;
+    hd__fill_kparams(ctx);
+    if (ctx->vw.params.solver != HD_SOLVER_MULTIGRID)
+        r = hd__be_diffuse_sweeps(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI, n);
+    else
+        for (s = 0; s < n && r == HD_SUCCESS; ++s) r = hd__diffuse_once(ctx);
+    ctx->part.sweeps += n;
+    ctx->seconds[1] += hd__now() - t0;
+    return r;
+}
+
+/* Closes the open iteration, all its parts done: the convergence estimate, counted with the
+   diffusion (iterations recorded into a caller's command buffer have not run yet: the next call
+   measures them, hd__record_measure). */
+static hd_result hd__light_close(hd__ctx *ctx)
+{
+    hd_result r = HD_SUCCESS;
+    double t0 = hd__now();
+    hd__part_end(ctx);
     if (ctx->no_measure) ctx->rec_light++;
     else r = hd__light_measure(ctx);
-    t2 = hd__now();
-    ctx->seconds[0] += t1 - t0;
-    ctx->seconds[1] += t2 - t1;
+    ctx->seconds[1] += hd__now() - t0;
     if (!hd__light_converged(ctx)) ctx->converged_frames = 0;
     return r;
+}
+
+/* One light iteration, no projection, or what is left of the one in progress. HD: a direct-light
+   sample per voxel and the diffusion sweeps; CD: one convection step per light, their sum into
+   E, and the sweeps (convection and sum count as the direct stage). Then the convergence
+   estimate. A failed part ends the iteration. */
+static hd_result hd__light_iteration(hd__ctx *ctx)
+{
+    hd_result r = HD_SUCCESS;
+    size_t nd;
+    int ns;
+    if (!ctx->part.open) hd__light_open(ctx);
+    nd = hd__direct_units(ctx);
+    ns = hd__sweep_units(ctx);
+    if (ctx->part.dl < nd) r = hd__direct_part(ctx, nd - ctx->part.dl);
+    if (r == HD_SUCCESS && ctx->part.sweeps < ns) r = hd__sweeps_part(ctx, ns - ctx->part.sweeps);
+    if (r != HD_SUCCESS) {
+        hd__part_end(ctx);
+        return r;
+    }
+    return hd__light_close(ctx);
+}
+
+/* The fewest direct-list entries a piece of a split iteration runs (HD__PART_MIN_ENTRIES, or the
+   list's 1/256th where that is more): smaller pieces cost more in dispatch than they save. */
+#define HD__PART_MIN_ENTRIES 1024
+
+/* The units of a piece that fit `left` seconds at `rate` seconds each, at most `remaining`; 0
+   when fewer than `least` fit. Without a measured rate: a probe of `least` units. */
+static size_t hd__part_fit(double left, double rate, size_t remaining, size_t least)
+{
+    double n;
+    if (least > remaining) least = remaining;
+    if (!(rate > 0.0)) return least;
+    n = left / rate;
+    if (n >= (double)remaining) return remaining;
+    if (n < (double)least) return 0;
+    return (size_t)n;
+}
+
+/* A unit cost measured over n units: a dearer one is taken at once, a cheaper one moves the
+   estimate halfway to it (the direct light's cost per entry varies several times along the list,
+   with the medium's density: the estimate errs on the dear side). */
+static void hd__part_rate(double *rate, double seconds, size_t n)
+{
+    double r = seconds / (double)(n ? n : 1);
+    if (!(r > 0.0)) return;
+    *rate = *rate > 0.0 && r < *rate ? 0.5 * (*rate + r) : r;
+}
+
+static void hd__light_settled(hd__ctx *ctx, int before);
+
+/* hd_render's light work under render_budget: pieces of light iterations (hd__part_fit over the
+   measured unit costs) until the next does not fit before `deadline` (hd__now() seconds) or
+   the light has converged. The first piece of a call runs whatever the time left (the smallest
+   piece: HD__PART_MIN_ENTRIES entries or one sweep), so the light always advances. An
+   iteration's measurement runs once its last sweep is done. */
+static hd_result hd__light_budget(hd__ctx *ctx, double deadline)
+{
+    int pieces = 0;
+    for (;;) {
+        hd_result r;
+        double left = deadline - hd__now(), t0;
+        size_t nd = hd__direct_units(ctx), least, k;
+        int ns = hd__sweep_units(ctx);
+        if (!ctx->part.open && (hd__light_converged(ctx) || ctx->iterations >= 0x7fffffffu)) return HD_SUCCESS;
+        if (pieces > 0 && !(left > 0.0)) return HD_SUCCESS;
+        if (ctx->part.dl < nd) {
+            least = ctx->vw.params.method == HD_METHOD_CD ? 1 : nd / 256 > HD__PART_MIN_ENTRIES ? nd / 256 : HD__PART_MIN_ENTRIES;
+            k = hd__part_fit(left, ctx->part.s_entry, nd - ctx->part.dl, least);
+            if (k == 0 && pieces > 0) return HD_SUCCESS;
+            if (k == 0) k = least < nd - ctx->part.dl ? least : nd - ctx->part.dl;
+            /* a piece at most twice the last one: the next stretch of the list may cost more */
+            if (ctx->part.last_dl > 0 && k > 2 * ctx->part.last_dl && k > least) k = 2 * ctx->part.last_dl > least ? 2 * ctx->part.last_dl : least;
+            ctx->part.last_dl = k;
+            if (!ctx->part.open) hd__light_open(ctx);
+            t0 = hd__now();
+            if ((r = hd__direct_part(ctx, k)) != HD_SUCCESS || (r = hd__be_wait(&ctx->vw)) != HD_SUCCESS) {
+                hd__part_end(ctx);
+                return r;
+            }
+            hd__part_rate(&ctx->part.s_entry, hd__now() - t0, k);
+        } else if (ctx->part.sweeps < ns) {
+            /* the measurement comes with the last sweep: its time counts against the piece */
+            double l2 = left - ctx->part.s_measure;
+            k = hd__part_fit(l2, ctx->part.s_sweep, (size_t)(ns - ctx->part.sweeps), 1);
+            if (k == 0 && pieces > 0) return HD_SUCCESS;
+            if (k == 0) k = 1;
+            if (!ctx->part.open) hd__light_open(ctx);
+            t0 = hd__now();
+            if ((r = hd__sweeps_part(ctx, (int)k)) != HD_SUCCESS || (r = hd__be_wait(&ctx->vw)) != HD_SUCCESS) {
+                hd__part_end(ctx);
+                return r;
+            }
+            hd__part_rate(&ctx->part.s_sweep, hd__now() - t0, k);
+        } else if (!ctx->part.open) {
+            hd__light_open(ctx); /* nothing to run (an empty list, no diffusion): a measurement */
+        }
+        if (ctx->part.open && ctx->part.dl >= nd && ctx->part.sweeps >= ns) {
+            int before = hd__light_converged(ctx);
+            t0 = hd__now();
+            if ((r = hd__light_close(ctx)) != HD_SUCCESS) return r;
+            hd__part_rate(&ctx->part.s_measure, hd__now() - t0, 1);
+            hd__light_settled(ctx, before);
+        }
+        ++pieces;
+    }
 }
 
 /* One projection frame from the current E and phi into the image's running mean. At render
@@ -199,6 +357,8 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     } else {
         r = hd__be_project(&ctx->vw);
     }
+    /* under a budget the frame's time is the device's, not its enqueueing's */
+    if (r == HD_SUCCESS && ctx->vw.params.render_budget > 0.0f && !ctx->no_measure) r = hd__be_wait(&ctx->vw);
     t2 = hd__now();
     ctx->seconds[2] += t2 - t0;
     /* a recorded frame has not run: hd_vulkan_record times it on the device instead */
@@ -315,6 +475,10 @@ static hd_result hd__record_measure(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* The share of render_budget the light and the frame plan for; the rest is the call's overhead
+   (the preparation, the backend's bracket and wait). */
+#define HD__BUDGET_MARGIN 0.9
+
 /* hd_render's work after hd__prepare. */
 static hd_result hd__render(hd__ctx *ctx)
 {
@@ -331,12 +495,16 @@ static hd_result hd__render(hd__ctx *ctx)
         } while (hd__now() - t0 + last <= budget);
         return HD_SUCCESS;
     }
-    /* refine while not converged: at least once, then while the budget has room for another */
-    while (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu) {
-        double ti = hd__now();
-        if ((r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
-        last = hd__now() - ti;
-        if (hd__now() - t0 + last > budget) break;
+    if (budget > 0.0) {
+        /* a hard limit from the call's start: the light's pieces until the time the frame is
+           predicted to need (half the budget before any frame is measured), with a margin of
+           HD__BUDGET_MARGIN for the call's own overhead */
+        double start = ctx->call_t0 > 0.0 && ctx->call_t0 <= t0 ? ctx->call_t0 : t0;
+        double frame = ctx->cost.gen > 0 ? hd__frame_cost_predict(ctx, hd__next_scale(ctx)) : budget * HD__FRAME_SHARE;
+        if ((r = hd__light_budget(ctx, start + budget * HD__BUDGET_MARGIN - frame)) != HD_SUCCESS) return r;
+    } else {
+        /* no budget: one light iteration per call (the rest of one a budget split) */
+        if (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu && (r = hd__refine_once(ctx)) != HD_SUCCESS) return r;
     }
     if (hd__light_converged(ctx)) {
         /* the image is done once frame_window frames at its final scale are in; then the view

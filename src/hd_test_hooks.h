@@ -34,7 +34,7 @@ static hd_result hd__test_direct_once(hd__ctx *ctx)
     ctx->iterations++;
     ctx->dl_n++; /* E's mean holds one sample more */
     hd__fill_kparams(ctx);
-    return hd__be_direct(&ctx->vw);
+    return hd__be_direct(&ctx->vw, 0, ctx->vw.dl_count);
 }
 HD__MAYBE_UNUSED static hd_result hd__test_direct(hd_context h, int n)
 {

@@ -419,7 +419,108 @@ static void test_tf_warm(void)
     }
 }
 
+/* render_budget splits a light iteration over hd_render calls: with a budget far below one
+   iteration's time each call runs one piece (a range of the direct light's list or one sweep),
+   hd_stats.light_progress rises within the iteration and iterations counts complete ones only;
+   a camera move between the pieces keeps the iteration open. After the same number of complete
+   iterations E, phi and light_error are bit for bit those of whole iterations (hd_refine), for
+   HD with each solver and for CD. */
+static void budget_split_case(const char *name, hd_method method, hd_solver solver)
+{
+    enum { ITER = 3 };
+    hd_desc d;
+    hd_context whole, split;
+    hd_stats s, t;
+    hd_camera cam;
+    size_t n = (size_t)N * N * N;
+    float *e0 = (float *)malloc(n * sizeof(float)), *p0 = (float *)malloc(n * sizeof(float));
+    float *e1 = (float *)malloc(n * sizeof(float)), *p1 = (float *)malloc(n * sizeof(float));
+    int calls = 0, parts = 0, direct = 0, rising = 1;
+    double prev = 0.0;
+    make_desc(&d, NULL);
+    d.params.illumination_downsample = 1;
+    d.params.method = method;
+    d.params.solver = solver;
+    d.params.light_tolerance = 1e-6f; /* nothing converges within ITER iterations */
+    CHECK(hd_create(&d, &whole) == HD_SUCCESS);
+    d.params.render_budget = 1e-6f;
+    CHECK(hd_create(&d, &split) == HD_SUCCESS);
+    CHECK(hd_refine(whole, ITER) == HD_SUCCESS);
+    cam = d.camera;
+    for (;;) {
+        CHECK(hd_render(split) == HD_SUCCESS);
+        CHECK(hd_get_stats(split, &s) == HD_SUCCESS);
+        ++calls;
+        if (s.light_progress > 0.0) {
+            ++parts;
+            direct += s.light_progress < 0.5; /* the direct stage in progress: its list split */
+            if (s.light_progress < 1.0 && s.light_progress > prev) prev = s.light_progress;
+            else rising = 0;
+        } else {
+            prev = 0.0;
+        }
+        /* a camera move restarts the image, not the light iteration in progress */
+        cam.eye[0] += 0.01f;
+        CHECK(hd_set_camera(split, &cam) == HD_SUCCESS);
+        if ((s.iterations >= ITER && s.light_progress == 0.0) || calls > 10000) break;
+    }
+    CHECK_MSG(s.iterations == ITER && parts >= 2 * ITER && (direct >= ITER || method == HD_METHOD_CD) && rising,
+              "%s: %llu iterations in %d calls, %d in between (%d in the direct stage), rising %d", name,
+              (unsigned long long)s.iterations, calls, parts, direct, rising);
+    CHECK(hd_get_stats(whole, &t) == HD_SUCCESS && t.iterations == ITER && t.light_progress == 0.0);
+    CHECK_MSG(s.light_error == t.light_error, "%s: light_error %g split, %g whole", name, s.light_error, t.light_error);
+    CHECK(hd_read_illumination(whole, HD_ILLUMINATION_DIRECT, e0, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(whole, HD_ILLUMINATION_SCATTERED, p0, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(split, HD_ILLUMINATION_DIRECT, e1, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(split, HD_ILLUMINATION_SCATTERED, p1, n) == HD_SUCCESS);
+    CHECK_MSG(memcmp(e0, e1, n * sizeof(float)) == 0 && memcmp(p0, p1, n * sizeof(float)) == 0, "%s: split E, phi differ", name);
+    /* hd_refine finishes a split iteration first: one more render opens one, a refine closes it */
+    CHECK(hd_render(split) == HD_SUCCESS && hd_get_stats(split, &s) == HD_SUCCESS && s.light_progress > 0.0);
+    CHECK(hd_refine(split, 1) == HD_SUCCESS && hd_refine(whole, 1) == HD_SUCCESS);
+    CHECK(hd_get_stats(split, &s) == HD_SUCCESS && s.iterations == ITER + 1 && s.light_progress == 0.0);
+    CHECK(hd_read_illumination(whole, HD_ILLUMINATION_SCATTERED, p0, n) == HD_SUCCESS);
+    CHECK(hd_read_illumination(split, HD_ILLUMINATION_SCATTERED, p1, n) == HD_SUCCESS);
+    CHECK_MSG(memcmp(p0, p1, n * sizeof(float)) == 0, "%s: phi after a finished split iteration differs", name);
+    hd_destroy(whole);
+    hd_destroy(split);
+    free(e0); free(p0); free(e1); free(p1);
+}
+
+static void test_budget_split(void)
+{
+    budget_split_case("HD red-black", HD_METHOD_HD, HD_SOLVER_RED_BLACK);
+    budget_split_case("HD Jacobi", HD_METHOD_HD, HD_SOLVER_JACOBI);
+    budget_split_case("HD multigrid", HD_METHOD_HD, HD_SOLVER_MULTIGRID);
+    budget_split_case("CD", HD_METHOD_CD, HD_SOLVER_RED_BLACK);
+}
+
+/* A change of the light's inputs (a warm TF change) ends a split iteration where it is; the
+   next call starts the next one, and the light goes on converging. */
+static void test_budget_split_setter(void)
+{
+    hd_desc d;
+    hd_context ctx;
+    hd_stats s;
+    hd_params p;
+    int i;
+    make_desc(&d, NULL);
+    d.params.illumination_downsample = 1;
+    d.params.render_budget = 1e-6f;
+    CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+    CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS && s.light_progress > 0.0 && s.iterations == 0);
+    CHECK(hd_query_desc(ctx, &d) == HD_SUCCESS);
+    p = d.params;
+    p.extinction = 30.0f;
+    CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
+    CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.light_progress == 0.0);
+    for (i = 0; i < 2000 && !s.light_converged; ++i) CHECK(hd_render(ctx) == HD_SUCCESS && hd_get_stats(ctx, &s) == HD_SUCCESS);
+    CHECK_MSG(s.light_converged && s.light_progress == 0.0, "after the change: converged %d in %d calls", s.light_converged, i);
+    hd_destroy(ctx);
+}
+
 const hd_test_case hd_tests_living[] = {
+    {"living_budget_split", test_budget_split},
+    {"living_budget_split_setter", test_budget_split_setter},
     {"living_tf_warm", test_tf_warm},
     {"living_no_frame", test_no_frame},
     {"living_update_same", test_update_same},

@@ -1289,8 +1289,58 @@ static void case_refine(hd_method method, hd_voxel_type type, const int *d, int 
     scene_free(&s);
 }
 
+/* render_budget splitting light iterations over hd_render calls on the backend (a budget far
+   below one iteration: each call runs one piece, a range of the direct light's list or one
+   sweep), against the reference's whole iterations (hd_refine): after n complete iterations E
+   and phi agree as whole iterations do. */
+static void case_budget_split(hd_method method, hd_voxel_type type, const int *d, int lights, int n)
+{
+    scene s;
+    guard g;
+    pair p;
+    char name[128];
+    errors e = {0.0, 0.0, 0.0, -1.0};
+    scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
+    s.params.method = method;
+    s.params.light_tolerance = 1e-6f;
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "budget split x%d %s %s %dx%dx%d %dL", n, hd_api_cpu.method_name(method), type_name(type), d[0], d[1],
+             d[2], lights);
+    if (pair_create(&p, &s)) {
+        hd_desc q;
+        hd_stats st;
+        hd_result r;
+        int calls = 0, between = 0;
+        if ((r = hd_api_cpu.refine(p.ref, n)) != HD_SUCCESS) pair_fail(&p, "reference refine", r);
+        if ((r = hd_api_backend.query_desc(p.dut, &q)) != HD_SUCCESS) pair_fail(&p, "backend query_desc", r);
+        q.params.render_budget = 1e-6f;
+        if (p.ok && (r = hd_api_backend.set_params(p.dut, &q.params)) != HD_SUCCESS) pair_fail(&p, "backend set_params", r);
+        while (p.ok && calls < 20000) {
+            if ((r = hd_api_backend.render(p.dut)) != HD_SUCCESS || (r = hd_api_backend.get_stats(p.dut, &st)) != HD_SUCCESS) {
+                pair_fail(&p, "backend render", r);
+                break;
+            }
+            ++calls;
+            between += st.light_progress > 0.0;
+            if (st.iterations >= (uint64_t)n && st.light_progress == 0.0) break;
+        }
+        if (p.ok && (st.iterations != (uint64_t)n || between < n)) {
+            p.ok = 0;
+            snprintf(p.why, sizeof p.why, "%llu iterations in %d calls, %d of them within an iteration", (unsigned long long)st.iterations,
+                     calls, between);
+        }
+        pair_compare(&p, CMP_E | CMP_PHI, &e);
+    }
+    report(name, &p, &g, &e, 0);
+    pair_destroy(&p);
+    guard_free(&g);
+    scene_free(&s);
+}
+
 static void render_cases(const int *odd, const int *other)
 {
+    case_budget_split(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 3);
+    case_budget_split(HD_METHOD_CD, HD_VOXEL_F32, other, 2, 3);
     case_refine(HD_METHOD_HD, HD_VOXEL_U8, odd, 3, 0, 2, 0, 8);
     case_refine(HD_METHOD_HD, HD_VOXEL_U16, other, 1, 1, 3, 1, 6);
     case_refine(HD_METHOD_CD, HD_VOXEL_F32, odd, 1, 0, -1, 0, 6);
