@@ -861,9 +861,10 @@ static hd_result hd__vk_vol_write(const hd__view *vw, const hd__box *vox)
     return hd__vk_flush(vw);
 }
 
-/* Whole image <- host floats (x fastest), submitted and waited for; an r16f image gets them
+/* Whole image <- host floats (x fastest), submitted and waited for (the test hooks' and the
+   benchmarks' writes of E and phi); an r16f image gets them
    rounded to nearest even (hdk_f2h, the CPU backend's rounding). */
-static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
+HD__MAYBE_UNUSED static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
 {
     hd__backend *be = vw->be;
     size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
