@@ -861,10 +861,11 @@ static hd_result hd__vk_vol_write(const hd__view *vw, const hd__box *vox)
     return hd__vk_flush(vw);
 }
 
+#ifdef HYBRIDDIFF_TESTING
 /* Whole image <- host floats (x fastest), submitted and waited for (the test hooks' and the
    benchmarks' writes of E and phi); an r16f image gets them
    rounded to nearest even (hdk_f2h, the CPU backend's rounding). */
-HD__MAYBE_UNUSED static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
+static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
 {
     hd__backend *be = vw->be;
     size_t bytes = (size_t)im->extent[0] * im->extent[1] * im->extent[2] * (size_t)im->texel;
@@ -885,6 +886,7 @@ HD__MAYBE_UNUSED static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk
     hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
     return hd__vk_flush(vw);
 }
+#endif
 
 /* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar), or
    with a slice list (list, count) those z slices only, in its order, in one copy; an r16f
