@@ -75,6 +75,7 @@ help:
 	@echo "  make bench-vulkan-multigrid         Vulkan multigrid steps against the CPU, interleaved"
 	@echo "  make bench-gl                       GL backend figures on the head CT"
 	@echo "  make bench-multigrid                time to a 1e-4 residual: red-black sweeps against multigrid CG"
+	@echo "  make bench-scale                    light and memory against volume size: head CT and a sparse cloud, 256^3, 512^3"
 	@echo "  make bench-project                  projection frame time per backend, this tree against PROJECT_BASE"
 	@echo "  make bench-orbit                    orbit frames per backend and PSNR per time budget (docs/orbit/)"
 	@echo "  make bench-budget                   the smallest render_budget each backend holds on a 1280x720 / 1080p orbit"

@@ -175,6 +175,7 @@ typedef enum hd_voxel_type {
     HD_VOXEL_U8,
     HD_VOXEL_U16,
     HD_VOXEL_F32,
+    HD_VOXEL_I16, /* signed 16-bit (a CT in Hounsfield units) */
     HD_VOXEL_COUNT
 } hd_voxel_type;
 
@@ -317,7 +318,9 @@ typedef struct hd_volume_desc {
                              each >= the largest extent (dims * spacing) / HD_MAX_SPACING_RATIO */
     const void *data;     /* dims[0]*dims[1]*dims[2] voxels; copied by hd_create */
     float value_range[2]; /* raw value mapped to TF coordinate 0 and 1; {0,0} -> {0,255} for U8,
-                             {0,65535} for U16, {0,1} for F32. Values outside are clamped. */
+                             {0,65535} for U16, {-32768,32767} for I16, {0,1} for F32. Values
+                             outside are clamped. Every backend keeps U8, U16 and I16 voxels as
+                             they are (1 or 2 bytes each) and maps them in its kernels. */
     float transform[16];  /* volume to world, a 4x4 affine matrix, column-major (element row r,
                              column c at [c * 4 + r]), applied to the box above (centred at 0,
                              largest side 1); all zero: the identity (the box as it is). Per-axis

@@ -24,7 +24,22 @@
 #define HD_ILLUM_FMT r32f
 #define HD_ILLUM_ROUND(v) (v)
 #endif
+/* The volume in its own format: HD_VOL_STORE (hd_gl.h's prefix; HD_VOL_* of hd_k_params.h, which
+   comes later: 1 U8, 2 U16, 3 I16, 0 F32) picks the image's format, so imageLoad returns the raw
+   voxel (GL 4.3 core formats r8ui, r16ui, r16i). */
+#ifndef HD_VOL_STORE
+#define HD_VOL_STORE 0
+#endif
+#if HD_VOL_STORE == 1
+layout(binding = 0, r8ui) uniform readonly uimage3D hd_i_vol;
+#elif HD_VOL_STORE == 2
+layout(binding = 0, r16ui) uniform readonly uimage3D hd_i_vol;
+#elif HD_VOL_STORE == 3
+layout(binding = 0, r16i) uniform readonly iimage3D hd_i_vol;
+#else
 layout(binding = 0, r32f) uniform readonly image3D hd_i_vol;
+#endif
+#define HD_VOL_RAW(i, px, py, pz, t) float(imageLoad(hd_i_vol, ivec3((px), (py), (pz))).r)
 layout(std430, binding = 0) readonly buffer hd_b_tf { float tf[]; };
 layout(std430, binding = 1) readonly buffer hd_b_maj { float maj[]; };
 layout(binding = 1, r32f) uniform image3D hd_i_sig;

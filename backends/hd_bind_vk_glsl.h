@@ -37,7 +37,22 @@
 #define HD_ILLUM_FMT r32f
 #define HD_ILLUM_ROUND(v) (v)
 #endif
-layout(binding = 1, r32f) uniform readonly image3D hd_i_vol;
+/* The volume packed along x in an r32ui image (a format every device stores): an F32 volume's
+   floats one a texel, 16-bit voxels two a texel, U8 four, the first in the low bits (rows padded
+   to whole texels). Specialization constant 4, hd_sc_vstore, is its HD_VOL_* (1 U8, 2 U16, 3 I16,
+   0 F32; hd_k_params.h comes later), fixed when hd_vulkan.h makes the pipelines, so only its own
+   load is compiled. */
+layout(binding = 1, r32ui) uniform readonly uimage3D hd_i_vol;
+layout(constant_id = 4) const int hd_sc_vstore = 0;
+#define HD_VOL_STORE hd_sc_vstore
+float hd_vol_raw_at(int x, int y, int z, int t)
+{
+    if (t == 1) return float(bitfieldExtract(imageLoad(hd_i_vol, ivec3(x >> 2, y, z)).r, 8 * (x & 3), 8));
+    if (t == 2) return float(bitfieldExtract(imageLoad(hd_i_vol, ivec3(x >> 1, y, z)).r, 16 * (x & 1), 16));
+    if (t == 3) return float(bitfieldExtract(int(imageLoad(hd_i_vol, ivec3(x >> 1, y, z)).r), 16 * (x & 1), 16));
+    return uintBitsToFloat(imageLoad(hd_i_vol, ivec3(x, y, z)).r);
+}
+#define HD_VOL_RAW(i, px, py, pz, t) hd_vol_raw_at((px), (py), (pz), (t))
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
 layout(std430, binding = 3) readonly buffer hd_b_maj { float maj[]; };
 layout(binding = 4, r32f) uniform image3D hd_i_sig;

@@ -137,7 +137,7 @@ static int hd__gl_diffuse_slot(int counts_z)
 typedef struct hd__gl_tex {
     GLuint name;
     int extent[3];
-    GLenum format; /* GL_R32F, or GL_R16F (E / phi / phi2 at float16) */
+    GLenum format; /* GL_R32F, or GL_R16F (E / phi / phi2 at float16); the volume's by its storage */
 } hd__gl_tex;
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
@@ -432,7 +432,7 @@ static hd_result hd__gl_program(const hd__view *vw, int p)
     int stage = q < HD__GL_PROGRAM_COUNT ? q : HD__GL_DIFFUSE;
     hd__backend *be = vw->be;
     const char *src[1 + HD__GL_SOURCE_LINES];
-    char prefix[256];
+    char prefix[384];
     GLsizei n = 0;
     size_t i;
     if (be->programs[p]) return HD_SUCCESS;
@@ -443,8 +443,8 @@ static hd_result hd__gl_program(const hd__view *vw, int p)
     } else {
         int len = snprintf(prefix, sizeof prefix,
                            "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE %d\n"
-                           "layout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n%s",
-                           HD_MAX_LIGHTS, stage + 1, HD__GL_LOCAL_X, half ? "#define HD_ILLUM_R16F 1\n" : "");
+                           "#define HD_VOL_STORE %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n%s",
+                           HD_MAX_LIGHTS, stage + 1, vw->vtype, HD__GL_LOCAL_X, half ? "#define HD_ILLUM_R16F 1\n" : "");
         if (q >= HD__GL_PROGRAM_COUNT)
             snprintf(prefix + len, sizeof prefix - (size_t)len, "#define HD_DIFFUSE_FLAGS %d\n#define HD_DIFFUSE_ZK %d\n#define HD_DIFFUSE_YK %d\n",
                      hd__gl_diffuse_flags(q - HD__GL_PROGRAM_COUNT), be->diffuse_zk, be->diffuse_yk);
@@ -521,6 +521,7 @@ static hd_result hd__gl_tex_new_as(const hd__view *vw, hd__gl_tex *t, int w, int
     t->format = fmt;
     if ((r = hd__gl_check(vw, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
     if (src) be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, w, h, d, GL_RED, GL_FLOAT, src);
+    else if (fmt == GL_R8UI || fmt == GL_R16UI || fmt == GL_R16I) (void)0; /* the volume: hd__gl_vol_new fills it */
     else if (be->gl.ClearTexImage && be->version >= 44) be->gl.ClearTexImage(t->name, 0, GL_RED, GL_FLOAT, NULL);
     else {
         float *zero = (float *)hd__calloc(vw, (size_t)w * h * d, sizeof(float));
@@ -530,6 +531,55 @@ static hd_result hd__gl_tex_new_as(const hd__view *vw, hd__gl_tex *t, int w, int
     }
     if ((r = hd__gl_check(vw, what, __LINE__)) != HD_SUCCESS) { hd__gl_free_tex(be, t); return r; }
     return HD_SUCCESS;
+}
+
+/* The volume's texture format and its upload's format and type, by the core's storage (vtype):
+   the integer formats keep the raw voxels, which the programs read with imageLoad as they are
+   (hd_bind_gl_glsl.h's HD_VOL_STORE). */
+static void hd__gl_vol_format(int vtype, GLenum *fmt, GLenum *up_fmt, GLenum *up_type)
+{
+    *fmt = vtype == HD_VOL_U8 ? GL_R8UI : vtype == HD_VOL_U16 ? GL_R16UI : vtype == HD_VOL_I16 ? GL_R16I : GL_R32F;
+    *up_fmt = vtype == HD_VOL_F32 ? GL_RED : GL_RED_INTEGER;
+    *up_type = vtype == HD_VOL_U8 ? GL_UNSIGNED_BYTE : vtype == HD_VOL_U16 ? GL_UNSIGNED_SHORT : vtype == HD_VOL_I16 ? GL_SHORT : GL_FLOAT;
+}
+
+/* Voxels of box vox from the core's copy into the volume texture: one TexSubImage3D, the unpack
+   row length and image height set for it (rows of 1- and 2-byte voxels are not 4-byte aligned)
+   and put back to the bracket's defaults. */
+static void hd__gl_vol_write(const hd__view *vw, const hd__box *vox)
+{
+    hd__backend *be = vw->be;
+    GLenum fmt, up_fmt, up_type;
+    hd__gl_vol_format(vw->vtype, &fmt, &up_fmt, &up_type);
+    be->gl.BindTexture(GL_TEXTURE_3D, be->vol.name);
+    be->gl.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, vw->dims[0]);
+    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, vw->dims[1]);
+    be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, vox->lo[0], vox->lo[1], vox->lo[2], vox->hi[0] - vox->lo[0], vox->hi[1] - vox->lo[1],
+                         vox->hi[2] - vox->lo[2], up_fmt, up_type,
+                         (const unsigned char *)vw->vol +
+                             (((size_t)vox->lo[2] * vw->dims[1] + vox->lo[1]) * vw->dims[0] + vox->lo[0]) * hd__vol_elem(vw->vtype));
+    be->gl.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+}
+
+/* The volume's texture in the core's storage, filled from its copy. */
+static hd_result hd__gl_vol_new(const hd__view *vw)
+{
+    hd__backend *be = vw->be;
+    hd__box all;
+    GLenum fmt, up_fmt, up_type;
+    hd_result r;
+    int d;
+    hd__gl_vol_format(vw->vtype, &fmt, &up_fmt, &up_type);
+    if ((r = hd__gl_tex_new_as(vw, &be->vol, vw->dims[0], vw->dims[1], vw->dims[2], fmt, NULL, "the volume")) != HD_SUCCESS) return r;
+    for (d = 0; d < 3; ++d) {
+        all.lo[d] = 0;
+        all.hi[d] = vw->dims[d];
+    }
+    hd__gl_vol_write(vw, &all);
+    return hd__gl_check(vw, "uploading the volume", __LINE__);
 }
 
 /* A GL_R32F 3D texture, the grids' usual form. */
@@ -789,7 +839,7 @@ static hd_result hd__gl_setup(const hd__view *vw)
     if ((r = hd__gl_buffer_data(vw, &be->dummy_buffer, 16, NULL, GL_STATIC_DRAW, "a placeholder buffer")) != HD_SUCCESS) return r;
     if ((r = hd__gl_tex_new(vw, &be->dummy, 1, 1, 1, NULL, "a placeholder image")) != HD_SUCCESS) return r;
     if ((r = hd__gl_tex_new_as(vw, &be->dummy16, 1, 1, 1, GL_R16F, NULL, "a float16 placeholder image")) != HD_SUCCESS) return r;
-    return hd__gl_tex_new(vw, &be->vol, vw->dims[0], vw->dims[1], vw->dims[2], vw->vol, "the volume");
+    return hd__gl_vol_new(vw);
 }
 
 static hd_result hd__be_create(hd__view *vw)
@@ -845,14 +895,7 @@ static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, co
 {
     hd__backend *be = vw->be;
     int y, z;
-    be->gl.BindTexture(GL_TEXTURE_3D, be->vol.name);
-    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, vw->dims[0]);
-    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, vw->dims[1]);
-    be->gl.TexSubImage3D(GL_TEXTURE_3D, 0, vox->lo[0], vox->lo[1], vox->lo[2], vox->hi[0] - vox->lo[0], vox->hi[1] - vox->lo[1],
-                         vox->hi[2] - vox->lo[2], GL_RED, GL_FLOAT,
-                         vw->vol + ((size_t)vox->lo[2] * vw->dims[1] + vox->lo[1]) * vw->dims[0] + vox->lo[0]);
-    be->gl.PixelStorei(GL_UNPACK_ROW_LENGTH, 0);
-    be->gl.PixelStorei(GL_UNPACK_IMAGE_HEIGHT, 0);
+    hd__gl_vol_write(vw, vox);
     be->gl.BindBuffer(GL_COPY_WRITE_BUFFER, be->maj);
     for (z = cells->lo[2]; z < cells->hi[2]; ++z)
         for (y = cells->lo[1]; y < cells->hi[1]; ++y) {
@@ -1177,8 +1220,8 @@ static hd_result hd__gl_mg_program(const hd__view *vw, int stage, int counts_z, 
     if (!*slot) {
         snprintf(prefix, sizeof prefix,
                  "#version 430 core\n#define HD_MAX_LIGHTS %d\n#define HD_STAGE 0\n#define HD_MG_STAGE %d\n"
-                 "#define HD_DIFFUSE_FLAGS %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
-                 HD_MAX_LIGHTS, stage, flags, HD__GL_LOCAL_X);
+                 "#define HD_DIFFUSE_FLAGS %d\n#define HD_VOL_STORE %d\nlayout(local_size_x = %d, local_size_y = 1, local_size_z = 1) in;\n",
+                 HD_MAX_LIGHTS, stage, flags, vw->vtype, HD__GL_LOCAL_X);
         src[0] = prefix;
         for (i = 0; i < HD__GL_COMMON_LINES; ++i) src[1 + i] = hd__gl_source[i];
         for (i = 0; i < HD__GL_SOURCE_MG_LINES; ++i) src[1 + HD__GL_COMMON_LINES + i] = hd__gl_source_mg[i];

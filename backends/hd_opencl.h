@@ -427,7 +427,8 @@ static hd_result hd__be_create(hd__view *vw)
     HD__INFO(&vw->log, "opencl: device %s (%s)%s", name, version, be->fp64 ? "" : ", no double precision (no multigrid solver)");
     if ((r = hd__cl_build(vw)) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(vw, &be->params, sizeof(hd__kparams), NULL, "the parameter block")) != HD_SUCCESS) return r;
-    if ((r = hd__cl_buffer(vw, &be->vol, vw->nvox * sizeof(float), vw->vol, "the volume")) != HD_SUCCESS) return r;
+    /* the volume as the core keeps it: U8 / U16 / I16 (read as uchar / ushort / short) or floats */
+    if ((r = hd__cl_buffer(vw, &be->vol, vw->nvox * hd__vol_elem(vw->vtype), vw->vol, "the volume")) != HD_SUCCESS) return r;
     if ((r = hd__cl_buffer(vw, &be->maj, ncell * sizeof(float), NULL, "the majorant grid")) != HD_SUCCESS) return r;
     return HD_SUCCESS;
 }
@@ -455,13 +456,13 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
 static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
 {
     hd__backend *be = vw->be;
-    size_t o[3], n[3], f = sizeof(float);
-    size_t vr = (size_t)vw->dims[0] * f, vs = vr * (size_t)vw->dims[1];
+    size_t o[3], n[3], f = sizeof(float), e = hd__vol_elem(vw->vtype);
+    size_t vr = (size_t)vw->dims[0] * e, vs = vr * (size_t)vw->dims[1];
     size_t mr = (size_t)vw->mdims[0] * f, ms = mr * (size_t)vw->mdims[1];
     int d;
     for (d = 0; d < 3; ++d) {
-        o[d] = (size_t)vox->lo[d] * (d == 0 ? f : 1);
-        n[d] = (size_t)(vox->hi[d] - vox->lo[d]) * (d == 0 ? f : 1);
+        o[d] = (size_t)vox->lo[d] * (d == 0 ? e : 1);
+        n[d] = (size_t)(vox->hi[d] - vox->lo[d]) * (d == 0 ? e : 1);
     }
     HD__CL_TRY(vw, clEnqueueWriteBufferRect(be->queue, be->vol, CL_TRUE, o, o, n, vr, vs, vr, vs, vw->vol, 0, NULL, NULL),
                "clEnqueueWriteBufferRect(volume)");

@@ -143,7 +143,7 @@ HD_FN size_t hd__split_slots(int gx, int gy, size_t slices)
 
 typedef struct hd__kctx {
     const hd__kparams *p;
-    const float *vol;  /* normalised voxel values, dims.x*dims.y*dims.z */
+    const void *vol;   /* the volume, dims.x*dims.y*dims.z voxels as p->vstore.x stores them */
     const float *tf;   /* RGBA * TF count */
     const float *maj;  /* majorant per cell of the majorant grid */
     float *sig;        /* sigma_t at the illumination grid's voxel centres */
@@ -162,6 +162,13 @@ typedef struct hd__kctx {
     const float *lv;   /* CD: the light volume being read (one light's rho) */
     float *lv2;        /* CD: the light volume being written (ping-pong) */
 } hd__kctx;
+
+HD_FN float hd__c_vol_raw(const hd__kctx *K, int i, int t)
+{
+    return t == HD_VOL_U8 ? (float)((const uint8_t *)K->vol)[i]
+         : t == HD_VOL_U16 ? (float)((const uint16_t *)K->vol)[i]
+         : t == HD_VOL_I16 ? (float)((const int16_t *)K->vol)[i] : ((const float *)K->vol)[i];
+}
 
 /* The projection's shortcuts (hd_k_project.h), taken where the CPU backend fills them in. */
 #define HD_PRELUDE_LIGHT_SUM 1
@@ -186,7 +193,8 @@ typedef struct hd__kctx {
    loads per sample pay for every instruction of the address */
 #define HD__C_AT(xx, yy, zz) \
     ((((zz) * 2 + (((xx) + (yy) + (zz)) & 1)) * K->p->gdims.y + (yy)) * ((K->p->gdims.x + 1) >> 1) + ((xx) >> 1))
-#define HD__LD_vol(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->vol[(i)])
+/* Voxel i of the volume as stored (t: HD_VOL_*), the raw integer or the F32 volume's value. */
+#define HD_VOL_RAW(i, x, y, z, t) ((void)(x), (void)(y), (void)(z), hd__c_vol_raw(K, (i), (t)))
 #define HD__LD_lv(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv[(i)])
 #define HD__LD_lv2(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lv2[(i)])
 #define HD__LD_lsum(i, x, y, z) ((void)(x), (void)(y), (void)(z), K->lsum[(i)])

@@ -96,7 +96,7 @@ HD_FN int hdk_clampi(int v, int lo, int hi) { return v < lo ? lo : (v > hi ? hi 
    __kernel entry points in hd_entry_cl.h. */
 typedef struct hd__kctx {
     __constant struct hd__kparams *p;
-    __global const float *vol;
+    __global const float *vol;  /* the volume as p->vstore.x stores it (HD_VOL_RAW reads it) */
     __global const float *tf;
     __global const float *maj;
     __global float *sig;
@@ -127,6 +127,15 @@ typedef struct hd__kctx {
     int hx, gy, cx, cp;
     size_t cid;
 } hd__kctx;
+
+/* Voxel i of the volume as stored (t: HD_VOL_* of hd_k_params.h, which comes after this file:
+   1 U8, 2 U16, 3 I16, 0 F32): the raw integer, or the F32 volume's value. */
+HD_FN float hd__cl_vol_raw(const hd__kctx *K, int i, int t)
+{
+    return t == 1 ? (float)((__global const uchar *)K->vol)[i]
+         : t == 2 ? (float)((__global const ushort *)K->vol)[i]
+         : t == 3 ? (float)((__global const short *)K->vol)[i] : K->vol[i];
+}
 
 /* The projection reads the summed light grid and the step's TF table (hd_k_project.h); the
    backend keeps both up to date before every projection. */
@@ -163,7 +172,7 @@ typedef struct hd__kctx {
 #define HD__CL_AT(x, y, zz) \
     ((((zz) * 2 + ((K->cp + HD__CL_D(x) + (y) + (zz)) & 1)) * K->gy + (y)) * K->hx + ((HD__CL_D(x) + K->cp) >> 1))
 #define HD__CL_COL(buf, x, y, zz) ((K->buf + K->cid)[HD__CL_AT(x, y, zz)])
-#define HD__LD_vol(i, x, y, z) (K->vol[(i)])
+#define HD_VOL_RAW(i, x, y, z, t) hd__cl_vol_raw(K, (i), (t))
 #define HD__LD_lv(i, x, y, z) (K->lv[(i)])
 #define HD__LD_lv2(i, x, y, z) (K->lv2[(i)])
 #define HD__LD_lsum(i, x, y, z) (K->lsum[(i)])

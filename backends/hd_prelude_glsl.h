@@ -87,7 +87,18 @@ float hdk_f16_round(float v)
 #define HD_PRM(name) (hd_kp.name)
 
 #ifndef HD_GLSL_CUSTOM_BUFFERS
-layout(std430, binding = 1) readonly buffer hd_b_vol { float vol[]; };
+/* The volume packed in words: an F32 volume's floats, 2 voxels a word for the 16-bit storages,
+   4 for U8 (voxel i in word i >> 1 or i >> 2, the first in the low bits); t is HD_VOL_* (1 U8,
+   2 U16, 3 I16, hd_k_params.h, which comes after this file). */
+layout(std430, binding = 1) readonly buffer hd_b_vol { uint vol[]; };
+float hd_vol_raw_at(int i, int t)
+{
+    if (t == 1) return float(bitfieldExtract(vol[i >> 2], 8 * (i & 3), 8));
+    if (t == 2) return float(bitfieldExtract(vol[i >> 1], 16 * (i & 1), 16));
+    if (t == 3) return float(bitfieldExtract(int(vol[i >> 1]), 16 * (i & 1), 16));
+    return uintBitsToFloat(vol[i]);
+}
+#define HD_VOL_RAW(i, x, y, z, t) hd_vol_raw_at((i), (t))
 layout(std430, binding = 2) readonly buffer hd_b_tf { float tf[]; };
 layout(std430, binding = 3) readonly buffer hd_b_maj { float maj[]; };
 layout(std430, binding = 4) buffer hd_b_sig { float sig[]; };

@@ -622,11 +622,6 @@ static hd_result hd__vk_image_create_as(const hd__view *vw, hd__vk_image *im, in
     return HD_SUCCESS;
 }
 
-/* An r32f storage image3D, the grids' usual form. */
-static hd_result hd__vk_image_create(const hd__view *vw, hd__vk_image *im, int w, int h, int d, const char *what)
-{
-    return hd__vk_image_create_as(vw, im, w, h, d, VK_FORMAT_R32_SFLOAT, 0, what);
-}
 
 /* ---- command buffers -------------------------------------------------------------------------- */
 /* The command buffer to record into: the caller's (hd_vulkan_record) or the backend's, begun. */
@@ -821,7 +816,55 @@ static VkBufferImageCopy hd__vk_region(const hd__vk_image *im)
     return reg;
 }
 
-/* Whole image <- host floats (x fastest), submitted and waited for; an r16f image gets them
+/* The volume image packs voxels along x into r32ui texels (hd_bind_vk_glsl.h): 4 U8, 2 U16 / I16
+   or 1 float each. Texels of a row of n voxels: */
+static size_t hd__vk_vol_texels(const hd__view *vw, int n)
+{
+    size_t per = 4 / hd__vol_elem(vw->vtype);
+    return ((size_t)n + per - 1) / per;
+}
+
+/* The texels holding box vox's voxels, from the core's copy through the staging buffer (one
+   region, submitted and waited for): the box widened to whole texels along x, a row's last
+   texel zero-padded past the volume's end. */
+static hd_result hd__vk_vol_write(const hd__view *vw, const hd__box *vox)
+{
+    hd__backend *be = vw->be;
+    hd__vk_image *im = &be->vol;
+    size_t e = hd__vol_elem(vw->vtype), per = 4 / e;
+    size_t t0 = (size_t)vox->lo[0] / per, t1 = hd__vk_vol_texels(vw, vox->hi[0]), row = (t1 - t0) * 4;
+    size_t v0 = t0 * per, v1 = t1 * per < (size_t)vw->dims[0] ? t1 * per : (size_t)vw->dims[0];
+    int h = vox->hi[1] - vox->lo[1], dz = vox->hi[2] - vox->lo[2], y, z;
+    unsigned char *dst;
+    VkBufferImageCopy reg = hd__vk_region(im);
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r; /* the staging buffer is free */
+    if ((r = hd__vk_staging(vw, row * (size_t)h * (size_t)dz)) != HD_SUCCESS) return r;
+    dst = (unsigned char *)be->staging.map;
+    for (z = vox->lo[2]; z < vox->hi[2]; ++z)
+        for (y = vox->lo[1]; y < vox->hi[1]; ++y) {
+            const unsigned char *src = (const unsigned char *)vw->vol + (((size_t)z * vw->dims[1] + y) * vw->dims[0] + v0) * e;
+            memcpy(dst, src, (v1 - v0) * e);
+            memset(dst + (v1 - v0) * e, 0, row - (v1 - v0) * e);
+            dst += row;
+        }
+    reg.imageOffset.x = (int32_t)t0;
+    reg.imageOffset.y = vox->lo[1];
+    reg.imageOffset.z = vox->lo[2];
+    reg.imageExtent.width = (uint32_t)(t1 - t0);
+    reg.imageExtent.height = (uint32_t)h;
+    reg.imageExtent.depth = (uint32_t)dz;
+    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
+    hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+    return hd__vk_flush(vw);
+}
+
+#ifdef HYBRIDDIFF_TESTING
+/* Whole image <- host floats (x fastest), submitted and waited for (the test hooks' and the
+   benchmarks' writes of E and phi); an r16f image gets them
    rounded to nearest even (hdk_f2h, the CPU backend's rounding). */
 static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const float *src)
 {
@@ -844,6 +887,7 @@ static hd_result hd__vk_upload_image(const hd__view *vw, hd__vk_image *im, const
     hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
     return hd__vk_flush(vw);
 }
+#endif
 
 /* Whole image -> host floats (x fastest; channels stacked along z come out channel-planar), or
    with a slice list (list, count) those z slices only, in its order, in one copy; an r16f
@@ -932,24 +976,26 @@ static hd_result hd__vk_pipeline_code(const hd__view *vw, const uint32_t *code, 
                                       VkPipeline *out)
 {
     hd__backend *be = vw->be;
-    VkSpecializationMapEntry sme[4];
+    VkSpecializationMapEntry sme[5];
     VkSpecializationInfo spec;
-    int32_t data[4];
+    int32_t data[5];
     int i;
     data[0] = flags ? *flags : 0;
     data[1] = be->diffuse_zk;
     data[2] = jacobi;
     data[3] = be->diffuse_yk;
-    for (i = 0; i < 4; ++i) {
+    data[4] = vw->vtype; /* hd_sc_vstore: every stage's volume load */
+    for (i = 0; i < 5; ++i) {
         sme[i].constantID = (uint32_t)i;
         sme[i].offset = (uint32_t)(i * sizeof data[0]);
         sme[i].size = sizeof data[0];
     }
-    spec.mapEntryCount = 4;
-    spec.pMapEntries = sme;
+    /* without flags (not the diffusion stage) only the volume's storage is specialized */
+    spec.mapEntryCount = flags ? 5 : 1;
+    spec.pMapEntries = flags ? sme : sme + 4;
     spec.dataSize = sizeof data;
     spec.pData = data;
-    return hd__vk_compute_pipeline(vw, code, bytes, flags ? &spec : NULL, be->layout, out);
+    return hd__vk_compute_pipeline(vw, code, bytes, &spec, be->layout, out);
 }
 
 /* Stage p's pipeline; half: from its r16f SPIR-V (only the stages that touch E / phi have one). */
@@ -1469,9 +1515,19 @@ static hd_result hd__be_create(hd__view *vw)
     if ((r = hd__vk_image_new(vw, &be->dummy, 1, 1, 1, "a placeholder image")) != HD_SUCCESS) return r;
     if ((r = hd__vk_buffer_create(vw, &be->maj, (VkDeviceSize)vw->mdims[0] * vw->mdims[1] * vw->mdims[2] * sizeof(float),
                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 1, "the majorant grid")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_create(vw, &be->vol, vw->dims[0], vw->dims[1], vw->dims[2], "the volume")) != HD_SUCCESS) return r;
-    if ((r = hd__vk_image_init(vw, &be->vol)) != HD_SUCCESS) return r;
-    return hd__vk_upload_image(vw, &be->vol, vw->vol);
+    {
+        hd__box all;
+        int d;
+        if ((r = hd__vk_image_create_as(vw, &be->vol, (int)hd__vk_vol_texels(vw, vw->dims[0]), vw->dims[1], vw->dims[2],
+                                        VK_FORMAT_R32_UINT, 0, "the volume")) != HD_SUCCESS)
+            return r;
+        if ((r = hd__vk_image_init(vw, &be->vol)) != HD_SUCCESS) return r;
+        for (d = 0; d < 3; ++d) {
+            all.lo[d] = 0;
+            all.hi[d] = vw->dims[d];
+        }
+        return hd__vk_vol_write(vw, &all);
+    }
 }
 
 /* TF and majorants: small host-visible buffers written in place (nothing is in flight here). */
@@ -1505,39 +1561,15 @@ static hd_result hd__be_upload_inputs(const hd__view *vw)
     return HD_SUCCESS;
 }
 
-/* hd_update_volume: the box of the volume through the staging buffer into the volume image (one
-   region, submitted and waited for), the majorant cells' rows written in place. */
+/* hd_update_volume: the box of the volume into the volume image (hd__vk_vol_write), the majorant
+   cells' rows written in place. */
 static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, const hd__box *cells)
 {
     hd__backend *be = vw->be;
-    hd__vk_image *im = &be->vol;
-    int w = vox->hi[0] - vox->lo[0], h = vox->hi[1] - vox->lo[1], dz = vox->hi[2] - vox->lo[2], x, y, z;
-    size_t bytes = (size_t)w * h * dz * (size_t)im->texel, k = 0;
-    VkBufferImageCopy reg = hd__vk_region(im);
-    VkCommandBuffer cb = VK_NULL_HANDLE;
+    int y, z;
     hd_result r;
     HD__VK_IDLE(vw); /* the staging buffer and the majorants are free */
-    if ((r = hd__vk_staging(vw, bytes)) != HD_SUCCESS) return r;
-    for (z = vox->lo[2]; z < vox->hi[2]; ++z)
-        for (y = vox->lo[1]; y < vox->hi[1]; ++y) {
-            const float *row = vw->vol + ((size_t)z * vw->dims[1] + y) * vw->dims[0] + vox->lo[0];
-            if (im->texel == 2)
-                for (x = 0; x < w; ++x) ((uint16_t *)be->staging.map)[k + (size_t)x] = hdk_f2h(row[x]);
-            else
-                memcpy((float *)be->staging.map + k, row, (size_t)w * sizeof(float));
-            k += (size_t)w;
-        }
-    reg.imageOffset.x = vox->lo[0];
-    reg.imageOffset.y = vox->lo[1];
-    reg.imageOffset.z = vox->lo[2];
-    reg.imageExtent.width = (uint32_t)w;
-    reg.imageExtent.height = (uint32_t)h;
-    reg.imageExtent.depth = (uint32_t)dz;
-    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
-    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
-    hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_vol_write(vw, vox)) != HD_SUCCESS) return r;
     for (z = cells->lo[2]; z < cells->hi[2]; ++z)
         for (y = cells->lo[1]; y < cells->hi[1]; ++y) {
             size_t at = ((size_t)z * vw->mdims[1] + y) * vw->mdims[0] + (size_t)cells->lo[0];

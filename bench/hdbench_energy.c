@@ -375,7 +375,7 @@ static uint64_t ref_key(const scene *s, hd_method m)
 {
     uint64_t h = 1469598103934665603ull;
     size_t nvox = (size_t)s->vol.desc.dims[0] * s->vol.desc.dims[1] * s->vol.desc.dims[2];
-    size_t vb = s->vol.desc.type == HD_VOXEL_U8 ? 1 : s->vol.desc.type == HD_VOXEL_U16 ? 2 : 4;
+    size_t vb = s->vol.desc.type == HD_VOXEL_U8 ? 1 : s->vol.desc.type == HD_VOXEL_U16 || s->vol.desc.type == HD_VOXEL_I16 ? 2 : 4;
     float optics[4] = {EXTINCTION, ALBEDO, (float)MAX_BOUNCES, 40.0f};
     int ints[4];
     ints[0] = (int)m;

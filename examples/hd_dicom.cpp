@@ -1159,6 +1159,21 @@ extern "C" int hdx_dicom_load_series(const char *dir_c, hd_volume_file *out, cha
         hi = std::max(hi, data[i]);
     }
     out->desc.type = HD_VOXEL_F32;
+    // Hounsfield units (integers within int16 after the rescale, as CTs are) are kept as I16:
+    // half the bytes, and the library keeps them so on the device
+    bool integral = lo >= -32768.0f && hi <= 32767.0f;
+    for (size_t i = 0; integral && i < total; ++i) integral = data[i] == std::floor(data[i]);
+    if (integral) {
+        unsigned char *b = (unsigned char *)data; // in place: voxel i's 2 bytes go where floats <= i were read
+        for (size_t i = 0; i < total; ++i) {
+            float f;
+            std::memcpy(&f, b + 4 * i, sizeof f);
+            const int16_t v = (int16_t)f;
+            std::memcpy(b + 2 * i, &v, sizeof v);
+        }
+        if (int16_t *shrunk = (int16_t *)std::realloc(data, total * sizeof(int16_t))) data = (float *)shrunk;
+        out->desc.type = HD_VOXEL_I16;
+    }
     out->desc.dims[0] = (int)cols;
     out->desc.dims[1] = (int)rows;
     out->desc.dims[2] = (int)slices.size();

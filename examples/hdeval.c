@@ -279,7 +279,7 @@ static uint64_t ref_key(int m, int lights)
     char buf[2048];
     uint64_t h = 1469598103934665603ull;
     size_t nvox = (size_t)g_vol.desc.dims[0] * g_vol.desc.dims[1] * g_vol.desc.dims[2];
-    size_t vbytes = g_vol.desc.type == HD_VOXEL_U8 ? 1 : g_vol.desc.type == HD_VOXEL_U16 ? 2 : 4;
+    size_t vbytes = g_vol.desc.type == HD_VOXEL_U8 ? 1 : g_vol.desc.type == HD_VOXEL_U16 || g_vol.desc.type == HD_VOXEL_I16 ? 2 : 4;
     int i;
     h = fnv(h, g_vol.data, nvox * vbytes);
     h = fnv(h, g_tf.rgba, (size_t)g_tf.count * 4 * sizeof(float));

@@ -508,7 +508,7 @@ static void progress(int done, int total, double elapsed, int final)
 
 static const char *voxel_type_name(hd_voxel_type t)
 {
-    return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32";
+    return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : t == HD_VOXEL_I16 ? "i16" : "f32";
 }
 
 /* ---- defaults for data other than the head CT ------------------------------------------------- */
@@ -517,6 +517,7 @@ static float voxel_value(const hd_volume_file *v, size_t i)
 {
     if (v->desc.type == HD_VOXEL_U8) return (float)((const uint8_t *)v->data)[i];
     if (v->desc.type == HD_VOXEL_U16) return (float)((const uint16_t *)v->data)[i];
+    if (v->desc.type == HD_VOXEL_I16) return (float)((const int16_t *)v->data)[i];
     return ((const float *)v->data)[i];
 }
 
@@ -1050,7 +1051,7 @@ int main(int argc, char **argv)
     }
 
     if (!tf_arg) {
-        if (vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f) hdx_tf_preset("ct-skin", &tf);
+        if ((vol.desc.type == HD_VOXEL_F32 || vol.desc.type == HD_VOXEL_I16) && vol.value_min <= -500.0f) hdx_tf_preset("ct-skin", &tf);
         else histogram_tf(&vol, &tf);
     }
     if (!camera_given && !raw) known_volume_camera(input, &vol, &desc.camera);

@@ -623,7 +623,7 @@ int main(int argc, char **argv)
     resize(&v, w, h);
 
     /* the scene: hdrender's defaults */
-    v.is_ct = vol.desc.type == HD_VOXEL_F32 && vol.value_min <= -500.0f;
+    v.is_ct = (vol.desc.type == HD_VOXEL_F32 || vol.desc.type == HD_VOXEL_I16) && vol.value_min <= -500.0f;
     v.vmin = vol.value_min;
     v.vmax = vol.value_max;
     set_tf(&v, v.is_ct ? 0 : HDX_TF_PRESET_COUNT - 1);

@@ -90,8 +90,11 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
     if (d.volume.spacing[0] == 0.0f && d.volume.spacing[1] == 0.0f && d.volume.spacing[2] == 0.0f)
         d.volume.spacing[0] = d.volume.spacing[1] = d.volume.spacing[2] = 1.0f;
-    if (d.volume.value_range[0] == 0.0f && d.volume.value_range[1] == 0.0f)
-        d.volume.value_range[1] = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f : 1.0f;
+    if (d.volume.value_range[0] == 0.0f && d.volume.value_range[1] == 0.0f) {
+        d.volume.value_range[0] = d.volume.type == HD_VOXEL_I16 ? -32768.0f : 0.0f;
+        d.volume.value_range[1] = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f
+                                : d.volume.type == HD_VOXEL_I16 ? 32767.0f : 1.0f;
+    }
     if (!d.allocator.alloc) { d.allocator.alloc = hd__malloc_default; d.allocator.free = hd__free_default; }
 
     ctx = (hd__ctx *)d.allocator.alloc(sizeof *ctx, d.allocator.user_data);

@@ -168,7 +168,6 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                     enum { B = HD__MAJORANT_CELL + 1 };
                     int32_t blk[B * B * B];
                     int c[3], lo[3], hi[3], bx, by, bz;
-                    const float *vol = ctx->vw.vol;
                     size_t i = ((size_t)cz * ctx->vw.mdims[1] + cy) * ctx->vw.mdims[0] + cx;
                     if (hd__dl_run_range(entry_run, ctx->vw.tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
                     c[0] = cx; c[1] = cy; c[2] = cz;
@@ -187,7 +186,7 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                         for (y = 0; y < by; ++y)
                             for (x = 0; x < bx; ++x)
                                 blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
-                                                                      vol[((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x]);
+                                                                      hd__vol_value(&ctx->vw, ((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x));
                     for (z = lo[2]; z < hi[2]; ++z)
                         for (y = lo[1]; y < hi[1]; ++y)
                             for (x = lo[0]; x < hi[0]; ++x) {
@@ -201,12 +200,14 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                                 const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
                                 int xa = x - lo[0], xb = x1 - lo[0];
                                 int32_t a = b0[xa];
-                                float v = vol[r00 + x];
+                                float v = hd__vol_value(&ctx->vw, r00 + x);
                                 uint8_t full_cell = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
                                                       b3[xa] == a && b3[xb] == a);
                                 /* 8 equal values interpolate to that value exactly, whatever the weights */
-                                if (full_cell && vol[r00 + x1] == v && vol[r10 + x] == v && vol[r10 + x1] == v && vol[r01 + x] == v &&
-                                    vol[r01 + x1] == v && vol[r11 + x] == v && vol[r11 + x1] == v &&
+                                if (full_cell && hd__vol_value(&ctx->vw, r00 + x1) == v && hd__vol_value(&ctx->vw, r10 + x) == v &&
+                                    hd__vol_value(&ctx->vw, r10 + x1) == v && hd__vol_value(&ctx->vw, r01 + x) == v &&
+                                    hd__vol_value(&ctx->vw, r01 + x1) == v && hd__vol_value(&ctx->vw, r11 + x) == v &&
+                                    hd__vol_value(&ctx->vw, r11 + x1) == v &&
                                     !(hd__tf_alpha(ctx, v) * ctx->vw.params.extinction > 0.0f))
                                     full_cell = 0;
                                 if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full_cell = 0;

@@ -55,10 +55,14 @@ typedef struct hd__view {
                                 (desc.opencl, .vulkan, .gl, .threads) */
     hd_params params;        /* the current parameters (defaults filled in) */
     hd_camera camera;        /* the current camera: the image is camera.width x height */
-    /* the volume: normalised voxel values in [0, 1], x fastest */
+    /* the volume, x fastest, as vtype stores it (hd_k_params.h): HD_VOL_F32 holds the voxels'
+       normalised values in [0, 1], HD_VOL_U8 / U16 / I16 the raw voxels, which the kernels and
+       hd__vol_value map to [0, 1] as clamp((raw - vnorm[0]) * vnorm[1], 0, 1) */
     int dims[3];
     size_t nvox;
-    float *vol;
+    void *vol;
+    int vtype;
+    float vnorm[2];
     int mdims[3];            /* the majorant grid (HD__MAJORANT_CELL voxels per cell edge) */
     float *majorant;         /* per cell: max sigma_t (0 outside the crop box) */
     float *tf;               /* the transfer function: RGBA * tf_count */
@@ -86,6 +90,9 @@ typedef struct hd__view {
                                 bottom first; 2 from a Vulkan image or buffer (hd_vulkan_record_depth),
                                 3 from an OpenCL buffer (hd_opencl_set_depth_buffer), rows top first */
 } hd__view;
+
+/* Bytes of one voxel as vtype stores it. */
+static size_t hd__vol_elem(int vtype) { return vtype == HD_VOL_U8 ? 1 : vtype == HD_VOL_F32 ? 4 : 2; }
 
 /* ---- logging ---------------------------------------------------------------------------- */
 static void hd__logf(const hd_logger *log, hd_log_level level, hd_result code, const char *file,

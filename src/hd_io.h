@@ -10,8 +10,9 @@
    what really inflates. So the peak allocation is the loaded volume (twice it while a growing
    buffer is copied) plus the header and one chunk, whatever the header claims.
 
-   Output types: u8 stays HD_VOXEL_U8, u16 stays HD_VOXEL_U16, every other type is converted to
-   HD_VOXEL_F32 (non-finite values become 0, with a warning). desc.value_range is the range of the
+   Output types: u8 stays HD_VOXEL_U8, u16 stays HD_VOXEL_U16, i16 stays HD_VOXEL_I16 (a CT in
+   Hounsfield units) and i8 widens to it; every other type is converted to HD_VOXEL_F32
+   (non-finite values become 0, with a warning). desc.value_range is the range of the
    values in the file ({v, v + 1} for a constant volume, so that the range is never empty).
 
    Order of the size checks (NRRD sizes and raw dims alike): a size <= 0 is
@@ -162,7 +163,10 @@ static void hd__io_free(const hd__io_opt *o, void *p)
 }
 
 /* Bytes a voxel takes once loaded: u8 and u16 stay, the rest becomes f32. */
-static size_t hd__io_out_size(int type) { return type == HD__IO_U8 ? 1 : type == HD__IO_U16 ? 2 : 4; }
+static size_t hd__io_out_size(int type)
+{
+    return type == HD__IO_U8 ? 1 : type == HD__IO_U16 || type == HD__IO_I16 || type == HD__IO_I8 ? 2 : 4;
+}
 
 /* hd_load_options.max_bytes: the data as stored and as loaded, whichever is larger. */
 static hd_result hd__io_check_limit(size_t count, int type, const hd__io_opt *o, const char *what,
@@ -352,6 +356,17 @@ static void hd__io_conv_elems(hd__io_conv *c, const unsigned char *src, size_t k
         }
         if (vlo < lo) lo = vlo;
         if (vhi > hi) hi = vhi;
+    } else if (c->type == HD__IO_I16 || c->type == HD__IO_I8) {
+        int16_t *d = (int16_t *)(void *)c->out + c->done;
+        int vlo = 32767, vhi = -32768;
+        for (i = 0; i < k; ++i) {
+            int v = (int)hd__io_value(src + c->esize * i, c->type, c->big);
+            d[i] = (int16_t)v;
+            if (v < vlo) vlo = v;
+            if (v > vhi) vhi = v;
+        }
+        if (vlo < lo) lo = vlo;
+        if (vhi > hi) hi = vhi;
     } else {
         float *d = (float *)(void *)c->out + c->done;
         for (i = 0; i < k; ++i) {
@@ -420,7 +435,8 @@ static void hd__io_conv_end(hd__io_conv *c, hd_volume_file *out, const hd__io_op
     out->data = c->out;
     out->desc.data = c->out;
     out->desc.type = c->type == HD__IO_U8 ? HD_VOXEL_U8
-                     : c->type == HD__IO_U16 ? HD_VOXEL_U16 : HD_VOXEL_F32;
+                     : c->type == HD__IO_U16 ? HD_VOXEL_U16
+                     : c->type == HD__IO_I16 || c->type == HD__IO_I8 ? HD_VOXEL_I16 : HD_VOXEL_F32;
     out->allocator = o->al;
     hd__io_set_range(out, c->lo, c->hi);
     c->out = NULL;

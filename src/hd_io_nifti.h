@@ -25,13 +25,37 @@ static float hd__io_f32(const unsigned char *p, int big)
     return f;
 }
 
-/* value * slope + inter, in place: out becomes F32 (converted from U8/U16 when needed). */
+/* The integer voxel i of an U8, U16 or I16 volume. */
+static double hd__io_int_at(const hd_volume_file *out, size_t i)
+{
+    return out->desc.type == HD_VOXEL_U8 ? (double)((const unsigned char *)out->data)[i]
+         : out->desc.type == HD_VOXEL_U16 ? (double)((const uint16_t *)out->data)[i] : (double)((const int16_t *)out->data)[i];
+}
+
+/* value * slope + inter, in place. An integer volume whose rescaled values are integers that
+   I16 holds (a CT stored unsigned with intercept -1024) becomes I16; otherwise out becomes F32
+   (converted from U8/U16/I16 when needed). */
 static hd_result hd__io_rescale(hd_volume_file *out, size_t count, double slope, double inter,
                                 const hd__io_opt *o, const hd_logger *logger)
 {
     float *d;
     double lo = 0.0, hi = 0.0;
     size_t i, bad = 0;
+    if (out->desc.type != HD_VOXEL_F32 && slope == floor(slope) && inter == floor(inter)) {
+        double a = (double)out->value_min * slope + inter, b = (double)out->value_max * slope + inter;
+        if (a >= -32768.0 && a <= 32767.0 && b >= -32768.0 && b <= 32767.0) {
+            int16_t *q = out->desc.type == HD_VOXEL_I16 ? (int16_t *)out->data : (int16_t *)hd__io_alloc(o, count * sizeof(int16_t));
+            if (!q)
+                return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "nifti: cannot allocate %zu voxels", count);
+            for (i = 0; i < count; ++i) q[i] = (int16_t)(hd__io_int_at(out, i) * slope + inter);
+            if (q != out->data) hd__io_free(o, out->data);
+            out->data = q;
+            out->desc.data = q;
+            out->desc.type = HD_VOXEL_I16;
+            hd__io_set_range(out, a < b ? a : b, a < b ? b : a);
+            return HD_SUCCESS;
+        }
+    }
     if (out->desc.type == HD_VOXEL_F32) {
         d = (float *)out->data;
     } else {
@@ -39,9 +63,7 @@ static hd_result hd__io_rescale(hd_volume_file *out, size_t count, double slope,
         if (!d)
             return HD__IO_FAIL(logger, HD_ERROR_OUT_OF_MEMORY, "nifti: cannot allocate %zu voxels",
                                count);
-        for (i = 0; i < count; ++i)
-            d[i] = out->desc.type == HD_VOXEL_U8 ? (float)((const unsigned char *)out->data)[i]
-                                                 : (float)((const uint16_t *)out->data)[i];
+        for (i = 0; i < count; ++i) d[i] = (float)hd__io_int_at(out, i);
         hd__io_free(o, out->data);
         out->data = d;
         out->desc.type = HD_VOXEL_F32;

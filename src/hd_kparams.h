@@ -74,6 +74,8 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->background.x = ctx->vw.params.background[0];
     k->background.y = ctx->vw.params.background[1];
     k->background.z = ctx->vw.params.background[2];
+    k->vstore.x = ctx->vw.vtype;
+    k->vnorm.x = ctx->vw.vnorm[0]; k->vnorm.y = ctx->vw.vnorm[1];
     k->chan_color.x = ctx->chan_color[0]; k->chan_color.y = ctx->chan_color[1]; k->chan_color.z = ctx->chan_color[2];
     /* the crop box is on when it cuts an axis; an axis it spans whole gets bounds no sample
        reaches, so samples at the volume's faces stay as without a crop box */

@@ -276,8 +276,9 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     out->image_bytes = hd__image_floats(ctx->vw.camera.width, ctx->vw.camera.height,
                                         (ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) *
                        sizeof(float);
-    /* every backend holds the volume and the majorant grid as floats and the TF as RGBA floats */
-    out->volume_bytes = ctx->vw.nvox * sizeof(float) + (size_t)ctx->vw.tf_count * 16 +
+    /* the volume as stored (U8, U16, I16 or normalised floats; Vulkan pads each row to 4 bytes),
+       the majorant grid as floats and the TF as RGBA floats */
+    out->volume_bytes = ctx->vw.nvox * hd__vol_elem(ctx->vw.vtype) + (size_t)ctx->vw.tf_count * 16 +
                         (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2] * sizeof(float);
     memcpy(out->illumination_dims, ctx->vw.gdims, sizeof ctx->vw.gdims);
     out->illumination_channels = ctx->vw.channels;

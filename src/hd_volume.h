@@ -6,6 +6,7 @@ static float hd__raw_value(const hd_volume_desc *v, size_t i)
     switch (v->type) {
     case HD_VOXEL_U8: return (float)((const uint8_t *)v->data)[i];
     case HD_VOXEL_U16: return (float)((const uint16_t *)v->data)[i];
+    case HD_VOXEL_I16: return (float)((const int16_t *)v->data)[i];
     default: return ((const float *)v->data)[i];
     }
 }
@@ -34,6 +35,20 @@ static float hd__norm_value(const hd__norm *m, float raw)
     return t != t ? 0.0f : (t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t));
 }
 
+/* The normalised value of voxel i as the kernels compute it (hdk_voxel, hd_k_common.h). */
+static float hd__vol_value(const hd__view *vw, size_t i)
+{
+    float raw;
+    switch (vw->vtype) {
+    case HD_VOL_U8: raw = (float)((const uint8_t *)vw->vol)[i]; break;
+    case HD_VOL_U16: raw = (float)((const uint16_t *)vw->vol)[i]; break;
+    case HD_VOL_I16: raw = (float)((const int16_t *)vw->vol)[i]; break;
+    default: return ((const float *)vw->vol)[i];
+    }
+    raw = (raw - vw->vnorm[0]) * vw->vnorm[1];
+    return raw < 0.0f ? 0.0f : (raw > 1.0f ? 1.0f : raw);
+}
+
 /* The value range a trilinear sample inside each majorant cell of the box can take: the min and
    max over the cell's voxels and a one-voxel halo (voxels c M - 1 .. c M + M per axis). */
 static void hd__cell_ranges(hd__ctx *ctx, const hd__box *cells)
@@ -49,10 +64,11 @@ static void hd__cell_ranges(hd__ctx *ctx, const hd__box *cells)
                 float lo = 1.0f, hi = 0.0f;
                 for (z = z0; z <= z1; ++z)
                     for (y = y0; y <= y1; ++y) {
-                        const float *row = ctx->vw.vol + ((size_t)z * n[1] + y) * n[0];
+                        size_t row = ((size_t)z * n[1] + y) * n[0];
                         for (x = x0; x <= x1; ++x) {
-                            if (row[x] < lo) lo = row[x];
-                            if (row[x] > hi) hi = row[x];
+                            float t = hd__vol_value(&ctx->vw, row + (size_t)x);
+                            if (t < lo) lo = t;
+                            if (t > hi) hi = t;
                         }
                     }
                 ctx->cell_range[2 * (((size_t)cz * md[1] + cy) * md[0] + cx)] = lo;
@@ -72,8 +88,17 @@ static hd__box hd__all_cells(const hd__ctx *ctx)
     return b;
 }
 
-/* Normalises the voxels to TF coordinates and records, per majorant cell, the value range a
-   trilinear sample inside the cell can take (its voxels and a one-voxel halo). */
+/* How the volume is kept: U8, U16 and I16 voxels as they are, with the map to TF coordinates
+   that hd__norm_value computes in float (an F32 volume's voxels are normalised here, once).
+   A value range whose map needs double (hd__norm) keeps the normalised floats instead. */
+static int hd__vol_store(const hd_volume_desc *v, const hd__norm *m)
+{
+    if (m->wide) return HD_VOL_F32;
+    return v->type == HD_VOXEL_U8 ? HD_VOL_U8 : v->type == HD_VOXEL_U16 ? HD_VOL_U16 : v->type == HD_VOXEL_I16 ? HD_VOL_I16 : HD_VOL_F32;
+}
+
+/* Keeps the voxels (hd__vol_store) and records, per majorant cell, the value range a trilinear
+   sample inside the cell can take (its voxels and a one-voxel halo). */
 static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
 {
     hd__norm m = hd__norm_of(v);
@@ -89,13 +114,22 @@ static hd_result hd__prepare_volume(hd__ctx *ctx, const hd_volume_desc *v)
     }
     for (d = 0; d < 3; ++d) ctx->box[d] = (float)(extent[d] / emax);
     ctx->vw.nvox = (size_t)ctx->vw.dims[0] * ctx->vw.dims[1] * ctx->vw.dims[2];
-    ctx->vw.vol = (float *)hd__alloc(&ctx->vw, ctx->vw.nvox * sizeof(float));
+    ctx->vw.vtype = hd__vol_store(v, &m);
+    ctx->vw.vnorm[0] = ctx->vw.vtype == HD_VOL_F32 ? 0.0f : m.lo;
+    ctx->vw.vnorm[1] = ctx->vw.vtype == HD_VOL_F32 ? 1.0f : m.scale;
+    if (ctx->vw.vtype == HD_VOL_F32 && v->type != HD_VOXEL_F32)
+        HD__INFO(&ctx->vw.log, "volume.value_range {%g, %g} is too wide or too narrow for float: the volume is kept as normalised floats",
+                 (double)v->value_range[0], (double)v->value_range[1]);
+    ctx->vw.vol = hd__alloc(&ctx->vw, ctx->vw.nvox * hd__vol_elem(ctx->vw.vtype));
     ncell = (size_t)ctx->vw.mdims[0] * ctx->vw.mdims[1] * ctx->vw.mdims[2];
     ctx->cell_range = (float *)hd__alloc(&ctx->vw, ncell * 2 * sizeof(float));
     ctx->vw.majorant = (float *)hd__calloc(&ctx->vw, ncell, sizeof(float));
     if (!ctx->vw.vol || !ctx->cell_range || !ctx->vw.majorant)
         return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "cannot allocate the volume (%zu voxels)", ctx->vw.nvox);
-    for (i = 0; i < ctx->vw.nvox; ++i) ctx->vw.vol[i] = hd__norm_value(&m, hd__raw_value(v, i));
+    if (ctx->vw.vtype != HD_VOL_F32)
+        memcpy(ctx->vw.vol, v->data, ctx->vw.nvox * hd__vol_elem(ctx->vw.vtype));
+    else
+        for (i = 0; i < ctx->vw.nvox; ++i) ((float *)ctx->vw.vol)[i] = hd__norm_value(&m, hd__raw_value(v, i));
     all = hd__all_cells(ctx);
     hd__cell_ranges(ctx, &all);
     return HD_SUCCESS;
@@ -280,13 +314,18 @@ static void hd__majorant_follow(hd__ctx *ctx, const char *what)
 }
 
 /* ---- hd_update_volume ------------------------------------------------------------------------- */
-static size_t hd__voxel_bytes(hd_voxel_type t) { return t == HD_VOXEL_U8 ? 1 : t == HD_VOXEL_U16 ? 2 : 4; }
+static size_t hd__voxel_bytes(hd_voxel_type t) { return t == HD_VOXEL_U8 ? 1 : t == HD_VOXEL_U16 || t == HD_VOXEL_I16 ? 2 : 4; }
 
 static float hd__raw_at(hd_voxel_type t, const unsigned char *p)
 {
     if (t == HD_VOXEL_U8) return (float)*p;
     if (t == HD_VOXEL_U16) {
         uint16_t v;
+        memcpy(&v, p, sizeof v);
+        return (float)v;
+    }
+    if (t == HD_VOXEL_I16) {
+        int16_t v;
         memcpy(&v, p, sizeof v);
         return (float)v;
     }
@@ -306,7 +345,7 @@ static hd_result hd__update_voxels(hd__ctx *ctx, const hd_volume_update *u, int 
     const hd_logger *log = &ctx->vw.log;
     const hd_volume_desc *v = &ctx->vw.desc.volume;
     const int *dims = ctx->vw.dims;
-    static const char *types[] = {"INVALID", "U8", "U16", "F32"};
+    static const char *types[] = {"INVALID", "U8", "U16", "F32", "I16"};
     hd__norm m = hd__norm_of(v);
     hd__box box, chg, cells;
     size_t es, rp, sp;
@@ -354,11 +393,22 @@ static hd_result hd__update_voxels(hd__ctx *ctx, const hd_volume_update *u, int 
     for (z = box.lo[2]; z < box.hi[2]; ++z)
         for (y = box.lo[1]; y < box.hi[1]; ++y) {
             const unsigned char *row = (const unsigned char *)u->data + (size_t)(z - box.lo[2]) * sp + (size_t)(y - box.lo[1]) * rp;
-            float *dst = ctx->vw.vol + ((size_t)z * dims[1] + y) * dims[0];
+            size_t at = ((size_t)z * dims[1] + y) * dims[0];
             for (x = box.lo[0]; x < box.hi[0]; ++x) {
-                float t = hd__norm_value(&m, hd__raw_at(v->type, row + (size_t)(x - box.lo[0]) * es));
-                if (t == dst[x]) continue;
-                dst[x] = t;
+                const unsigned char *src = row + (size_t)(x - box.lo[0]) * es;
+                float t;
+                if (ctx->vw.vtype == HD_VOL_F32) {
+                    float *dst = (float *)ctx->vw.vol + at + x;
+                    t = hd__norm_value(&m, hd__raw_at(v->type, src));
+                    if (t == *dst) continue;
+                    *dst = t;
+                } else { /* the raw voxel is kept; a change its normalised value does not see is no change */
+                    unsigned char *dst = (unsigned char *)ctx->vw.vol + (at + (size_t)x) * es;
+                    float was = hd__vol_value(&ctx->vw, at + (size_t)x);
+                    if (memcmp(dst, src, es) == 0) continue;
+                    memcpy(dst, src, es);
+                    if (hd__vol_value(&ctx->vw, at + (size_t)x) == was) continue;
+                }
                 if (x < chg.lo[0]) chg.lo[0] = x;
                 if (x >= chg.hi[0]) chg.hi[0] = x + 1;
                 if (y < chg.lo[1]) chg.lo[1] = y;

@@ -61,6 +61,7 @@ int hdt_volume_state_get(hd_context h, hdt_volume_state *s)
     s->gvox = (size_t)ctx->vw.gdims[0] * ctx->vw.gdims[1] * ctx->vw.gdims[2];
     s->dl_count = ctx->vw.dl_count;
     s->vol = ctx->vw.vol;
+    s->vol_bytes = ctx->vw.nvox * hd__vol_elem(ctx->vw.vtype);
     s->cell_range = ctx->cell_range;
     s->majorant = ctx->vw.majorant;
     s->max_sigma = ctx->max_sigma;

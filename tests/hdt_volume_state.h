@@ -11,7 +11,9 @@
 
 typedef struct hdt_volume_state {
     size_t nvox, ncell, gvox, dl_count;
-    float *vol, *cell_range, *majorant, max_sigma;
+    void *vol;        /* the voxels as the core keeps them (normalised floats for F32) */
+    size_t vol_bytes; /* their bytes */
+    float *cell_range, *majorant, max_sigma;
     unsigned char *bits;
     uint32_t *dl_idx;
     uint64_t dl_n;

@@ -76,7 +76,7 @@ static hd_result io_parse_both(const unsigned char *b, size_t n, hd_volume_file 
               hd_result_string(r));
     if (r == HD_SUCCESS && r2 == HD_SUCCESS) {
         size_t bytes = (size_t)out->desc.dims[0] * out->desc.dims[1] * out->desc.dims[2] *
-                       (out->desc.type == HD_VOXEL_U8 ? 1 : out->desc.type == HD_VOXEL_U16 ? 2 : 4);
+                       (out->desc.type == HD_VOXEL_U8 ? 1 : out->desc.type == HD_VOXEL_U16 || out->desc.type == HD_VOXEL_I16 ? 2 : 4);
         CHECK(v2.desc.type == out->desc.type);
         CHECK(memcmp(v2.desc.dims, out->desc.dims, sizeof v2.desc.dims) == 0);
         CHECK(memcmp(v2.desc.spacing, out->desc.spacing, sizeof v2.desc.spacing) == 0);
@@ -142,12 +142,12 @@ static void io_nrrd_type_spellings(void)
 {
     static const char *u8[] = {"uchar", "unsigned char", "uint8", "uint8_t", "UCHAR"};
     static const char *i16[] = {"short", "short int", "signed short", "signed short int",
-                                "int16", "int16_t"};
+                                "int16", "int16_t", "signed char", "int8"};
     static const char *u16[] = {"ushort", "unsigned short", "unsigned short int", "uint16",
                                 "uint16_t"};
     static const char *i32[] = {"int", "signed int", "int32", "int32_t"};
     static const char *f32[] = {"float", "double", "uint", "uint32", "longlong", "int64",
-                                "ulonglong", "uint64_t", "signed char", "int8"};
+                                "ulonglong", "uint64_t"};
     char text[256];
     size_t i;
     hd_volume_file v;
@@ -171,7 +171,7 @@ static void io_nrrd_type_spellings(void)
     }
     IO_TYPE_CASE(u8, HD_VOXEL_U8)
     IO_TYPE_CASE(u16, HD_VOXEL_U16)
-    IO_TYPE_CASE(i16, HD_VOXEL_F32)
+    IO_TYPE_CASE(i16, HD_VOXEL_I16)
     IO_TYPE_CASE(i32, HD_VOXEL_F32)
     IO_TYPE_CASE(f32, HD_VOXEL_F32)
 #undef IO_TYPE_CASE
@@ -207,7 +207,7 @@ static void io_nrrd_u16_endian(void)
     }
 }
 
-static void io_nrrd_int16_to_f32(void)
+static void io_nrrd_int16_kept(void)
 {
     static const int16_t vals[8] = {-1024, -1, 0, 1, 3071, -32768, 32767, 40};
     int big;
@@ -227,9 +227,9 @@ static void io_nrrd_int16_to_f32(void)
                  "endian: %s\r\nencoding: raw\r\n\r\n", big ? "big" : "little");
         b = gen_cat(text, data, sizeof data, &n);
         CHECK_MSG(io_parse_both(b, n, &v, &l) == HD_SUCCESS, "%s", l.last);
-        CHECK(v.desc.type == HD_VOXEL_F32);
+        CHECK(v.desc.type == HD_VOXEL_I16);
         if (v.data)
-            for (i = 0; i < 8; ++i) CHECK(((const float *)v.data)[i] == (float)vals[i]);
+            for (i = 0; i < 8; ++i) CHECK(((const int16_t *)v.data)[i] == vals[i]);
         CHECK(v.value_min == -32768.0f && v.value_max == 32767.0f);
         CHECK(v.desc.value_range[0] == -32768.0f && v.desc.value_range[1] == 32767.0f);
         CHECK(fabsf(v.desc.spacing[0] - 0.5f) < 1e-6f);
@@ -369,9 +369,9 @@ static void io_nrrd_gzip(void)
     CHECK(z != NULL);
     b = gen_cat(header, z, zn, &n);
     CHECK_MSG(io_parse_both(b, n, &v, &l) == HD_SUCCESS, "%s", l.last);
-    CHECK(v.desc.type == HD_VOXEL_F32 && v.desc.spacing[2] == 1.5f);
+    CHECK(v.desc.type == HD_VOXEL_I16 && v.desc.spacing[2] == 1.5f);
     if (v.data)
-        for (i = 0; i < NX * NY * NZ; ++i) CHECK(((const float *)v.data)[i] == (float)vals[i]);
+        for (i = 0; i < NX * NY * NZ; ++i) CHECK(((const int16_t *)v.data)[i] == vals[i]);
     CHECK(v.value_min == -1024.0f && v.value_max == 3071.0f);
     hd_volume_free(&v);
     free(b);
@@ -391,7 +391,7 @@ static void io_nrrd_gzip(void)
     }
     CHECK_MSG(hd_volume_load_nrrd(path, &v, &lg) == HD_SUCCESS, "%s", l.last);
     if (v.data)
-        for (i = 0; i < NX * NY * NZ; ++i) CHECK(((const float *)v.data)[i] == (float)vals[i]);
+        for (i = 0; i < NX * NY * NZ; ++i) CHECK(((const int16_t *)v.data)[i] == vals[i]);
     hd_volume_free(&v);
     io_remove(path);
 }
@@ -410,10 +410,10 @@ static void io_raw_loader(void)
     CHECK(io_write(path, buf, sizeof buf, NULL, 0));
 
     CHECK(hd_volume_load_raw(path, dims, HD_RAW_I16, HD_ENDIAN_BIG, 5, &v, &lg) == HD_SUCCESS);
-    CHECK(v.desc.type == HD_VOXEL_F32 && v.desc.dims[0] == 4 && v.desc.dims[2] == 2);
+    CHECK(v.desc.type == HD_VOXEL_I16 && v.desc.dims[0] == 4 && v.desc.dims[2] == 2);
     CHECK(v.desc.spacing[0] == 1.0f && v.desc.spacing[1] == 1.0f && v.desc.spacing[2] == 1.0f);
     if (v.data)
-        for (i = 0; i < 24; ++i) CHECK(((const float *)v.data)[i] == (float)(i * 1000 - 5000));
+        for (i = 0; i < 24; ++i) CHECK(((const int16_t *)v.data)[i] == i * 1000 - 5000);
     CHECK(v.value_min == -5000.0f && v.value_max == 18000.0f);
     CHECK(v.desc.value_range[0] == -5000.0f && v.desc.value_range[1] == 18000.0f);
     hd_volume_free(&v);
@@ -806,7 +806,7 @@ const hd_test_case hd_tests_io[] = {
     {"io_nrrd_roundtrip", io_nrrd_roundtrip},
     {"io_nrrd_type_spellings", io_nrrd_type_spellings},
     {"io_nrrd_u16_endian", io_nrrd_u16_endian},
-    {"io_nrrd_int16_to_f32", io_nrrd_int16_to_f32},
+    {"io_nrrd_int16_kept", io_nrrd_int16_kept},
     {"io_nrrd_float_double", io_nrrd_float_double},
     {"io_nrrd_nonfinite_and_constant", io_nrrd_nonfinite_and_constant},
     {"io_nrrd_skips", io_nrrd_skips},

@@ -109,9 +109,9 @@ static void fmt_mhd_detached(void)
                     "ElementByteOrderMSB = True\nElementDataFile = s.raw\n", 0));
     CHECK(fmt_write(fmt_path("s.raw"), raw, sizeof raw));
     CHECK(hd_volume_load_mhd(fmt_path("s.mhd"), &v, &lg) == HD_SUCCESS);
-    CHECK(v.desc.type == HD_VOXEL_F32 && v.desc.dims[0] == 3 && v.desc.dims[1] == 2 &&
+    CHECK(v.desc.type == HD_VOXEL_I16 && v.desc.dims[0] == 3 && v.desc.dims[1] == 2 &&
           v.desc.dims[2] == 1);
-    for (i = 0; v.data && i < 6; ++i) CHECK(((float *)v.data)[i] == (float)vals[i]);
+    for (i = 0; v.data && i < 6; ++i) CHECK(((int16_t *)v.data)[i] == vals[i]);
     hd_volume_free(&v);
     /* the loader by extension */
     CHECK(hd_volume_load(fmt_path("s.mhd"), &v, &lg) == HD_SUCCESS && v.desc.dims[0] == 3);
@@ -257,14 +257,14 @@ static void fmt_nifti_endian(void)
     b = gen_nifti(1, 4, 16, 3, dim, pix1, 352, 0, 0, be, 48, &nb);
     CHECK(hd_volume_parse_nifti(a, na, &va, &lg) == HD_SUCCESS);
     CHECK(hd_volume_parse_nifti(b, nb, &vb, &lg) == HD_SUCCESS);
-    CHECK(va.desc.type == HD_VOXEL_F32 && vb.desc.type == HD_VOXEL_F32);
+    CHECK(va.desc.type == HD_VOXEL_I16 && vb.desc.type == HD_VOXEL_I16);
     CHECK(va.desc.dims[0] == 4 && va.desc.dims[1] == 3 && va.desc.dims[2] == 2);
     CHECK(memcmp(va.desc.dims, vb.desc.dims, sizeof va.desc.dims) == 0);
     CHECK(va.desc.spacing[0] == 2.0f && va.desc.spacing[1] == 2.5f && va.desc.spacing[2] == 3.0f);
     CHECK(memcmp(va.desc.spacing, vb.desc.spacing, sizeof va.desc.spacing) == 0);
     for (i = 0; va.data && vb.data && i < 24; ++i) {
-        CHECK(((float *)va.data)[i] == (float)vals[i]);
-        CHECK(((float *)vb.data)[i] == (float)vals[i]);
+        CHECK(((int16_t *)va.data)[i] == vals[i]);
+        CHECK(((int16_t *)vb.data)[i] == vals[i]);
     }
     CHECK(va.value_min == -1000.0f && va.value_max == 1300.0f && l.errors == 0);
     hd_volume_free(&va);
@@ -277,10 +277,10 @@ static void fmt_nifti_endian(void)
         CHECK(fmt_write(fmt_path("b.nii.gz"), z, zn));
         CHECK(hd_volume_load(fmt_path("b.nii"), &va, &lg) == HD_SUCCESS);
         CHECK(hd_volume_load_nifti(fmt_path("b.nii.gz"), &vb, &lg) == HD_SUCCESS);
-        CHECK(va.data && vb.data && memcmp(va.data, vb.data, 24 * 4) == 0);
+        CHECK(va.data && vb.data && memcmp(va.data, vb.data, 24 * 2) == 0);
         hd_volume_free(&vb);
         CHECK(hd_volume_load(fmt_path("b.nii.gz"), &vb, &lg) == HD_SUCCESS);
-        CHECK(va.data && vb.data && memcmp(va.data, vb.data, 24 * 4) == 0);
+        CHECK(va.data && vb.data && memcmp(va.data, vb.data, 24 * 2) == 0);
         hd_volume_free(&va);
         hd_volume_free(&vb);
         remove(fmt_path("b.nii"));
@@ -304,11 +304,17 @@ static void fmt_nifti_types_scaling(void)
     CHECK(v.desc.type == HD_VOXEL_U8 && v.data && memcmp(v.data, u8, 8) == 0);
     hd_volume_free(&v);
     free(a);
-    a = gen_nifti(0, 2, 8, 3, dim, pix1, 400, 2.0f, -10.0f, u8, 8, &n); /* scaled, offset 400 */
+    a = gen_nifti(0, 2, 8, 3, dim, pix1, 400, 2.0f, -10.0f, u8, 8, &n); /* scaled, offset 400: */
+    CHECK(hd_volume_parse_nifti(a, n, &v, &lg) == HD_SUCCESS);         /* integers, kept as I16 */
+    CHECK(v.desc.type == HD_VOXEL_I16);
+    for (i = 0; v.data && i < 8; ++i) CHECK(((int16_t *)v.data)[i] == 2 * u8[i] - 10);
+    CHECK(v.value_min == -10.0f && v.value_max == 500.0f);
+    hd_volume_free(&v);
+    free(a);
+    a = gen_nifti(0, 2, 8, 3, dim, pix1, 352, 0.5f, 0.0f, u8, 8, &n); /* not integers: F32 */
     CHECK(hd_volume_parse_nifti(a, n, &v, &lg) == HD_SUCCESS);
     CHECK(v.desc.type == HD_VOXEL_F32);
-    for (i = 0; v.data && i < 8; ++i) CHECK(((float *)v.data)[i] == 2.0f * u8[i] - 10.0f);
-    CHECK(v.value_min == -10.0f && v.value_max == 500.0f);
+    for (i = 0; v.data && i < 8; ++i) CHECK(((float *)v.data)[i] == 0.5f * u8[i]);
     hd_volume_free(&v);
     free(a);
     for (i = 0; i < 8; ++i) gen_putf(f + 4 * i, (float)i * 0.25f, 1);

@@ -545,17 +545,17 @@ static void lim_max_bytes(void)
     o.max_bytes = 63;
     lg = lim_logger(&l);
     LIM_EXPECT(hd_volume_load_ex(lim_path("m.nrrd"), &o, &v, &lg), HD_ERROR_FILE_TOO_LARGE, l);
-    /* short: 128 bytes in the file, 256 loaded */
-    z = gen_deflate(d, 128, 0, &zn);
-    b = gen_cat("NDims = 3\nDimSize = 4 4 4\nElementType = MET_SHORT\nCompressedData = True\n"
+    /* char: 64 bytes in the file, 128 loaded (widened to I16) */
+    z = gen_deflate(d, 64, 0, &zn);
+    b = gen_cat("NDims = 3\nDimSize = 4 4 4\nElementType = MET_CHAR\nCompressedData = True\n"
                 "ElementDataFile = LOCAL\n", z, zn, &n);
     CHECK(lim_write(lim_path("m.mha"), b, n, NULL, 0));
     free(b);
     free(z);
-    o.max_bytes = 255;
+    o.max_bytes = 127;
     lg = lim_logger(&l);
     LIM_EXPECT(hd_volume_load_ex(lim_path("m.mha"), &o, &v, &lg), HD_ERROR_FILE_TOO_LARGE, l);
-    o.max_bytes = 256;
+    o.max_bytes = 128;
     lg = lim_logger(&l);
     CHECK(hd_volume_load_ex(lim_path("m.mha"), &o, &v, &lg) == HD_SUCCESS);
     hd_volume_free(&v);

@@ -155,11 +155,11 @@ static int same_volume_state(hd_context a, hd_context b)
     CHECK(hd_read_illumination(b, HD_ILLUMINATION_DIRECT, e, N * N * N) == HD_SUCCESS);
     if (!hdt_volume_state_get(a, &s) || !hdt_volume_state_get(b, &t)) return 0;
     ok = s.nvox == t.nvox && s.ncell == t.ncell && s.gvox == t.gvox && s.max_sigma == t.max_sigma && s.dl_count == t.dl_count &&
-         memcmp(s.vol, t.vol, s.nvox * sizeof(float)) == 0 && memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0 &&
+         s.vol_bytes == t.vol_bytes && memcmp(s.vol, t.vol, s.vol_bytes) == 0 && memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0 &&
          memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0 && s.bits && t.bits &&
          memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0 && memcmp(s.dl_idx, t.dl_idx, s.dl_count * sizeof(uint32_t)) == 0;
     CHECK_MSG(ok, "vol %d, cell ranges %d, majorants %d, max_sigma %g/%g, mask %d, list %zu/%zu",
-              memcmp(s.vol, t.vol, s.nvox * sizeof(float)) == 0, memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0,
+              s.vol_bytes == t.vol_bytes && memcmp(s.vol, t.vol, s.vol_bytes) == 0, memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0,
               memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0, (double)s.max_sigma, (double)t.max_sigma,
               s.bits && t.bits && memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0, s.dl_count, t.dl_count);
     return ok;
@@ -308,6 +308,7 @@ static void test_update_bad(void)
     CHECK(render_to_rest(c, 300) > 0);
     CHECK(hd_get_stats(c, &a) == HD_SUCCESS && a.light_converged);
     CHECK(hdt_volume_state_get(c, &vs));
+    CHECK(vs.vol_bytes == sizeof saved);
     memcpy(saved, vs.vol, sizeof saved);
     good = box_update(HD_VOXEL_F32, vox2);
 #define BAD(stmt, code) do { u = good; stmt; \
@@ -345,7 +346,7 @@ static void test_update_bad(void)
     CHECK(hd_iterate(c, 3) == HD_SUCCESS);
     CHECK(hd_update_volume(c, &good) == HD_SUCCESS);
     CHECK(hd_iterate(c, 1) == HD_SUCCESS && hd_get_stats(c, &b) == HD_SUCCESS && b.iterations == 1 && b.frames == 1);
-    for (i = 0; i < 3; ++i) CHECK(hdt_volume_state_get(c, &vs) && vs.vol[((size_t)(BZ0 + i) * N + BY0) * N + BX0] == vox2[((size_t)(BZ0 + i) * N + BY0) * N + BX0]);
+    for (i = 0; i < 3; ++i) CHECK(hdt_volume_state_get(c, &vs) && ((const float *)vs.vol)[((size_t)(BZ0 + i) * N + BY0) * N + BX0] == vox2[((size_t)(BZ0 + i) * N + BY0) * N + BX0]);
     CHECK(log.errors == errors);
     hd_destroy(c);
 }

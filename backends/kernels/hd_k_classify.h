@@ -9,7 +9,7 @@ HD_FN void hdk_classify_voxel(HD_KARGS int x, int y, int z)
     hd_v3 u = HD_V3((HD_F(x) + 0.5f) / HD_F(gx), (HD_F(y) + 0.5f) / HD_F(gy), (HD_F(z) + 0.5f) / HD_F(gz));
     float v;
     if (gx == HD_PRM(dims).x && gy == HD_PRM(dims).y && gz == HD_PRM(dims).z) {
-        v = HD_GET(vol, i, x, y, z); /* same grid: the voxel itself, no interpolation round-off */
+        v = hdk_voxel(HD_KPASS i, x, y, z); /* same grid: the voxel itself, no interpolation round-off */
     } else {
         v = hdk_sample_value(HD_KPASS u);
     }

@@ -74,8 +74,24 @@ HD_FN int hdk_lerp_axis(float u, int n, HD_INOUT(float) w)
     return i0;
 }
 
-#ifndef HD_PRELUDE_SAMPLES_VOLUME
-/* Trilinear interpolation of the normalised volume at texture coordinate u. */
+/* The volume's storage (HD_VOL_*, hd_k_params.h): a constant where the backend fixes it when it
+   builds its kernels (GL, Vulkan), else the parameter block's. */
+#ifndef HD_VOL_STORE
+#define HD_VOL_STORE HD_PRM(vstore).x
+#endif
+
+/* The normalised value of voxel (x, y, z), index i (x fastest). An F32 volume holds it; the
+   integer storages hold the raw voxel (HD_VOL_RAW, the prelude's load), mapped here exactly as the
+   core maps an F32 volume's voxels, so an integer volume and the same values given as F32 render
+   alike (docs/DESIGN-STORAGE.md). */
+HD_FN float hdk_voxel(HD_KARGS int i, int x, int y, int z)
+{
+    if (HD_VOL_STORE == HD_VOL_F32) return HD_VOL_RAW(i, x, y, z, HD_VOL_F32);
+    return hdk_clampf((HD_VOL_RAW(i, x, y, z, HD_VOL_STORE) - HD_PRM(vnorm).x) * HD_PRM(vnorm).y, 0.0f, 1.0f);
+}
+
+/* Trilinear interpolation of the normalised volume at texture coordinate u: of the 8 voxels'
+   normalised values, so that it does not depend on how the volume is stored. */
 HD_FN float hdk_sample_value(HD_KARGS hd_v3 u)
 {
     int nx = HD_PRM(dims).x, ny = HD_PRM(dims).y, nz = HD_PRM(dims).z;
@@ -86,15 +102,18 @@ HD_FN float hdk_sample_value(HD_KARGS hd_v3 u)
     int x1 = hdk_mini(x0 + 1, nx - 1), y1 = hdk_mini(y0 + 1, ny - 1), z1 = hdk_mini(z0 + 1, nz - 1);
     int r00 = (z0 * ny + y0) * nx, r10 = (z0 * ny + y1) * nx;
     int r01 = (z1 * ny + y0) * nx, r11 = (z1 * ny + y1) * nx;
-    float c00 = HD_GET(vol, r00 + x0, x0, y0, z0) + wx * (HD_GET(vol, r00 + x1, x1, y0, z0) - HD_GET(vol, r00 + x0, x0, y0, z0));
-    float c10 = HD_GET(vol, r10 + x0, x0, y1, z0) + wx * (HD_GET(vol, r10 + x1, x1, y1, z0) - HD_GET(vol, r10 + x0, x0, y1, z0));
-    float c01 = HD_GET(vol, r01 + x0, x0, y0, z1) + wx * (HD_GET(vol, r01 + x1, x1, y0, z1) - HD_GET(vol, r01 + x0, x0, y0, z1));
-    float c11 = HD_GET(vol, r11 + x0, x0, y1, z1) + wx * (HD_GET(vol, r11 + x1, x1, y1, z1) - HD_GET(vol, r11 + x0, x0, y1, z1));
+    float v000 = hdk_voxel(HD_KPASS r00 + x0, x0, y0, z0), v100 = hdk_voxel(HD_KPASS r00 + x1, x1, y0, z0);
+    float v010 = hdk_voxel(HD_KPASS r10 + x0, x0, y1, z0), v110 = hdk_voxel(HD_KPASS r10 + x1, x1, y1, z0);
+    float v001 = hdk_voxel(HD_KPASS r01 + x0, x0, y0, z1), v101 = hdk_voxel(HD_KPASS r01 + x1, x1, y0, z1);
+    float v011 = hdk_voxel(HD_KPASS r11 + x0, x0, y1, z1), v111 = hdk_voxel(HD_KPASS r11 + x1, x1, y1, z1);
+    float c00 = v000 + wx * (v100 - v000);
+    float c10 = v010 + wx * (v110 - v010);
+    float c01 = v001 + wx * (v101 - v001);
+    float c11 = v011 + wx * (v111 - v011);
     float c0 = c00 + wy * (c10 - c00);
     float c1 = c01 + wy * (c11 - c01);
     return c0 + wz * (c1 - c0);
 }
-#endif
 
 /* A table of n rgba entries, entry i at value i / (n - 1) (the TF, the projection's step table):
    the first float of the segment value v falls in (v clamped to 0..1), and v's place f in it.

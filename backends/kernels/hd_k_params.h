@@ -1,6 +1,12 @@
 /* hd_k_params.h - the parameter block every kernel reads (shared source; no #include here).
    Only 16-byte vectors, so C, OpenCL and std140 GLSL agree on the layout. The host fills it in
    src/hd_kparams.h (hd__fill_kparams). */
+/* How the volume (vol) is stored: HD_VOL_F32 its normalised values, the others the raw voxels,
+   mapped by vnorm (hdk_voxel, hd_k_common.h). */
+#define HD_VOL_F32 0
+#define HD_VOL_U8 1
+#define HD_VOL_U16 2
+#define HD_VOL_I16 3
 HD_PARAMS_BEGIN
 HD_PARAM_I4(dims)       /* volume dims x, y, z; w = TF entry count */
 HD_PARAM_I4(gdims)      /* illumination grid dims x, y, z; w = channels (1 or 3) */
@@ -42,6 +48,8 @@ HD_PARAM_I4(env)        /* the environment (hd_k_light.h): x = width, y = height
 HD_PARAM_F4(env_r0)     /* rows of the rotation from the volume's frame into the map's */
 HD_PARAM_F4(env_r1)
 HD_PARAM_F4(env_r2)
+HD_PARAM_I4(vstore)     /* x = the volume's storage (HD_VOL_*), y, z, w = 0 */
+HD_PARAM_F4(vnorm)      /* raw voxel to TF coordinate: clamp((raw - x) * y, 0, 1); z, w = 0 */
 HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position, w = type */
 HD_PARAM_F4_ARRAY(light_b, HD_MAX_LIGHTS) /* rgb = colour * intensity (x only with 1 channel), w = 1/r^2 */
 HD_PARAMS_END

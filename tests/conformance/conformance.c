@@ -83,7 +83,7 @@ static float scene_value(int x, int y, int z, const int *d)
 
 static void scene_init(scene *s, hd_voxel_type type, int dx, int dy, int dz, int lights, int mixed_colors, int point)
 {
-    size_t n, i, bpv = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 ? 2 : 4;
+    size_t n, i, bpv = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 || type == HD_VOXEL_I16 ? 2 : 4;
     int x, y, z, l;
     static const float tf[] = {0.0f, 0.0f, 0.0f, 0.0f, 0.9f, 0.6f, 0.5f, 0.05f, 0.9f, 0.8f, 0.6f, 0.3f,
                                1.0f, 1.0f, 0.9f, 0.6f, 1.0f, 1.0f, 1.0f, 1.0f};
@@ -99,6 +99,7 @@ static void scene_init(scene *s, hd_voxel_type type, int dx, int dy, int dz, int
                 float v = scene_value(x, y, z, s->dims);
                 if (type == HD_VOXEL_U8) ((uint8_t *)s->data)[i] = (uint8_t)(v * 255.0f + 0.5f);
                 else if (type == HD_VOXEL_U16) ((uint16_t *)s->data)[i] = (uint16_t)(v * 65535.0f + 0.5f);
+                else if (type == HD_VOXEL_I16) ((int16_t *)s->data)[i] = (int16_t)((int32_t)(v * 65535.0f + 0.5f) - 32768);
                 else ((float *)s->data)[i] = v;
             }
     memcpy(s->tf, tf, sizeof tf);
@@ -415,7 +416,7 @@ static void write_pattern(pair *p, hd_illumination which, float scale)
 }
 
 /* ---- the cases -------------------------------------------------------------------------------- */
-static const char *type_name(hd_voxel_type t) { return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : "f32"; }
+static const char *type_name(hd_voxel_type t) { return t == HD_VOXEL_U8 ? "u8" : t == HD_VOXEL_U16 ? "u16" : t == HD_VOXEL_I16 ? "i16" : "f32"; }
 
 /* One sweep (red-black or Jacobi) or a solve of many, from identical E and phi. */
 static void case_diffusion(hd_voxel_type type, const int *d, hd_solver solver, int sweeps, int channels)
@@ -634,7 +635,7 @@ static void case_update(hd_method method, hd_voxel_type type, const int *d, int 
     pair p;
     char name[128];
     errors e = {0.0, 0.0, 0.0, -1.0};
-    size_t es = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 ? 2 : 4, i;
+    size_t es = type == HD_VOXEL_U8 ? 1 : type == HD_VOXEL_U16 || type == HD_VOXEL_I16 ? 2 : 4, i;
     unsigned char *next;
     int k;
     scene_init(&s, type, d[0], d[1], d[2], lights, 0, 1);
@@ -662,6 +663,11 @@ static void case_update(hd_method method, hd_voxel_type type, const int *d, int 
                             uint16_t v;
                             memcpy(&v, next + 2 * i, 2);
                             v = (uint16_t)(k ? v / 3 : v + (65535 - v) / 2);
+                            memcpy(next + 2 * i, &v, 2);
+                        } else if (type == HD_VOXEL_I16) {
+                            int16_t v;
+                            memcpy(&v, next + 2 * i, 2);
+                            v = (int16_t)(k ? (v + 32768) / 3 - 32768 : v + (32767 - v) / 2);
                             memcpy(next + 2 * i, &v, 2);
                         } else {
                             float v;
@@ -1337,6 +1343,71 @@ static void case_budget_split(hd_method method, hd_voxel_type type, const int *d
     scene_free(&s);
 }
 
+/* Native storage: the same raw values given as I16 (or U16, U8) and as F32, with the same
+   value_range, on the backend: the kernels map the integers as the core maps the floats, so the
+   two contexts' E, phi and image agree within float rounding (the deterministic bound), with
+   n whole iterations of method. */
+static void case_storage(hd_method method, hd_voxel_type type, const int *d, int lights, int n)
+{
+    scene si, sf;
+    guard g;
+    pair p;
+    char name[128];
+    errors e = {0.0, 0.0, 0.0, -1.0};
+    hd_desc di, df;
+    size_t i, nv = (size_t)d[0] * d[1] * d[2];
+    hd_result r;
+    scene_init(&si, type, d[0], d[1], d[2], lights, 0, 1);
+    scene_init(&sf, HD_VOXEL_F32, d[0], d[1], d[2], lights, 0, 1);
+    si.params.method = sf.params.method = method;
+    for (i = 0; i < nv; ++i)
+        ((float *)sf.data)[i] = type == HD_VOXEL_U8 ? (float)((const uint8_t *)si.data)[i]
+                              : type == HD_VOXEL_U16 ? (float)((const uint16_t *)si.data)[i] : (float)((const int16_t *)si.data)[i];
+    guard_take(&g, &si);
+    di = scene_desc(&si);
+    df = scene_desc(&sf);
+    /* a range inside the type's: values on both sides are clamped */
+    di.volume.value_range[0] = df.volume.value_range[0] = type == HD_VOXEL_I16 ? -30000.0f : type == HD_VOXEL_U16 ? 3000.0f : 10.0f;
+    di.volume.value_range[1] = df.volume.value_range[1] = type == HD_VOXEL_I16 ? 20000.0f : type == HD_VOXEL_U16 ? 50000.0f : 230.0f;
+    snprintf(name, sizeof name, "storage %s as f32 x%d %s %dx%dx%d %dL", type_name(type), n, hd_api_cpu.method_name(method), d[0], d[1], d[2],
+             lights);
+    memset(&p, 0, sizeof p);
+    p.ok = 1;
+    p.s = &si;
+    if ((r = hd_api_backend.create(&df, &p.ref)) != HD_SUCCESS) pair_fail(&p, "backend create (f32)", r);
+    else if ((r = hd_api_backend.create(&di, &p.dut)) != HD_SUCCESS) pair_fail(&p, "backend create", r);
+    if (p.ok) {
+        hd_stats a, b;
+        static float ia[48 * 40 * 4], ib[48 * 40 * 4];
+        if ((r = hd_api_backend.iterate(p.ref, n)) != HD_SUCCESS) pair_fail(&p, "iterate (f32)", r);
+        if ((r = hd_api_backend.iterate(p.dut, n)) != HD_SUCCESS) pair_fail(&p, "iterate", r);
+        if (p.ok && hd_api_backend.get_stats(p.ref, &a) == HD_SUCCESS && hd_api_backend.get_stats(p.dut, &b) == HD_SUCCESS) {
+            /* the integer volume takes its own bytes on the device, the F32 one four per voxel */
+            if (a.volume_bytes - b.volume_bytes != nv * (4 - (type == HD_VOXEL_U8 ? 1 : 2)))
+                pair_fail(&p, "volume_bytes is not the stored type's", HD_SUCCESS);
+        }
+        if (p.ok && hd_api_backend.read_image_f32(p.ref, ia, sizeof ia / sizeof ia[0]) == HD_SUCCESS &&
+            hd_api_backend.read_image_f32(p.dut, ib, sizeof ib / sizeof ib[0]) == HD_SUCCESS)
+            rel_errors(ia, ib, sizeof ia / sizeof ia[0], &e);
+        else
+            pair_fail(&p, "read_image_f32", HD_ERROR_BACKEND);
+    }
+    report(name, &p, &g, &e, 1);
+    if (p.ref.id) hd_api_backend.destroy(p.ref);
+    if (p.dut.id) hd_api_backend.destroy(p.dut);
+    guard_free(&g);
+    scene_free(&si);
+    scene_free(&sf);
+}
+
+static void storage_cases(const int *odd, const int *other)
+{
+    case_storage(HD_METHOD_HD, HD_VOXEL_I16, odd, 3, 6);
+    case_storage(HD_METHOD_HD, HD_VOXEL_U8, other, 1, 6);
+    case_storage(HD_METHOD_PT_MS, HD_VOXEL_U16, odd, 1, 4);
+    case_storage(HD_METHOD_CD, HD_VOXEL_I16, other, 3, 4);
+}
+
 static void render_cases(const int *odd, const int *other)
 {
     case_budget_split(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 3);
@@ -1378,10 +1449,11 @@ static int backend_available(int *hard)
 int main(int argc, char **argv)
 {
     static const int odd[3] = {37, 53, 29}, other[3] = {24, 17, 33};
-    static const hd_voxel_type types[3] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32};
+    static const hd_voxel_type types[4] = {HD_VOXEL_U8, HD_VOXEL_U16, HD_VOXEL_F32, HD_VOXEL_I16};
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     int render = argc > 1 && strcmp(argv[1], "--render") == 0, direct = argc > 1 && strcmp(argv[1], "--direct") == 0;
     int scenes = argc > 1 && strcmp(argv[1], "--scene") == 0, envs = argc > 1 && strcmp(argv[1], "--env") == 0;
+    int storage = argc > 1 && strcmp(argv[1], "--storage") == 0;
     int hard = 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
     if (!backend_available(&hard)) {
@@ -1391,6 +1463,11 @@ int main(int argc, char **argv)
         else printf("0 passed, 0 failed (backend %s SKIPPED, never counted as passed%s)\n", hd_api_backend.backend_name(),
                     require ? "; HD_CONFORMANCE_REQUIRE=1: a skip fails" : "");
         return hard || require ? 1 : 0;
+    }
+    if (storage) { /* the native storage cases alone */
+        storage_cases(odd, other);
+        printf("%d passed, %d failed\n", n_passed, n_failed);
+        return n_failed == 0 ? 0 : 1;
     }
     if (quick || crop || render || direct || scenes || envs) { /* quick: one case per stage, for valgrind; crop: the
                                       crop box cases; render: the per-frame API's; direct: the
@@ -1415,10 +1492,12 @@ int main(int argc, char **argv)
         return n_failed == 0 ? 0 : 1;
     }
     /* deterministic stages */
-    for (t = 0; t < 3; ++t) {
+    for (t = 0; t < 4; ++t) {
         case_diffusion(types[t], odd, HD_SOLVER_RED_BLACK, 1, 1);
         case_project(types[t], odd, 1, 1);
     }
+    /* native 8/16-bit storage against the same values as floats */
+    storage_cases(odd, other);
     case_diffusion(HD_VOXEL_U8, odd, HD_SOLVER_JACOBI, 1, 1);
     case_diffusion(HD_VOXEL_U16, odd, HD_SOLVER_RED_BLACK, 200, 1);
     case_diffusion(HD_VOXEL_F32, other, HD_SOLVER_JACOBI, 200, 1);
@@ -1433,10 +1512,12 @@ int main(int argc, char **argv)
     case_iterate(HD_VOXEL_U16, odd, 3, 1, 1, CHANGE_TF, 8);
     case_iterate(HD_VOXEL_F32, odd, 16, 0, 1, CHANGE_CAMERA, 8);
     case_iterate(HD_VOXEL_U8, other, 3, 0, 1, CHANGE_CAMERA, 8);
+    case_iterate(HD_VOXEL_I16, other, 3, 1, 1, CHANGE_TF, 8);
     /* a volume that changes: hd_update_volume halfway */
     case_update(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 8);
     case_update(HD_METHOD_HD, HD_VOXEL_F32, other, 3, 1, 8);
     case_update(HD_METHOD_CD, HD_VOXEL_U16, odd, 1, 1, 8);
+    case_update(HD_METHOD_HD, HD_VOXEL_I16, odd, 3, 1, 8);
     /* the baselines */
     case_downsample(HD_VOXEL_U8, odd, 2, 0, 0, 1, 8);
     case_downsample(HD_VOXEL_F32, other, 3, 0, 0, 3, 8);

@@ -773,7 +773,7 @@ static void fz_gen_volume(hd_volume_desc *v)
     unsigned hash;
     memset(v, 0, sizeof *v);
     b = fz_u8();
-    v->type = (hd_voxel_type)(b < 240 ? 1 + b % 3 : b < 246 ? 0 : b < 250 ? 4 : -1);
+    v->type = (hd_voxel_type)(b < 240 ? 1 + b % 4 : b < 246 ? 0 : b < 250 ? HD_VOXEL_COUNT : -1);
     for (i = 0; i < 3; ++i) {
         b = fz_u8();
         v->dims[i] = b < 248 ? 1 + b % FZ_DIM : b < 251 ? 0 : b < 254 ? -1 : HD_MAX_DIM + 1;
@@ -799,7 +799,10 @@ static void fz_gen_volume(hd_volume_desc *v)
     memset(fz_vox, 0, sizeof fz_vox);
     lo = v->value_range[0];
     hi = v->value_range[1];
-    if (lo == 0.0f && hi == 0.0f) hi = v->type == HD_VOXEL_U8 ? 255.0f : v->type == HD_VOXEL_U16 ? 65535.0f : 1.0f;
+    if (lo == 0.0f && hi == 0.0f) {
+        lo = v->type == HD_VOXEL_I16 ? -32768.0f : 0.0f;
+        hi = v->type == HD_VOXEL_U8 ? 255.0f : v->type == HD_VOXEL_U16 ? 65535.0f : v->type == HD_VOXEL_I16 ? 32767.0f : 1.0f;
+    }
     mid = (float)(0.5 * (double)lo + 0.5 * (double)hi);
     pat = fz_u8() % 6;
     /* patterns 4 and 5 draw from a palette of 4 values by a hash of the voxel index */
@@ -823,6 +826,9 @@ static void fz_gen_volume(hd_volume_desc *v)
                     memcpy(fz_vox + 4 * i, &f, 4);
                 } else if (v->type == HD_VOXEL_U16) {
                     uint16_t u = (uint16_t)(cls == 0 ? 0 : cls == 1 ? 32768 : cls == 2 ? 65535 : (int)(unit * 65535.0f));
+                    memcpy(fz_vox + 2 * i, &u, 2);
+                } else if (v->type == HD_VOXEL_I16) {
+                    int16_t u = (int16_t)(cls == 0 ? -32768 : cls == 1 ? 0 : cls == 2 ? 32767 : (int)(unit * 65535.0f) - 32768);
                     memcpy(fz_vox + 2 * i, &u, 2);
                 } else {
                     fz_vox[i] = (uint8_t)(cls == 0 ? 0 : cls == 1 ? 128 : cls == 2 ? 255 : (int)(unit * 255.0f));
@@ -1508,11 +1514,15 @@ static void fz_check_reference(int ci, const hd_desc *d)
     double lo = d->volume.value_range[0], hi = d->volume.value_range[1];
     size_t n = (size_t)d->volume.dims[0] * d->volume.dims[1] * d->volume.dims[2], i, npx;
     hd_result r;
-    if (lo == 0.0 && hi == 0.0) hi = d->volume.type == HD_VOXEL_U8 ? 255.0 : d->volume.type == HD_VOXEL_U16 ? 65535.0 : 1.0;
+    if (lo == 0.0 && hi == 0.0) {
+        lo = d->volume.type == HD_VOXEL_I16 ? -32768.0 : 0.0;
+        hi = d->volume.type == HD_VOXEL_U8 ? 255.0 : d->volume.type == HD_VOXEL_U16 ? 65535.0 : d->volume.type == HD_VOXEL_I16 ? 32767.0 : 1.0;
+    }
     for (i = 0; i < n; ++i) {
         double v, t;
         if (d->volume.type == HD_VOXEL_U8) v = ((const uint8_t *)d->volume.data)[i];
         else if (d->volume.type == HD_VOXEL_U16) { uint16_t u; memcpy(&u, (const uint8_t *)d->volume.data + 2 * i, 2); v = u; }
+        else if (d->volume.type == HD_VOXEL_I16) { int16_t u; memcpy(&u, (const uint8_t *)d->volume.data + 2 * i, 2); v = u; }
         else { float f; memcpy(&f, (const uint8_t *)d->volume.data + 4 * i, 4); v = f; }
         t = (v - lo) / (hi - lo);
         ref[i] = t != t ? 0.0f : t < 0.0 ? 0.0f : t > 1.0 ? 1.0f : (float)t;
@@ -1560,6 +1570,7 @@ static void fz_tr_desc(const hd_desc *d)
             if (i % 8 == 0) fz_tr("\n   ");
             if (d->volume.type == HD_VOXEL_F32) { float f; memcpy(&f, fz_vox + 4 * i, 4); fz_tr(" %s,", fz_cf(f, b)); }
             else if (d->volume.type == HD_VOXEL_U16) { uint16_t u; memcpy(&u, fz_vox + 2 * i, 2); fz_tr(" %u,", (unsigned)u); }
+            else if (d->volume.type == HD_VOXEL_I16) { int16_t u; memcpy(&u, fz_vox + 2 * i, 2); fz_tr(" %d,", (int)u); }
             else fz_tr(" %u,", (unsigned)fz_vox[i]);
         }
         fz_tr("\n    d.volume.data = vox;\n");
@@ -1651,8 +1662,9 @@ static void fz_create(int ci)
         if (memcmp(&now.spacing[k], &sp, sizeof sp)) fz_fail("spacing[%d] %g", k, (double)now.spacing[k]);
     }
     if (d.volume.value_range[0] == 0.0f && d.volume.value_range[1] == 0.0f) {
-        float hi = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f : 1.0f;
-        if (now.range[0] != 0.0f || now.range[1] != hi) fz_fail("the default value range {%g, %g}", (double)now.range[0], (double)now.range[1]);
+        float hi = d.volume.type == HD_VOXEL_U8 ? 255.0f : d.volume.type == HD_VOXEL_U16 ? 65535.0f : d.volume.type == HD_VOXEL_I16 ? 32767.0f : 1.0f;
+        float lo = d.volume.type == HD_VOXEL_I16 ? -32768.0f : 0.0f;
+        if (now.range[0] != lo || now.range[1] != hi) fz_fail("the default value range {%g, %g}", (double)now.range[0], (double)now.range[1]);
     } else if (memcmp(now.range, d.volume.value_range, sizeof now.range)) fz_fail("the value range");
     if (memcmp(&now.p, &fp, sizeof fp)) fz_fail("hd_query_desc's params are not the desc's, defaults filled in");
     if (memcmp(&now.cam, &fc, sizeof fc)) fz_fail("hd_query_desc's camera is not the desc's, defaults filled in");

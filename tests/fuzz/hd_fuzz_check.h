@@ -88,7 +88,7 @@ static void hd_fuzz_check(hd_result r, hd_volume_file *v)
         if (!isfinite(v->desc.value_range[0]) || !isfinite(v->desc.value_range[1]) ||
             !(v->desc.value_range[1] > v->desc.value_range[0]))
             abort();
-        es = v->desc.type == HD_VOXEL_U8 ? 1 : v->desc.type == HD_VOXEL_U16 ? 2
+        es = v->desc.type == HD_VOXEL_U8 ? 1 : v->desc.type == HD_VOXEL_U16 || v->desc.type == HD_VOXEL_I16 ? 2
              : v->desc.type == HD_VOXEL_F32 ? 4 : 0;
         if (!es) abort();
         for (i = 0; i < n * es; ++i) sum += ((const unsigned char *)v->data)[i];
