@@ -70,6 +70,6 @@ int hd_backend_runtime_present(char *why, size_t why_size);
                         hd_volume_parse_nrrd, hd_volume_free, hd__test_prepare, hd__test_direct, \
                         hd__test_diffuse, hd__test_project, hd__test_write_illumination, hd__test_finish, \
                         hd__test_direct_all, hd_refine, hd_render, hd_set_depth, hd_set_volume_transform, hd_update_volume, \
-                        hd_set_environment,
+                        hd_set_environment, \
                         hd_read_depth}
 #endif
