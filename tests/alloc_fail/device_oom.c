@@ -54,8 +54,9 @@ static void device_oom(int n)
 static void test_device_oom_512(void) { device_oom(512); }
 
 /* The reduced frames' region of the image buffer is made by the first frame at a render scale
-   > 1 (hd_k_upsample.h). A 4000x3600 image (230 MB of RGBA floats) fits the device's largest
-   allocation under the 1 GiB limit (256 MiB), the image with that region (288 MB) does not: the
+   > 1 (hd_k_upsample.h). A 3600x3400 image (245 MB: RGBA floats and the depth plane) fits the
+   device's largest allocation under the 1 GiB limit (256 MiB), the image with that region
+   (294 MB) does not: the
    scale-2 frame fails with HD_ERROR_OUT_OF_DEVICE_MEMORY and one log line, the image buffer held
    before stays, and full frames render on. */
 static void test_device_oom_image_room(void)
@@ -67,15 +68,15 @@ static void test_device_oom_image_room(void)
     hd_stats s;
     hd_result r;
     oom_log log;
-    size_t full = (size_t)4000 * 3600 * 16;
+    size_t full = (size_t)3600 * 3400 * 20;
     memset(vol, 200, sizeof vol);
     memset(&d, 0, sizeof d);
     memset(&log, 0, sizeof log);
     d.volume.type = HD_VOXEL_U8;
     d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = 8;
     d.volume.data = vol;
-    d.camera.width = 4000;
-    d.camera.height = 3600;
+    d.camera.width = 3600;
+    d.camera.height = 3400;
     d.camera.eye[1] = 8.0f; /* far: the volume covers few pixels, the frame is cheap */
     d.camera.up[2] = 1.0f;
     d.params.illumination_downsample = 1;
@@ -88,7 +89,7 @@ static void test_device_oom_image_room(void)
     p.render_scale = 2;
     CHECK(hd_set_params(ctx, &p) == HD_SUCCESS);
     r = hd_iterate(ctx, 1);
-    printf("  %s: a 4000x3600 image's scale-2 frame under the device memory limit: %s\n", hd_backend_name(), hd_result_string(r));
+    printf("  %s: a 3600x3400 image's scale-2 frame under the device memory limit: %s\n", hd_backend_name(), hd_result_string(r));
     CHECK_MSG(r == HD_ERROR_OUT_OF_DEVICE_MEMORY && log.errors == 1 && log.last == r, "got %s, %d errors logged", hd_result_string(r),
               log.errors);
     CHECK(hd_get_stats(ctx, &s) == HD_SUCCESS && s.image_bytes == full);
