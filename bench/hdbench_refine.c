@@ -36,17 +36,6 @@ static struct {
     int modes[MAX_MODES]; /* -1000 HD, -2000 PT_MS, else refine_bounces of HD_REST_REFINE */
 } O;
 
-static double bench_clock(void)
-{
-    static double cores = 0.0;
-    struct timespec ts;
-    if (cores <= 0.0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        cores = n > 0 ? (double)n : 1.0;
-    }
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ((double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec) / cores;
-}
 
 static void check(hd_result r, const char *what)
 {
@@ -218,9 +207,9 @@ static void run_mode(const hd_desc *desc, int m, const float *ref_tm, double ref
         check(hd_create(&d, &c), "hd_create");
     }
     while (j < O.nb) {
-        double t0 = bench_clock();
+        double t0 = hdo_cpu_clock();
         check(hd_render(c), "hd_render");
-        t += bench_clock() - t0;
+        t += hdo_cpu_clock() - t0;
         while (j < O.nb && O.budgets[j] < t) {
             psnr[j] = last_psnr; mean[j] = last_mean; paths[j] = last_paths;
             ++j;
