@@ -57,18 +57,7 @@ static struct {
 /* The budget clock: wall time, or (default) this process's CPU time over the online cores, which
    is the wall time on otherwise idle cores when the workers block instead of spinning (the CPU
    backend's do): on a shared machine it stays put while the wall clock stretches with the load. */
-static double bench_clock(void)
-{
-    static double cores = 0.0;
-    struct timespec ts;
-    if (O.wall) return hdo_now();
-    if (cores <= 0.0) {
-        long n = sysconf(_SC_NPROCESSORS_ONLN);
-        cores = n > 0 ? (double)n : 1.0;
-    }
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ((double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec) / cores;
-}
+static double bench_clock(void) { return O.wall ? hdo_now() : hdo_cpu_clock(); }
 
 static void check(hd_result r, const char *what)
 {
@@ -341,7 +330,7 @@ static void budget_run(hd_context c, int hd_mode, const float *ref, float *img, 
     size_t npix = (size_t)O.size * (size_t)O.size;
     double t = 0.0, last = NAN;
     int j = 0, n = 0;
-    hd_desc d;
+    hd_desc d = HD_DESC_INIT; /* zeroed: gcc 12 cannot see hd_query_desc set it */
     check(hd_query_desc(c, &d), "hd_query_desc");
     while (j < O.nb) {
         double ts = bench_clock();

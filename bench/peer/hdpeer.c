@@ -61,7 +61,7 @@ static void picture(int size, const char *path)
 {
     size_t npix = (size_t)size * (size_t)size, i;
     uint8_t *rgba = (uint8_t *)malloc(npix * 4), *rgb = (uint8_t *)malloc(npix * 3);
-    hd_desc d;
+    hd_desc d = HD_DESC_INIT; /* zeroed: gcc 12 cannot see hd_query_desc set it */
     int f;
     if (!rgba || !rgb) {
         fprintf(stderr, "hdpeer: out of memory\n");
