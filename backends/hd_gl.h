@@ -1341,22 +1341,36 @@ static int hd__gl_output_format(GLint internal, GLenum *type)
                                                                : -1;
 }
 
+/* Binds the caller's texture to target on unit 0 and reads its level 0's size and internal format;
+   a name that is not a texture of that target is HD_ERROR_INVALID_TEXTURE. */
+static hd_result hd__gl_texture_query(const hd__view *vw, const char *fn, GLenum target, unsigned texture, GLint size[3], GLint *internal)
+{
+    hd__backend *be = vw->be;
+    size[0] = size[1] = size[2] = 0;
+    *internal = 0;
+    be->gl.BindTexture(target, (GLuint)texture);
+    if (be->gl.GetError() != GL_NO_ERROR)
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a %s texture name in the current context", fn, texture,
+                       target == GL_TEXTURE_3D ? "3D" : "2D");
+    be->gl.GetTexLevelParameteriv(target, 0, GL_TEXTURE_WIDTH, &size[0]);
+    be->gl.GetTexLevelParameteriv(target, 0, GL_TEXTURE_HEIGHT, &size[1]);
+    if (target == GL_TEXTURE_3D) be->gl.GetTexLevelParameteriv(target, 0, GL_TEXTURE_DEPTH, &size[2]);
+    be->gl.GetTexLevelParameteriv(target, 0, GL_TEXTURE_INTERNAL_FORMAT, internal);
+    return HD_SUCCESS;
+}
+
 static hd_result hd__be_output_texture(const hd__view *vw, unsigned texture, const hd_output *out, int exact)
 {
     static const char *const names[HD_OUTPUT_FORMAT_COUNT] = {"GL_RGBA8 or GL_SRGB8_ALPHA8", "GL_RGBA16F", "GL_RGBA32F"};
     const char *fn = exact ? "hd_gl_render_to_texture" : "hd_gl_render_to_texture_ex";
     hd__backend *be = vw->be;
-    GLint w = 0, h = 0, internal = 0;
+    GLint size[3], internal, w, h;
     GLenum type;
     int cw = out->width, ch = out->height;
     size_t bytes = (size_t)cw * ch * hd__output_pixel_bytes(out->format);
     hd_result r;
-    be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)texture);
-    if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 2D texture name in the current context", fn, texture);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if ((r = hd__gl_texture_query(vw, fn, GL_TEXTURE_2D, texture, size, &internal)) != HD_SUCCESS) return r;
+    w = size[0], h = size[1];
     if (exact && (w != cw || h != ch || internal != GL_RGBA8))
         return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: texture %u is %dx%d, format 0x%04x; needs %dx%d GL_RGBA8 (the camera's size)",
                        fn, texture, (int)w, (int)h, (unsigned)internal, cw, ch);
@@ -1399,15 +1413,10 @@ static hd_result hd__be_illumination_texture(const hd__view *vw, unsigned textur
 {
     const char *fn = "hd_gl_illumination_texture";
     hd__backend *be = vw->be;
-    GLint w = 0, h = 0, d = 0, internal = 0;
+    GLint size[3], internal, w, h, d;
     hd_result r;
-    be->gl.BindTexture(GL_TEXTURE_3D, (GLuint)texture);
-    if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 3D texture name in the current context", fn, texture);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_WIDTH, &w);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_HEIGHT, &h);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_DEPTH, &d);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_3D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if ((r = hd__gl_texture_query(vw, fn, GL_TEXTURE_3D, texture, size, &internal)) != HD_SUCCESS) return r;
+    w = size[0], h = size[1], d = size[2];
     if (internal != GL_R32F)
         return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "%s: texture %u has internal format 0x%04x; the light needs GL_R32F", fn, texture,
                        (unsigned)internal);
@@ -1432,15 +1441,11 @@ static hd_result hd__be_depth_texture(const hd__view *vw, unsigned texture)
 {
     const char *fn = "hd_gl_set_depth_texture";
     hd__backend *be = vw->be;
-    GLint w = 0, h = 0, internal = 0;
+    GLint size[3], internal, w, h;
     size_t bytes = (size_t)vw->camera.width * vw->camera.height * sizeof(float);
     hd_result r;
-    be->gl.BindTexture(GL_TEXTURE_2D, (GLuint)texture);
-    if (be->gl.GetError() != GL_NO_ERROR)
-        return HD__ERR(&vw->log, HD_ERROR_INVALID_TEXTURE, "%s: %u is not a 2D texture name in the current context", fn, texture);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &w);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &h);
-    be->gl.GetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if ((r = hd__gl_texture_query(vw, fn, GL_TEXTURE_2D, texture, size, &internal)) != HD_SUCCESS) return r;
+    w = size[0], h = size[1];
     if (internal != GL_DEPTH_COMPONENT16 && internal != GL_DEPTH_COMPONENT24 && internal != GL_DEPTH_COMPONENT32F &&
         internal != GL_DEPTH24_STENCIL8 && internal != GL_DEPTH32F_STENCIL8)
         return HD__ERR(&vw->log, HD_ERROR_DEPTH_FORMAT, "%s: texture %u has internal format 0x%04x, not GL_DEPTH_COMPONENT16, 24, 32F, "
