@@ -130,8 +130,9 @@ static int hd__area_light_count(const hd_light *lights, int count)
 
 /* Lights as given (env_power: an environment's power, -1 without one), before the defaults (zero colour -> white, zero intensity -> 1), which the
    power limit applies after: sum of intensity * max(colour) <= HD_MAX_LIGHT_POWER keeps E, phi
-   and the image finite (a sample is at most HD_MAX_LIGHTS * power * 1e12, the point lights'
-   1/r^2 floor; README "Guarantees"). */
+   and the image finite (a sample is at most 10 (HD_MAX_LIGHTS + 1) * power * 1e12: one over
+   the least chance of a light (src/hd_kparams.h, hd__light_cdf) times the point lights' 1/r^2
+   floor, which caps an area light's A cos / r^2 too; README "Guarantees"). */
 static hd_result hd__check_lights(const hd_light *lights, int count, double env_power, const hd_logger *log)
 {
     int i;

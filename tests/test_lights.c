@@ -154,18 +154,18 @@ static void test_area_shapes_match_exact(void)
     q.position[0] = -0.4f; q.position[1] = 0.7f; q.position[2] = -0.3f;
     q.edge1[0] = 0.8f; q.edge1[1] = 0.1f;
     q.edge2[1] = 0.15f; q.edge2[2] = 0.6f;
-    CHECK(tl_check_exact("quad above, tilted", &q, 2.0, 256, 48) < 0.01);
+    CHECK(tl_check_exact("quad above, tilted", &q, 1.0, 1024, 48) < 0.01);
     /* a disk beside the box along +x, facing it and a little down */
     k.type = HD_LIGHT_DISK;
     k.position[0] = 0.8f; k.position[1] = 0.2f;
     k.direction[0] = -1.0f; k.direction[1] = -0.3f;
     k.radius = 0.35f;
-    CHECK(tl_check_exact("disk beside", &k, 2.0, 256, 48) < 0.01);
+    CHECK(tl_check_exact("disk beside", &k, 1.0, 1024, 48) < 0.01);
     /* a sphere near a corner */
     s.type = HD_LIGHT_SPHERE;
     s.position[0] = 0.6f; s.position[1] = -0.7f; s.position[2] = 0.5f;
     s.radius = 0.3f;
-    CHECK(tl_check_exact("sphere near a corner", &s, 2.0, 256, 96) < 0.01);
+    CHECK(tl_check_exact("sphere near a corner", &s, 1.0, 1024, 96) < 0.01);
 }
 
 /* The emitting side: the quad with its edges swapped (normal away from the box) and a disk
