@@ -16,9 +16,9 @@ HD_FN void hdk_direct_voxel(HD_KARGS int x, int y, int z)
     int i = (z * gy + y) * gx + x;
     int nvox = gx * gy * gz;
     hd_u32 key = hdk_rng_key(HD_U(i), HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_DIRECT);
-    /* The light is drawn per run of 8 voxels along x, not per voxel: still with the same chances
-       for every voxel (unbiased), and SIMD lanes on a GPU (or in llvmpipe/PoCL) that walk toward the same
-       light stay coherent. */
+    /* The light is drawn per run of 8 voxels along x, not per voxel: still with the same
+       chances for every voxel (unbiased), and SIMD lanes on a GPU (or in llvmpipe/PoCL) that
+       walk toward the same light stay coherent. */
     hd_u32 lkey = hdk_rng_key(HD_U(i) >> 3u, HD_U(HD_PRM(frame).x), HD_U(HD_PRM(frame).z), HD_STREAM_LIGHT);
     float prob = 1.0f;
     int l = hdk_light_choose(HD_KPASS hdk_rand(lkey, 0u), HD_REF(prob));
