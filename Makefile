@@ -85,6 +85,7 @@ help:
 	@echo "  make eval-refine                    a resting view refined toward PT_MS: PSNR per budget (docs/DESIGN-REFINE.md)"
 	@echo "  make eval-multigrid                 the multigrid study: PSNR against PT_MS over time (docs/eval/multigrid/)"
 	@echo "  make bench-energy                   HD's mean radiance and PSNR against PT_MS per scene (docs/DESIGN-ENERGY.md)"
+	@echo "  make bench-lights                   HD's cost with a quad and a sphere light, PSNR against PT_MS, the light choice (docs/DESIGN-LIGHTS.md)"
 	@echo "  make compile-time                   CPU seconds to compile each backend's implementation against stb_image.h"
 
 LIB_SRC := hybriddiff.h $(wildcard src/*.h backends/*.h backends/kernels/*.h)

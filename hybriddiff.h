@@ -182,6 +182,9 @@ typedef enum hd_voxel_type {
 typedef enum hd_light_type {
     HD_LIGHT_DIRECTIONAL = 0,
     HD_LIGHT_POINT,
+    HD_LIGHT_QUAD,   /* area lights (hd_light): a parallelogram, a disk, a sphere */
+    HD_LIGHT_DISK,
+    HD_LIGHT_SPHERE,
     HD_LIGHT_TYPE_COUNT
 } hd_light_type;
 
@@ -343,15 +346,31 @@ typedef struct hd_transfer_function {
 typedef struct hd_light {
     hd_light_type type;
     float direction[3]; /* DIRECTIONAL: the direction the light travels in (need not be unit;
-                           any nonzero finite vector) */
-    float position[3];  /* POINT: position in world space (the volume box is centred at 0
+                           any nonzero finite vector); DISK: its normal */
+    float position[3];  /* POINT: position in world space (QUAD: a corner, DISK, SPHERE: the
+                           centre; the volume box is centred at 0
                            unless volume.transform moves it),
                            components within +-HD_MAX_LIGHT_DISTANCE */
     float color[3];     /* linear RGB, >= 0; {0,0,0} -> {1,1,1} */
     float intensity;    /* >= 0; 0 -> 1. Over all lights, sum of intensity * max(color) <=
                            HD_MAX_LIGHT_POWER */
     int inverse_square; /* POINT: 1 = intensity / r^2 falloff (r in world units), 0 = none */
+    float edge1[3];     /* QUAD: the two edges from the corner at position (world units, within */
+    float edge2[3];     /*   +-HD_MAX_LIGHT_DISTANCE, nonzero, not parallel) */
+    float radius;       /* DISK, SPHERE: radius in world units, in (0, HD_MAX_LIGHT_DISTANCE] */
 } hd_light;
+/* Area lights. QUAD: the parallelogram position + u edge1 + v edge2, u, v in [0, 1]; it emits on
+   the side of edge1 x edge2 only. DISK: centre position, normal direction (the side it emits
+   on, one-sided as the quad), radius. SPHERE: centre position, radius; it emits outward, so a
+   point inside it gets none of its light. Units: intensity * colour is the emitted radiance,
+   the same from every point of the surface in every direction it emits in (not the power: a
+   light twice the area gives twice the light); a small quad of area A far away at distance r
+   gives the irradiance intensity * A * cos / r^2, as a point light of intensity * A with
+   inverse_square. The direct light samples a quad and a disk uniformly over the area, a sphere
+   uniformly over the cone it subtends; the path tracers reach them by next-event estimation
+   only: a scattered or camera ray does not see them. Method CD cannot hold them
+   (HD_ERROR_UNSUPPORTED). Degenerate ones (zero or parallel edges, zero normal, radius <= 0,
+   NaN or infinite values) are HD_ERROR_INVALID_LIGHT. */
 
 /* An environment: light arriving from every direction at infinity, given as an equirectangular
    (latitude-longitude) map of linear RGB radiance. Set by its own call (hd_set_environment), not

@@ -90,6 +90,16 @@ static const char *usage_text =
     "                          down); repeatable, up to 64 lights\n"
     "  --light point:X,Y,Z[:R,G,B][:INTENSITY][:falloff]\n"
     "                          point light at X,Y,Z; falloff: intensity / r^2\n"
+    "  --light quad:X,Y,Z:E1X,E1Y,E1Z:E2X,E2Y,E2Z[:R,G,B][:INTENSITY]\n"
+    "                          area light: the parallelogram from corner X,Y,Z along edges\n"
+    "                          E1 and E2, emitting on the side of E1 x E2 only\n"
+    "  --light disk:X,Y,Z:NX,NY,NZ:RADIUS[:R,G,B][:INTENSITY]\n"
+    "                          area light: a disk at X,Y,Z emitting toward its normal N\n"
+    "  --light sphere:X,Y,Z:RADIUS[:R,G,B][:INTENSITY]\n"
+    "                          area light: a sphere emitting outward. For area lights\n"
+    "                          INTENSITY x colour is the emitted radiance (per area and\n"
+    "                          solid angle), so a larger light is brighter; they light\n"
+    "                          the volume but are not drawn, and method cd cannot use them\n"
     "  --lights N              N preset directional lights placed around the camera\n"
     "                          (1: key light, 3: key, fill and rim; default 1)\n"
     "  --env FILE.hdr[:ROTATION][:INTENSITY]\n"
@@ -353,12 +363,14 @@ static void parse_size(const char *flag, const char *s, int *w, int *h)
     *h = (int)b;
 }
 
-/* dir:X,Y,Z[:R,G,B][:INTENSITY]  or  point:X,Y,Z[:R,G,B][:INTENSITY][:falloff] */
+/* dir:X,Y,Z[:R,G,B][:INTENSITY], point:X,Y,Z[:R,G,B][:INTENSITY][:falloff],
+   quad:X,Y,Z:E1X,E1Y,E1Z:E2X,E2Y,E2Z[:R,G,B][:INTENSITY] (a corner and two edges),
+   disk:X,Y,Z:NX,NY,NZ:RADIUS[:R,G,B][:INTENSITY] (centre, normal), sphere:X,Y,Z:RADIUS[...] */
 static hd_light parse_light(const char *s)
 {
     hd_light l;
     char buf[256], *parts[8];
-    int n = 0, i, have_color = 0, have_intensity = 0;
+    int n = 0, i, have_color = 0, have_intensity = 0, first = 2;
     char *p;
     memset(&l, 0, sizeof l);
     if (strlen(s) >= sizeof buf) fail(2, "--light: '%s' is too long", s);
@@ -374,16 +386,39 @@ static hd_light parse_light(const char *s)
         l.type = HD_LIGHT_DIRECTIONAL;
     else if (strcmp(parts[0], "point") == 0)
         l.type = HD_LIGHT_POINT;
+    else if (strcmp(parts[0], "quad") == 0)
+        l.type = HD_LIGHT_QUAD;
+    else if (strcmp(parts[0], "disk") == 0)
+        l.type = HD_LIGHT_DISK;
+    else if (strcmp(parts[0], "sphere") == 0)
+        l.type = HD_LIGHT_SPHERE;
     else
-        fail(2, "--light: '%s' must start with dir: or point:", s);
+        fail(2, "--light: '%s' must start with dir:, point:, quad:, disk: or sphere:", s);
     if (n < 2) fail(2, "--light: '%s' needs a %s X,Y,Z", s,
-                    l.type == HD_LIGHT_POINT ? "position" : "direction");
+                    l.type == HD_LIGHT_DIRECTIONAL ? "direction" : l.type == HD_LIGHT_QUAD ? "corner" :
+                    l.type == HD_LIGHT_POINT ? "position" : "centre");
     /* the library's limit for positions; a direction's squares stay finite in float as well */
-    parse_floats_in("--light", parts[1], l.type == HD_LIGHT_POINT ? l.position : l.direction, 3, HD_MAX_LIGHT_DISTANCE);
+    parse_floats_in("--light", parts[1], l.type == HD_LIGHT_DIRECTIONAL ? l.direction : l.position, 3, HD_MAX_LIGHT_DISTANCE);
     if (l.type == HD_LIGHT_DIRECTIONAL &&
         l.direction[0] == 0.0f && l.direction[1] == 0.0f && l.direction[2] == 0.0f)
         fail(2, "--light: '%s': the direction is zero", s);
-    for (i = 2; i < n; ++i) {
+    /* the shape of an area light; the library refuses a degenerate one with its own message */
+    if (l.type == HD_LIGHT_QUAD) {
+        if (n < 4) fail(2, "--light: '%s' needs a corner and two edges: quad:X,Y,Z:E1X,E1Y,E1Z:E2X,E2Y,E2Z", s);
+        parse_floats_in("--light quad edge", parts[2], l.edge1, 3, HD_MAX_LIGHT_DISTANCE);
+        parse_floats_in("--light quad edge", parts[3], l.edge2, 3, HD_MAX_LIGHT_DISTANCE);
+        first = 4;
+    } else if (l.type == HD_LIGHT_DISK) {
+        if (n < 4) fail(2, "--light: '%s' needs a centre, a normal and a radius: disk:X,Y,Z:NX,NY,NZ:RADIUS", s);
+        parse_floats_in("--light disk normal", parts[2], l.direction, 3, HD_MAX_LIGHT_DISTANCE);
+        l.radius = parse_float("--light disk radius", parts[3], 0.0f, HD_MAX_LIGHT_DISTANCE, 1, 0);
+        first = 4;
+    } else if (l.type == HD_LIGHT_SPHERE) {
+        if (n < 3) fail(2, "--light: '%s' needs a centre and a radius: sphere:X,Y,Z:RADIUS", s);
+        l.radius = parse_float("--light sphere radius", parts[2], 0.0f, HD_MAX_LIGHT_DISTANCE, 1, 0);
+        first = 3;
+    }
+    for (i = first; i < n; ++i) {
         if (strcmp(parts[i], "falloff") == 0) {
             if (l.type != HD_LIGHT_POINT)
                 fail(2, "--light: '%s': falloff is for point lights", s);

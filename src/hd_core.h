@@ -121,6 +121,10 @@ typedef struct hd__ctx {
     hd_environment env;
     int env_grey;
     double env_power;
+    double env_fluence;      /* the map's fluence at a point in the open: the integral of its
+                                max(rgb) radiance (times the intensity) over the sphere */
+    int light_uniform;       /* 1: the light of a sample is drawn uniformly, not by its estimated
+                                light (hd__light_cdf); set only by a test hook */
     /* method state */
     unsigned dirty;
     uint64_t iterations;

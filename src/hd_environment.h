@@ -105,6 +105,21 @@ static float *hd__env_tables(const hd__view *vw, const hd_environment *e, size_t
     return t;
 }
 
+/* The fluence of a map's tables (radiance times the intensity) in the open: the sum over the
+   texels of max(rgb) times the solid angle, 2 pi^2 sin(theta) / (w h). The light choice's
+   estimate (hd__light_cdf). */
+static double hd__env_fluence(const float *t, int w, int h)
+{
+    double sum = 0.0;
+    int i, j;
+    for (j = 0; j < h; ++j) {
+        double st = sin(3.14159265358979323846 * ((double)j + 0.5) / (double)h), s = 0.0;
+        for (i = 0; i < w; ++i) s += (double)hd__max3(t + 3 * ((size_t)j * (size_t)w + (size_t)i));
+        sum += s * st;
+    }
+    return sum * 2.0 * 3.14159265358979323846 * 3.14159265358979323846 / ((double)w * (double)h);
+}
+
 /* The environment's part of the parameter block: the tables' places and the rotation from the
    volume's frame into the map's, whose rows are the map's axes (world = R map) mapped into the
    volume's frame. */
@@ -160,6 +175,7 @@ static hd_result hd__api_set_environment(hd__ctx *ctx, const hd_environment *env
         ctx->env_on = 1;
         ctx->env_grey = grey;
         ctx->env_power = power;
+        ctx->env_fluence = hd__env_fluence(tab, env->width, env->height);
     }
     hd__set_channels(ctx);
     ctx->dirty |= HD__DIRTY_ENV | HD__INV_WARM_LIGHT;

@@ -1,6 +1,94 @@
 /* hd_kparams.h - the kernels' parameter block (backends/kernels/hd_k_params.h) packed from the
    context. Part of the core (src/hd_core.h). */
 /* ---- the kernels' parameter block ------------------------------------------------------------ */
+/* A vector of the world in the volume's frame (lengths kept: the frame's axes are unit). */
+static void hd__dir_to_volume(const hd__ctx *ctx, const float v[3], double out[3])
+{
+    double dv[3] = {v[0], v[1], v[2]};
+    if (ctx->xf.identity) { out[0] = dv[0]; out[1] = dv[1]; out[2] = dv[2]; }
+    else hd__xform_dir(&ctx->xf, dv, out);
+}
+
+/* An area light's shape in the volume's frame (hd_k_light.h, hdk_light_pick): a quad's edges
+   and area, a disk's unit normal, radius and a unit tangent, a sphere's radius. */
+static void hd__area_kparams(const hd__ctx *ctx, const hd_light *l, hd_f4 *c, hd_f4 *d)
+{
+    double e1[3], e2[3], n[3], t[3], len;
+    if (l->type == HD_LIGHT_QUAD) {
+        hd__dir_to_volume(ctx, l->edge1, e1);
+        hd__dir_to_volume(ctx, l->edge2, e2);
+        n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+        n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+        n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+        c->x = (float)e1[0]; c->y = (float)e1[1]; c->z = (float)e1[2];
+        c->w = (float)sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        d->x = (float)e2[0]; d->y = (float)e2[1]; d->z = (float)e2[2];
+    } else if (l->type == HD_LIGHT_DISK) {
+        float f[3], u[3];
+        hd__dir_to_volume(ctx, l->direction, n);
+        hd__store3(f, n);
+        hd__unit3(f, u); /* nonzero: hd__check_area_light */
+        c->x = u[0]; c->y = u[1]; c->z = u[2]; c->w = l->radius;
+        /* a tangent: the normal crossed with the axis it is least along */
+        if (fabsf(u[0]) < 0.6f) { t[0] = 0.0; t[1] = u[2]; t[2] = -u[1]; }
+        else { t[0] = -u[2]; t[1] = 0.0; t[2] = u[0]; }
+        len = sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+        d->x = (float)(t[0] / len); d->y = (float)(t[1] / len); d->z = (float)(t[2] / len);
+    } else {
+        c->x = c->y = c->z = 0.0f; c->w = l->radius;
+        d->x = d->y = d->z = 0.0f;
+    }
+}
+
+/* The share of the lights' samples each light gets unconditionally: the rest goes by the
+   estimate, so a light the estimate gets wrong is still sampled often enough. */
+#define HD__LIGHT_UNIFORM_SHARE 0.1
+
+/* The chance the kernels draw each light with (hdk_light_choose, hd_k_light.h): its estimated
+   light at the box's centre over the sum, mixed with a uniform share; the CDF over the list in
+   light_d[l].w, the environment the rest up to 1. The estimate is the fluence at the centre
+   in the open (largest channel): a directional light's irradiance, a point light's intensity
+   over r^2 (r at least half the box's diagonal), an area light's radiance times the solid angle
+   it subtends (at most 2 pi), the map's integral. */
+static void hd__light_cdf(const hd__ctx *ctx, hd__kparams *k)
+{
+    double est[HD_MAX_LIGHTS + 1], sum = 0.0, acc = 0.0, hb2;
+    const float *box = ctx->kbox;
+    int i, n = ctx->light_count, nl = n + (ctx->env_on ? 1 : 0);
+    hb2 = 0.25 * ((double)box[0] * box[0] + (double)box[1] * box[1] + (double)box[2] * box[2]);
+    for (i = 0; i < n; ++i) {
+        const hd_light *l = &ctx->lights[i];
+        const hd_f4 *a = &k->light_a[i], *b = &k->light_b[i], *c = &k->light_c[i];
+        double rad = b->x > b->y ? b->x : b->y, r2 = (double)a->x * a->x + (double)a->y * a->y + (double)a->z * a->z;
+        if (b->z > rad) rad = b->z;
+        if (r2 < hb2) r2 = hb2;
+        if (l->type == HD_LIGHT_DIRECTIONAL || (l->type == HD_LIGHT_POINT && !l->inverse_square)) est[i] = rad;
+        else if (l->type == HD_LIGHT_POINT) est[i] = rad / r2;
+        else {
+            double area = l->type == HD_LIGHT_QUAD ? (double)c->w : 3.14159265358979323846 * (double)c->w * (double)c->w;
+            double omega = area / r2;
+            if (l->type == HD_LIGHT_QUAD) { /* the centre, not the corner */
+                double m[3] = {a->x + 0.5 * (k->light_c[i].x + k->light_d[i].x), a->y + 0.5 * (k->light_c[i].y + k->light_d[i].y),
+                               a->z + 0.5 * (k->light_c[i].z + k->light_d[i].z)};
+                double q2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+                omega = area / (q2 > hb2 ? q2 : hb2);
+            }
+            est[i] = rad * (omega < 6.283185307179586 ? omega : 6.283185307179586);
+        }
+        if (!(est[i] >= 0.0) || est[i] > 1e30) est[i] = 0.0;
+        sum += est[i];
+    }
+    if (ctx->env_on) { est[n] = ctx->env_fluence; sum += est[n]; }
+    for (i = 0; i < n; ++i) {
+        double p = 1.0 / (double)nl;
+        if (!ctx->light_uniform && sum > 0.0)
+            p = (1.0 - HD__LIGHT_UNIFORM_SHARE) * est[i] / sum + HD__LIGHT_UNIFORM_SHARE / (double)nl;
+        acc += p;
+        k->light_d[i].w = (float)acc;
+    }
+    if (n > 0 && !ctx->env_on) k->light_d[n - 1].w = 1.0f;
+}
+
 static void hd__fill_kparams(hd__ctx *ctx)
 {
     hd__kparams *k = &ctx->vw.kp;
@@ -102,10 +190,11 @@ static void hd__fill_kparams(hd__ctx *ctx)
         } else if (!ctx->xf.identity) {
             double q[3];
             hd__xform_point(&ctx->xf, l->position, q);
-            a->x = (float)q[0]; a->y = (float)q[1]; a->z = (float)q[2]; a->w = 1.0f;
+            a->x = (float)q[0]; a->y = (float)q[1]; a->z = (float)q[2]; a->w = (float)l->type;
         } else {
-            a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = 1.0f;
+            a->x = l->position[0]; a->y = l->position[1]; a->z = l->position[2]; a->w = (float)l->type;
         }
+        if (l->type >= HD_LIGHT_QUAD) hd__area_kparams(ctx, l, &k->light_c[i], &k->light_d[i]);
         if (ctx->vw.channels == 1) {
             b->x = b->y = b->z = l->intensity * hd__max3(l->color); /* the colour is chan_color */
         } else {
@@ -113,4 +202,5 @@ static void hd__fill_kparams(hd__ctx *ctx)
         }
         b->w = l->type == HD_LIGHT_POINT && l->inverse_square ? 1.0f : 0.0f;
     }
+    hd__light_cdf(ctx, k);
 }

@@ -187,11 +187,11 @@ static hd_result hd__check_lights_frame(const hd_light *lights, int count, const
     if (x->identity) return HD_SUCCESS;
     for (i = 0; i < count; ++i) {
         double p[3];
-        if (lights[i].type != HD_LIGHT_POINT) continue;
+        if (lights[i].type == HD_LIGHT_DIRECTIONAL) continue;
         hd__xform_point(x, lights[i].position, p);
         for (c = 0; c < 3; ++c)
             if (!(fabs(p[c]) <= (double)HD_MAX_LIGHT_DISTANCE))
-                return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: point light %g world units from the volume's centre along its axis %d, beyond %g",
+                return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: light %g world units from the volume's centre along its axis %d, beyond %g",
                                i, fabs(p[c]), c, (double)HD_MAX_LIGHT_DISTANCE);
     }
     return HD_SUCCESS;

@@ -153,4 +153,13 @@ HD__MAYBE_UNUSED static int hd__test_first_scale(hd_context h)
     hd__ctx *ctx = hd__lookup(h);
     return ctx ? hd__first_scale(ctx) : 0;
 }
+/* on = 1: draw the light of each sample uniformly among the lights instead of by their
+   estimated light (hd__light_cdf), to measure what the choice by estimate gains. */
+HD__MAYBE_UNUSED static hd_result hd__test_light_uniform(hd_context h, int on)
+{
+    HD__GET_CTX(ctx, h);
+    ctx->light_uniform = on != 0;
+    ctx->dirty |= HD__INV_WARM_LIGHT;
+    return HD_SUCCESS;
+}
 #endif /* HD_CORE_H: inside the implementation */

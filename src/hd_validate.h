@@ -90,13 +90,53 @@ static int hd__unit3(const float v[3], float out[3])
            out[0] * out[0] + out[1] * out[1] + out[2] * out[2] > 0.5f;
 }
 
+/* An area light's shape (hybriddiff.h, hd_light): finite, nonzero, not parallel, within
+   HD_MAX_LIGHT_DISTANCE. */
+static hd_result hd__check_area_light(const hd_light *l, int i, const hd_logger *log)
+{
+    const char *name = l->type == HD_LIGHT_QUAD ? "quad" : l->type == HD_LIGHT_DISK ? "disk" : "sphere";
+    float u1[3], u2[3], c[3];
+    int k;
+    if (!hd__finite3(l->edge1) || !hd__finite3(l->edge2) || !hd__finite(l->radius))
+        return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: %s light has a NaN or infinite edge or radius", i, name);
+    if (l->type == HD_LIGHT_QUAD) {
+        for (k = 0; k < 3; ++k)
+            if (fabsf(l->edge1[k]) > HD_MAX_LIGHT_DISTANCE || fabsf(l->edge2[k]) > HD_MAX_LIGHT_DISTANCE)
+                return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: quad light edge beyond %g world units", i, (double)HD_MAX_LIGHT_DISTANCE);
+        if (!hd__unit3(l->edge1, u1) || !hd__unit3(l->edge2, u2))
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: quad light with a zero edge (size 0)", i);
+        c[0] = u1[1] * u2[2] - u1[2] * u2[1];
+        c[1] = u1[2] * u2[0] - u1[0] * u2[2];
+        c[2] = u1[0] * u2[1] - u1[1] * u2[0];
+        if (!(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] > 1e-8f))
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: quad light with parallel edges (no area)", i);
+        return HD_SUCCESS;
+    }
+    if (!(l->radius > 0.0f) || l->radius > HD_MAX_LIGHT_DISTANCE)
+        return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: %s light radius %g is outside (0, %g]", i, name,
+                       (double)l->radius, (double)HD_MAX_LIGHT_DISTANCE);
+    if (l->type == HD_LIGHT_DISK && !hd__unit3(l->direction, u1))
+        return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: disk light with a zero normal (direction)", i);
+    return HD_SUCCESS;
+}
+
+/* How many of the lights are area lights (which method CD cannot hold). */
+static int hd__area_light_count(const hd_light *lights, int count)
+{
+    int i, n = 0;
+    for (i = 0; lights && i < count; ++i) n += lights[i].type >= HD_LIGHT_QUAD && lights[i].type < HD_LIGHT_TYPE_COUNT;
+    return n;
+}
+
 /* Lights as given (env_power: an environment's power, -1 without one), before the defaults (zero colour -> white, zero intensity -> 1), which the
    power limit applies after: sum of intensity * max(colour) <= HD_MAX_LIGHT_POWER keeps E, phi
-   and the image finite (a sample is at most HD_MAX_LIGHTS * power * 1e12, the point lights'
-   1/r^2 floor; README "Guarantees"). */
+   and the image finite (a sample is at most 10 (HD_MAX_LIGHTS + 1) * power * 1e12: one over
+   the least chance of a light (src/hd_kparams.h, hd__light_cdf) times the point lights' 1/r^2
+   floor, which caps an area light's A cos / r^2 too; README "Guarantees"). */
 static hd_result hd__check_lights(const hd_light *lights, int count, double env_power, const hd_logger *log)
 {
     int i;
+    hd_result r;
     double power = env_power > 0.0 ? env_power : 0.0; /* an environment's (src/hd_environment.h), which may stand alone */
     if (count == 0 && env_power >= 0.0) return HD_SUCCESS;
     if (count == 0) return HD__ERR(log, HD_ERROR_NO_LIGHTS, "no lights: give at least one, or set an environment");
@@ -115,10 +155,11 @@ static hd_result hd__check_lights(const hd_light *lights, int count, double env_
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d has a negative colour or intensity", i);
         if (l->type == HD_LIGHT_DIRECTIONAL && !hd__unit3(l->direction, unit))
             return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: directional light with a zero direction", i);
-        if (l->type == HD_LIGHT_POINT &&
+        if (l->type >= HD_LIGHT_QUAD && (r = hd__check_area_light(l, i, log)) != HD_SUCCESS) return r;
+        if (l->type != HD_LIGHT_DIRECTIONAL &&
             (fabsf(l->position[0]) > HD_MAX_LIGHT_DISTANCE || fabsf(l->position[1]) > HD_MAX_LIGHT_DISTANCE ||
              fabsf(l->position[2]) > HD_MAX_LIGHT_DISTANCE))
-            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: point light at {%g, %g, %g}, beyond %g world units",
+            return HD__ERR(log, HD_ERROR_INVALID_LIGHT, "light %d: light at {%g, %g, %g}, beyond %g world units",
                            i, (double)l->position[0], (double)l->position[1], (double)l->position[2],
                            (double)HD_MAX_LIGHT_DISTANCE);
         cmax = l->color[0] > l->color[1] ? l->color[0] : l->color[1];

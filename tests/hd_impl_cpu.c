@@ -48,6 +48,8 @@ unsigned hdt_slot_generation(int slot, unsigned generation)
     hd__slots[slot].generation = generation;
     return old;
 }
+hd_result hdt_light_uniform(hd_context h, int on);
+hd_result hdt_light_uniform(hd_context h, int on) { return hd__test_light_uniform(h, on); }
 int hdt_slots(void);
 int hdt_slots(void) { return HD_MAX_CONTEXTS; }
 

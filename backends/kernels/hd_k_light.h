@@ -1,8 +1,17 @@
 /* hd_k_light.h - choosing and sampling a light (shared source): the list's directional and
-   point lights (hdk_light_dir, hd_k_common.h) and the environment map (hd_set_environment).
+   point lights (hdk_light_dir, hd_k_common.h), its area lights (quad, disk, sphere) and the
+   environment map (hd_set_environment).
    Light index l: 0 .. counts.x - 1 the list, counts.x the environment while env.x > 0; the
    direct light (hd_k_direct.h) and the path tracers' next-event estimation (hd_k_path.h) draw
-   one uniformly and weigh its sample by the count.
+   one with the chances the host gives (hdk_light_choose: by each light's estimated light,
+   src/hd_kparams.h, hd__light_cdf) and weigh its sample by one over its chance.
+
+   Area lights are sampled uniformly over their area (quad, disk: one-sided, emitting on the
+   side of the normal) or over the cone a sphere subtends from the point, and weigh the
+   radiance by the area's solid angle per sample: L A cos / r^2 (at most HD_AREA_G_MAX times L,
+   as a point light's 1/r^2 is floored), L 2 pi (1 - cos theta_max) for the sphere. They are
+   not delta lights, but no scattered ray sees them (hd_k_path.h), so their density is given as 0
+   and next-event estimation takes their whole weight.
 
    The environment is an equirectangular map, sampled by importance through the tables the host
    builds once per map (src/hd_environment.h) in the buffer env:
@@ -31,8 +40,37 @@
 #endif
 #endif
 
-/* The lights to choose from: the list, and the environment if one is set. */
-#define HDK_LIGHTS (HD_PRM(counts).x + (HD_PRM(env).x > 0 ? 1 : 0))
+#define HD_AREA_G_MAX 1.0e12f /* the largest A cos / r^2 of one area-light sample (r^2 >= 1e-12 for a point light) */
+
+HD_FN hd_v3 hdk_cross(hd_v3 a, hd_v3 b)
+{
+    return HD_V3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+/* The light drawn by u in [0, 1): the first l of the list with u < light_d[l].w (the host's CDF
+   over the list), the environment past it; its chance in *prob (> 0). */
+HD_FN int hdk_light_choose(HD_KARGS float u, HD_INOUT(float) prob)
+{
+    int n = HD_PRM(counts).x, lo = 0, hi = HD_PRM(counts).x;
+    float c0, c1;
+    while (lo < hi) { /* at most 7 steps for HD_MAX_LIGHTS */
+        int mid = (lo + hi) >> 1;
+        if (u < HD_PRM(light_d)[mid].w) hi = mid;
+        else lo = mid + 1;
+    }
+    if (lo >= n && HD_PRM(env).x <= 0) lo = n - 1; /* u at the CDF's rounding end */
+    c0 = lo > 0 ? HD_PRM(light_d)[hdk_maxi(lo - 1, 0)].w : 0.0f;
+    c1 = lo < n ? HD_PRM(light_d)[hdk_mini(lo, n - 1)].w : 1.0f;
+    HD_DEREF(prob) = hdk_maxf(c1 - c0, 1.0e-6f);
+    return lo;
+}
+
+/* The chance of drawing the environment (0 without one), n = counts.x the list's lights. */
+HD_FN float hdk_env_chance(HD_KARGS int n)
+{
+    if (HD_PRM(env).x <= 0) return 0.0f;
+    return n > 0 ? 1.0f - HD_PRM(light_d)[hdk_mini(n, HD_MAX_LIGHTS) - 1].w : 1.0f;
+}
 
 /* Component c (0..2) of v. */
 HD_FN float hdk_v3_at(hd_v3 v, int c)
@@ -119,16 +157,79 @@ HD_FN hd_v3 hdk_env_sample(HD_KARGS float xi0, float xi1, HD_INOUT(float) pdf, H
     return hdk_normalize(hdk_env_to_volume(HD_KPASS m));
 }
 
+/* Area light l (type 2 quad, 3 disk, 4 sphere) seen from p: the direction toward a point of it
+   drawn from xi0, xi1, where tracking stops (*tmax), the radiance over the direction's density
+   (falloff included) in the return's x, y, z as hdk_light_pick's *w. */
+HD_FN hd_v3 hdk_area_sample(HD_KARGS int l, hd_v3 p, float xi0, float xi1, HD_INOUT(float) tmax, HD_INOUT(hd_v3) w)
+{
+    hd_v4 la = HD_PRM(light_a)[l], lc = HD_PRM(light_c)[l], ld = HD_PRM(light_d)[l];
+    hd_v3 lb = HD_XYZ(HD_PRM(light_b)[l]);
+    hd_v3 d, q, n;
+    float g = 0.0f, r2, r;
+    if (la.w > 3.5f) { /* sphere: uniform in the cone it subtends */
+        hd_v3 v = hdk_sub(HD_XYZ(la), p), wz, a, b1, b2;
+        float d2 = hdk_dot(v, v), rad2 = lc.w * lc.w, dist, s2, omc, ct, st, ph, th;
+        if (!(d2 > rad2)) { /* inside the sphere: it emits outward only */
+            HD_DEREF(tmax) = 0.0f;
+            HD_DEREF(w) = HD_V3(0.0f, 0.0f, 0.0f);
+            return HD_V3(0.0f, 0.0f, 1.0f);
+        }
+        dist = hdk_sqrt(d2);
+        wz = hdk_scale(v, 1.0f / dist);
+        s2 = rad2 / d2;
+        omc = s2 / (1.0f + hdk_sqrt(hdk_maxf(0.0f, 1.0f - s2))); /* 1 - cos theta_max, no cancellation */
+        ct = 1.0f - xi0 * omc;
+        st = hdk_sqrt(hdk_maxf(0.0f, xi0 * omc * (2.0f - xi0 * omc)));
+        ph = 6.28318531f * xi1;
+        a = hdk_absf(wz.x) > 0.9f ? HD_V3(0.0f, 1.0f, 0.0f) : HD_V3(1.0f, 0.0f, 0.0f);
+        b1 = hdk_normalize(hdk_cross(a, wz));
+        b2 = hdk_cross(wz, b1);
+        d = hdk_normalize(hdk_add(hdk_scale(wz, ct), hdk_add(hdk_scale(b1, st * hdk_cos(ph)), hdk_scale(b2, st * hdk_sin(ph)))));
+        /* the nearer crossing of the sphere along d */
+        th = dist * ct - hdk_sqrt(hdk_maxf(0.0f, rad2 - d2 * st * st));
+        HD_DEREF(tmax) = hdk_minf(hdk_maxf(th, 0.0f), hdk_box_exit(HD_KPASS p, d));
+        HD_DEREF(w) = hdk_scale(lb, 6.28318531f * omc);
+        return d;
+    }
+    if (la.w < 2.5f) { /* quad: corner + xi0 edge 1 + xi1 edge 2, normal edge1 x edge2 */
+        q = hdk_add(HD_XYZ(la), hdk_add(hdk_scale(HD_XYZ(lc), xi0), hdk_scale(HD_XYZ(ld), xi1)));
+        n = hdk_normalize(hdk_cross(HD_XYZ(lc), HD_XYZ(ld)));
+        g = lc.w;
+    } else { /* disk: uniform in area, radius sqrt(xi0) */
+        float rr = lc.w * hdk_sqrt(xi0), ph = 6.28318531f * xi1;
+        hd_v3 t1 = HD_XYZ(ld), t2;
+        n = HD_XYZ(lc);
+        t2 = hdk_cross(n, t1);
+        q = hdk_add(HD_XYZ(la), hdk_add(hdk_scale(t1, rr * hdk_cos(ph)), hdk_scale(t2, rr * hdk_sin(ph))));
+        g = HD_PI * lc.w * lc.w;
+    }
+    {
+        hd_v3 v = hdk_sub(q, p);
+        float cl;
+        r2 = hdk_maxf(hdk_dot(v, v), 1.0e-12f);
+        r = hdk_sqrt(r2);
+        d = hdk_scale(v, 1.0f / r);
+        cl = -hdk_dot(n, d); /* the cosine at the light: > 0 on the side it emits on */
+        g = cl > 0.0f ? hdk_minf(g * cl / r2, HD_AREA_G_MAX) : 0.0f;
+        HD_DEREF(tmax) = hdk_minf(r, hdk_box_exit(HD_KPASS p, d));
+        HD_DEREF(w) = hdk_scale(lb, g);
+    }
+    return d;
+}
+
 /* Light l seen from p (inside the box): the direction toward it, where tracking toward it stops
    (*tmax: the light or the box's edge), in *w its radiance over the density of the direction
    per channel (falloff included; only x with one illumination channel), and that density in
-   *pdf: 0 for the list's delta lights, which no scattered path can hit. xi0, xi1 place the
-   environment's sample. */
+   *pdf: 0 for the list's lights, which no scattered path can hit. xi0, xi1 place the
+   sample of the environment or of an area light. */
 HD_FN hd_v3 hdk_light_pick(HD_KARGS int l, hd_v3 p, float xi0, float xi1, HD_INOUT(float) tmax, HD_INOUT(hd_v3) w,
                           HD_INOUT(float) pdf)
 {
     hd_v3 d;
-    if (l < HD_PRM(counts).x) {
+    if (l < HD_PRM(counts).x && HD_PRM(light_a)[hdk_mini(l, HD_MAX_LIGHTS - 1)].w > 1.5f) {
+        d = hdk_area_sample(HD_KPASS l, p, xi0, xi1, tmax, w);
+        HD_DEREF(pdf) = 0.0f;
+    } else if (l < HD_PRM(counts).x) {
         float falloff = 0.0f;
         hd_v4 lb = HD_PRM(light_b)[l];
         d = hdk_light_dir(HD_KPASS l, p, tmax, HD_REF(falloff));

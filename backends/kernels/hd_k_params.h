@@ -50,6 +50,8 @@ HD_PARAM_F4(env_r1)
 HD_PARAM_F4(env_r2)
 HD_PARAM_I4(vstore)     /* x = the volume's storage (HD_VOL_*), y, z, w = 0 */
 HD_PARAM_F4(vnorm)      /* raw voxel to TF coordinate: clamp((raw - x) * y, 0, 1); z, w = 0 */
-HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position, w = type */
+HD_PARAM_F4_ARRAY(light_a, HD_MAX_LIGHTS) /* xyz = unit travel direction or position (a quad's corner), w = hd_light_type */
 HD_PARAM_F4_ARRAY(light_b, HD_MAX_LIGHTS) /* rgb = colour * intensity (x only with 1 channel), w = 1/r^2 */
+HD_PARAM_F4_ARRAY(light_c, HD_MAX_LIGHTS) /* area lights: a quad's edge 1 and area, a disk's unit normal and radius, a sphere's radius (w) */
+HD_PARAM_F4_ARRAY(light_d, HD_MAX_LIGHTS) /* xyz = a quad's edge 2, a disk's unit tangent; w = the chance of lights 0..l (hdk_light_choose) */
 HD_PARAMS_END

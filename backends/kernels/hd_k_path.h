@@ -6,14 +6,15 @@
      - the path weight w *= albedo * c(x): the TF colour is the per-channel scattering albedo, so
        the expected weight is exactly the chance the path survives as scattering in each channel
        (absorption is not sampled, it is carried in w: no bias, less variance);
-     - next-event estimation: one light l chosen uniformly among L (the list and the
-       environment, hd_k_light.h), its transmittance by the selected tracking estimator (ratio
-       tracking by default), so the vertex adds
-           w * L * I_l * falloff * T(x -> l) * p(mu) * m,   mu = d . omega_l,
+     - next-event estimation: one light l drawn with chance P_l among the list and the
+       environment (hdk_light_choose, hd_k_light.h), its transmittance by the selected tracking
+       estimator (ratio tracking by default), so the vertex adds
+           w * I_l * falloff * T(x -> l) * p(mu) * m / P_l,   mu = d . omega_l,
        p the phase function (isotropic 1/(4 pi), or Henyey-Greenstein with g = medium.z), I_l
-       the environment's radiance over its direction's density q, and m the multiple importance
-       sampling weight (balance heuristic) q / L / (q / L + p) for the environment at a vertex
-       whose path goes on, 1 otherwise;
+       the environment's radiance over its direction's density q (an area light's over its
+       point's), and m the multiple importance sampling weight (balance heuristic)
+       P q / (P q + p) for the environment at a vertex whose path goes on, 1 otherwise (area
+       lights too: no ray sees them);
      - then the path scatters in a direction drawn from p (importance sampled, so w is unchanged),
        after Russian roulette from HD_PT_RR_BOUNCES vertices on, until counts.w vertices.
    PT_SS is this kernel with counts.w = 1 and g = 0 (set by the host): one collision, one shadow
@@ -21,7 +22,7 @@
    Every loop is bounded: at most counts.w (max_bounces <= 100000) vertices per path, each
    free flight and shadow ray at most HD_MAX_TRACK_STEPS (hdk_track).
    A camera ray that leaves the box unscattered sees the background; a scattered ray that leaves
-   sees the environment (if one is set) with the other weight of the pair, p / (q / L + p), so
+   sees the environment (if one is set) with the other weight of the pair, p / (P q + p), so
    each direction is counted once; the background is a backdrop, not a light, as in HD's
    projection. Alpha is 1 if
    the camera ray collides, so its mean is 1 - T_cam as in the projection. With the host's depth
@@ -39,11 +40,6 @@
    weight march.y, which the host sets to 1/n for these methods (a plain progressive mean). */
 
 #define HD_PT_RR_BOUNCES 3 /* Russian roulette from this many vertices on */
-
-HD_FN hd_v3 hdk_cross(hd_v3 a, hd_v3 b)
-{
-    return HD_V3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
 
 /* Henyey-Greenstein phase function per steradian; mu = cosine between the propagation
    directions before and after scattering; g = 0 is isotropic, 1 / (4 pi). */
@@ -95,7 +91,7 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
     float t0 = hdk_box_entry(HD_KPASS o, d, HD_REF(t1));
     int geo = 0;
     float td = hdk_depth_t(HD_KPASS px, py, fx, fy, sx, sy, o, d, HD_REF(geo));
-    int nl = HDK_LIGHTS, max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
+    int max_vertices = HD_PRM(counts).w, mode = HD_PRM(counts).y;
     float albedo = HD_PRM(medium).y, g = HD_PRM(medium).z;
     float lr = 0.0f, lg = 0.0f, lb = 0.0f, alpha = 0.0f;
     float wr = 1.0f, wg = 1.0f, wb = 1.0f;
@@ -115,7 +111,7 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         float t = hdk_free_flight(HD_KPASS p, d, tmax, key, dim, HD_REF(nd));
         hd_v4 c;
         int l;
-        float lt = 0.0f, lpdf = 0.0f, tr, f, ph, xe0 = 0.0f, xe1 = 0.0f;
+        float lt = 0.0f, lpdf = 0.0f, lprob = 1.0f, tr, f, ph, xe0 = 0.0f, xe1 = 0.0f;
         hd_v3 ld, lw = HD_V3(0.0f, 0.0f, 0.0f);
         dim = nd;
         if (!(t < tmax)) {
@@ -123,7 +119,7 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
             if (vertices > 0 && HD_PRM(env).x > 0) { /* a scattered ray that leaves sees the environment */
                 float st = 0.0f;
                 int et = hdk_env_texel(HD_KPASS d, HD_REF(st));
-                float q = hdk_env_pdf(HD_KPASS et, st) / HD_F(nl);
+                float q = hdk_env_pdf(HD_KPASS et, st) * hdk_env_chance(HD_KPASS HD_PRM(counts).x);
                 hd_v3 le = hdk_env_rgb(HD_KPASS et);
                 float m = pphase / (pphase + q);
                 lr += wr * m * hdk_light_colour(HD_KPASS le, 0);
@@ -144,16 +140,18 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
             break;
         }
         /* next-event estimation toward one light */
-        l = hdk_mini(HD_I(hdk_rand(key, dim) * HD_F(nl)), nl - 1);
+        l = hdk_light_choose(HD_KPASS hdk_rand(key, dim), HD_REF(lprob));
         dim += 1u;
-        if (l >= HD_PRM(counts).x) { xe0 = hdk_rand(key, dim); xe1 = hdk_rand(key, dim + 1u); dim += 2u; }
+        if (l >= HD_PRM(counts).x || HD_PRM(light_a)[hdk_mini(l, HD_MAX_LIGHTS - 1)].w > 1.5f) { /* the environment, an area light */
+            xe0 = hdk_rand(key, dim); xe1 = hdk_rand(key, dim + 1u); dim += 2u;
+        }
         ld = hdk_light_pick(HD_KPASS l, p, xe0, xe1, HD_REF(lt), HD_REF(lw), HD_REF(lpdf));
         tr = hdk_transmittance(HD_KPASS p, ld, lt, key, dim, mode, HD_REF(nd));
         dim = nd;
         ph = hdk_phase_hg(g, hdk_dot(d, ld));
-        f = HD_F(nl) * tr * ph;
+        f = tr * ph / lprob;
         /* the environment's share of a direction a scattered ray may also reach */
-        if (lpdf > 0.0f && vertices + 1 < max_vertices) f *= lpdf / (lpdf + HD_F(nl) * ph);
+        if (lpdf > 0.0f && vertices + 1 < max_vertices) f *= lprob * lpdf / (lprob * lpdf + ph);
         lr += wr * f * hdk_light_colour(HD_KPASS lw, 0);
         lg += wg * f * hdk_light_colour(HD_KPASS lw, 1);
         lb += wb * f * hdk_light_colour(HD_KPASS lw, 2);

@@ -26,7 +26,8 @@
    is the library's and fails; HD_CONFORMANCE_REQUIRE=1 (CI) makes a skip fail too.
    `conformance-opencl --quick`: one case per stage (what `make valgrind-opencl` runs); `--crop`:
    the crop box cases only; `--render`: the per-frame API's; `--direct`: the direct light's and
-   the self-check; `--scene`: the host scene's (matrices, a placed volume, depth). */
+   the self-check; `--scene`: the host scene's (matrices, a placed volume, depth); `--env`: the
+   environment's; `--area`: the area lights'. */
 #include "hd_api.h"
 #include <math.h>
 #include <stdio.h>
@@ -250,6 +251,32 @@ static void pair_destroy(pair *p)
 /* What a case compares. */
 enum { CMP_E = 1, CMP_PHI = 2, CMP_IMAGE = 4 };
 
+/* The least chance the library gives a light among several (src/hd_kparams.h, hd__light_cdf:
+   0.1 of the draws are shared uniformly), so one sample weighs at most nl / 0.1 times its light. */
+#define CONF_LIGHT_SHARE 0.1
+
+/* The largest radiance weight of one sample of area light L at pos, over its radiance: A cos / r^2
+   <= A / (distance to its plane)^2 for a quad or disk, 2 pi (1 - cos theta_max) <= 2 pi for a
+   sphere. */
+static double area_bound(const hd_light *L, const double pos[3])
+{
+    double n[3], len, dp = 0.0, area;
+    int k;
+    if (L->type == HD_LIGHT_SPHERE) return 2.0 * 3.14159265358979;
+    if (L->type == HD_LIGHT_QUAD) {
+        n[0] = (double)L->edge1[1] * L->edge2[2] - (double)L->edge1[2] * L->edge2[1];
+        n[1] = (double)L->edge1[2] * L->edge2[0] - (double)L->edge1[0] * L->edge2[2];
+        n[2] = (double)L->edge1[0] * L->edge2[1] - (double)L->edge1[1] * L->edge2[0];
+        area = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    } else {
+        for (k = 0; k < 3; ++k) n[k] = L->direction[k];
+        area = 3.14159265358979 * (double)L->radius * L->radius;
+    }
+    len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (k = 0; k < 3; ++k) dp += n[k] / len * (pos[k] - L->position[k]);
+    return fmin(area / fmax(dp * dp, 1e-12), 1e12);
+}
+
 /* HD's E after n direct-light samples per voxel: the worst of |got - ref| over one sample's
    weight, L max_l I_l,c f_l(x) / n at each voxel x of the grid and channel c (f_l = 1 / r^2 for
    a point light that asks for it, else 1; a tracking weight is at most 1). The lights and the
@@ -259,7 +286,7 @@ static double sample_ratio(const pair *p, const hd_stats *st, const float *ref, 
     hd_desc q;
     double box[3], m, worst = 0.0;
     int gx = st->illumination_dims[0], gy = st->illumination_dims[1], gz = st->illumination_dims[2];
-    int nch = st->illumination_channels, x, y, z, c, l, k;
+    int nch = st->illumination_channels, x, y, z, c, l, k, nl;
     size_t nvox = (size_t)gx * gy * gz;
     if (hd_api_cpu.query_desc(p->ref, &q) != HD_SUCCESS || st->iterations == 0) return 1e30;
     for (k = 0, m = 0.0; k < 3; ++k) {
@@ -285,11 +312,16 @@ static double sample_ratio(const pair *p, const hd_stats *st, const float *ref, 
                             double r2 = 0.0;
                             for (k = 0; k < 3; ++k) r2 += (L->position[k] - pos[k]) * (L->position[k] - pos[k]);
                             f = 1.0 / fmax(r2, 1e-12);
+                        } else if (L->type >= HD_LIGHT_QUAD) {
+                            f = area_bound(L, pos);
                         }
                         if (col * L->intensity * f > w) w = col * L->intensity * f;
                     }
                     if (p->s->env && p->s->env_bound > w) w = p->s->env_bound;
-                    w *= (double)(q.light_count + (p->s->env ? 1 : 0)) / (double)st->iterations;
+                    /* one over the least chance of a light (hd__light_cdf: a uniform share
+                       of CONF_LIGHT_SHARE; one light is always drawn) */
+                    nl = q.light_count + (p->s->env ? 1 : 0);
+                    w *= (nl > 1 ? (double)nl / CONF_LIGHT_SHARE : 1.0) / (double)st->iterations;
                     if (got[i] != got[i]) d = 1e30;
                     if (d > 0.0 && d / (w > 0.0 ? w : 1e-30) > worst) worst = d / (w > 0.0 ? w : 1e-30);
                 }
@@ -885,6 +917,55 @@ static void env_cases(const int *odd, const int *other)
     case_env(HD_METHOD_PT_MS, HD_VOXEL_F32, odd, 2, 1, 0, 8);
 }
 
+/* Area lights: a quad above the box emitting down (shape bit 1), a disk beside it along +x
+   facing it (2), a sphere near a corner (4), beside `lights` lights of scene_init (mixed
+   colours, points among them); HD (E, phi and the image), PT_SS or PT_MS (the image). */
+static void case_area(hd_method method, hd_voxel_type type, const int *d, int shapes, int lights, int n)
+{
+    scene s;
+    guard g;
+    char name[128];
+    hd_light *L;
+    scene_init(&s, type, d[0], d[1], d[2], lights, 1, 1);
+    s.params.method = method;
+    if (shapes & 1) {
+        L = &s.lights[s.light_count++];
+        memset(L, 0, sizeof *L);
+        L->type = HD_LIGHT_QUAD; L->intensity = 3.0f;
+        L->position[0] = -0.3f; L->position[1] = 0.6f; L->position[2] = -0.25f;
+        L->edge1[0] = 0.6f; L->edge1[1] = 0.05f; L->edge2[2] = 0.5f; /* edge1 x edge2 points down */
+        L->color[0] = 1.0f; L->color[1] = 0.8f; L->color[2] = 0.6f;
+    }
+    if (shapes & 2) {
+        L = &s.lights[s.light_count++];
+        memset(L, 0, sizeof *L);
+        L->type = HD_LIGHT_DISK; L->intensity = 2.0f;
+        L->position[0] = 0.55f; L->position[1] = 0.1f;
+        L->direction[0] = -1.0f; L->direction[1] = -0.2f; L->radius = 0.25f;
+    }
+    if (shapes & 4) {
+        L = &s.lights[s.light_count++];
+        memset(L, 0, sizeof *L);
+        L->type = HD_LIGHT_SPHERE; L->intensity = 4.0f;
+        L->position[0] = -0.6f; L->position[1] = -0.6f; L->position[2] = 0.6f; L->radius = 0.2f;
+        L->color[0] = 0.6f; L->color[1] = 0.8f; L->color[2] = 1.0f;
+    }
+    guard_take(&g, &s);
+    snprintf(name, sizeof name, "%s x%d %s %dx%dx%d area%s%s%s + %dL", hd_api_cpu.method_name(method), n, type_name(type), d[0], d[1],
+             d[2], shapes & 1 ? " quad" : "", shapes & 2 ? " disk" : "", shapes & 4 ? " sphere" : "", lights);
+    iterate_case(name, &s, &g, n, method_is_pt(method) ? CMP_IMAGE : CMP_E | CMP_PHI | CMP_IMAGE, 0);
+    guard_free(&g);
+    scene_free(&s);
+}
+static void area_cases(const int *odd, const int *other)
+{
+    case_area(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 1, 8);
+    case_area(HD_METHOD_HD, HD_VOXEL_F32, other, 2, 0, 8);
+    case_area(HD_METHOD_HD, HD_VOXEL_U16, odd, 4, 2, 8);
+    case_area(HD_METHOD_PT_SS, HD_VOXEL_U8, other, 7, 0, 8);
+    case_area(HD_METHOD_PT_MS, HD_VOXEL_F32, odd, 7, 2, 8);
+}
+
 /* The per-frame API: light refined without frames (hd_refine) until it converges, then frames
    from the converged light (hd_render) before and after a camera move; both sides must agree on
    the light, the image, and the iteration and frame counts. With scale != 0 (params.render_scale)
@@ -1453,6 +1534,7 @@ int main(int argc, char **argv)
     int t, quick = argc > 1 && strcmp(argv[1], "--quick") == 0, crop = argc > 1 && strcmp(argv[1], "--crop") == 0;
     int render = argc > 1 && strcmp(argv[1], "--render") == 0, direct = argc > 1 && strcmp(argv[1], "--direct") == 0;
     int scenes = argc > 1 && strcmp(argv[1], "--scene") == 0, envs = argc > 1 && strcmp(argv[1], "--env") == 0;
+    int areas = argc > 1 && strcmp(argv[1], "--area") == 0;
     int storage = argc > 1 && strcmp(argv[1], "--storage") == 0;
     int hard = 0;
     printf("conformance: backend %s against the reference %s\n", hd_api_backend.backend_name(), hd_api_cpu.backend_name());
@@ -1469,11 +1551,13 @@ int main(int argc, char **argv)
         printf("%d passed, %d failed\n", n_passed, n_failed);
         return n_failed == 0 ? 0 : 1;
     }
-    if (quick || crop || render || direct || scenes || envs) { /* quick: one case per stage, for valgrind; crop: the
+    if (quick || crop || render || direct || scenes || envs || areas) { /* quick: one case per stage, for valgrind; crop: the
                                       crop box cases; render: the per-frame API's; direct: the
                                       direct light's and the rule's self-check */
         if (envs) {
             env_cases(odd, other);
+        } else if (areas) {
+            area_cases(odd, other);
         } else if (direct) {
             direct_cases(odd, other);
         } else if (render) {
@@ -1542,6 +1626,8 @@ int main(int argc, char **argv)
     scene_cases();
     /* an environment map, beside lights and alone */
     env_cases(odd, other);
+    /* area lights: each shape, beside lights and alone */
+    area_cases(odd, other);
     /* binary16 illumination storage */
     case_half(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 0, HD_SOLVER_RED_BLACK, 8);
     case_half(HD_METHOD_HD, HD_VOXEL_U16, odd, 3, 1, 0, HD_SOLVER_RED_BLACK, 8);

@@ -206,6 +206,9 @@ static void fz_tr_lights(const hd_light *l, int n)
         snprintf(w, sizeof w, "lights[%d].color", i); fz_tr_f(w, l[i].color, 3);
         snprintf(w, sizeof w, "lights[%d].intensity", i); fz_tr_f(w, &l[i].intensity, 1);
         snprintf(w, sizeof w, "lights[%d].inverse_square", i); fz_tr_i(w, l[i].inverse_square);
+        snprintf(w, sizeof w, "lights[%d].edge1", i); fz_tr_f(w, l[i].edge1, 3);
+        snprintf(w, sizeof w, "lights[%d].edge2", i); fz_tr_f(w, l[i].edge2, 3);
+        snprintf(w, sizeof w, "lights[%d].radius", i); fz_tr_f(w, &l[i].radius, 1);
     }
 }
 
@@ -425,6 +428,37 @@ static void fz_light_defaults(hd_light *l)
     if (l->intensity == 0.0f) l->intensity = 1.0f;
 }
 
+/* An area light's shape breaks a rule (hybriddiff.h, hd_light): a NaN or infinite edge or
+   radius; a quad's edge beyond HD_MAX_LIGHT_DISTANCE, zero or parallel to the other; a disk's or
+   sphere's radius outside (0, HD_MAX_LIGHT_DISTANCE], a disk's zero normal. */
+static int fz_area_bad(const hd_light *l)
+{
+    double a[3], b[3], c[3], la, lb;
+    int k;
+    if (!fz_finite3(l->edge1) || !fz_finite3(l->edge2) || !fz_finite(l->radius)) return 1;
+    if (l->type == HD_LIGHT_QUAD) {
+        for (k = 0; k < 3; ++k)
+            if (fabsf(l->edge1[k]) > HD_MAX_LIGHT_DISTANCE || fabsf(l->edge2[k]) > HD_MAX_LIGHT_DISTANCE) return 1;
+        for (k = 0; k < 3; ++k) { a[k] = l->edge1[k]; b[k] = l->edge2[k]; }
+        la = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        lb = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+        if (!(la > 0.0) || !(lb > 0.0)) return 1;
+        c[0] = a[1] * b[2] - a[2] * b[1]; c[1] = a[2] * b[0] - a[0] * b[2]; c[2] = a[0] * b[1] - a[1] * b[0];
+        return !((c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / (la * la * lb * lb) > 1e-8);
+    }
+    if (!(l->radius > 0.0f) || l->radius > HD_MAX_LIGHT_DISTANCE) return 1;
+    return l->type == HD_LIGHT_DISK && l->direction[0] == 0.0f && l->direction[1] == 0.0f && l->direction[2] == 0.0f;
+}
+
+/* Whether lights l[0..n) hold an area light (which method CD refuses). */
+static int fz_has_area(const hd_light *l, int n)
+{
+    int i;
+    for (i = 0; l && i < n; ++i)
+        if (l[i].type >= HD_LIGHT_QUAD && l[i].type < HD_LIGHT_TYPE_COUNT) return 1;
+    return 0;
+}
+
 /* hd_set_lights (hybriddiff.h, hd_light and the limits above it): the codes of the first light
    that breaks a rule (the power limit counts the lights up to it). */
 static fz_set fz_lights_want(const hd_light *l, int n)
@@ -445,7 +479,11 @@ static fz_set fz_lights_want(const hd_light *l, int n)
         }
         if (l[i].type == HD_LIGHT_DIRECTIONAL && l[i].direction[0] == 0.0f && l[i].direction[1] == 0.0f && l[i].direction[2] == 0.0f)
             bad |= FZ_R(HD_ERROR_INVALID_LIGHT);
-        if (l[i].type == HD_LIGHT_POINT && (fabsf(l[i].position[0]) > HD_MAX_LIGHT_DISTANCE ||
+        if (l[i].type >= HD_LIGHT_QUAD && l[i].type < HD_LIGHT_TYPE_COUNT && fz_area_bad(&l[i])) {
+            bad |= FZ_R(HD_ERROR_INVALID_LIGHT);
+            return bad;
+        }
+        if (l[i].type != HD_LIGHT_DIRECTIONAL && (fabsf(l[i].position[0]) > HD_MAX_LIGHT_DISTANCE ||
                                             fabsf(l[i].position[1]) > HD_MAX_LIGHT_DISTANCE ||
                                             fabsf(l[i].position[2]) > HD_MAX_LIGHT_DISTANCE))
             bad |= FZ_R(HD_ERROR_INVALID_LIGHT);
@@ -717,7 +755,10 @@ static void fz_light_field(hd_light *l, int k)
     case 2: fz_vec(l->position, pos, 5); break;
     case 3: fz_vec(l->color, cols, 4); break;
     case 4: l->intensity = FZ_PICK(0.0f, 1.0f, 10.0f, 0.5f, 1e6f); break;
-    default: l->inverse_square = fz_u8() & 1; break;
+    case 5: l->inverse_square = fz_u8() & 1; break;
+    case 6: fz_vec(l->edge1, dirs, 4); break;
+    case 7: fz_vec(l->edge2, pos, 5); break;
+    default: l->radius = FZ_PICK(0.0f, 0.25f, 1.0f, -1.0f, 2e15f); break;
     }
 }
 
@@ -726,7 +767,7 @@ static void fz_gen_light(hd_light *l)
     int k;
     memset(l, 0, sizeof *l);
     l->direction[2] = -1.0f;
-    for (k = 0; k < 6; ++k)
+    for (k = 0; k < 9; ++k)
         if (fz_u8() & 1) fz_light_field(l, k);
 }
 
@@ -1005,6 +1046,7 @@ static void fz_op_params(int ci, int fresh)
     filled = p;
     fz_params_defaults(&filled);
     allowed = null ? FZ_R(HD_ERROR_NULL_POINTER) : fz_params_want(&filled);
+    if (!null && filled.method == HD_METHOD_CD && fz_has_area(pre.s.l, pre.s.nl)) allowed = (allowed & ~FZ_OK) | FZ_R(HD_ERROR_UNSUPPORTED);
     if (!null) fz_tr_params("p", &p);
     fz_tr("    r = hd_set_params(c%d, %s);\n", ci, null ? "NULL" : "&p");
     fz_begin(ci, &pre, "hd_set_params");
@@ -1081,11 +1123,12 @@ static void fz_op_lights(int ci)
     fz_snap_take(fz_c[ci].h, &pre.s);
     n = pre.s.nl < 4 ? pre.s.nl : 4;
     memcpy(l, pre.s.l, (size_t)n * sizeof *l);
-    if (b < 140) fz_light_field(&l[fz_u8() % n], fz_u8() % 6);
+    if (b < 140) fz_light_field(&l[fz_u8() % n], fz_u8() % 9);
     else if (b < 170 && n < 3) fz_gen_light(&l[n++]);
     else if (b < 190 && n > 1) --n;
     else lp = fz_gen_lights(l, &n);
     allowed = fz_lights_want(lp, n);
+    if ((allowed & FZ_OK) && pre.s.p.method == HD_METHOD_CD && fz_has_area(lp, n)) allowed = FZ_R(HD_ERROR_UNSUPPORTED);
     fz_tr_lights(lp, n);
     fz_tr("    r = hd_set_lights(c%d, %s, %d);\n", ci, lp ? "lights" : "NULL", n);
     fz_begin(ci, &pre, "hd_set_lights");
@@ -1101,8 +1144,10 @@ static void fz_op_lights(int ci)
     for (i = 0; i < n && !changed; ++i) {
         int k;
         const hd_light *x = &filled[i], *y = &pre.s.l[i];
-        changed |= x->type != y->type || x->intensity != y->intensity || x->inverse_square != y->inverse_square;
-        for (k = 0; k < 3; ++k) changed |= x->direction[k] != y->direction[k] || x->position[k] != y->position[k] || x->color[k] != y->color[k];
+        changed |= x->type != y->type || x->intensity != y->intensity || x->inverse_square != y->inverse_square || x->radius != y->radius;
+        for (k = 0; k < 3; ++k)
+            changed |= x->direction[k] != y->direction[k] || x->position[k] != y->position[k] || x->color[k] != y->color[k] ||
+                       x->edge1[k] != y->edge1[k] || x->edge2[k] != y->edge2[k];
     }
     /* "lights -> E, phi warm; image (CD, another light count: reset)"; new grids for another
        channel count reset them; the path tracers' image is their state */
@@ -1357,7 +1402,8 @@ static void fz_op_preset(int ci)
         fz_tr("    r = hd_set_params(c%d, &p);\n", ci);
         fz_begin(ci, &pre, "hd_set_params (preset)");
         r = hd_set_params(fz_c[ci].h, &p);
-        fz_end(&pre, r, fz_params_want(&filled));
+        fz_end(&pre, r, filled.method == HD_METHOD_CD && fz_has_area(pre.s.l, pre.s.nl) ?
+                            (fz_params_want(&filled) & ~FZ_OK) | FZ_R(HD_ERROR_UNSUPPORTED) : fz_params_want(&filled));
         if (r != HD_SUCCESS) return;
         fz_snap_take(fz_c[ci].h, &now);
         if (memcmp(&now.p, &filled, sizeof filled)) fz_fail("hd_query_desc's params are not the preset's");
@@ -1627,6 +1673,7 @@ static void fz_create(int ci)
         else maybe |= parts[k] & ~FZ_OK;
     }
     if (d.threads < 0) must |= FZ_R(IP);
+    if (!must && fp.method == HD_METHOD_CD && fz_has_area(d.lights, d.light_count)) must = FZ_R(HD_ERROR_UNSUPPORTED);
     allowed = must ? must | maybe : FZ_OK | maybe;
     o = fz_owner_new();
     d.logger.func = fz_log;
