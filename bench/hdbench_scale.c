@@ -8,7 +8,7 @@
    hd_stats.light_converged (as hd_render decides), and one 512^2 frame over the converged
    light. Prints a table and, with --dat FILE, gnuplot's data.
    Usage: hdbench_scale [--ct data/head.nrrd] [--sizes native,2x,256,512] [--cloud 256,512]
-                        [--solvers rb,mg] [--max-iters N] [--dat FILE] [--as-f32]
+                        [--solvers rb,mg,auto] [--max-iters N] [--dat FILE] [--as-f32]
    --as-f32: the CT's Hounsfield units given as F32 (the float path, for comparison). */
 #if !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
 #define HYBRIDDIFF_BACKEND_CPU
@@ -130,7 +130,7 @@ static uint8_t *cloud_make(int n, double *occupied)
 }
 
 typedef struct result {
-    int ok, iters, converged;
+    int ok, iters, converged, solver; /* solver: the one hd_create chose (AUTO's pick) */
     double bpv, host_extra_mb, vol_mb, iter_s, conv_s, frame_s, occupied;
 } result;
 
@@ -146,6 +146,10 @@ static result run_case(hd_desc *d, hd_solver solver, int max_iters, double vol_b
     d->params.solver = solver;
     d->camera.width = d->camera.height = 64; /* the light's iterations: a small image */
     if (hd_create(d, &c) != HD_SUCCESS) return r;
+    {
+        hd_desc q;
+        if (hd_query_desc(c, &q) == HD_SUCCESS) r.solver = (int)q.params.solver;
+    }
     r.host_extra_mb = (double)((peak_kb() > before ? peak_kb() - before : 0)) / 1024.0;
     r.vol_mb = vol_bytes / 1048576.0;
     t0 = now_s();
@@ -193,14 +197,17 @@ static result in_child(hd_desc *d, hd_solver solver, int max_iters, double vol_b
     return r;
 }
 
-static void print_row(FILE *dat, const char *name, const int *n, const char *solver, const result *r)
+static void print_row(FILE *dat, const char *name, const int *n, const char *asked, const result *r)
 {
     double nvox = (double)n[0] * n[1] * n[2];
+    char solver[16];
+    snprintf(solver, sizeof solver, "%s%s", asked,
+             strcmp(asked, "auto") ? "" : r->solver == HD_SOLVER_MULTIGRID ? ":mg" : ":rb");
     if (!r->ok) {
-        printf("| %-6s | %4dx%4dx%4d | %-3s | failed |\n", name, n[0], n[1], n[2], solver);
+        printf("| %-6s | %4dx%4dx%4d | %-7s | failed |\n", name, n[0], n[1], n[2], solver);
         return;
     }
-    printf("| %-6s | %4dx%4dx%4d | %6.1f M | %-3s | %5.2f | %7.0f MB (%.2f x %.0f MB) | %7.3f s | %4d%s | %7.1f s | %6.2f s |\n", name, n[0], n[1], n[2],
+    printf("| %-6s | %4dx%4dx%4d | %6.1f M | %-7s | %5.2f | %7.0f MB (%.2f x %.0f MB) | %7.3f s | %4d%s | %7.1f s | %6.2f s |\n", name, n[0], n[1], n[2],
            nvox / 1e6, solver, r->bpv, r->host_extra_mb, r->vol_mb > 0 ? r->host_extra_mb / r->vol_mb : 0.0, r->vol_mb, r->iter_s,
            r->iters, r->converged ? "" : "+", r->conv_s, r->frame_s);
     fflush(stdout);
@@ -297,7 +304,7 @@ int main(int argc, char **argv)
                     while (*p && *p != ',' && k < sizeof name - 1) name[k++] = *p++;
                     while (*p && *p != ',') ++p;
                     if (*p == ',') ++p;
-                    r = in_child(&d, !strcmp(name, "mg") ? HD_SOLVER_MULTIGRID : HD_SOLVER_RED_BLACK, max_iters,
+                    r = in_child(&d, !strcmp(name, "mg") ? HD_SOLVER_MULTIGRID : !strcmp(name, "auto") ? HD_SOLVER_AUTO : HD_SOLVER_RED_BLACK, max_iters,
                                  (double)n[0] * n[1] * n[2] * (pass == 0 ? (as_f32 ? 4.0 : 2.0) : 1.0));
                     print_row(dat, pass == 0 ? (as_f32 ? "ct-f32" : "ct") : "cloud", n, name, &r);
                 }
