@@ -152,11 +152,11 @@ static int hd__solver_fallback(hd__ctx *ctx, const char *why)
 
 /* One step of multigrid; where AUTO's multigrid is refused (a device without double precision),
    red-black's sweeps instead. */
-static hd_result hd__mg_step_or_fallback(hd__ctx *ctx, int sweeps)
+static hd_result hd__mg_step_or_fallback(hd__ctx *ctx)
 {
     hd_result r = hd__mg_step(ctx);
     if (r == HD_ERROR_UNSUPPORTED && hd__solver_fallback(ctx, "multigrid is not available on this device"))
-        r = hd__be_diffuse_sweeps(&ctx->vw, 0, sweeps);
+        r = hd__be_diffuse(&ctx->vw, 0);
     return r;
 }
 
@@ -164,7 +164,7 @@ static hd_result hd__mg_step_or_fallback(hd__ctx *ctx, int sweeps)
    V-cycle; docs/DESIGN-MULTIGRID.md has its cost in red-black sweeps). */
 static hd_result hd__diffuse_once(hd__ctx *ctx)
 {
-    if (ctx->vw.params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step_or_fallback(ctx, 1);
+    if (ctx->vw.params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step_or_fallback(ctx);
     return hd__be_diffuse(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI);
 }
 
@@ -222,8 +222,7 @@ static hd_result hd__sweeps_part(hd__ctx *ctx, int n)
     if (ctx->vw.params.solver != HD_SOLVER_MULTIGRID)
         r = hd__be_diffuse_sweeps(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI, n);
     else
-        for (s = 0; s < n && r == HD_SUCCESS && ctx->vw.params.solver == HD_SOLVER_MULTIGRID; ++s)
-            r = hd__mg_step_or_fallback(ctx, n - s);
+        for (s = 0; s < n && r == HD_SUCCESS && ctx->vw.params.solver == HD_SOLVER_MULTIGRID; ++s) r = hd__diffuse_once(ctx);
     ctx->part.sweeps += n;
     ctx->seconds[1] += hd__now() - t0;
     return r;
