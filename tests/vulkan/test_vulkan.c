@@ -1325,6 +1325,61 @@ static int validation_layer_present(void)
     return 0;
 }
 
+/* A volume wider than the device's maxImageDimension3D (the library's own limits pass it):
+   HD_ERROR_UNSUPPORTED and one logged error, at hd_create or the first iteration. */
+static int limit_errors;
+static void limit_log(void *u, hd_log_level l, hd_result c, const char *m, const char *f, int line)
+{
+    (void)u; (void)c; (void)f; (void)line;
+    if (l == HD_LOG_ERROR) { ++limit_errors; printf("volume limit: logged \"%s\"\n", m); }
+}
+static void test_volume_limit(void)
+{
+    static float vox[HD_MAX_DIM * 2 * 2];
+    VkApplicationInfo app;
+    VkInstanceCreateInfo ici;
+    VkInstance inst;
+    VkPhysicalDevice phys[8];
+    VkPhysicalDeviceProperties props;
+    uint32_t nphys = 8, max3d = 0;
+    hd_desc d;
+    hd_context c;
+    hd_result r;
+    int i;
+    memset(&app, 0, sizeof app);
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.apiVersion = VK_API_VERSION_1_1;
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    ici.pApplicationInfo = &app;
+    if (vkCreateInstance(&ici, NULL, &inst) != VK_SUCCESS) { ++failures; printf("FAIL volume limit: no instance\n"); return; }
+    if (vkEnumeratePhysicalDevices(inst, &nphys, phys) >= 0 && nphys > 0) {
+        vkGetPhysicalDeviceProperties(phys[0], &props); /* the backend's device: the first */
+        max3d = props.limits.maxImageDimension3D;
+    }
+    vkDestroyInstance(inst, NULL);
+    if (max3d == 0 || max3d >= HD_MAX_DIM) { printf("volume limit: maxImageDimension3D %u: skipped\n", max3d); return; }
+    for (i = 0; i < HD_MAX_DIM * 2 * 2; ++i) vox[i] = (float)(i % 7) / 7.0f;
+    memset(&d, 0, sizeof d);
+    d.volume.type = HD_VOXEL_F32; /* one voxel a texel */
+    d.volume.dims[0] = HD_MAX_DIM;
+    d.volume.dims[1] = d.volume.dims[2] = 2;
+    d.volume.data = vox;
+    d.camera.width = d.camera.height = 16;
+    d.logger.func = limit_log;
+    limit_errors = 0;
+    r = hd_create(&d, &c);
+    if (r == HD_SUCCESS) {
+        r = hd_iterate(c, 1);
+        hd_destroy(c);
+    }
+    if (!(r == HD_ERROR_UNSUPPORTED && limit_errors == 1)) {
+        ++failures;
+        printf("FAIL volume limit: a %dx2x2 volume over maxImageDimension3D %u: %s, %d errors logged\n", HD_MAX_DIM, max3d,
+               hd_result_string(r), limit_errors);
+    } else printf("ok volume limit: a %dx2x2 volume over maxImageDimension3D %u refused\n", HD_MAX_DIM, max3d);
+}
+
 int main(void)
 {
     const char *req = getenv("HD_CONFORMANCE_REQUIRE");
@@ -1356,6 +1411,7 @@ int main(void)
             test_output_target();
             test_record_converged();
             test_record_depth();
+            test_volume_limit();
         }
     }
     if (failures) printf("FAILED\n");
