@@ -196,7 +196,15 @@ typedef enum hd_tracking {
 } hd_tracking;
 
 typedef enum hd_solver {
-    HD_SOLVER_DEFAULT = 0,   /* = RED_BLACK */
+    HD_SOLVER_DEFAULT = 0,   /* = AUTO */
+    HD_SOLVER_AUTO = HD_SOLVER_DEFAULT, /* RED_BLACK for an illumination grid below 4 M voxels
+                                (the volume's voxels / illumination_downsample^3; 32 M volume voxels
+                                at the default 2), MULTIGRID from there: it converges in about the
+                                same iterations at any size (docs/PERFORMANCE.md, "Scale").
+                                hd_create and hd_set_params put the choice into params.solver
+                                (hd_get_params reads it) and fill diffusion_sweeps for it.
+                                RED_BLACK with float16 illumination, and for good where multigrid
+                                cannot run (a device without double precision, hd_vulkan_record) */
     HD_SOLVER_RED_BLACK,     /* red-black Gauss-Seidel, in place: two half-sweeps per sweep */
     HD_SOLVER_JACOBI,        /* Jacobi with a ping-pong buffer (+4 bytes per voxel) */
     HD_SOLVER_MULTIGRID,     /* conjugate gradients preconditioned by a geometric multigrid

@@ -8,8 +8,10 @@
    hd_stats.light_converged (as hd_render decides), and one 512^2 frame over the converged
    light. Prints a table and, with --dat FILE, gnuplot's data.
    Usage: hdbench_scale [--ct data/head.nrrd] [--sizes native,2x,256,512] [--cloud 256,512]
-                        [--solvers rb,mg] [--max-iters N] [--dat FILE] [--as-f32]
-   --as-f32: the CT's Hounsfield units given as F32 (the float path, for comparison). */
+                        [--solvers rb,mg,auto] [--max-iters N] [--dat FILE] [--as-f32] [--f16]
+   --as-f32: the CT's Hounsfield units given as F32 (the float path, for comparison); --f16:
+   illumination_precision FLOAT16. auto: HD_SOLVER_AUTO, printed with its pick. The CPU seconds
+   to converge (the process's, both threads) are the measure to compare on a shared machine. */
 #if !defined(HYBRIDDIFF_BACKEND_OPENCL) && !defined(HYBRIDDIFF_BACKEND_VULKAN) && !defined(HYBRIDDIFF_BACKEND_GL)
 #define HYBRIDDIFF_BACKEND_CPU
 #endif
@@ -30,6 +32,14 @@ static double now_s(void)
     struct timespec t;
     clock_gettime(CLOCK_MONOTONIC, &t);
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* The process's CPU seconds (every thread): the steadier measure on a shared machine. */
+static double cpu_s(void)
+{
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_utime.tv_sec + 1e-6 * (double)u.ru_utime.tv_usec + (double)u.ru_stime.tv_sec + 1e-6 * (double)u.ru_stime.tv_usec;
 }
 
 static size_t peak_kb(void)
@@ -130,30 +140,38 @@ static uint8_t *cloud_make(int n, double *occupied)
 }
 
 typedef struct result {
-    int ok, iters, converged;
-    double bpv, host_extra_mb, vol_mb, iter_s, conv_s, frame_s, occupied;
+    int ok, iters, converged, solver; /* solver: the one hd_create chose (AUTO's pick) */
+    double bpv, host_extra_mb, vol_mb, iter_s, conv_s, conv_cpu_s, frame_s, occupied;
 } result;
 
 /* One case in this process: the desc's volume, the solver, up to max_iters light iterations. */
-static result run_case(hd_desc *d, hd_solver solver, int max_iters, double vol_bytes)
+static result run_case(hd_desc *d, hd_solver solver, int max_iters, double vol_bytes, int f16)
 {
     result r;
     hd_context c;
     hd_stats st;
     size_t before = resident_kb(), nvox = (size_t)d->volume.dims[0] * d->volume.dims[1] * d->volume.dims[2];
-    double t0;
+    double t0, c0;
     memset(&r, 0, sizeof r);
     d->params.solver = solver;
+    if (f16) d->params.illumination_precision = HD_PRECISION_FLOAT16;
     d->camera.width = d->camera.height = 64; /* the light's iterations: a small image */
     if (hd_create(d, &c) != HD_SUCCESS) return r;
+    {
+        hd_desc q;
+        memset(&q, 0, sizeof q);
+        if (hd_query_desc(c, &q) == HD_SUCCESS) r.solver = (int)q.params.solver;
+    }
     r.host_extra_mb = (double)((peak_kb() > before ? peak_kb() - before : 0)) / 1024.0;
     r.vol_mb = vol_bytes / 1048576.0;
     t0 = now_s();
+    c0 = cpu_s();
     for (r.iters = 0; r.iters < max_iters; ++r.iters) {
         if (hd_render(c) != HD_SUCCESS || hd_get_stats(c, &st) != HD_SUCCESS) { hd_destroy(c); return r; }
         if (st.light_converged) break;
     }
     r.conv_s = now_s() - t0;
+    r.conv_cpu_s = cpu_s() - c0;
     r.converged = st.light_converged;
     r.iters = (int)st.iterations;
     r.iter_s = st.iterations ? (st.seconds_direct + st.seconds_diffusion) / (double)st.iterations : 0.0;
@@ -172,7 +190,7 @@ static result run_case(hd_desc *d, hd_solver solver, int max_iters, double vol_b
 }
 
 /* Runs fn's case in a child; its result comes back through a pipe. */
-static result in_child(hd_desc *d, hd_solver solver, int max_iters, double vol_bytes)
+static result in_child(hd_desc *d, hd_solver solver, int max_iters, double vol_bytes, int f16)
 {
     result r;
     int fd[2];
@@ -182,7 +200,7 @@ static result in_child(hd_desc *d, hd_solver solver, int max_iters, double vol_b
     fflush(stdout);
     pid = fork();
     if (pid == 0) {
-        result x = run_case(d, solver, max_iters, vol_bytes);
+        result x = run_case(d, solver, max_iters, vol_bytes, f16);
         ssize_t w = write(fd[1], &x, sizeof x);
         _exit(w == (ssize_t)sizeof x ? 0 : 1);
     }
@@ -193,26 +211,29 @@ static result in_child(hd_desc *d, hd_solver solver, int max_iters, double vol_b
     return r;
 }
 
-static void print_row(FILE *dat, const char *name, const int *n, const char *solver, const result *r)
+static void print_row(FILE *dat, const char *name, const int *n, const char *asked, const result *r)
 {
     double nvox = (double)n[0] * n[1] * n[2];
+    char solver[16];
+    snprintf(solver, sizeof solver, "%s%s", asked,
+             strcmp(asked, "auto") ? "" : r->solver == HD_SOLVER_MULTIGRID ? ":mg" : ":rb");
     if (!r->ok) {
-        printf("| %-6s | %4dx%4dx%4d | %-3s | failed |\n", name, n[0], n[1], n[2], solver);
+        printf("| %-6s | %4dx%4dx%4d | %-7s | failed |\n", name, n[0], n[1], n[2], solver);
         return;
     }
-    printf("| %-6s | %4dx%4dx%4d | %6.1f M | %-3s | %5.2f | %7.0f MB (%.2f x %.0f MB) | %7.3f s | %4d%s | %7.1f s | %6.2f s |\n", name, n[0], n[1], n[2],
+    printf("| %-6s | %4dx%4dx%4d | %6.1f M | %-7s | %5.2f | %7.0f MB (%.2f x %.0f MB) | %7.3f s | %4d%s | %7.1f s | %7.1f s | %6.2f s |\n", name, n[0], n[1], n[2],
            nvox / 1e6, solver, r->bpv, r->host_extra_mb, r->vol_mb > 0 ? r->host_extra_mb / r->vol_mb : 0.0, r->vol_mb, r->iter_s,
-           r->iters, r->converged ? "" : "+", r->conv_s, r->frame_s);
+           r->iters, r->converged ? "" : "+", r->conv_s, r->conv_cpu_s, r->frame_s);
     fflush(stdout);
     if (dat)
-        fprintf(dat, "%s %s %.0f %.4f %.3f %.5f %d %.3f %.4f\n", name, solver, nvox, r->bpv, r->host_extra_mb, r->iter_s, r->iters,
-                r->conv_s, r->frame_s);
+        fprintf(dat, "%s %s %.0f %.4f %.3f %.5f %d %.3f %.4f %.3f\n", name, solver, nvox, r->bpv, r->host_extra_mb, r->iter_s, r->iters,
+                r->conv_s, r->frame_s, r->conv_cpu_s);
 }
 
 int main(int argc, char **argv)
 {
     const char *ct_path = "data/head.nrrd", *sizes = "native,2x,256,512", *clouds = "256,512", *solvers = "rb,mg", *datp = NULL;
-    int max_iters = 200, i, as_f32 = 0;
+    int max_iters = 200, i, as_f32 = 0, f16 = 0;
     hd_volume_file ct;
     hd_logger log;
     hdx_tf tf;
@@ -228,6 +249,7 @@ int main(int argc, char **argv)
         else if (!strcmp(argv[i], "--max-iters") && i + 1 < argc) max_iters = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--dat") && i + 1 < argc) datp = argv[++i];
         else if (!strcmp(argv[i], "--as-f32")) as_f32 = 1;
+        else if (!strcmp(argv[i], "--f16")) f16 = 1;
         else { fprintf(stderr, "usage: see the top of bench/hdbench_scale.c\n"); return 2; }
     }
     memset(&log, 0, sizeof log);
@@ -244,8 +266,8 @@ int main(int argc, char **argv)
     light.intensity = 1.0f;
     printf("hdbench_scale: %s backend, %ld cores; light iterations capped at %d (+: not converged)\n", hd_backend_name(),
            sysconf(_SC_NPROCESSORS_ONLN), max_iters);
-    printf("| volume | dims | voxels | solver | device B/voxel | host peak in hd_create (x volume) | light iteration | iterations | to converge | frame 512^2 |\n");
-    printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    printf("| volume | dims | voxels | solver | device B/voxel | host peak in hd_create (x volume) | light iteration | iterations | to converge | CPU s to converge | frame 512^2 |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int pass = 0; pass < 2; ++pass) {
         snprintf(buf, sizeof buf, "%s", pass == 0 ? sizes : clouds);
         for (tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) { /* the only strtok walk */
@@ -297,8 +319,8 @@ int main(int argc, char **argv)
                     while (*p && *p != ',' && k < sizeof name - 1) name[k++] = *p++;
                     while (*p && *p != ',') ++p;
                     if (*p == ',') ++p;
-                    r = in_child(&d, !strcmp(name, "mg") ? HD_SOLVER_MULTIGRID : HD_SOLVER_RED_BLACK, max_iters,
-                                 (double)n[0] * n[1] * n[2] * (pass == 0 ? (as_f32 ? 4.0 : 2.0) : 1.0));
+                    r = in_child(&d, !strcmp(name, "mg") ? HD_SOLVER_MULTIGRID : !strcmp(name, "auto") ? HD_SOLVER_AUTO : HD_SOLVER_RED_BLACK, max_iters,
+                                 (double)n[0] * n[1] * n[2] * (pass == 0 ? (as_f32 ? 4.0 : 2.0) : 1.0), f16);
                     print_row(dat, pass == 0 ? (as_f32 ? "ct-f32" : "ct") : "cloud", n, name, &r);
                 }
             }

@@ -144,9 +144,10 @@ static const char *usage_text_method =
     "  --anisotropy G          Henyey-Greenstein g in (-1,1) (default 0)\n"
     "  --majorant F            global majorant, 0 = grid of local majorants (default 0)\n"
     "  --sweeps N              diffusion solver sweeps per iteration (default 4)\n"
-    "  --solver S              diffusion solver: rb (red-black Gauss-Seidel, default), jacobi,\n"
-    "                          multigrid (CG steps preconditioned by a V-cycle; --sweeps counts\n"
-    "                          steps, default 1; every backend, Vulkan with shaderFloat64)\n"
+    "  --solver S              diffusion solver: auto (default: rb below 4 M grid voxels, else\n"
+    "                          multigrid), rb (red-black Gauss-Seidel), jacobi, multigrid (CG\n"
+    "                          steps preconditioned by a V-cycle; --sweeps counts steps, default\n"
+    "                          1; every backend, Vulkan with shaderFloat64)\n"
     "  --tracking ratio|delta  transmittance estimator (default ratio)\n"
     "  --boundary box|surface  the diffusion's vacuum: phi = 0 outside the volume box (the\n"
     "                          paper's), or the Marshak condition at the medium's surface (default)\n"
@@ -979,10 +980,11 @@ int main(int argc, char **argv)
             desc.params.diffusion_sweeps = (int)parse_int(a, VAL(), 1, 100000);
         } else if (IS("--solver")) {
             VAL();
-            if (strcmp(v, "rb") == 0) desc.params.solver = HD_SOLVER_RED_BLACK;
+            if (strcmp(v, "auto") == 0) desc.params.solver = HD_SOLVER_AUTO;
+            else if (strcmp(v, "rb") == 0) desc.params.solver = HD_SOLVER_RED_BLACK;
             else if (strcmp(v, "jacobi") == 0) desc.params.solver = HD_SOLVER_JACOBI;
             else if (strcmp(v, "multigrid") == 0) desc.params.solver = HD_SOLVER_MULTIGRID;
-            else fail(2, "--solver: '%s' is not rb, jacobi or multigrid", v);
+            else fail(2, "--solver: '%s' is not auto, rb, jacobi or multigrid", v);
         } else if (IS("--tracking")) {
             VAL();
             if (strcmp(v, "ratio") == 0) desc.params.tracking = HD_TRACKING_RATIO;

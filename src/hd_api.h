@@ -57,6 +57,7 @@ static void hd__ctx_free(hd__ctx *ctx)
 HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
 {
     hd_desc d;
+    hd_params given;
     const hd_logger *log;
     hd__ctx *ctx;
     hd_result r;
@@ -85,8 +86,10 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     hd__camera_defaults(&d.camera);
     if ((r = hd__check_camera(&d.camera, log)) != HD_SUCCESS) return r;
     if ((r = hd__camera_frame(&d.camera, &xf, kbox, &cf, log)) != HD_SUCCESS) return r;
-    hd__params_defaults(&d.params);
+    given = d.params;
+    hd__params_defaults(&d.params, d.volume.dims, 0);
     if ((r = hd__check_params(&d.params, log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_grid(d.volume.dims, &d.params, log)) != HD_SUCCESS) return r;
     if (d.params.method == HD_METHOD_CD && hd__area_light_count(d.lights, d.light_count) > 0)
         return HD__ERR(log, HD_ERROR_UNSUPPORTED, "hd_create: method CD keeps one light volume per direction or point and cannot hold an area light");
     if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
@@ -107,6 +110,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     ctx->vw.log = d.logger;
     ctx->vw.camera = d.camera;
     ctx->vw.params = d.params;
+    ctx->params_given = given;
     ctx->vw.desc.volume.data = NULL; /* the caller's buffer is not kept */
     ctx->xf = xf;
     ctx->cf = cf;
@@ -394,8 +398,9 @@ static hd_result hd__api_set_params(hd__ctx *ctx, const hd_params *params)
     hd_result r;
     if (!params) return HD__ERR(&ctx->vw.log, HD_ERROR_NULL_POINTER, "hd_set_params: params is NULL");
     p = *params;
-    hd__params_defaults(&p);
+    hd__params_defaults(&p, ctx->vw.dims, ctx->no_multigrid);
     if ((r = hd__check_params(&p, &ctx->vw.log)) != HD_SUCCESS) return r;
+    if ((r = hd__check_grid(ctx->vw.dims, &p, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
     if (ctx->env_on && p.method == HD_METHOD_CD)
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_params: method CD cannot hold the environment (one light volume per light); clear it first");
@@ -403,6 +408,7 @@ static hd_result hd__api_set_params(hd__ctx *ctx, const hd_params *params)
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_params: method CD cannot hold an area light (one light volume per direction or point); remove it first");
     ctx->dirty |= hd__params_dirty(&ctx->vw.params, &p);
     ctx->vw.params = p;
+    ctx->params_given = *params;
     hd__set_channels(ctx);
     if (ctx->dirty & HD__DIRTY_ALLOC) hd__set_grid(ctx);
     if (ctx->dirty & HD__DIRTY_SIGMA) hd__build_majorants(ctx);
@@ -538,7 +544,8 @@ static hd_result hd__record_check(hd__ctx *ctx, void *command_buffer, int n, con
     if (n < 1) return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: n = %d, must be >= 1", fn, n);
     if (ctx->iterations + (uint64_t)n > 0x7fffffffu)
         return HD__ERR(&ctx->vw.log, HD_ERROR_INVALID_PARAMETER, "%s: more than 2^31 iterations; reset with a new seed", fn);
-    if (p->solver == HD_SOLVER_MULTIGRID && !p->disable_diffusion && (p->method == HD_METHOD_HD || p->method == HD_METHOD_CD))
+    if (p->solver == HD_SOLVER_MULTIGRID && !p->disable_diffusion && (p->method == HD_METHOD_HD || p->method == HD_METHOD_CD) &&
+        !hd__solver_fallback(ctx, "multigrid cannot be recorded"))
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED,
                        "%s: solver MULTIGRID reads its dot products back within each step, so it cannot be recorded; use hd_iterate", fn);
     return HD_SUCCESS;

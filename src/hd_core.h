@@ -146,6 +146,9 @@ typedef struct hd__ctx {
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */
     unsigned sig_gen;        /* bumped whenever sigma_t is reclassified (multigrid re-restricts) */
     hd__mg_cg mg;            /* HD_SOLVER_MULTIGRID's run state (src/hd_multigrid.h) */
+    hd_params params_given;  /* the parameters as the caller gave them (zeros: defaults): what
+                                HD_SOLVER_AUTO's fall-back fills in again (hd__solver_fallback) */
+    int no_multigrid;        /* HD_SOLVER_AUTO picks red-black: multigrid could not run here */
     hd__dl dl;
     uint16_t *srgb;          /* hd_read_image_rgba8's encoding table (hd__srgb_table), made on its first call */
     int image_empty;         /* the image holds no frame: new (a new camera size) or reset, none

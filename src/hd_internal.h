@@ -16,8 +16,12 @@
 #if HD_MAX_CONTEXTS < 1 || HD_MAX_CONTEXTS > 255
 #error "hybriddiff: HD_MAX_CONTEXTS must be in 1..255 (a context handle holds its slot in 8 bits)"
 #endif
-/* Kernels index with 32-bit ints: the largest grid they may address, channels included. */
+/* Kernels index with 32-bit ints. The volume's voxels: at most 2^30 (1024^3). The illumination
+   grid's voxels times its most channels (sigma_t and 3 colours with rgb_scattering, E and phi
+   with 3 colours): below 2^31, so at most 2^29 - 1 voxels (hd__check_grid). */
 #define HD__MAX_VOXELS (1u << 30)
+#define HD__MAX_GRID_CHANNELS 4
+#define HD__MAX_GRID_VOXELS ((1u << 29) - 1u)
 #define HD__MAX_RENDER_SCALE 16 /* params.render_scale's largest divisor */
 #define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
                                 majorants and few DDA steps (docs/DESIGN-CPU.md) */

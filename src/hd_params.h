@@ -54,7 +54,9 @@
     FLOAT(albedo, 0.9f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_WARM_PHI) \
     FLOAT(anisotropy, 0.0f, -1.0f, 1.0f, 1, "in (-1, 1)", HD__INV_WARM_PHI) \
     FLOAT(majorant, 0.0f, 0.0f, 1e6f, 0, "in [0, 1e6]", HD__INV_MEDIUM) \
-    ENUM(solver, hd_solver, HD_SOLVER_RED_BLACK, HD_SOLVER_COUNT, HD__INV_NONE) \
+    INT(illumination_downsample, 2, 1, 8, "in 1..8", HD__INV_GRIDS) \
+    ENUM(illumination_precision, hd_precision, HD_PRECISION_FLOAT32, HD_PRECISION_COUNT, HD__INV_GRIDS) \
+    ENUM(solver, hd_solver, hd__solver_auto(p, dims, no_multigrid), HD_SOLVER_COUNT, HD__INV_NONE) \
     INT(diffusion_sweeps, (p->solver == HD_SOLVER_MULTIGRID ? 1 : 4), 1, 100000, "in 1..100000", HD__INV_NONE) \
     BOOL(disable_diffusion, HD__INV_PHI) \
     ENUM(tracking, hd_tracking, HD_TRACKING_RATIO, HD_TRACKING_COUNT, HD__INV_NONE) \
@@ -64,10 +66,8 @@
     INT(frame_window, 8, 1, 0x7fffffff, "at least 1", HD__INV_IMAGE) \
     FLOAT(exposure, 1.0f, 0.0f, FLT_MAX, 0, "finite and >= 0", HD__INV_NONE) \
     INT(max_bounces, 64, 1, 100000, "in 1..100000", HD__DIRTY_PATHS) \
-    INT(illumination_downsample, 2, 1, 8, "in 1..8", HD__INV_GRIDS) \
     BOOL(rgb_scattering, HD__INV_GRIDS) \
     ENUM(diffusion_boundary, hd_boundary, HD_BOUNDARY_SURFACE, HD_BOUNDARY_COUNT, HD__INV_PHI) \
-    ENUM(illumination_precision, hd_precision, HD_PRECISION_FLOAT32, HD_PRECISION_COUNT, HD__INV_GRIDS) \
     FLOAT(light_tolerance, 0.1f, 0.0f, FLT_MAX, 0, "finite and >= 0", HD__INV_NONE) \
     FLOAT(render_budget, 0.0f, 0.0f, HD__MAX_RENDER_BUDGET, 0, "in [0, 10] seconds", HD__INV_NONE) \
     FLOAT3(crop_min, 0.0f, 0.0f, 1.0f, "in [0, 1]", HD__INV_MEDIUM) \
@@ -78,6 +78,22 @@
     INT(refine_bounces, -1, -1, 100000, "-1 or 1..100000", HD__INV_IMAGE) \
     FLOAT(depth_threshold, 0.5f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_IMAGE)
 
+/* ---- HD_SOLVER_AUTO -------------------------------------------------------------------------------
+   Red-black's iterations to converge grow with the grid (18 at the head CT's 0.9 M grid voxels,
+   28 at 7.1 M, 35 at 16.8 M), multigrid's do not (15-18), and a multigrid step costs 1.3-1.7
+   light iterations of red-black's: multigrid converges sooner from HD__SOLVER_AUTO_VOXELS grid
+   voxels on (docs/PERFORMANCE.md, "Scale"). Red-black where multigrid cannot run: float16
+   illumination, or a device without double precision (no_multigrid, set once a step was refused). */
+#define HD__SOLVER_AUTO_VOXELS 4000000u
+static hd_solver hd__solver_auto(const hd_params *p, const int *dims, int no_multigrid)
+{
+    size_t n = 1;
+    int d, f = p->illumination_downsample;
+    if (!dims || no_multigrid || p->illumination_precision == HD_PRECISION_FLOAT16 || f < 1) return HD_SOLVER_RED_BLACK;
+    for (d = 0; d < 3; ++d) n *= (size_t)((dims[d] + f - 1) / f);
+    return n >= HD__SOLVER_AUTO_VOXELS ? HD_SOLVER_MULTIGRID : HD_SOLVER_RED_BLACK;
+}
+
 /* ---- defaults: a zero field gets the row's default --------------------------------------------- */
 #define HD__PD_ENUM(n, t, def, count, inv) if ((int)p->n == 0) p->n = def;
 #define HD__PD_FLOAT(n, def, lo, hi, open, valid, inv) if (p->n == 0.0f) p->n = def;
@@ -86,7 +102,8 @@
 #define HD__PD_FLOAT3(n, def, lo, hi, valid, inv) \
     for (i = 0; i < 3; ++i) \
         if (p->n[i] == 0.0f) p->n[i] = def;
-static void hd__params_defaults(hd_params *p)
+/* dims: the volume's, for HD_SOLVER_AUTO (NULL: red-black); no_multigrid: AUTO picks red-black. */
+static void hd__params_defaults(hd_params *p, const int *dims, int no_multigrid)
 {
     int i;
     HD__PARAM_TABLE(HD__PD_ENUM, HD__PD_FLOAT, HD__PD_INT, HD__PD_NONE, HD__PD_NONE, HD__PD_FLOAT3)

@@ -134,11 +134,37 @@ static hd_result hd__prepare(hd__ctx *ctx)
     return HD_SUCCESS;
 }
 
+/* Multigrid that HD_SOLVER_AUTO picked cannot run (why: a step refused, or recording): red-black
+   from now on, with the caller's other parameters filled in again (diffusion_sweeps 0: red-black's
+   default). 0 where the caller asked for multigrid itself: the refusal stands. */
+static int hd__solver_fallback(hd__ctx *ctx, const char *why)
+{
+    hd_params p;
+    if (ctx->params_given.solver != HD_SOLVER_AUTO || ctx->vw.params.solver != HD_SOLVER_MULTIGRID) return 0;
+    ctx->no_multigrid = 1;
+    p = ctx->params_given;
+    hd__params_defaults(&p, ctx->vw.dims, 1);
+    ctx->dirty |= hd__params_dirty(&ctx->vw.params, &p);
+    ctx->vw.params = p;
+    HD__INFO(&ctx->vw.log, "solver AUTO: %s; red-black from now on", why);
+    return 1;
+}
+
+/* One step of multigrid; where AUTO's multigrid is refused (a device without double precision),
+   red-black's sweeps instead. */
+static hd_result hd__mg_step_or_fallback(hd__ctx *ctx)
+{
+    hd_result r = hd__mg_step(ctx);
+    if (r == HD_ERROR_UNSUPPORTED && hd__solver_fallback(ctx, "multigrid is not available on this device"))
+        r = hd__be_diffuse(&ctx->vw, 0);
+    return r;
+}
+
 /* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a
    V-cycle; docs/DESIGN-MULTIGRID.md has its cost in red-black sweeps). */
 static hd_result hd__diffuse_once(hd__ctx *ctx)
 {
-    if (ctx->vw.params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step(ctx);
+    if (ctx->vw.params.solver == HD_SOLVER_MULTIGRID) return hd__mg_step_or_fallback(ctx);
     return hd__be_diffuse(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI);
 }
 
@@ -196,7 +222,7 @@ static hd_result hd__sweeps_part(hd__ctx *ctx, int n)
     if (ctx->vw.params.solver != HD_SOLVER_MULTIGRID)
         r = hd__be_diffuse_sweeps(&ctx->vw, ctx->vw.params.solver == HD_SOLVER_JACOBI, n);
     else
-        for (s = 0; s < n && r == HD_SUCCESS; ++s) r = hd__diffuse_once(ctx);
+        for (s = 0; s < n && r == HD_SUCCESS && ctx->vw.params.solver == HD_SOLVER_MULTIGRID; ++s) r = hd__diffuse_once(ctx);
     ctx->part.sweeps += n;
     ctx->seconds[1] += hd__now() - t0;
     return r;

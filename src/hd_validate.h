@@ -40,10 +40,10 @@ static hd_result hd__check_volume(const hd_volume_desc *v, const hd_logger *log)
             return HD__ERR(log, HD_ERROR_INVALID_DIMENSIONS, "volume.dims[%d] = %d is outside 1..%d", i, v->dims[i], HD_MAX_DIM);
     }
     for (i = 0; i < 3; ++i) nvox *= (size_t)v->dims[i];
-    /* 3 channels of illumination are indexed by 32-bit ints in the kernels */
-    if (nvox > HD__MAX_VOXELS / 3)
+    /* the kernels index the volume with 32-bit ints */
+    if (nvox > HD__MAX_VOXELS)
         return HD__ERR(log, HD_ERROR_SIZE_OVERFLOW, "volume of %dx%dx%d voxels exceeds the %u-voxel limit",
-                       v->dims[0], v->dims[1], v->dims[2], HD__MAX_VOXELS / 3);
+                       v->dims[0], v->dims[1], v->dims[2], HD__MAX_VOXELS);
     if (!v->data) return HD__ERR(log, HD_ERROR_NULL_POINTER, "volume.data is NULL");
     for (i = 0; i < 3; ++i) {
         if (v->spacing[0] == 0.0f && v->spacing[1] == 0.0f && v->spacing[2] == 0.0f) break;
@@ -55,6 +55,21 @@ static hd_result hd__check_volume(const hd_volume_desc *v, const hd_logger *log)
         (v->value_range[0] == v->value_range[1] && v->value_range[0] != 0.0f))
         return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "volume.value_range {%g, %g} must be finite and not empty",
                        (double)v->value_range[0], (double)v->value_range[1]);
+    return HD_SUCCESS;
+}
+
+/* The illumination grid of dims over params.illumination_downsample (hd__set_grid's rounding):
+   its voxels times HD__MAX_GRID_CHANNELS must stay within the kernels' 32-bit indices. */
+static hd_result hd__check_grid(const int *dims, const hd_params *p, const hd_logger *log)
+{
+    int d, f = p->illumination_downsample, g[3];
+    size_t n = 1;
+    for (d = 0; d < 3; ++d) n *= (size_t)(g[d] = (dims[d] + f - 1) / f);
+    if (n > HD__MAX_GRID_VOXELS)
+        return HD__ERR(log, HD_ERROR_SIZE_OVERFLOW,
+                       "illumination grid of %dx%dx%d voxels (illumination_downsample %d) exceeds the %u-voxel limit "
+                       "(%d channels indexed by 32-bit ints): raise illumination_downsample",
+                       g[0], g[1], g[2], f, HD__MAX_GRID_VOXELS, HD__MAX_GRID_CHANNELS);
     return HD_SUCCESS;
 }
 

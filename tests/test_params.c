@@ -283,6 +283,58 @@ static void test_param_codes(void)
     hd_destroy(c);
 }
 
+/* HD_SOLVER_AUTO (the default) by the illumination grid's voxels: a 160^3 volume at
+   illumination_downsample 1 (4.1 M grid voxels) gets multigrid with 1 CG step, at 2 (0.5 M)
+   red-black with 4 sweeps, and red-black with float16 illumination; hd_set_params picks again.
+   An explicit solver stays. The grid's index limit: 1024^3 at downsample 1 is refused (the
+   check comes before the voxels are read), a volume over 2^30 voxels too. */
+enum { AN = 160 };
+static unsigned char avox[AN * AN * AN];
+static void test_solver_auto(void)
+{
+    hd_desc d, q;
+    hd_context c;
+    hd_test_log log;
+    hd_params p;
+    memset(&d, 0, sizeof d);
+    memset(avox, 100, sizeof avox);
+    d.volume.type = HD_VOXEL_U8;
+    d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = AN;
+    d.volume.data = avox;
+    d.camera.width = d.camera.height = 8;
+    d.threads = 1;
+    d.logger = hd_test_logger(&log);
+    d.params.illumination_downsample = 1;
+    CHECK(hd_create(&d, &c) == HD_SUCCESS);
+    CHECK(hd_query_desc(c, &q) == HD_SUCCESS);
+    CHECK(q.params.solver == HD_SOLVER_MULTIGRID && q.params.diffusion_sweeps == 1);
+    p = d.params;
+    p.illumination_downsample = 2;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_query_desc(c, &q) == HD_SUCCESS);
+    CHECK(q.params.solver == HD_SOLVER_RED_BLACK && q.params.diffusion_sweeps == 4);
+    p.illumination_downsample = 1;
+    p.illumination_precision = HD_PRECISION_FLOAT16;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_query_desc(c, &q) == HD_SUCCESS);
+    CHECK(q.params.solver == HD_SOLVER_RED_BLACK && q.params.diffusion_sweeps == 4);
+    p.illumination_precision = HD_PRECISION_FLOAT32;
+    p.solver = HD_SOLVER_JACOBI;
+    CHECK(hd_set_params(c, &p) == HD_SUCCESS && hd_query_desc(c, &q) == HD_SUCCESS);
+    CHECK(q.params.solver == HD_SOLVER_JACOBI && q.params.diffusion_sweeps == 4);
+    hd_destroy(c);
+    d.params.illumination_downsample = 2;
+    CHECK(hd_create(&d, &c) == HD_SUCCESS && hd_query_desc(c, &q) == HD_SUCCESS);
+    CHECK(q.params.solver == HD_SOLVER_RED_BLACK && q.params.diffusion_sweeps == 4);
+    hd_destroy(c);
+    d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = 1024;
+    d.params.illumination_downsample = 1;
+    log.errors = 0;
+    CHECK(hd_create(&d, &c) == HD_ERROR_SIZE_OVERFLOW && log.errors == 1);
+    d.volume.dims[2] = 1025;
+    d.params.illumination_downsample = 4;
+    log.errors = 0;
+    CHECK(hd_create(&d, &c) == HD_ERROR_SIZE_OVERFLOW && log.errors == 1);
+}
+
 /* Every slot at the end of its generations: the last handle of a slot works, and once destroyed
    the slot is retired (its handles never come back); the next context takes another slot. The
    slots' generations are restored after. */
@@ -374,6 +426,7 @@ const hd_test_case hd_tests_params[] = {
     {"param_warm_rows", test_param_warm_rows},
     {"param_max_bounces_restarts", test_param_max_bounces_restarts},
     {"param_codes", test_param_codes},
+    {"solver_auto", test_solver_auto},
     {"handle_retirement", test_handle_retirement},
     {"logger_after_destroy", test_logger_after_destroy},
     {"value_range_extremes", test_value_range_extremes},

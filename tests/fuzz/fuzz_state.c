@@ -310,7 +310,7 @@ static void fz_params_defaults(hd_params *p)
     if (p->method == HD_METHOD_DEFAULT) p->method = HD_METHOD_HD;
     if (p->extinction == 0.0f) p->extinction = 100.0f;
     if (p->albedo == 0.0f) p->albedo = 0.9f;
-    if (p->solver == HD_SOLVER_DEFAULT) p->solver = HD_SOLVER_RED_BLACK;
+    if (p->solver == HD_SOLVER_DEFAULT) p->solver = HD_SOLVER_RED_BLACK; /* AUTO: the volumes here are far below 4 M voxels */
     if (p->diffusion_sweeps == 0) p->diffusion_sweeps = p->solver == HD_SOLVER_MULTIGRID ? 1 : 4;
     if (p->tracking == HD_TRACKING_DEFAULT) p->tracking = HD_TRACKING_RATIO;
     if (p->step == 0.0f) p->step = 0.5f;

@@ -1047,6 +1047,43 @@ static void check_depth_texture(void)
     free(gl_rows); free(top); free(back);
 }
 
+/* A volume the GL cannot hold as one 3D texture (a side above GL_MAX_3D_TEXTURE_SIZE; the
+   library's own limits, HD_MAX_DIM and the grid's 32-bit indices, pass it): HD_ERROR_UNSUPPORTED
+   and one logged error, at hd_create or at the first iteration, never a crash. */
+static int limit_errors;
+static void limit_log(void *u, hd_log_level l, hd_result c, const char *m, const char *f, int line)
+{
+    (void)u; (void)c; (void)f; (void)line;
+    if (l == HD_LOG_ERROR) { ++limit_errors; printf("volume limit: logged \"%s\"\n", m); }
+}
+static void check_volume_limit(void)
+{
+    static float vox[8192 * 2 * 2];
+    GLint max3d = 0;
+    hd_desc d;
+    hd_context c;
+    hd_result r;
+    int i;
+    glGetIntegerv(GL_MAX_3D_TEXTURE_SIZE, &max3d);
+    if (max3d >= HD_MAX_DIM) { printf("volume limit: GL_MAX_3D_TEXTURE_SIZE %d holds HD_MAX_DIM: skipped\n", max3d); return; }
+    for (i = 0; i < 8192 * 2 * 2; ++i) vox[i] = (float)(i % 7) / 7.0f;
+    memset(&d, 0, sizeof d);
+    d.volume.type = HD_VOXEL_F32;
+    d.volume.dims[0] = HD_MAX_DIM;
+    d.volume.dims[1] = d.volume.dims[2] = 2;
+    d.volume.data = vox;
+    d.camera.width = d.camera.height = 16;
+    d.logger.func = limit_log;
+    limit_errors = 0;
+    r = hd_create(&d, &c);
+    if (r == HD_SUCCESS) {
+        r = hd_iterate(c, 1);
+        hd_destroy(c);
+    }
+    CHECK(r == HD_ERROR_UNSUPPORTED && limit_errors == 1, "a %dx2x2 volume over GL_MAX_3D_TEXTURE_SIZE %d: %s, %d errors logged",
+          HD_MAX_DIM, max3d, hd_result_string(r), limit_errors);
+}
+
 int main(void)
 {
     static const EGLint cfg_attrs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, 0, EGL_NONE};
@@ -1078,6 +1115,7 @@ int main(void)
     check_light_texture();
     check_depth_texture();
     check_shader_warnings();
+    check_volume_limit();
     /* the backend's own EGL context while the host's is current: it cannot render into the host's
        texture (different context, no sharing), so only the state is checked there */
     {

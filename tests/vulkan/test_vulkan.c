@@ -1325,6 +1325,109 @@ static int validation_layer_present(void)
     return 0;
 }
 
+/* HD_SOLVER_AUTO's multigrid (a 160^3 volume at illumination_downsample 1: 4.1 M grid voxels)
+   under hd_vulkan_record: red-black from then on (4 sweeps), the recording succeeds; a
+   multigrid the caller named is still refused, with one error. */
+static void test_record_solver_auto(void)
+{
+    enum { N = 160 };
+    static unsigned char avox[N * N * N];
+    hd_desc d = test_desc(), q;
+    hd_context h;
+    hd__backend *be;
+    vk_cmd c;
+    hd_params p;
+    hd_result r1 = HD_ERROR_UNSUPPORTED, r2 = HD_SUCCESS;
+    int i, mg = 0, ok;
+    for (i = 0; i < N * N * N; ++i) avox[i] = (unsigned char)(i % N < N / 2 ? 200 : 0);
+    d.volume.type = HD_VOXEL_U8;
+    d.volume.dims[0] = d.volume.dims[1] = d.volume.dims[2] = N;
+    d.volume.data = avox;
+    d.params.illumination_downsample = 1;
+    d.params.solver = HD_SOLVER_AUTO;
+    d.params.diffusion_sweeps = 0;
+    d.vulkan.enable_validation = have_layer;
+    messages = 0;
+    if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+    be = hd__lookup(h)->vw.be;
+    CHECK(hd_query_desc(h, &q) == HD_SUCCESS);
+    mg = q.params.solver == HD_SOLVER_MULTIGRID && q.params.diffusion_sweeps == 1;
+    if (cmd_begin(be, &c)) {
+        r1 = hd_vulkan_record(h, c.cb, 1);
+        cmd_submit(be, &c, 1);
+    }
+    CHECK(hd_query_desc(h, &q) == HD_SUCCESS);
+    ok = mg && r1 == HD_SUCCESS && q.params.solver == HD_SOLVER_RED_BLACK && q.params.diffusion_sweeps == 4;
+    p = q.params;
+    p.solver = HD_SOLVER_MULTIGRID;
+    p.diffusion_sweeps = 1;
+    CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+    if (cmd_begin(be, &c)) {
+        r2 = hd_vulkan_record(h, c.cb, 1);
+        cmd_submit(be, &c, 0);
+    }
+    ok = ok && r2 == HD_ERROR_UNSUPPORTED;
+    CHECK(hd_destroy(h) == HD_SUCCESS);
+    CHECK(ok && messages == 0);
+    printf("%s solver AUTO under recording: multigrid picked %d, record %s, then red-black; multigrid named: %s; %lu validation messages\n",
+           ok && messages == 0 ? "PASS" : "FAIL", mg, hd_result_string(r1), hd_result_string(r2), messages);
+}
+
+/* A volume wider than the device's maxImageDimension3D (the library's own limits pass it):
+   HD_ERROR_UNSUPPORTED and one logged error, at hd_create or the first iteration. */
+static int limit_errors;
+static void limit_log(void *u, hd_log_level l, hd_result c, const char *m, const char *f, int line)
+{
+    (void)u; (void)c; (void)f; (void)line;
+    if (l == HD_LOG_ERROR) { ++limit_errors; printf("volume limit: logged \"%s\"\n", m); }
+}
+static void test_volume_limit(void)
+{
+    static float vox[HD_MAX_DIM * 2 * 2];
+    VkApplicationInfo app;
+    VkInstanceCreateInfo ici;
+    VkInstance inst;
+    VkPhysicalDevice phys[8];
+    VkPhysicalDeviceProperties props;
+    uint32_t nphys = 8, max3d = 0;
+    hd_desc d;
+    hd_context c;
+    hd_result r;
+    int i;
+    memset(&app, 0, sizeof app);
+    app.sType = VK_STRUCTURE_TYPE_APPLICATION_INFO;
+    app.apiVersion = VK_API_VERSION_1_1;
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
+    ici.pApplicationInfo = &app;
+    if (vkCreateInstance(&ici, NULL, &inst) != VK_SUCCESS) { ++failures; printf("FAIL volume limit: no instance\n"); return; }
+    if (vkEnumeratePhysicalDevices(inst, &nphys, phys) >= 0 && nphys > 0) {
+        vkGetPhysicalDeviceProperties(phys[0], &props); /* the backend's device: the first */
+        max3d = props.limits.maxImageDimension3D;
+    }
+    vkDestroyInstance(inst, NULL);
+    if (max3d == 0 || max3d >= HD_MAX_DIM) { printf("volume limit: maxImageDimension3D %u: skipped\n", max3d); return; }
+    for (i = 0; i < HD_MAX_DIM * 2 * 2; ++i) vox[i] = (float)(i % 7) / 7.0f;
+    memset(&d, 0, sizeof d);
+    d.volume.type = HD_VOXEL_F32; /* one voxel a texel */
+    d.volume.dims[0] = HD_MAX_DIM;
+    d.volume.dims[1] = d.volume.dims[2] = 2;
+    d.volume.data = vox;
+    d.camera.width = d.camera.height = 16;
+    d.logger.func = limit_log;
+    limit_errors = 0;
+    r = hd_create(&d, &c);
+    if (r == HD_SUCCESS) {
+        r = hd_iterate(c, 1);
+        hd_destroy(c);
+    }
+    if (!(r == HD_ERROR_UNSUPPORTED && limit_errors == 1)) {
+        ++failures;
+        printf("FAIL volume limit: a %dx2x2 volume over maxImageDimension3D %u: %s, %d errors logged\n", HD_MAX_DIM, max3d,
+               hd_result_string(r), limit_errors);
+    } else printf("ok volume limit: a %dx2x2 volume over maxImageDimension3D %u refused\n", HD_MAX_DIM, max3d);
+}
+
 int main(void)
 {
     const char *req = getenv("HD_CONFORMANCE_REQUIRE");
@@ -1356,6 +1459,8 @@ int main(void)
             test_output_target();
             test_record_converged();
             test_record_depth();
+            test_volume_limit();
+            test_record_solver_auto();
         }
     }
     if (failures) printf("FAILED\n");
