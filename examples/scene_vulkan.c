@@ -3,6 +3,9 @@
    boxes with a depth buffer, a smoke cloud placed by a volume-to-world transform, one camera given
    to both as view and projection matrices (Vulkan's clip space: y down, depth zero to one), and
    everything recorded into one command buffer per frame:
+     0. hd_vulkan_record_illumination: the cloud's light (E + phi) copied into the application's
+        3D image, which the meshes' shader samples: the sun on the post where it stands in the
+        cloud's medium comes through the cloud (its shadow darkens the post downward);
      1. the meshes into the application's HDR image (RGBA16F colour, D32_SFLOAT depth);
      2. hd_vulkan_record_depth: the depth image copied into the library on the device, so the
         cloud's rays end at the meshes (a post standing in the cloud cuts it, a box in front of it
@@ -230,18 +233,21 @@ typedef struct app {
     VkCommandPool pool;
     VkCommandBuffer cb;
     image hdr, depth, cloud, ldr;  /* RGBA16F scene, D32 depth, the library's RGBA16F image, RGBA8 */
+    image light;                   /* the cloud's light, R32_SFLOAT 3D (hd_vulkan_record_illumination) */
+    int light_dims[3], light_filled;
     buffer vbo, readback;
-    VkSampler sampler;
+    VkSampler sampler, light_sampler;
     VkRenderPass pass_mesh, pass_blend, pass_tonemap;
     VkFramebuffer fb_mesh, fb_blend, fb_tonemap;
     VkDescriptorSetLayout set_layout;
     VkDescriptorPool dpool;
-    VkDescriptorSet set_cloud, set_hdr;
+    VkDescriptorSet set_cloud, set_hdr, set_light;
     VkPipelineLayout layout_mesh, layout_quad;
     VkPipeline pipe_mesh, pipe_blend, pipe_tonemap;
     mesh meshes[MESHES];
     hd_context hd;
     mat4 view, proj; /* the last frame's camera (Vulkan's clip space) */
+    mat4 place;      /* the cloud's volume-to-world transform */
 } app;
 
 static const float sun_dir[3] = {-0.45f, -0.8f, -0.4f}; /* the direction sunlight travels in */
@@ -313,6 +319,44 @@ static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, 
     vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
     vci.format = format;
     vci.subresourceRange.aspectMask = aspect;
+    vci.subresourceRange.levelCount = vci.subresourceRange.layerCount = 1;
+    vk_check(vkCreateImageView(a->dev, &vci, NULL, &im.view), "vkCreateImageView");
+    return im;
+}
+
+/* The cloud's light: a 3D R32_SFLOAT image of the illumination grid's size, sampled by the meshes. */
+static image make_light_image(const app *a)
+{
+    image im;
+    VkImageCreateInfo ici;
+    VkImageViewCreateInfo vci;
+    VkMemoryRequirements req;
+    VkMemoryAllocateInfo mai;
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    ici.imageType = VK_IMAGE_TYPE_3D;
+    ici.format = VK_FORMAT_R32_SFLOAT;
+    ici.extent.width = (uint32_t)a->light_dims[0], ici.extent.height = (uint32_t)a->light_dims[1];
+    ici.extent.depth = (uint32_t)a->light_dims[2];
+    ici.mipLevels = ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    vk_check(vkCreateImage(a->dev, &ici, NULL, &im.image), "vkCreateImage");
+    vkGetImageMemoryRequirements(a->dev, im.image, &req);
+    memset(&mai, 0, sizeof mai);
+    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
+    mai.allocationSize = req.size;
+    mai.memoryTypeIndex = memory_type(a, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    vk_check(vkAllocateMemory(a->dev, &mai, NULL, &im.memory), "vkAllocateMemory");
+    vk_check(vkBindImageMemory(a->dev, im.image, im.memory, 0), "vkBindImageMemory");
+    memset(&vci, 0, sizeof vci);
+    vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
+    vci.image = im.image;
+    vci.viewType = VK_IMAGE_VIEW_TYPE_3D;
+    vci.format = VK_FORMAT_R32_SFLOAT;
+    vci.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
     vci.subresourceRange.levelCount = vci.subresourceRange.layerCount = 1;
     vk_check(vkCreateImageView(a->dev, &vci, NULL, &im.view), "vkCreateImageView");
     return im;
@@ -533,15 +577,16 @@ static VkPipeline make_pipeline(const app *a, VkRenderPass rp, VkPipelineLayout 
     VkPipelineColorBlendAttachmentState cba;
     VkPipelineColorBlendStateCreateInfo cb;
     VkGraphicsPipelineCreateInfo gpci;
-    VkSpecializationMapEntry se[6];
+    VkSpecializationMapEntry se[18];
     VkSpecializationInfo si;
-    float sun[6];
+    float sun[18];
+    mat4 to_box = mat4_inverse(a->place);
     VkPipeline p;
-    for (int i = 0; i < 6; ++i) {
-        sun[i] = i < 3 ? sun_dir[i] : sun_rgb[i - 3];
+    for (int i = 0; i < 18; ++i) { /* the sun; the world-to-box transform's first three rows */
+        sun[i] = i < 3 ? sun_dir[i] : i < 6 ? sun_rgb[i - 3] : to_box.m[((i - 6) % 4) * 4 + (i - 6) / 4];
         se[i].constantID = (uint32_t)i, se[i].offset = (uint32_t)(i * sizeof(float)), se[i].size = sizeof(float);
     }
-    si.mapEntryCount = 6, si.pMapEntries = se, si.dataSize = sizeof sun, si.pData = sun;
+    si.mapEntryCount = 18, si.pMapEntries = se, si.dataSize = sizeof sun, si.pData = sun;
     memset(st, 0, sizeof st);
     for (int i = 0; i < 2; ++i) {
         st[i].sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -601,7 +646,7 @@ static VkPipeline make_pipeline(const app *a, VkRenderPass rp, VkPipelineLayout 
     return p;
 }
 
-static VkDescriptorSet make_set(const app *a, VkImageView view)
+static VkDescriptorSet make_set(const app *a, VkSampler sampler, VkImageView view)
 {
     VkDescriptorSetAllocateInfo ai;
     VkDescriptorImageInfo ii;
@@ -613,7 +658,7 @@ static VkDescriptorSet make_set(const app *a, VkImageView view)
     ai.descriptorSetCount = 1;
     ai.pSetLayouts = &a->set_layout;
     vk_check(vkAllocateDescriptorSets(a->dev, &ai, &s), "vkAllocateDescriptorSets");
-    ii.sampler = a->sampler, ii.imageView = view, ii.imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    ii.sampler = sampler, ii.imageView = view, ii.imageLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     memset(&w, 0, sizeof w);
     w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     w.dstSet = s;
@@ -630,9 +675,9 @@ static void make_scene_objects(app *a)
     VkSamplerCreateInfo sci;
     VkDescriptorSetLayoutBinding b;
     VkDescriptorSetLayoutCreateInfo dslci;
-    VkDescriptorPoolSize ps = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2};
+    VkDescriptorPoolSize ps = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3};
     VkDescriptorPoolCreateInfo dpci;
-    VkPushConstantRange pcr = {VK_SHADER_STAGE_VERTEX_BIT, 0, 28 * sizeof(float)};
+    VkPushConstantRange pcr = {VK_SHADER_STAGE_VERTEX_BIT, 0, 32 * sizeof(float)}; /* 128: every device's minimum */
     VkPipelineLayoutCreateInfo plci;
     VkCommandPoolCreateInfo cpci;
     VkCommandBufferAllocateInfo cbai;
@@ -679,15 +724,17 @@ static void make_scene_objects(app *a)
     vk_check(vkCreateDescriptorSetLayout(a->dev, &dslci, NULL, &a->set_layout), "vkCreateDescriptorSetLayout");
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    dpci.maxSets = 2;
+    dpci.maxSets = 3;
     dpci.poolSizeCount = 1;
     dpci.pPoolSizes = &ps;
     vk_check(vkCreateDescriptorPool(a->dev, &dpci, NULL, &a->dpool), "vkCreateDescriptorPool");
-    a->set_cloud = make_set(a, a->cloud.view);
-    a->set_hdr = make_set(a, a->hdr.view);
+    a->set_cloud = make_set(a, a->sampler, a->cloud.view);
+    a->set_hdr = make_set(a, a->sampler, a->hdr.view);
 
     memset(&plci, 0, sizeof plci);
     plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+    plci.setLayoutCount = 1;
+    plci.pSetLayouts = &a->set_layout; /* the cloud's light */
     plci.pushConstantRangeCount = 1;
     plci.pPushConstantRanges = &pcr;
     vk_check(vkCreatePipelineLayout(a->dev, &plci, NULL, &a->layout_mesh), "vkCreatePipelineLayout");
@@ -759,6 +806,7 @@ static void draw_frame(app *a, float yaw, float pitch, float dist, int read, int
     hd_camera cam;
     hd_vulkan_depth dep = HD_VULKAN_DEPTH_INIT;
     hd_vulkan_target target = HD_VULKAN_TARGET_INIT;
+    hd_vulkan_volume_target light = HD_VULKAN_VOLUME_TARGET_INIT;
     hd_output out = HD_OUTPUT_INIT;
     mat4 vp;
     a->view = mat4_look_at(eye, at, up);
@@ -778,18 +826,27 @@ static void draw_frame(app *a, float yaw, float pitch, float dist, int read, int
     mb.srcAccessMask = mb.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
     vkCmdPipelineBarrier(a->cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
 
+    /* 0. the cloud's light as it is now (the frame's iteration below refines it for the next
+       frame) into our 3D image, for the meshes inside the cloud */
+    light.image = (uint64_t)a->light.image;
+    light.format = VK_FORMAT_R32_SFLOAT;
+    light.layout = a->light_filled ? VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED;
+    light.final_layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    light.width = a->light_dims[0], light.height = a->light_dims[1], light.depth = a->light_dims[2];
+    hd_check(hd_vulkan_record_illumination(a->hd, a->cb, 0, &light), "hd_vulkan_record_illumination");
+    a->light_filled = 1;
+
     /* 1. the meshes with the depth buffer */
     begin_pass(a, a->pass_mesh, a->fb_mesh, 2);
     vkCmdBindPipeline(a->cb, VK_PIPELINE_BIND_POINT_GRAPHICS, a->pipe_mesh);
+    vkCmdBindDescriptorSets(a->cb, VK_PIPELINE_BIND_POINT_GRAPHICS, a->layout_mesh, 0, 1, &a->set_light, 0, NULL);
     vkCmdBindVertexBuffers(a->cb, 0, 1, &a->vbo.buffer, &zero);
     for (int i = 0; i < MESHES; ++i) {
-        float pc[28];
+        float pc[32];
         mat4 mvp = mat4_mul(vp, a->meshes[i].model);
         memcpy(pc, mvp.m, sizeof mvp.m);
-        for (int c = 0; c < 3; ++c) {
-            for (int r = 0; r < 3; ++r) pc[16 + c * 4 + r] = a->meshes[i].model.m[c * 4 + r];
-            pc[16 + c * 4 + 3] = a->meshes[i].albedo[c];
-        }
+        memcpy(pc + 16, a->meshes[i].model.m, sizeof a->meshes[i].model.m);
+        for (int c = 0; c < 3; ++c) pc[16 + c * 4 + 3] = a->meshes[i].albedo[c];
         vkCmdPushConstants(a->cb, a->layout_mesh, VK_SHADER_STAGE_VERTEX_BIT, 0, sizeof pc, pc);
         vkCmdDraw(a->cb, 36, 1, 0, 0);
     }
@@ -1001,6 +1058,7 @@ int main(int argc, char **argv)
         }
     }
     make_device(&a, validate);
+    a.place = mat4_mul(mat4_translate(0.0f, 1.6f, 0.0f), mat4_mul(mat4_rotate_y(0.4f), mat4_scale(4.0f, 2.6f, 4.0f)));
     make_scene_objects(&a);
 
     /* the scene: a ground plane, a box in front of the cloud, one behind, a post through it */
@@ -1018,7 +1076,7 @@ int main(int argc, char **argv)
     /* the cloud: its box (largest side 1, centred at 0) placed 4 units wide, 1.6 above the ground,
        turned about y; extinction and the light in world units; the library on our device */
     make_cloud(cloud, CLOUD_N);
-    place = mat4_mul(mat4_translate(0.0f, 1.6f, 0.0f), mat4_mul(mat4_rotate_y(0.4f), mat4_scale(4.0f, 2.6f, 4.0f)));
+    place = a.place;
     desc.volume.type = HD_VOXEL_U8;
     desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = CLOUD_N;
     desc.volume.data = cloud;
@@ -1041,6 +1099,22 @@ int main(int argc, char **argv)
     desc.vulkan.queue_family = a.family;
     desc.vulkan.get_instance_proc_addr = (hd_proc)vkGetInstanceProcAddr;
     hd_check(hd_create(&desc, &a.hd), "hd_create");
+    { /* the light's image, of the illumination grid's size; filtered where the format allows */
+        hd_stats st;
+        VkFormatProperties fp;
+        VkSamplerCreateInfo sci;
+        hd_check(hd_get_stats(a.hd, &st), "hd_get_stats");
+        memcpy(a.light_dims, st.illumination_dims, sizeof a.light_dims);
+        a.light = make_light_image(&a);
+        vkGetPhysicalDeviceFormatProperties(a.phys, VK_FORMAT_R32_SFLOAT, &fp);
+        memset(&sci, 0, sizeof sci);
+        sci.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
+        sci.magFilter = sci.minFilter =
+            fp.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+        sci.addressModeU = sci.addressModeV = sci.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+        vk_check(vkCreateSampler(a.dev, &sci, NULL, &a.light_sampler), "vkCreateSampler");
+        a.set_light = make_set(&a, a.light_sampler, a.light.view);
+    }
 
     /* the camera turns for all but the last 16 frames, which rest so the light and the image
        converge; each hd_vulkan_record_render adds one light iteration until the light has converged */
@@ -1074,13 +1148,14 @@ int main(int argc, char **argv)
     vkDestroyDescriptorPool(a.dev, a.dpool, NULL);
     vkDestroyDescriptorSetLayout(a.dev, a.set_layout, NULL);
     vkDestroySampler(a.dev, a.sampler, NULL);
+    vkDestroySampler(a.dev, a.light_sampler, NULL);
     vkDestroyFramebuffer(a.dev, a.fb_mesh, NULL);
     vkDestroyFramebuffer(a.dev, a.fb_blend, NULL);
     vkDestroyFramebuffer(a.dev, a.fb_tonemap, NULL);
     vkDestroyRenderPass(a.dev, a.pass_mesh, NULL);
     vkDestroyRenderPass(a.dev, a.pass_blend, NULL);
     vkDestroyRenderPass(a.dev, a.pass_tonemap, NULL);
-    free_image(&a, &a.hdr), free_image(&a, &a.depth), free_image(&a, &a.cloud), free_image(&a, &a.ldr);
+    free_image(&a, &a.hdr), free_image(&a, &a.depth), free_image(&a, &a.cloud), free_image(&a, &a.ldr), free_image(&a, &a.light);
     free_buffer(&a, &a.vbo), free_buffer(&a, &a.readback);
     vkDestroyCommandPool(a.dev, a.pool, NULL);
     vkDestroyDevice(a.dev, NULL);
