@@ -974,6 +974,55 @@ typedef struct hd_vulkan_depth {
    HD_ERROR_DEPTH_NEEDS_PROJECTION (a look-at camera). */
 HDDEF hd_result hd_vulkan_record_depth(hd_context ctx, void *command_buffer, const hd_vulkan_depth *depth);
 
+/* The caller's Vulkan target of hd_vulkan_record_illumination: a 3D image or a buffer (one of
+   them), handles as uint64_t (as hd_vulkan_target's); the library cannot query them.
+   Image: a 3D image of VK_FORMAT_R32_SFLOAT, mip level 0, at least hd_stats.illumination_dims
+   large (width, height, depth: its extent), made with VK_IMAGE_USAGE_TRANSFER_DST_BIT and owned
+   by desc.vulkan.queue_family. Texels (0, 0, 0) .. illumination_dims - 1 are written (x, y, z as
+   hd_read_illumination's), the others kept. Barriers (the library records them; the caller
+   records none around the call): the image must be in `layout` (GENERAL, TRANSFER_SRC_OPTIMAL,
+   TRANSFER_DST_OPTIMAL, SHADER_READ_ONLY_OPTIMAL; UNDEFINED discards its contents) when the
+   command buffer reaches the copy; the library takes it from `layout` (after every earlier
+   command: source stage ALL_COMMANDS, access MEMORY_READ | MEMORY_WRITE) to
+   TRANSFER_DST_OPTIMAL, copies the grid in (vkCmdCopyImage) and takes it to `final_layout`
+   (before every later command: destination stage ALL_COMMANDS, access MEMORY_READ |
+   MEMORY_WRITE); final_layout 0 -> `layout`, which must then not be UNDEFINED. A shader that
+   samples it asks for SHADER_READ_ONLY_OPTIMAL. Buffer: the channel's floats as
+   hd_read_illumination lays out one channel (x fastest, then y, then z), `offset` bytes (a
+   multiple of 4) from the buffer's start, inside buffer_size, made with
+   VK_BUFFER_USAGE_TRANSFER_DST_BIT; the same ALL_COMMANDS barriers around the copy
+   (vkCmdCopyImageToBuffer). */
+typedef struct hd_vulkan_volume_target {
+    uint64_t image;          /* VkImage, or 0 with a buffer */
+    int format;              /* the image's VkFormat: VK_FORMAT_R32_SFLOAT */
+    int layout;              /* the VkImageLayout it is in before the copy */
+    int final_layout;        /* the VkImageLayout it is left in; 0 -> layout */
+    int width, height, depth; /* the image's extent in texels */
+    uint64_t buffer;         /* VkBuffer, or 0 with an image */
+    uint64_t offset;         /* buffer: bytes to the first float (a multiple of 4) */
+    uint64_t buffer_size;    /* buffer: its size in bytes */
+} hd_vulkan_volume_target;
+#define HD_VULKAN_VOLUME_TARGET_INIT HD_ZERO_INIT
+
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): hd_gl_illumination_texture's
+   counterpart. Channel `channel` (0 .. hd_stats.illumination_channels - 1) of
+   HD_ILLUMINATION_TOTAL (E + phi, as the projection samples it: bit for bit
+   hd_read_illumination's) copied on the device into the caller's 3D image or buffer, recorded
+   into the caller's command buffer (in the recording state, as hd_vulkan_record's), with no CPU
+   round trip. The light copied is the light at the call, after every earlier call's work (which
+   the caller has run: submit and wait before the next call, as for hd_vulkan_record); where a
+   pass changed E or phi since the last frame, their sum is made first on the library's queue
+   (submitted and waited for). In a frame recorded into one command buffer, call it with
+   hd_vulkan_record_depth before hd_vulkan_record_render: the frame's light iteration then
+   refines the light the next frame copies. Errors, one log line each, nothing recorded:
+   HD_ERROR_NULL_POINTER (command buffer, target), HD_ERROR_INVALID_PARAMETER (not one of image
+   and buffer, the channel, the offset), HD_ERROR_OUTPUT_FORMAT (not R32_SFLOAT),
+   HD_ERROR_INVALID_ENUM (a layout), HD_ERROR_OUTPUT_OUTSIDE_TARGET (an image smaller than the
+   grid), HD_ERROR_BUFFER_TOO_SMALL (the floats past buffer_size), HD_ERROR_UNSUPPORTED (PT_SS,
+   PT_MS keep no light volume). */
+HDDEF hd_result hd_vulkan_record_illumination(hd_context ctx, void *command_buffer, int channel,
+                                              const hd_vulkan_volume_target *target);
+
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
    hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must
    be the camera's: else HD_ERROR_INVALID_TEXTURE) with no CPU round trip; rows bottom first,

@@ -10,7 +10,7 @@
 #define HD__NULL_PRIMITIVES(X) \
     X(upload_inputs) X(update_volume) X(alloc_illumination) X(alloc_jacobi) X(alloc_image) X(alloc_lights) X(clear) \
     X(classify) X(direct) X(direct_list) X(diffuse) X(diffuse_sweeps) X(convect) X(sum_lights) \
-    X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_depth) X(record_depth) X(read_illumination) X(mg_begin) X(mg_end) \
+    X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_depth) X(record_depth) X(record_illumination) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
     X(mg_extrapolate) X(wait) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
@@ -270,6 +270,12 @@ static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulk
 {
     (void)cb; (void)depth;
     hd__null_call(vw, HD__NULL_record_depth);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_record_illumination(const hd__view *vw, void *cb, int channel, const hd_vulkan_volume_target *target)
+{
+    (void)cb; (void)channel; (void)target;
+    hd__null_call(vw, HD__NULL_record_illumination);
     return HD_SUCCESS;
 }
 static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)

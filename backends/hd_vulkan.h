@@ -2478,6 +2478,113 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
     return HD_SUCCESS;
 }
 
+/* ---- the light into the caller's 3D image or buffer (hd_vulkan_record_illumination) ---------- */
+/* The layouts a 3D colour image may be in before the copy (before: UNDEFINED too) or be left in. */
+static int hd__vk_volume_layout(int l, int before)
+{
+    return l == VK_IMAGE_LAYOUT_GENERAL || l == VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL || l == VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL ||
+           l == VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL || (before && l == VK_IMAGE_LAYOUT_UNDEFINED);
+}
+
+/* lsum (E + phi, made first on the backend's queue when stale) copied into the caller's target
+   between two barriers: ALL_COMMANDS -> transfer, taking lsum to TRANSFER_SRC and the target
+   image to TRANSFER_DST; the copy; transfer -> ALL_COMMANDS, lsum back to GENERAL and the target
+   image to its final layout. */
+static hd_result hd__be_record_illumination(const hd__view *vw, void *cbp, int channel, const hd_vulkan_volume_target *t)
+{
+    const char *fn = "hd_vulkan_record_illumination";
+    hd__backend *be = vw->be;
+    VkCommandBuffer cb = (VkCommandBuffer)cbp;
+    const VkAccessFlags any = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
+    VkImageLayout final = (VkImageLayout)(t->final_layout ? t->final_layout : t->layout);
+    VkMemoryBarrier mb;
+    VkImageMemoryBarrier ib[2];
+    VkBufferMemoryBarrier bb;
+    VkDeviceSize bytes = (VkDeviceSize)vw->gdims[0] * vw->gdims[1] * vw->gdims[2] * sizeof(float);
+    hd_result r;
+    int i;
+    if (t->image && t->format != VK_FORMAT_R32_SFLOAT)
+        return HD__ERR(&vw->log, HD_ERROR_OUTPUT_FORMAT, "%s: VkFormat %d; the light needs VK_FORMAT_R32_SFLOAT", fn, t->format);
+    if (t->image && !hd__vk_volume_layout(t->layout, 1))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_ENUM, "%s: layout %d is not a 3D image's layout a copy can start from", fn, t->layout);
+    if (t->image && !hd__vk_volume_layout((int)final, 0))
+        return HD__ERR(&vw->log, HD_ERROR_INVALID_ENUM, "%s: final_layout %d%s is not a layout to leave a 3D image in", fn, (int)final,
+                       t->final_layout ? "" : " (0: layout)");
+    if (!be->lsum.image) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: no summed light grid (internal error)");
+    if (!be->gg.lsum_ok) {
+        VkCommandBuffer own = VK_NULL_HANDLE;
+        VkPipeline sum;
+        if ((r = hd__vk_stage_pipeline(vw, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS || (r = hd__vk_begin(vw, &own)) != HD_SUCCESS ||
+            (r = hd__vk_dispatch(vw, own, sum, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0)) != HD_SUCCESS ||
+            (r = hd__vk_flush(vw)) != HD_SUCCESS)
+            return r;
+        be->gg.lsum_ok = 1;
+    }
+    memset(&mb, 0, sizeof mb);
+    mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    mb.srcAccessMask = any;
+    mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    memset(ib, 0, sizeof ib);
+    for (i = 0; i < 2; ++i) {
+        ib[i].sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+        ib[i].srcAccessMask = any;
+        ib[i].srcQueueFamilyIndex = ib[i].dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+        ib[i].subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+        ib[i].subresourceRange.levelCount = 1;
+        ib[i].subresourceRange.layerCount = 1;
+    }
+    ib[0].image = be->lsum.image;
+    ib[0].dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    ib[0].oldLayout = HD__VK_G;
+    ib[0].newLayout = HD__VK_SRC;
+    ib[1].image = (VkImage)t->image;
+    ib[1].dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib[1].oldLayout = (VkImageLayout)t->layout;
+    ib[1].newLayout = HD__VK_DST;
+    memset(&bb, 0, sizeof bb);
+    bb.sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER;
+    bb.srcAccessMask = any;
+    bb.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bb.srcQueueFamilyIndex = bb.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    bb.buffer = (VkBuffer)t->buffer;
+    bb.offset = (VkDeviceSize)t->offset;
+    bb.size = bytes;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, t->buffer ? 1u : 0u, &bb,
+                                t->image ? 2u : 1u, ib);
+    if (t->image) {
+        VkImageCopy ic;
+        memset(&ic, 0, sizeof ic);
+        ic.srcSubresource.aspectMask = ic.dstSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+        ic.srcSubresource.layerCount = ic.dstSubresource.layerCount = 1;
+        ic.srcOffset.z = channel * vw->gdims[2];
+        ic.extent.width = (uint32_t)vw->gdims[0];
+        ic.extent.height = (uint32_t)vw->gdims[1];
+        ic.extent.depth = (uint32_t)vw->gdims[2];
+        be->fn.vkCmdCopyImage(cb, be->lsum.image, HD__VK_SRC, ib[1].image, HD__VK_DST, 1, &ic);
+    } else {
+        VkBufferImageCopy reg = hd__vk_region(&be->lsum);
+        reg.bufferOffset = (VkDeviceSize)t->offset;
+        reg.imageOffset.z = channel * vw->gdims[2];
+        reg.imageExtent.depth = (uint32_t)vw->gdims[2];
+        be->fn.vkCmdCopyImageToBuffer(cb, be->lsum.image, HD__VK_SRC, bb.buffer, 1, &reg);
+    }
+    mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    mb.dstAccessMask = any;
+    ib[0].srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+    ib[0].dstAccessMask = any;
+    ib[0].oldLayout = HD__VK_SRC;
+    ib[0].newLayout = HD__VK_G;
+    ib[1].srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib[1].dstAccessMask = any;
+    ib[1].oldLayout = HD__VK_DST;
+    ib[1].newLayout = final;
+    bb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    bb.dstAccessMask = any;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &mb, t->buffer ? 1u : 0u, &bb,
+                                t->image ? 2u : 1u, ib);
+    return HD_SUCCESS;
+}
+
 /* No GL texture: the core never calls it. */
 HD__BE_NO_TEXTURE("vulkan")
 HD__BE_NO_CL_BUFFER("vulkan")

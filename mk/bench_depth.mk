@@ -1,8 +1,10 @@
-# mk/bench_depth.mk - what the host's depth buffer (hd_set_depth) costs a frame, per backend.
-#   make bench-depth    build/hdbench_depth_{cpu,gl} on the head CT at DEPTH_SIZE^2: plain frames
-#                       against frames with a depth buffer of far values (the overhead) and with a
-#                       wall over half the image (bench/hdbench_depth.c; docs/PERFORMANCE.md)
-DEPTH_BACKENDS ?= cpu gl
+# mk/bench_depth.mk - what depth in (hd_set_depth) and depth out (the depth plane hd_read_depth
+# reads) cost a frame, per backend.
+#   make bench-depth    build/hdbench_depth_{cpu,gl,vulkan} on the head CT at DEPTH_SIZE: plain
+#                       frames against frames without the depth plane's write (depth out), with a
+#                       depth buffer of far values (depth in's overhead) and with a wall over half
+#                       the image (bench/hdbench_depth.c; docs/PERFORMANCE.md)
+DEPTH_BACKENDS ?= cpu gl vulkan
 DEPTH_DEF_cpu := -DHYBRIDDIFF_BACKEND_CPU
 DEPTH_DEF_opencl := -DHYBRIDDIFF_BACKEND_OPENCL
 DEPTH_DEF_gl := -DHYBRIDDIFF_BACKEND_GL
@@ -11,8 +13,8 @@ DEPTH_LIB_cpu :=
 DEPTH_LIB_opencl := -lOpenCL
 DEPTH_LIB_gl := -lEGL
 DEPTH_LIB_vulkan := -lvulkan
-DEPTH_SIZE ?= 512
-DEPTH_FRAMES ?= 15
+DEPTH_SIZE ?= 1280x720
+DEPTH_FRAMES ?= 7
 
 .PHONY: bench-depth
 

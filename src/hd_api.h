@@ -353,6 +353,40 @@ static hd_result hd__api_vulkan_record_depth(hd__ctx *ctx, void *command_buffer,
     ctx->dirty |= HD__DIRTY_IMAGE;
     return HD_SUCCESS;
 }
+/* hd_vulkan_record_illumination: the checks that need no device (the backend checks the image's
+   format and layouts), then the backend's recording of the copy. */
+static hd_result hd__api_vulkan_record_illumination(hd__ctx *ctx, void *command_buffer, int channel, const hd_vulkan_volume_target *t)
+{
+    const char *fn = "hd_vulkan_record_illumination";
+    const hd_logger *log = &ctx->vw.log;
+    hd_result r;
+    if (!(hd__be_features() & HD__BE_RECORD)) return HD__ERR(log, HD_ERROR_UNSUPPORTED, "%s: this is the %s backend", fn, hd__be_name());
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "%s: method %s keeps no illumination volume", fn, hd_method_name(ctx->vw.params.method));
+    if (!command_buffer) return HD__ERR(log, HD_ERROR_NULL_POINTER, "%s: command_buffer is NULL", fn);
+    if (!t) return HD__ERR(log, HD_ERROR_NULL_POINTER, "%s: target is NULL", fn);
+    if ((t->image != 0) == (t->buffer != 0))
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "%s: the target names %s; give an image or a buffer", fn,
+                       t->image ? "an image and a buffer" : "neither an image nor a buffer");
+    if (channel < 0 || channel >= ctx->vw.channels)
+        return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "%s: channel %d, the grid has %d", fn, channel, ctx->vw.channels);
+    if (t->image && (t->width < ctx->vw.gdims[0] || t->height < ctx->vw.gdims[1] || t->depth < ctx->vw.gdims[2]))
+        return HD__ERR(log, HD_ERROR_OUTPUT_OUTSIDE_TARGET, "%s: the image is %dx%dx%d, the illumination grid %dx%dx%d", fn, t->width,
+                       t->height, t->depth, ctx->vw.gdims[0], ctx->vw.gdims[1], ctx->vw.gdims[2]);
+    if (t->buffer) {
+        uint64_t bytes = (uint64_t)ctx->vw.gdims[0] * (uint64_t)ctx->vw.gdims[1] * (uint64_t)ctx->vw.gdims[2] * 4u;
+        if (t->offset % 4u != 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "%s: offset %llu is not a multiple of 4", fn, (unsigned long long)t->offset);
+        if (t->offset > t->buffer_size || t->buffer_size - t->offset < bytes)
+            return HD__ERR(log, HD_ERROR_BUFFER_TOO_SMALL, "%s: %llu bytes from offset %llu past the buffer's %llu", fn,
+                           (unsigned long long)bytes, (unsigned long long)t->offset, (unsigned long long)t->buffer_size);
+    }
+    HD__BE_CALL(r, ctx, hd__be_record_illumination(&ctx->vw, command_buffer, channel, t));
+    return r;
+}
+HDDEF hd_result hd_vulkan_record_illumination(hd_context h, void *command_buffer, int channel, const hd_vulkan_volume_target *target)
+{
+    HD__GUARDED(h, "hd_vulkan_record_illumination", hd__api_vulkan_record_illumination(ctx, command_buffer, channel, target));
+}
 /* hd_opencl_set_depth_buffer: the checks that need no device, the backend's copy, then the depth
    is the backend's. */
 static hd_result hd__api_cl_depth(hd__ctx *ctx, void *buffer, size_t offset)

@@ -253,6 +253,14 @@ static hd_result hd__be_record_output(const hd__view *vw, const hd_vulkan_target
    checked the pointers, one of image and buffer, the buffer's range and the camera, and sets
    vw->depth_device after. Runs in a bracket after the core's preparation. */
 static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth);
+/* HD__BE_RECORD: records into the caller's command buffer `cb` the copy of channel `channel` of
+   E + phi (the projection's summed light, made first on the backend's own queue when stale) into
+   the caller's 3D image or buffer (hybriddiff.h's hd_vulkan_volume_target), with its barriers,
+   after checking what the core has not (the image's format: HD_ERROR_OUTPUT_FORMAT, its layouts:
+   HD_ERROR_INVALID_ENUM; each with one log line, nothing recorded). The core has checked the
+   method (HD, CD), the pointers, one of image and buffer, the channel, the image's extent and the
+   buffer's range. Runs in a bracket after the core's preparation. */
+static hd_result hd__be_record_illumination(const hd__view *vw, void *cb, int channel, const hd_vulkan_volume_target *target);
 /* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line:
    HD_ERROR_INVALID_TEXTURE not a 2D texture, HD_ERROR_OUTPUT_FORMAT its internal format,
    HD_ERROR_OUTPUT_OUTSIDE_TARGET the region past its size; exact: hd_gl_render_to_texture's
@@ -304,6 +312,12 @@ static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t
     static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulkan_depth *depth)    \
     {                                                                                                   \
         (void)cb; (void)depth;                                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static hd_result hd__be_record_illumination(const hd__view *vw, void *cb, int channel,              \
+                                                const hd_vulkan_volume_target *target)                  \
+    {                                                                                                   \
+        (void)cb; (void)channel; (void)target;                                                          \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
     }
 #define HD__BE_NO_CL_BUFFER(NAME)                                                                       \

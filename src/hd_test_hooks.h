@@ -87,12 +87,17 @@ HD__MAYBE_UNUSED static hd_result hd__test_residual(hd_context h, double *out)
 }
 #endif
 
+/* Set: hd__test_project's frames write no depth plane (kp.region.z = 0, as a block without one),
+   so a benchmark sees what writing it costs (bench/hdbench_depth.c). */
+HD__MAYBE_UNUSED static int hd__test_no_depth_plane;
+
 /* n projection frames of the current E and phi into the image. */
 static hd_result hd__test_project_once(hd__ctx *ctx)
 {
     hd_result r;
     ctx->frames++;
     hd__fill_kparams(ctx);
+    if (hd__test_no_depth_plane) ctx->vw.kp.region.z = 0;
     if ((r = hd__be_project(&ctx->vw)) == HD_SUCCESS) ctx->image_empty = 0; /* the image holds a frame */
     return r;
 }

@@ -761,8 +761,8 @@ static void test_depth_out_slab(void)
 /* ---- the light out ------------------------------------------------------------------------------ */
 /* HD_ILLUMINATION_TOTAL is E + phi of the other two read-backs, bit for bit, for one channel and
    three (lights of different colours); the GL-only calls (hd_gl_illumination_texture,
-   hd_gl_set_depth_texture) are HD_ERROR_UNSUPPORTED here with one logged line, the path tracers'
-   read HD_ERROR_UNSUPPORTED. */
+   hd_gl_set_depth_texture) and the Vulkan-only hd_vulkan_record_illumination are
+   HD_ERROR_UNSUPPORTED here with one logged line, the path tracers' read HD_ERROR_UNSUPPORTED. */
 static void test_light_out(void)
 {
     hd_desc d = scene_desc(vox_blob, tf_blob, 3);
@@ -791,6 +791,13 @@ static void test_light_out(void)
         CHECK(hd_gl_illumination_texture(ctx, 1u, 0) == HD_ERROR_UNSUPPORTED && log.errors == 1);
         log.errors = 0;
         CHECK(hd_gl_set_depth_texture(ctx, 1u) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        {
+            hd_vulkan_volume_target vt = HD_VULKAN_VOLUME_TARGET_INIT;
+            vt.buffer = 1u;
+            vt.buffer_size = (uint64_t)n * sizeof(float);
+            log.errors = 0;
+            CHECK(hd_vulkan_record_illumination(ctx, &vt, 0, &vt) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+        }
         free(t); free(e); free(p);
         hd_destroy(ctx);
     }

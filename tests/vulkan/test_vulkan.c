@@ -1250,6 +1250,216 @@ static void test_record_depth(void)
            ok && same && differs && messages == 0 ? "PASS" : "FAIL", same ? "bit for bit" : "NOT", differs ? "" : " (no effect!)", messages);
 }
 
+/* 13: hd_vulkan_record_illumination: E + phi of each channel (one light: 1; two of different
+   colours: 3) into the caller's VkBuffer (at an offset) and into a 3D R32_SFLOAT image one texel
+   larger each way, cleared to a pattern by the caller in the same command buffer: bit for bit
+   hd_read_illumination's HD_ILLUMINATION_TOTAL, the texels beyond the grid kept; after
+   hd_refine (the summed light stale) it follows the light; recorded before hd_vulkan_record_render
+   in one command buffer it holds the light at the call, the frame's iteration after it. Refusals
+   (NULL command buffer or target, an image and a buffer, neither, a channel past the grid's, a
+   negative one, R16_SFLOAT, layout PRESENT_SRC, final layout UNDEFINED, an image smaller than the
+   grid, an odd offset, a buffer too small, method PT_SS) each its own hd_result and one logged
+   error, nothing recorded (the image keeps its pattern). No validation message. */
+static int light_equal(const float *a, const float *b, size_t n)
+{
+    return memcmp(a, b, n * sizeof(float)) == 0;
+}
+/* The 3D image (gx+1) x (gy+1) x (gz+1) cleared to -7 (the caller's commands, TRANSFER_DST). */
+static int vk_image3d(hd__backend *be, VkFormat fmt, int w, int h, int dd, vk_obj *o)
+{
+    VkImageCreateInfo ici;
+    VkMemoryRequirements req;
+    memset(o, 0, sizeof *o);
+    memset(&ici, 0, sizeof ici);
+    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
+    ici.imageType = VK_IMAGE_TYPE_3D;
+    ici.format = fmt;
+    ici.extent.width = (uint32_t)w;
+    ici.extent.height = (uint32_t)h;
+    ici.extent.depth = (uint32_t)dd;
+    ici.mipLevels = 1;
+    ici.arrayLayers = 1;
+    ici.samples = VK_SAMPLE_COUNT_1_BIT;
+    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
+    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    if (be->fn.vkCreateImage(be->device, &ici, NULL, &o->image) != VK_SUCCESS) return 0;
+    be->fn.vkGetImageMemoryRequirements(be->device, o->image, &req);
+    return vk_memory(be, &req, 0, o) && be->fn.vkBindImageMemory(be->device, o->image, o->memory, 0) == VK_SUCCESS;
+}
+static void cmd_clear3d(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from)
+{
+    VkImageMemoryBarrier ib;
+    VkClearColorValue c;
+    VkImageSubresourceRange range;
+    memset(&ib, 0, sizeof ib);
+    ib.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+    ib.srcAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    ib.oldLayout = from;
+    ib.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    ib.srcQueueFamilyIndex = ib.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    ib.image = im;
+    ib.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    ib.subresourceRange.levelCount = 1;
+    ib.subresourceRange.layerCount = 1;
+    range = ib.subresourceRange;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, NULL, 0, NULL, 1, &ib);
+    memset(&c, 0, sizeof c);
+    c.float32[0] = -7.0f;
+    be->fn.vkCmdClearColorImage(cb, im, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c, 1, &range);
+}
+/* The 3D image (in TRANSFER_SRC_OPTIMAL) into host buffer `host`. */
+static void cmd_read3d(hd__backend *be, VkCommandBuffer cb, VkImage im, VkBuffer host, int w, int h, int dd)
+{
+    VkBufferImageCopy reg;
+    VkMemoryBarrier mb;
+    memset(&mb, 0, sizeof mb);
+    mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+    mb.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+    mb.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+    be->fn.vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+    memset(&reg, 0, sizeof reg);
+    reg.imageSubresource.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
+    reg.imageSubresource.layerCount = 1;
+    reg.imageExtent.width = (uint32_t)w;
+    reg.imageExtent.height = (uint32_t)h;
+    reg.imageExtent.depth = (uint32_t)dd;
+    be->fn.vkCmdCopyImageToBuffer(cb, im, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, host, 1, &reg);
+}
+static void test_record_illumination(void)
+{
+    int rgb, ok = 1, refusals_ok = 1, kept_ok = 1, follows = 0, at_call = 1, channels_seen = 0;
+    hd_light l[2];
+    messages = 0;
+    memset(l, 0, sizeof l);
+    l[0].direction[1] = -1.0f; l[0].color[0] = 1.0f; l[0].color[1] = 0.5f; l[0].color[2] = 0.2f;
+    l[1].direction[0] = 1.0f; l[1].color[0] = 0.2f; l[1].color[1] = 0.6f; l[1].color[2] = 1.0f;
+    for (rgb = 0; rgb < 2 && ok; ++rgb) {
+        hd_desc d = test_desc();
+        hd_context h;
+        hd__backend *be;
+        hd_stats st;
+        vk_obj buf, im, host;
+        float *tot, *prev;
+        size_t g, n, i;
+        int gx, gy, gz, ch, k, pass;
+        VkDeviceSize bytes, ibytes;
+        d.lights = l;
+        d.light_count = rgb ? 2 : 1;
+        d.vulkan.enable_validation = have_layer;
+        if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
+        be = hd__lookup(h)->vw.be;
+        CHECK(hd_iterate(h, 2) == HD_SUCCESS && hd_get_stats(h, &st) == HD_SUCCESS);
+        gx = st.illumination_dims[0]; gy = st.illumination_dims[1]; gz = st.illumination_dims[2]; ch = st.illumination_channels;
+        CHECK(ch == (rgb ? 3 : 1));
+        g = (size_t)gx * gy * gz;
+        n = g * ch;
+        bytes = g * sizeof(float);
+        ibytes = (VkDeviceSize)(gx + 1) * (gy + 1) * (gz + 1) * sizeof(float);
+        tot = (float *)malloc(n * sizeof(float));
+        prev = (float *)malloc(n * sizeof(float));
+        ok &= tot && prev && vk_buffer(be, 64 + bytes, &buf) && vk_buffer(be, ibytes, &host) &&
+              vk_image3d(be, VK_FORMAT_R32_SFLOAT, gx + 1, gy + 1, gz + 1, &im);
+        for (pass = 0; pass < 3 && ok; ++pass) {
+            if (pass == 1) CHECK(hd_refine(h, 2) == HD_SUCCESS); /* light only: the summed light is stale */
+            ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, tot, n) == HD_SUCCESS;
+            if (pass == 1) follows = !light_equal(tot, prev, n);
+            memcpy(prev, tot, n * sizeof(float));
+            for (k = 0; k < ch && ok; ++k) {
+                vk_cmd c;
+                hd_vulkan_volume_target tb = HD_VULKAN_VOLUME_TARGET_INIT, ti = HD_VULKAN_VOLUME_TARGET_INIT;
+                const float *img = (const float *)host.map;
+                int x, y, z;
+                tb.buffer = (uint64_t)buf.buffer; tb.offset = 64; tb.buffer_size = 64 + bytes;
+                ti.image = (uint64_t)im.image; ti.format = VK_FORMAT_R32_SFLOAT;
+                ti.layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL; ti.final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+                ti.width = gx + 1; ti.height = gy + 1; ti.depth = gz + 1;
+                memset(buf.map, 0xff, (size_t)(64 + bytes));
+                if (!cmd_begin(be, &c)) { ok = 0; break; }
+                cmd_clear3d(be, c.cb, im.image, VK_IMAGE_LAYOUT_UNDEFINED);
+                ok &= hd_vulkan_record_illumination(h, c.cb, k, &tb) == HD_SUCCESS;
+                if (pass == 0 && k == 0) { /* refusals: nothing recorded, one error each */
+                    struct { hd_vulkan_volume_target t; int ch; void *cb; hd_result want; } cs[12];
+                    unsigned long e0;
+                    int j, nc = 0;
+                    hd_result r;
+                    for (j = 0; j < 12; ++j) { cs[j].t = ti; cs[j].ch = 0; cs[j].cb = c.cb; }
+                    cs[nc].cb = NULL; cs[nc++].want = HD_ERROR_NULL_POINTER;
+                    cs[nc].t.buffer = (uint64_t)buf.buffer; cs[nc++].want = HD_ERROR_INVALID_PARAMETER;
+                    cs[nc].t.image = 0; cs[nc++].want = HD_ERROR_INVALID_PARAMETER;
+                    cs[nc].ch = ch; cs[nc++].want = HD_ERROR_INVALID_PARAMETER;
+                    cs[nc].ch = -1; cs[nc++].want = HD_ERROR_INVALID_PARAMETER;
+                    cs[nc].t.format = VK_FORMAT_R16_SFLOAT; cs[nc++].want = HD_ERROR_OUTPUT_FORMAT;
+                    cs[nc].t.layout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR; cs[nc++].want = HD_ERROR_INVALID_ENUM;
+                    cs[nc].t.layout = VK_IMAGE_LAYOUT_UNDEFINED; cs[nc].t.final_layout = 0; cs[nc++].want = HD_ERROR_INVALID_ENUM;
+                    cs[nc].t.depth = gz - 1; cs[nc++].want = HD_ERROR_OUTPUT_OUTSIDE_TARGET;
+                    cs[nc].t = tb; cs[nc].t.offset = 66; cs[nc++].want = HD_ERROR_INVALID_PARAMETER;
+                    cs[nc].t = tb; cs[nc].t.buffer_size = 60 + bytes; cs[nc++].want = HD_ERROR_BUFFER_TOO_SMALL;
+                    for (j = 0; j < nc; ++j) {
+                        e0 = err_count;
+                        r = hd_vulkan_record_illumination(h, cs[j].cb, cs[j].ch, &cs[j].t);
+                        if (r != cs[j].want || err_count != e0 + 1) {
+                            refusals_ok = 0;
+                            fprintf(stderr, "  refusal %d: %s, %lu errors\n", j, hd_result_string(r), err_count - e0);
+                        }
+                    }
+                    e0 = err_count;
+                    r = hd_vulkan_record_illumination(h, c.cb, 0, NULL);
+                    refusals_ok &= r == HD_ERROR_NULL_POINTER && err_count == e0 + 1;
+                }
+                ok &= hd_vulkan_record_illumination(h, c.cb, k, &ti) == HD_SUCCESS;
+                cmd_read3d(be, c.cb, im.image, host.buffer, gx + 1, gy + 1, gz + 1);
+                if (pass == 2) ok &= hd_vulkan_record_render(h, c.cb, NULL, NULL) == HD_SUCCESS; /* after the copies */
+                ok &= cmd_submit(be, &c, 1);
+                if (!ok) break;
+                if (!light_equal((const float *)((const char *)buf.map + 64), tot + (size_t)k * g, g)) {
+                    ok = 0;
+                    fprintf(stderr, "  pass %d channel %d: the buffer is not E + phi\n", pass, k);
+                }
+                for (z = 0; z <= gz; ++z)
+                    for (y = 0; y <= gy; ++y)
+                        for (x = 0; x <= gx; ++x) {
+                            float v = img[((size_t)z * (gy + 1) + y) * (gx + 1) + x];
+                            if (x < gx && y < gy && z < gz) {
+                                if (memcmp(&v, &tot[k * g + ((size_t)z * gy + y) * gx + x], sizeof v) != 0) ok = 0;
+                            } else if (v != -7.0f) kept_ok = 0;
+                        }
+                if (!ok) fprintf(stderr, "  pass %d channel %d: the image is not E + phi\n", pass, k);
+                if (pass == 2) { /* the frame's light iteration ran after the copy */
+                    ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, prev, n) == HD_SUCCESS;
+                    at_call &= !light_equal(prev, tot, n);
+                    memcpy(tot, prev, n * sizeof(float));
+                }
+                channels_seen += pass == 0;
+            }
+            for (i = 0, k = 0; i < g; ++i) k += tot[i] > 0.0f;
+            CHECK((size_t)k > g / 20);
+        }
+        vk_free(be, &buf); vk_free(be, &im); vk_free(be, &host);
+        free(tot); free(prev);
+        CHECK(hd_destroy(h) == HD_SUCCESS);
+    }
+    { /* the path tracers keep no light volume */
+        hd_desc d = test_desc();
+        hd_context h;
+        hd_vulkan_volume_target t = HD_VULKAN_VOLUME_TARGET_INIT;
+        unsigned long e0;
+        d.params.method = HD_METHOD_PT_SS;
+        t.buffer = 1; t.buffer_size = 1u << 30;
+        CHECK(hd_create(&d, &h) == HD_SUCCESS);
+        e0 = err_count;
+        refusals_ok &= hd_vulkan_record_illumination(h, (void *)&t, 0, &t) == HD_ERROR_UNSUPPORTED && err_count == e0 + 1;
+        CHECK(hd_destroy(h) == HD_SUCCESS);
+    }
+    CHECK(ok && refusals_ok && kept_ok && follows && at_call && channels_seen == 4 && messages == 0);
+    printf("%s light into the caller's VkBuffer and 3D R32_SFLOAT image (1 and 3 channels): %s hd_read_illumination's E + phi, "
+           "texels beyond the grid %s, %s the light after hd_refine, %s before the frame's iteration; refusals %s; %lu validation messages\n",
+           ok && refusals_ok && kept_ok && follows && at_call && channels_seen == 4 && messages == 0 ? "PASS" : "FAIL",
+           ok ? "bit for bit" : "NOT", kept_ok ? "kept" : "WRITTEN", follows ? "follows" : "does NOT follow",
+           at_call ? "the light at the call" : "NOT the light at the call", refusals_ok ? "one error each" : "WRONG", messages);
+}
+
 /* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
    contiguous run of the dispatch's blocks, as a thread pool of T threads splits them, draws about
    a quarter of its blocks from each quarter of the image (blocks in order would give one run the
@@ -1461,6 +1671,7 @@ int main(void)
             test_record_depth();
             test_volume_limit();
             test_record_solver_auto();
+            test_record_illumination();
         }
     }
     if (failures) printf("FAILED\n");
