@@ -130,6 +130,7 @@
 #undef HD__DIRTY_VOLUME
 #undef HD__DIRTY_WARM_E
 #undef HD__DIRTY_WARM_PHI
+#undef HD__DL_ALPHA_RATIO
 #undef HD__DL_BRICK
 #undef HD__DL_COORD_EPS
 #undef HD__DL_VALUE_EPS
