@@ -10,6 +10,7 @@
 #define HD_STAGE_SUM_LIGHT 6
 #define HD_STAGE_PATH 7
 #define HD_STAGE_LIGHT_SUM 8
+#define HD_STAGE_UPSAMPLE 9 /* a reduced frame's upsample pass alone: the projection's pipeline is far dearer per pixel on lavapipe */
 #ifndef HD_DIFFUSE_ZK
 #define HD_DIFFUSE_ZK 1 /* slices per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
 #endif
@@ -154,6 +155,8 @@ void main()
         if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hdk_upsample_pixel(x, y);
         else hdk_project_pixel(x, y);
     }
+#elif HD_STAGE == HD_STAGE_UPSAMPLE
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hdk_upsample_pixel(x, y);
 #elif HD_STAGE == HD_STAGE_CONVECT
     if (x < g.x && y < g.y && z < g.z) hdk_convect_voxel(x, y, z, hd_pc.z);
 #elif HD_STAGE == HD_STAGE_SUM_LIGHT
