@@ -10,6 +10,7 @@
 #define HD_STAGE_SUM_LIGHT 6
 #define HD_STAGE_PATH 7
 #define HD_STAGE_LIGHT_SUM 8
+#define HD_STAGE_UPSAMPLE 9 /* a reduced frame's upsample pass alone: the projection's pipeline is far dearer per pixel on lavapipe */
 #ifndef HD_DIFFUSE_ZK
 #define HD_DIFFUSE_ZK 1 /* slices per invocation of the diffusion stage (Vulkan: hd_bind_vk_glsl.h) */
 #endif
@@ -142,18 +143,17 @@ void main()
 #elif HD_STAGE == HD_STAGE_DIFFUSE
     hdk_diffuse_block(x, y, z);
 #elif HD_STAGE == HD_STAGE_PROJECT
-    /* with HD_FLAG_UPSAMPLE: a reduced frame's upsample pass (hd_k_upsample.h). hd_pc.y > 1: the
-       dispatch's rows in blocks of hd_pc.z, block b drawing the image's block b * hd_pc.y mod
-       blocks (backends/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run of work groups
-       covers the whole image */
+    /* hd_pc.y > 1: the dispatch's rows in blocks of hd_pc.z, block b drawing the image's block
+       b * hd_pc.y mod blocks (backends/hd_gpu.h, hd__gpu_row_stride), so that each contiguous run
+       of work groups covers the whole image (a reduced frame's upsample pass is
+       HD_STAGE_UPSAMPLE's) */
     if (hd_pc.y > 1) {
         int rb = hd_pc.z, nb = (HD_PRM(image).y + rb - 1) / rb;
         y = int(uint(y / rb) * uint(hd_pc.y) % uint(nb)) * rb + y % rb;
     }
-    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
-        if ((HD_PRM(counts).z & HD_FLAG_UPSAMPLE) != 0) hdk_upsample_pixel(x, y);
-        else hdk_project_pixel(x, y);
-    }
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hdk_project_pixel(x, y);
+#elif HD_STAGE == HD_STAGE_UPSAMPLE
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hdk_upsample_pixel(x, y);
 #elif HD_STAGE == HD_STAGE_CONVECT
     if (x < g.x && y < g.y && z < g.z) hdk_convect_voxel(x, y, z, hd_pc.z);
 #elif HD_STAGE == HD_STAGE_SUM_LIGHT

@@ -95,9 +95,9 @@ typedef struct hd__gl_fns {
 } hd__gl_fns;
 
 enum { HD__GL_CLASSIFY, HD__GL_DIRECT, HD__GL_DIFFUSE, HD__GL_PROJECT, HD__GL_CONVECT, HD__GL_SUM_LIGHT,
-       HD__GL_PATH, HD__GL_LIGHT_SUM, HD__GL_OUTPUT, HD__GL_PROGRAM_COUNT };
+       HD__GL_PATH, HD__GL_LIGHT_SUM, HD__GL_UPSAMPLE, HD__GL_OUTPUT, HD__GL_PROGRAM_COUNT };
 static const char *const hd__gl_stage_names[HD__GL_PROGRAM_COUNT] = {
-    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "light_sum", "output"};
+    "classify", "direct", "diffuse", "project", "convect", "sum_light", "path", "light_sum", "upsample", "output"};
 /* The diffusion program is compiled once per combination of the flags it tests (RGB scattering,
    surface boundary), each with `#define HD_DIFFUSE_FLAGS n`: llvmpipe, like lavapipe, runs both
    sides of a branch on a uniform, so a flag read at run time costs the untaken path's image loads
@@ -1052,8 +1052,11 @@ static hd_result hd__be_project(const hd__view *vw)
                            vw->be->ptab_n, p, HD__GPU_ROW_BLOCK, 0);
 }
 
-/* The projection's program runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_glsl.h). */
-static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+/* The upsample pass: its own small program (HD_STAGE_UPSAMPLE), one invocation per pixel. */
+static hd_result hd__be_upsample(const hd__view *vw)
+{
+    return hd__gl_dispatch(vw, HD__GL_UPSAMPLE, 0, vw->kp.image.x, vw->kp.image.y, 1, 0, 0, 0, 0);
+}
 
 /* ---- read-back ------------------------------------------------------------------------------- */
 static hd_result hd__be_read_image(const hd__view *vw, float *dst)

@@ -101,7 +101,7 @@ typedef struct hd__vk_fns {
 } hd__vk_fns;
 
 enum { HD__VK_CLASSIFY, HD__VK_DIRECT, HD__VK_DIFFUSE, HD__VK_PROJECT, HD__VK_CONVECT, HD__VK_SUM_LIGHT,
-       HD__VK_PATH, HD__VK_LIGHT_SUM, HD__VK_PIPELINE_COUNT };
+       HD__VK_PATH, HD__VK_LIGHT_SUM, HD__VK_UPSAMPLE, HD__VK_PIPELINE_COUNT };
 #define HD__VK_LOCAL_X 64u /* hd_entry_glsl.h's work group: 64 x 1 x 1 */
 #define HD__VK_DIFFUSE_VARIANTS 160 /* diffusion pipelines per context, one per flags value, solver and precision
                                      (128 + multigrid's 16 flag words with HD_FLAG_DIFFUSE_RHS, red-black, float32) */
@@ -1003,14 +1003,14 @@ static hd_result hd__vk_pipeline(const hd__view *vw, int p, int32_t flags, int32
 {
     static const uint32_t *const code[2][HD__VK_PIPELINE_COUNT] = {
         {hd__spv_classify, hd__spv_direct, hd__spv_diffuse, hd__spv_project, hd__spv_convect, hd__spv_sum_light, hd__spv_path,
-         hd__spv_light_sum},
+         hd__spv_light_sum, hd__spv_upsample},
         {NULL, hd__spv_direct_half, hd__spv_diffuse_half, hd__spv_project_half, NULL, hd__spv_sum_light_half, NULL,
-         hd__spv_light_sum_half}};
+         hd__spv_light_sum_half, NULL}};
     static const size_t size[2][HD__VK_PIPELINE_COUNT] = {
         {sizeof hd__spv_classify, sizeof hd__spv_direct, sizeof hd__spv_diffuse, sizeof hd__spv_project,
-         sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path, sizeof hd__spv_light_sum},
+         sizeof hd__spv_convect, sizeof hd__spv_sum_light, sizeof hd__spv_path, sizeof hd__spv_light_sum, sizeof hd__spv_upsample},
         {0, sizeof hd__spv_direct_half, sizeof hd__spv_diffuse_half, sizeof hd__spv_project_half, 0, sizeof hd__spv_sum_light_half, 0,
-         sizeof hd__spv_light_sum_half}};
+         sizeof hd__spv_light_sum_half, 0}};
     half = half && code[1][p] != NULL;
     return hd__vk_pipeline_code(vw, code[half][p], size[half][p], p == HD__VK_DIFFUSE ? &flags : NULL, jacobi, out);
 }
@@ -1875,8 +1875,16 @@ static hd_result hd__be_project(const hd__view *vw)
     return hd__vk_flush(vw);
 }
 
-/* The projection's pipeline runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_glsl.h). */
-static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+/* The upsample pass: its own small pipeline (HD_STAGE_UPSAMPLE), one invocation per pixel. */
+static hd_result hd__be_upsample(const hd__view *vw)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r;
+    if ((r = hd__vk_dispatch(vw, cb, vw->be->pipelines[HD__VK_UPSAMPLE], 0, vw->kp.image.x, vw->kp.image.y, 1, 0, 0, 0, 0)) != HD_SUCCESS)
+        return r;
+    return hd__vk_flush(vw);
+}
 
 /* ---- read-back ------------------------------------------------------------------------------- */
 /* Floats [first, first + n) of the image buffer into dst. */

@@ -517,7 +517,9 @@ static hd_result hd__api_render(hd__ctx *ctx)
 {
     hd_result r;
     ctx->call_t0 = hd__now();
+    ctx->part.planned = 0;
     HD__BE_CALL(r, ctx, hd__render(ctx));
+    hd__budget_late(ctx, ctx->call_t0, hd__now());
     return r;
 }
 HDDEF hd_result hd_render(hd_context h)

@@ -75,6 +75,9 @@ typedef struct hd__part {
     double s_entry;      /* seconds per direct unit, smoothed; 0: none measured yet */
     double s_sweep;      /* seconds per sweep */
     double s_measure;    /* seconds of the convergence estimate */
+    double late;         /* how much later than planned a budgeted call with light work ended,
+                            smoothed (src/hd_schedule.h, hd__budget_late): the next plans less */
+    int planned;         /* the current call planned its light work against the budget */
 } hd__part;
 
 /* The direct light's voxels besides what the backend reads (vw.dl_idx, src/hd_direct_mask.h). */

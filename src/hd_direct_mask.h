@@ -33,6 +33,38 @@ static int32_t hd__dl_run_range(const int32_t *entry_run, int n, float t0, float
     return entry_run[i0]; /* consecutive zero entries share their run */
 }
 
+/* 1 when no value within HD__DL_VALUE_EPS of [t0, t1] lies in a zero-alpha run: a value's
+   entries (hd__dl_run_range) are at least two, from its first on, and the first entries of the
+   range's values lie between those of t0 and t1, so no pair of zero-alpha entries starting there
+   (pairs: src/hd_direct_mask.h, hd__direct_mask_box) leaves each value an entry with alpha > 0. */
+static int hd__dl_live_range(const int32_t *pairs, int n, float t0, float t1)
+{
+    float lo = t0 - HD__DL_VALUE_EPS, hi = t1 - HD__DL_VALUE_EPS, n1 = (float)(n - 1);
+    int i0, i1;
+    lo = lo < 0.0f ? 0.0f : lo;
+    hi = hi < 0.0f ? 0.0f : hi;
+    lo = lo > 1.0f ? 1.0f : lo;
+    hi = hi > 1.0f ? 1.0f : hi;
+    i0 = (int)(lo * n1);
+    i1 = (int)(hi * n1);
+    if (i0 > n - 2) i0 = n - 2;
+    if (i1 > n - 2) i1 = n - 2;
+    return pairs[i1 + 1] - pairs[i0] == 0;
+}
+
+/* 1 when hd__tf_alpha(v) * extinction > 0 for every v in [t0, t1]: hd__tf_alpha interpolates
+   entries i and i + 1, i = min(floor(v (n - 1)), n - 2), monotone in v, and no pair it can
+   interpolate is weak (weak: hd__direct_mask_box). A pair is strong when its smaller alpha is at
+   least HD__DL_ALPHA_RATIO of the larger (the interpolation's rounding, a few units in the last
+   place of the larger, cannot bring it to 0) and times the extinction is far from underflow. */
+#define HD__DL_ALPHA_RATIO (1.0f / 65536.0f)
+static int hd__dl_solid_range(const int32_t *weak, int n, float t0, float t1)
+{
+    float n1 = (float)(n - 1), lo = t0 < 0.0f ? 0.0f : (t0 > 1.0f ? 1.0f : t0), hi = t1 < 0.0f ? 0.0f : (t1 > 1.0f ? 1.0f : t1);
+    int i0 = (int)(lo * n1) < n - 2 ? (int)(lo * n1) : n - 2, i1 = (int)(hi * n1) < n - 2 ? (int)(hi * n1) : n - 2;
+    return weak[i1 + 1] - weak[i0] == 0;
+}
+
 /* The same for one value. */
 static int32_t hd__dl_run(const int32_t *entry_run, int n, float t)
 {
@@ -102,8 +134,8 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
     const int *n = ctx->vw.dims, *g = ctx->vw.gdims, M = HD__MAJORANT_CELL;
     int dn[3], G0[3], G1[3], Gn[3], D0[3], D1[3], Dn[3], d, x, y, z, j, full = !vox || !ctx->dl.bits, any = 0;
     size_t gvox = (size_t)g[0] * g[1] * g[2], k;
-    int32_t *entry_run = NULL;
-    uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL;
+    int32_t *entry_run = NULL, *pairs = NULL, *weak = NULL, *ps = NULL;
+    uint8_t *cell = NULL, *ax = NULL, *ay = NULL, *crop = NULL, *line = NULL;
     int (*span)[2] = NULL;
     hd_result r = HD_SUCCESS;
     if (changed) *changed = 0;
@@ -115,8 +147,10 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
     }
     span = (int (*)[2])hd__alloc(&ctx->vw, (size_t)(g[0] + g[1] + g[2]) * sizeof *span);
     entry_run = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
+    pairs = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
+    weak = (int32_t *)hd__alloc(&ctx->vw, (size_t)ctx->vw.tf_count * sizeof(int32_t));
     crop = (uint8_t *)hd__alloc(&ctx->vw, (size_t)(dn[0] + dn[1] + dn[2]));
-    if (!ctx->dl.bits || !span || !entry_run || !crop) goto oom;
+    if (!ctx->dl.bits || !span || !entry_run || !pairs || !weak || !crop) goto oom;
     for (d = 0, k = 0; d < 3; ++d)
         for (x = 0; x < g[d]; ++x, ++k) hd__dl_axis(x, g[d], n[d], &span[k][0], &span[k][1]);
     /* the grid voxels to redo, G0..G1 per axis (the spans are monotone in x: a range), and the
@@ -143,12 +177,23 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
     cell = (uint8_t *)hd__calloc(&ctx->vw, (size_t)Dn[0] * Dn[1] * Dn[2], 1);
     ax = (uint8_t *)hd__alloc(&ctx->vw, (size_t)Gn[0] * Dn[1] * Dn[2]);
     ay = (uint8_t *)hd__alloc(&ctx->vw, (size_t)Gn[0] * Gn[1] * Dn[2]);
-    if (!cell || !ax || !ay) goto oom;
+    ps = (int32_t *)hd__alloc(&ctx->vw, ((size_t)Dn[0] + 1) * sizeof(int32_t));
+    line = (uint8_t *)hd__alloc(&ctx->vw, (size_t)Gn[0]);
+    if (!cell || !ax || !ay || !ps || !line) goto oom;
     /* runs of zero-alpha entries; with no extinction nothing is medium */
     for (j = 0, k = 0; j < ctx->vw.tf_count; ++j) {
         int zero = !(ctx->vw.tf[4 * j + 3] > 0.0f) || !(ctx->vw.params.extinction > 0.0f);
         if (zero && (j == 0 || entry_run[j - 1] == 0)) ++k;
         entry_run[j] = zero ? (int32_t)k : 0;
+    }
+    /* pairs[j]: how many of the entries i < j start a pair of zero-alpha entries (i, i + 1) */
+    for (j = 0, pairs[0] = 0; j + 1 < ctx->vw.tf_count; ++j) pairs[j + 1] = pairs[j] + (entry_run[j] != 0 && entry_run[j + 1] != 0);
+    /* weak[j]: how many of the entries i < j start a pair (i, i + 1) whose interpolation may not
+       keep alpha * extinction > 0 (hd__dl_solid_range) */
+    for (j = 0, weak[0] = 0; j + 1 < ctx->vw.tf_count; ++j) {
+        float a0 = ctx->vw.tf[4 * j + 3], a1 = ctx->vw.tf[4 * j + 7], lo = a0 < a1 ? a0 : a1, hi = a0 < a1 ? a1 : a0;
+        int strong = lo >= hi * HD__DL_ALPHA_RATIO && (double)lo * (double)ctx->vw.params.extinction >= 1e-30;
+        weak[j + 1] = weak[j] + !strong;
     }
     /* dual cells per axis that meet the crop box: cell j holds the samples at u n - 0.5 in
        [j, j + 1], the first and last also those the clamp folds onto them */
@@ -159,7 +204,10 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
     /* a dual cell is empty when its 8 voxels share one zero run. Dual cells are taken per
        majorant cell (those whose lower corner it holds): the cell's value range, filter halo
        included, covers their 8 voxels, so when it lies in one zero run they are all empty and no
-       voxel's run is needed; elsewhere the runs of the cell's block of voxels are computed once */
+       voxel's run is needed; when no value of the range can lie in a zero run (hd__dl_live_range)
+       only 8 equal values of alpha 0 empty one, and when besides every value's alpha is > 0
+       (hd__dl_solid_range) only the crop box does; elsewhere the runs of the cell's block of
+       voxels are computed once */
     {
         int cx, cy, cz;
         for (cz = D0[2] / M; cz <= D1[2] / M; ++cz)
@@ -167,9 +215,12 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                 for (cx = D0[0] / M; cx <= D1[0] / M; ++cx) {
                     enum { B = HD__MAJORANT_CELL + 1 };
                     int32_t blk[B * B * B];
-                    int c[3], lo[3], hi[3], bx, by, bz;
+                    int c[3], lo[3], hi[3], bx, by, bz, kind;
                     size_t i = ((size_t)cz * ctx->vw.mdims[1] + cy) * ctx->vw.mdims[0] + cx;
-                    if (hd__dl_run_range(entry_run, ctx->vw.tf_count, ctx->cell_range[2 * i], ctx->cell_range[2 * i + 1]) != 0) continue;
+                    float vlo = ctx->cell_range[2 * i], vhi = ctx->cell_range[2 * i + 1];
+                    if (hd__dl_run_range(entry_run, ctx->vw.tf_count, vlo, vhi) != 0) continue;
+                    /* 0: the voxels' runs are needed; 1: every run is 0; 2: every alpha is > 0 too */
+                    kind = !hd__dl_live_range(pairs, ctx->vw.tf_count, vlo, vhi) ? 0 : hd__dl_solid_range(weak, ctx->vw.tf_count, vlo, vhi) ? 2 : 1;
                     c[0] = cx; c[1] = cy; c[2] = cz;
                     for (d = 0; d < 3; ++d) {
                         lo[d] = c[d] * M;                              /* first dual cell and voxel */
@@ -178,67 +229,84 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                         if (hi[d] > D1[d] + 1) hi[d] = D1[d] + 1;
                     }
                     if (lo[0] >= hi[0] || lo[1] >= hi[1] || lo[2] >= hi[2]) continue;
+                    if (kind == 2) {
+                        for (z = lo[2]; z < hi[2]; ++z)
+                            for (y = lo[1]; y < hi[1]; ++y) {
+                                uint8_t *row = cell + ((size_t)(z - D0[2]) * Dn[1] + (y - D0[1])) * Dn[0] - D0[0];
+                                uint8_t yz = (uint8_t)(crop[dn[0] + y] && crop[dn[0] + dn[1] + z]);
+                                for (x = lo[0]; x < hi[0]; ++x) row[x] = (uint8_t)(yz && crop[x]);
+                            }
+                        continue;
+                    }
                     /* runs of voxels lo .. min(hi, n - 1) */
                     bx = (hi[0] < n[0] - 1 ? hi[0] : n[0] - 1) - lo[0] + 1;
                     by = (hi[1] < n[1] - 1 ? hi[1] : n[1] - 1) - lo[1] + 1;
                     bz = (hi[2] < n[2] - 1 ? hi[2] : n[2] - 1) - lo[2] + 1;
-                    for (z = 0; z < bz; ++z)
-                        for (y = 0; y < by; ++y)
-                            for (x = 0; x < bx; ++x)
-                                blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
-                                                                      hd__vol_value(&ctx->vw, ((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x));
+                    if (kind == 0)
+                        for (z = 0; z < bz; ++z)
+                            for (y = 0; y < by; ++y)
+                                for (x = 0; x < bx; ++x)
+                                    blk[(z * B + y) * B + x] = hd__dl_run(entry_run, ctx->vw.tf_count,
+                                                                          hd__vol_value(&ctx->vw, ((size_t)(lo[2] + z) * n[1] + lo[1] + y) * n[0] + lo[0] + x));
                     for (z = lo[2]; z < hi[2]; ++z)
                         for (y = lo[1]; y < hi[1]; ++y)
                             for (x = lo[0]; x < hi[0]; ++x) {
                                 int x1 = x + 1 < n[0] ? x + 1 : x, y1 = y + 1 < n[1] ? y + 1 : y, z1 = z + 1 < n[2] ? z + 1 : z;
                                 size_t r00 = ((size_t)z * n[1] + y) * n[0], r10 = ((size_t)z * n[1] + y1) * n[0];
                                 size_t r01 = ((size_t)z1 * n[1] + y) * n[0], r11 = ((size_t)z1 * n[1] + y1) * n[0];
-                                /* the block's rows of the 4 voxel rows, at x and x1 */
-                                const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
-                                const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
-                                const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
-                                const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
-                                int xa = x - lo[0], xb = x1 - lo[0];
-                                int32_t a = b0[xa];
-                                float v = hd__vol_value(&ctx->vw, r00 + x);
-                                uint8_t full_cell = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
-                                                      b3[xa] == a && b3[xb] == a);
+                                float v;
+                                uint8_t full_cell = 1;
+                                if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full_cell = 0;
+                                if (full_cell && kind == 0) {
+                                    /* the block's rows of the 4 voxel rows, at x and x1 */
+                                    const int32_t *b0 = blk + ((z - lo[2]) * B + (y - lo[1])) * B;
+                                    const int32_t *b1 = blk + ((z - lo[2]) * B + (y1 - lo[1])) * B;
+                                    const int32_t *b2 = blk + ((z1 - lo[2]) * B + (y - lo[1])) * B;
+                                    const int32_t *b3 = blk + ((z1 - lo[2]) * B + (y1 - lo[1])) * B;
+                                    int xa = x - lo[0], xb = x1 - lo[0];
+                                    int32_t a = b0[xa];
+                                    full_cell = !(a != 0 && b0[xb] == a && b1[xa] == a && b1[xb] == a && b2[xa] == a && b2[xb] == a &&
+                                                  b3[xa] == a && b3[xb] == a);
+                                }
                                 /* 8 equal values interpolate to that value exactly, whatever the weights */
-                                if (full_cell && hd__vol_value(&ctx->vw, r00 + x1) == v && hd__vol_value(&ctx->vw, r10 + x) == v &&
-                                    hd__vol_value(&ctx->vw, r10 + x1) == v && hd__vol_value(&ctx->vw, r01 + x) == v &&
-                                    hd__vol_value(&ctx->vw, r01 + x1) == v && hd__vol_value(&ctx->vw, r11 + x) == v &&
-                                    hd__vol_value(&ctx->vw, r11 + x1) == v &&
+                                if (full_cell && (v = hd__vol_value(&ctx->vw, r00 + x), hd__vol_value(&ctx->vw, r00 + x1) == v) &&
+                                    hd__vol_value(&ctx->vw, r10 + x) == v && hd__vol_value(&ctx->vw, r10 + x1) == v &&
+                                    hd__vol_value(&ctx->vw, r01 + x) == v && hd__vol_value(&ctx->vw, r01 + x1) == v &&
+                                    hd__vol_value(&ctx->vw, r11 + x) == v && hd__vol_value(&ctx->vw, r11 + x1) == v &&
                                     !(hd__tf_alpha(ctx, v) * ctx->vw.params.extinction > 0.0f))
                                     full_cell = 0;
-                                if (!crop[x] || !crop[dn[0] + y] || !crop[dn[0] + dn[1] + z]) full_cell = 0;
                                 cell[((size_t)(z - D0[2]) * Dn[1] + (y - D0[1])) * Dn[0] + (x - D0[0])] = full_cell;
                             }
                 }
     }
-    /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis */
+    /* grid voxels whose reads reach a non-empty cell: the OR over their span, axis by axis (along
+       x from a row's running count of non-empty cells, along y and z row by row) */
     for (z = 0; z < Dn[2]; ++z)
-        for (y = 0; y < Dn[1]; ++y)
-            for (x = 0; x < Gn[0]; ++x) {
-                const uint8_t *c = cell + ((size_t)z * Dn[1] + y) * Dn[0];
-                uint8_t v = 0;
-                for (j = span[G0[0] + x][0]; j <= span[G0[0] + x][1]; ++j) v |= c[j - D0[0]];
-                ax[((size_t)z * Dn[1] + y) * Gn[0] + x] = v;
-            }
+        for (y = 0; y < Dn[1]; ++y) {
+            const uint8_t *c = cell + ((size_t)z * Dn[1] + y) * Dn[0];
+            uint8_t *o = ax + ((size_t)z * Dn[1] + y) * Gn[0];
+            for (j = 0, ps[0] = 0; j < Dn[0]; ++j) ps[j + 1] = ps[j] + c[j];
+            for (x = 0; x < Gn[0]; ++x) o[x] = (uint8_t)(ps[span[G0[0] + x][1] - D0[0] + 1] != ps[span[G0[0] + x][0] - D0[0]]);
+        }
     for (z = 0; z < Dn[2]; ++z)
-        for (y = 0; y < Gn[1]; ++y)
-            for (x = 0; x < Gn[0]; ++x) {
-                uint8_t v = 0;
-                for (j = span[g[0] + G0[1] + y][0]; j <= span[g[0] + G0[1] + y][1]; ++j) v |= ax[((size_t)z * Dn[1] + (j - D0[1])) * Gn[0] + x];
-                ay[((size_t)z * Gn[1] + y) * Gn[0] + x] = v;
+        for (y = 0; y < Gn[1]; ++y) {
+            uint8_t *o = ay + ((size_t)z * Gn[1] + y) * Gn[0];
+            memset(o, 0, (size_t)Gn[0]);
+            for (j = span[g[0] + G0[1] + y][0]; j <= span[g[0] + G0[1] + y][1]; ++j) {
+                const uint8_t *a = ax + ((size_t)z * Dn[1] + (j - D0[1])) * Gn[0];
+                for (x = 0; x < Gn[0]; ++x) o[x] |= a[x];
             }
+        }
     for (z = 0; z < Gn[2]; ++z)
-        for (y = 0; y < Gn[1]; ++y)
-            for (x = 0; x < Gn[0]; ++x) {
-                uint8_t v = 0, was;
-                k = ((size_t)(G0[2] + z) * g[1] + (size_t)(G0[1] + y)) * g[0] + (size_t)(G0[0] + x);
-                for (j = span[g[0] + g[1] + G0[2] + z][0]; j <= span[g[0] + g[1] + G0[2] + z][1]; ++j)
-                    v |= ay[((size_t)(j - D0[2]) * Gn[1] + y) * Gn[0] + x];
-                was = (uint8_t)(ctx->dl.bits[k >> 3] >> (k & 7) & 1u);
+        for (y = 0; y < Gn[1]; ++y) {
+            memset(line, 0, (size_t)Gn[0]);
+            for (j = span[g[0] + g[1] + G0[2] + z][0]; j <= span[g[0] + g[1] + G0[2] + z][1]; ++j) {
+                const uint8_t *a = ay + ((size_t)(j - D0[2]) * Gn[1] + y) * Gn[0];
+                for (x = 0; x < Gn[0]; ++x) line[x] |= a[x];
+            }
+            k = ((size_t)(G0[2] + z) * g[1] + (size_t)(G0[1] + y)) * g[0] + (size_t)G0[0];
+            for (x = 0; x < Gn[0]; ++x, ++k) {
+                uint8_t v = line[x], was = (uint8_t)(ctx->dl.bits[k >> 3] >> (k & 7) & 1u);
                 if (v == was) continue;
                 any = 1;
                 if (v) {
@@ -249,10 +317,15 @@ static hd_result hd__direct_mask_box(hd__ctx *ctx, const hd__box *vox, int *chan
                     --ctx->vw.dl_count;
                 }
             }
+        }
 done:
     if (full || any) r = hd__direct_list_build(ctx);
     if (changed) *changed = full || any;
     hd__free(&ctx->vw, entry_run);
+    hd__free(&ctx->vw, pairs);
+    hd__free(&ctx->vw, weak);
+    hd__free(&ctx->vw, ps);
+    hd__free(&ctx->vw, line);
     hd__free(&ctx->vw, cell);
     hd__free(&ctx->vw, ax);
     hd__free(&ctx->vw, ay);
@@ -263,6 +336,10 @@ done:
 oom:
     r = HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's mask (%zu voxels)", gvox);
     hd__free(&ctx->vw, entry_run);
+    hd__free(&ctx->vw, pairs);
+    hd__free(&ctx->vw, weak);
+    hd__free(&ctx->vw, ps);
+    hd__free(&ctx->vw, line);
     hd__free(&ctx->vw, cell);
     hd__free(&ctx->vw, ax);
     hd__free(&ctx->vw, ay);

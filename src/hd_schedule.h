@@ -505,6 +505,19 @@ static hd_result hd__record_measure(hd__ctx *ctx)
    (the preparation, the backend's bracket and wait). */
 #define HD__BUDGET_MARGIN 0.9
 
+/* After an hd_render call that planned light work against render_budget (part.planned), which
+   began at `start` and ended at `end`: how much later than the plan's end (HD__BUDGET_MARGIN of
+   the budget) it ended, taken at once when later than the estimate, else moving it an eighth of
+   the way (a loaded machine stretches the pieces and the frame alike; the estimate, when
+   positive, comes off the next calls' light deadlines). */
+static void hd__budget_late(hd__ctx *ctx, double start, double end)
+{
+    double l = end - start - (double)ctx->vw.params.render_budget * HD__BUDGET_MARGIN;
+    if (!ctx->part.planned) return;
+    ctx->part.planned = 0;
+    ctx->part.late = l > ctx->part.late ? l : ctx->part.late + 0.125 * (l - ctx->part.late);
+}
+
 /* hd_render's work after hd__prepare. */
 static hd_result hd__render(hd__ctx *ctx)
 {
@@ -527,7 +540,9 @@ static hd_result hd__render(hd__ctx *ctx)
            HD__BUDGET_MARGIN for the call's own overhead */
         double start = ctx->call_t0 > 0.0 && ctx->call_t0 <= t0 ? ctx->call_t0 : t0;
         double frame = ctx->cost.gen > 0 ? hd__frame_cost_predict(ctx, hd__next_scale(ctx)) : budget * HD__FRAME_SHARE;
-        if ((r = hd__light_budget(ctx, start + budget * HD__BUDGET_MARGIN - frame)) != HD_SUCCESS) return r;
+        double late = ctx->part.late > 0.0 ? ctx->part.late : 0.0;
+        ctx->part.planned = !hd__light_converged(ctx);
+        if ((r = hd__light_budget(ctx, start + budget * HD__BUDGET_MARGIN - frame - late)) != HD_SUCCESS) return r;
     } else {
         /* no budget: one light iteration per call (the rest of one a budget split) */
         if (!hd__light_converged(ctx) && ctx->iterations < 0x7fffffffu && (r = hd__refine_once(ctx)) != HD_SUCCESS) return r;

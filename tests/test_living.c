@@ -519,7 +519,95 @@ static void test_budget_split_setter(void)
     hd_destroy(ctx);
 }
 
+
+/* The direct light's mask equals its definition (hdt_direct_mask_check: dual cell by dual cell)
+   on a 21x17x19 volume of plateaus, exact zeros and noise, F32 and U8, for TFs whose zero-alpha
+   entries come singly, in runs, or not at all, with a crop box and a coarser grid; and again
+   after a box update and a whole-volume update. */
+int hdt_direct_mask_check(hd_context h, size_t *tracked);
+enum { MX = 21, MY = 17, MZ = 19 };
+static float mask_value(int x, int y, int z, int t)
+{
+    float dx = x - 9.0f - 2.0f * t, dy = y - 8.0f, dz = z - 9.5f, r = sqrtf(dx * dx + dy * dy + dz * dz);
+    uint32_t h = (uint32_t)(x * 73856093 ^ y * 19349663 ^ z * 83492791 ^ t * 2654435761u);
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    h ^= h >> 15;
+    if (r > 8.0f) return 0.0f;                     /* exact zeros */
+    if (r < 3.0f) return 0.6f;                     /* a plateau */
+    if (x > 14) return (float)(h & 255) / 255.0f;  /* noise */
+    return 0.5f * (8.0f - r) / 5.0f + 0.01f * (float)(h & 3);
+}
+static void mask_case(const char *name, hd_voxel_type type, const float *tf, int count, int down, int crop)
+{
+    static float f[MX * MY * MZ];
+    static uint8_t b[MX * MY * MZ];
+    hd_desc d;
+    hd_context c;
+    hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+    size_t tracked = 0;
+    int x, y, z, t;
+    static float e[4 * MX * MY * MZ];
+    for (t = 0; t < 3; ++t) {
+        for (z = 0; z < MZ; ++z)
+            for (y = 0; y < MY; ++y)
+                for (x = 0; x < MX; ++x) {
+                    size_t i = ((size_t)z * MY + y) * MX + x;
+                    f[i] = mask_value(x, y, z, t);
+                    b[i] = (uint8_t)(f[i] * 255.0f + 0.5f);
+                }
+        if (t == 0) {
+            make_desc(&d, NULL);
+            d.volume.type = type;
+            d.volume.dims[0] = MX; d.volume.dims[1] = MY; d.volume.dims[2] = MZ;
+            d.volume.data = type == HD_VOXEL_U8 ? (const void *)b : (const void *)f;
+            d.transfer_function.rgba = tf;
+            d.transfer_function.count = count;
+            d.params.illumination_downsample = down;
+            if (crop) {
+                d.params.crop_min[0] = 0.2f; d.params.crop_min[1] = 0.0f; d.params.crop_min[2] = 0.31f;
+                d.params.crop_max[0] = 0.77f; d.params.crop_max[1] = 0.6f; d.params.crop_max[2] = 1.0f;
+            }
+            CHECK(hd_create(&d, &c) == HD_SUCCESS);
+        } else {
+            u.type = type;
+            u.dims[0] = MX; u.dims[1] = MY; u.dims[2] = MZ;
+            if (t == 1) { /* the box x 4..12, y 2..15, z 6..18 */
+                size_t es = type == HD_VOXEL_U8 ? 1 : 4;
+                u.offset[0] = 4; u.offset[1] = 2; u.offset[2] = 6;
+                u.size[0] = 9; u.size[1] = 14; u.size[2] = 13;
+                u.row_pitch = MX * es;
+                u.slice_pitch = (size_t)MX * MY * es;
+                u.data = (type == HD_VOXEL_U8 ? (const char *)b : (const char *)f) + (((size_t)6 * MY + 2) * MX + 4) * es;
+            } else {
+                memset(u.offset, 0, sizeof u.offset);
+                memset(u.size, 0, sizeof u.size);
+                u.row_pitch = u.slice_pitch = 0;
+                u.data = type == HD_VOXEL_U8 ? (const void *)b : (const void *)f;
+            }
+            CHECK(hd_update_volume(c, &u) == HD_SUCCESS);
+        }
+        CHECK(hd_read_illumination(c, HD_ILLUMINATION_DIRECT, e, 4 * MX * MY * MZ) == HD_SUCCESS); /* prepares */
+        CHECK_MSG(hdt_direct_mask_check(c, &tracked), "%s, step %d: the mask differs from its definition (%zu tracked)", name, t, tracked);
+        if (t == 0) CHECK_MSG(tracked > 0, "%s: nothing tracked", name);
+    }
+    hd_destroy(c);
+}
+static void test_mask_definition(void)
+{
+    static const float single[12] = {0, 0, 0, 0, 1, 1, 1, 0.4f, 1, 1, 1, 1};
+    static const float runs[32] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 0.5f, 1, 1, 1, 0.2f, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1};
+    static const float none[8] = {1, 1, 1, 0.3f, 1, 1, 1, 1};
+    mask_case("single zero, F32", HD_VOXEL_F32, single, 3, 1, 0);
+    mask_case("zero runs, F32", HD_VOXEL_F32, runs, 8, 1, 0);
+    mask_case("zero runs, U8, crop", HD_VOXEL_U8, runs, 8, 1, 1);
+    mask_case("zero runs, F32, grid / 2", HD_VOXEL_F32, runs, 8, 2, 0);
+    mask_case("no zero, F32, crop, grid / 2", HD_VOXEL_F32, none, 2, 2, 1);
+    mask_case("single zero, U8, grid / 2", HD_VOXEL_U8, single, 3, 2, 1);
+}
+
 const hd_test_case hd_tests_living[] = {
+    {"living_mask_definition", test_mask_definition},
     {"living_budget_split", test_budget_split},
     {"living_budget_split_setter", test_budget_split_setter},
     {"living_tf_warm", test_tf_warm},

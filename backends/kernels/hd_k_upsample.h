@@ -3,8 +3,9 @@
    reduced size) into the image buffer's second region, which starts after the w x h image
    (region.x = w h, the pixel offset hdk_accumulate_pixel adds), as a running mean of its own. This
    pass then fills the full image from that region by bilinear interpolation, so the image read
-   back is always w x h. The backends run it through the projection's entry point when
-   counts.z has HD_FLAG_UPSAMPLE (image.x, y = w, h; region.y = s). */
+   back is always w x h (image.x, y = w, h; region.y = s; counts.z has HD_FLAG_UPSAMPLE). OpenCL
+   runs it through the projection's kernel on that flag; GL and Vulkan through an entry point of
+   its own (HD_STAGE_UPSAMPLE), and the CPU backend from a column table (hd__cpu_upsample_row). */
 #define HD_FLAG_UPSAMPLE 32
 
 /* Full-image pixel (px, py) from the reduced region: pixel centres map onto the reduced grid's
