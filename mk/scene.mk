@@ -11,7 +11,7 @@
 #                           cloud, the post in it cuts it; the PNG is lit (T)
 .PHONY: scene test-scene scene-vulkan test-scene-vulkan
 
-$(B)/scene: examples/scene.c examples/hd_png.h $(LIB_SRC) | $(B)
+$(B)/scene: examples/scene.c examples/hd_png.h examples/hd_scene_common.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) -lglfw -lOpenGL -lEGL
 
 scene: $(B)/scene
@@ -33,7 +33,7 @@ $(B)/scene_vulkan_spv.h: examples/scene_vulkan.glsl mk/scene.mk | $(B)
 	    cat $(B)/scene_spv_$$1.h >> $@.tmp; rm -f $(B)/scene_spv_$$1.h; done
 	@mv $@.tmp $@
 
-$(B)/scene_vulkan: examples/scene_vulkan.c $(B)/scene_vulkan_spv.h examples/hd_png.h $(LIB_SRC) | $(B)
+$(B)/scene_vulkan: examples/scene_vulkan.c $(B)/scene_vulkan_spv.h examples/hd_png.h examples/hd_scene_common.h $(LIB_SRC) | $(B)
 	$(CC) $(CPPFLAGS) -Iexamples -I$(B) $(WARN) $(CFLAGS) $< -o $@ $(LDLIBS) $(VK_LDLIBS)
 
 scene-vulkan: $(B)/scene_vulkan
