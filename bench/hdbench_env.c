@@ -15,6 +15,7 @@
 #include "hybriddiff.h"
 #include "examples/hd_tf.h"
 #include "examples/hd_crop.h"
+#include "examples/hd_tonemap.h"
 #include "examples/hd_env.h"
 #include "hd_bench_median.h"
 
@@ -24,22 +25,6 @@
 
 #define MAX_ROUNDS 64
 
-static double srgb(double v)
-{
-    v = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
-    return v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
-}
-static double psnr(const float *a, const float *b, int n)
-{
-    double se = 0.0;
-    int i, c;
-    for (i = 0; i < n; ++i)
-        for (c = 0; c < 3; ++c) {
-            double d = srgb(8.0 * a[4 * i + c]) - srgb(8.0 * b[4 * i + c]);
-            se += d * d;
-        }
-    return 10.0 * log10(1.0 / (se / (3.0 * n)));
-}
 static double mean_rgb(const float *a, int n)
 {
     double s = 0.0;
@@ -72,7 +57,7 @@ static double reference(const hd_environment *env, int paths, float *ref, float 
     if (hd_iterate(a, paths / 2) != HD_SUCCESS || hd_iterate(b, paths / 2) != HD_SUCCESS) exit(1);
     hd_read_image_f32(a, ref, (size_t)npix * 4);
     hd_read_image_f32(b, tmp, (size_t)npix * 4);
-    p = psnr(ref, tmp, npix);
+    p = hdx_psnr_linear(ref, tmp, npix, 8.0);
     for (i = 0; i < 4 * npix; ++i) ref[i] = 0.5f * (ref[i] + tmp[i]);
     hd_destroy(a);
     hd_destroy(b);
@@ -171,7 +156,7 @@ int main(int argc, char **argv)
         hd_context hd = make(HD_METHOD_HD, e, 7u);
         if (hd_iterate(hd, 32) != HD_SUCCESS) return 1;
         hd_read_image_f32(hd, img, (size_t)npix * 4);
-        p = psnr(img, ref, npix);
+        p = hdx_psnr_linear(img, ref, npix, 8.0);
         printf("  %-24s %d^2: HD (32 it) vs PT_MS (%d paths) %.2f dB; reference halves %.2f dB; mean radiance HD %.4f, PT_MS %.4f\n",
                names[k], size, paths, p, floor_db, mean_rgb(img, npix), mean_rgb(ref, npix));
         hd_destroy(hd);

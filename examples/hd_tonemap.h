@@ -50,4 +50,19 @@ HDX_TM_FN double hdx_psnr_rgb(const float *a, const float *b, size_t npix)
     return hdx_psnr(s / (3.0 * (double)npix));
 }
 
+/* PSNR over the RGB channels of two linear RGBA float images, each tone-mapped at exposure on the
+   fly (hdx_psnr_rgb's metric without tone-mapped copies). */
+HDX_TM_FN double hdx_psnr_linear(const float *a, const float *b, size_t npix, double exposure)
+{
+    double s = 0.0;
+    size_t i;
+    int c;
+    for (i = 0; i < npix; ++i)
+        for (c = 0; c < 3; ++c) {
+            double d = hdx_srgb(exposure * a[4 * i + c]) - hdx_srgb(exposure * b[4 * i + c]);
+            s += d * d;
+        }
+    return hdx_psnr(s / (3.0 * (double)npix));
+}
+
 #endif
