@@ -166,7 +166,9 @@ static uint32_t memory_type(const app *a, uint32_t bits, VkMemoryPropertyFlags w
     exit(1);
 }
 
-static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect)
+/* A 2D or 3D image of extent w x h x d in device-local memory, with a view of its whole. */
+static image make_image_of(const app *a, VkImageType type, VkFormat format, int w, int h, int d, VkImageUsageFlags usage,
+                           VkImageAspectFlags aspect)
 {
     image im;
     VkImageCreateInfo ici;
@@ -175,9 +177,9 @@ static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, 
     VkMemoryAllocateInfo mai;
     memset(&ici, 0, sizeof ici);
     ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.imageType = type;
     ici.format = format;
-    ici.extent.width = (uint32_t)a->w, ici.extent.height = (uint32_t)a->h, ici.extent.depth = 1;
+    ici.extent.width = (uint32_t)w, ici.extent.height = (uint32_t)h, ici.extent.depth = (uint32_t)d;
     ici.mipLevels = ici.arrayLayers = 1;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
     ici.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -194,7 +196,7 @@ static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, 
     memset(&vci, 0, sizeof vci);
     vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
     vci.image = im.image;
-    vci.viewType = VK_IMAGE_VIEW_TYPE_2D;
+    vci.viewType = type == VK_IMAGE_TYPE_3D ? VK_IMAGE_VIEW_TYPE_3D : VK_IMAGE_VIEW_TYPE_2D;
     vci.format = format;
     vci.subresourceRange.aspectMask = aspect;
     vci.subresourceRange.levelCount = vci.subresourceRange.layerCount = 1;
@@ -202,42 +204,17 @@ static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, 
     return im;
 }
 
+/* A frame-sized 2D image. */
+static image make_image(const app *a, VkFormat format, VkImageUsageFlags usage, VkImageAspectFlags aspect)
+{
+    return make_image_of(a, VK_IMAGE_TYPE_2D, format, a->w, a->h, 1, usage, aspect);
+}
+
 /* The cloud's light: a 3D R32_SFLOAT image of the illumination grid's size, sampled by the meshes. */
 static image make_light_image(const app *a)
 {
-    image im;
-    VkImageCreateInfo ici;
-    VkImageViewCreateInfo vci;
-    VkMemoryRequirements req;
-    VkMemoryAllocateInfo mai;
-    memset(&ici, 0, sizeof ici);
-    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    ici.imageType = VK_IMAGE_TYPE_3D;
-    ici.format = VK_FORMAT_R32_SFLOAT;
-    ici.extent.width = (uint32_t)a->light_dims[0], ici.extent.height = (uint32_t)a->light_dims[1];
-    ici.extent.depth = (uint32_t)a->light_dims[2];
-    ici.mipLevels = ici.arrayLayers = 1;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
-    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    vk_check(vkCreateImage(a->dev, &ici, NULL, &im.image), "vkCreateImage");
-    vkGetImageMemoryRequirements(a->dev, im.image, &req);
-    memset(&mai, 0, sizeof mai);
-    mai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    mai.allocationSize = req.size;
-    mai.memoryTypeIndex = memory_type(a, req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    vk_check(vkAllocateMemory(a->dev, &mai, NULL, &im.memory), "vkAllocateMemory");
-    vk_check(vkBindImageMemory(a->dev, im.image, im.memory, 0), "vkBindImageMemory");
-    memset(&vci, 0, sizeof vci);
-    vci.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
-    vci.image = im.image;
-    vci.viewType = VK_IMAGE_VIEW_TYPE_3D;
-    vci.format = VK_FORMAT_R32_SFLOAT;
-    vci.subresourceRange.aspectMask = VK_IMAGE_ASPECT_COLOR_BIT;
-    vci.subresourceRange.levelCount = vci.subresourceRange.layerCount = 1;
-    vk_check(vkCreateImageView(a->dev, &vci, NULL, &im.view), "vkCreateImageView");
-    return im;
+    return make_image_of(a, VK_IMAGE_TYPE_3D, VK_FORMAT_R32_SFLOAT, a->light_dims[0], a->light_dims[1], a->light_dims[2],
+                         VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
 }
 
 static buffer make_buffer(const app *a, VkDeviceSize bytes, VkBufferUsageFlags usage)
