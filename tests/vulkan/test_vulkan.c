@@ -729,18 +729,20 @@ static int vk_memory(hd__backend *be, VkMemoryRequirements *req, int host, vk_ob
     return 1;
 }
 
-static int vk_image(hd__backend *be, VkFormat fmt, int w, int h, vk_obj *o)
+/* A 2D (d = 1) or 3D image in device memory, usable for copies both ways and sampling (and as the
+   depth attachment when D32). */
+static int vk_image_of(hd__backend *be, VkImageType type, VkFormat fmt, int w, int h, int d, vk_obj *o)
 {
     VkImageCreateInfo ici;
     VkMemoryRequirements req;
     memset(o, 0, sizeof *o);
     memset(&ici, 0, sizeof ici);
     ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    ici.imageType = VK_IMAGE_TYPE_2D;
+    ici.imageType = type;
     ici.format = fmt;
     ici.extent.width = (uint32_t)w;
     ici.extent.height = (uint32_t)h;
-    ici.extent.depth = 1;
+    ici.extent.depth = (uint32_t)d;
     ici.mipLevels = 1;
     ici.arrayLayers = 1;
     ici.samples = VK_SAMPLE_COUNT_1_BIT;
@@ -752,6 +754,8 @@ static int vk_image(hd__backend *be, VkFormat fmt, int w, int h, vk_obj *o)
     be->fn.vkGetImageMemoryRequirements(be->device, o->image, &req);
     return vk_memory(be, &req, 0, o) && be->fn.vkBindImageMemory(be->device, o->image, o->memory, 0) == VK_SUCCESS;
 }
+
+static int vk_image(hd__backend *be, VkFormat fmt, int w, int h, vk_obj *o) { return vk_image_of(be, VK_IMAGE_TYPE_2D, fmt, w, h, 1, o); }
 
 static int vk_buffer(hd__backend *be, VkDeviceSize bytes, vk_obj *o)
 {
@@ -1264,29 +1268,6 @@ static int light_equal(const float *a, const float *b, size_t n)
 {
     return memcmp(a, b, n * sizeof(float)) == 0;
 }
-/* The 3D image (gx+1) x (gy+1) x (gz+1) cleared to -7 (the caller's commands, TRANSFER_DST). */
-static int vk_image3d(hd__backend *be, VkFormat fmt, int w, int h, int dd, vk_obj *o)
-{
-    VkImageCreateInfo ici;
-    VkMemoryRequirements req;
-    memset(o, 0, sizeof *o);
-    memset(&ici, 0, sizeof ici);
-    ici.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    ici.imageType = VK_IMAGE_TYPE_3D;
-    ici.format = fmt;
-    ici.extent.width = (uint32_t)w;
-    ici.extent.height = (uint32_t)h;
-    ici.extent.depth = (uint32_t)dd;
-    ici.mipLevels = 1;
-    ici.arrayLayers = 1;
-    ici.samples = VK_SAMPLE_COUNT_1_BIT;
-    ici.tiling = VK_IMAGE_TILING_OPTIMAL;
-    ici.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    ici.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    if (be->fn.vkCreateImage(be->device, &ici, NULL, &o->image) != VK_SUCCESS) return 0;
-    be->fn.vkGetImageMemoryRequirements(be->device, o->image, &req);
-    return vk_memory(be, &req, 0, o) && be->fn.vkBindImageMemory(be->device, o->image, o->memory, 0) == VK_SUCCESS;
-}
 static void cmd_clear3d(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageLayout from)
 {
     VkImageMemoryBarrier ib;
@@ -1360,7 +1341,7 @@ static void test_record_illumination(void)
         tot = (float *)malloc(n * sizeof(float));
         prev = (float *)malloc(n * sizeof(float));
         ok &= tot && prev && vk_buffer(be, 64 + bytes, &buf) && vk_buffer(be, ibytes, &host) &&
-              vk_image3d(be, VK_FORMAT_R32_SFLOAT, gx + 1, gy + 1, gz + 1, &im);
+              vk_image_of(be, VK_IMAGE_TYPE_3D, VK_FORMAT_R32_SFLOAT, gx + 1, gy + 1, gz + 1, &im);
         for (pass = 0; pass < 3 && ok; ++pass) {
             if (pass == 1) CHECK(hd_refine(h, 2) == HD_SUCCESS); /* light only: the summed light is stale */
             ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, tot, n) == HD_SUCCESS;
