@@ -90,7 +90,8 @@ static hd_solver hd__solver_auto(const hd_params *p, const int *dims, int no_mul
     size_t n = 1;
     int d, f = p->illumination_downsample;
     if (!dims || no_multigrid || p->illumination_precision == HD_PRECISION_FLOAT16 || f < 1) return HD_SOLVER_RED_BLACK;
-    for (d = 0; d < 3; ++d) n *= (size_t)((dims[d] + f - 1) / f);
+    /* Runs before the checks: f may be INT_MAX, so no dims + f - 1. */
+    for (d = 0; d < 3; ++d) n *= (size_t)dims[d] / (size_t)f + ((size_t)dims[d] % (size_t)f != 0);
     return n >= HD__SOLVER_AUTO_VOXELS ? HD_SOLVER_MULTIGRID : HD_SOLVER_RED_BLACK;
 }
 
