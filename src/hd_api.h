@@ -90,8 +90,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     hd__params_defaults(&d.params, d.volume.dims, 0);
     if ((r = hd__check_params(&d.params, log)) != HD_SUCCESS) return r;
     if ((r = hd__check_grid(d.volume.dims, &d.params, log)) != HD_SUCCESS) return r;
-    if (d.params.method == HD_METHOD_CD && hd__area_light_count(d.lights, d.light_count) > 0)
-        return HD__ERR(log, HD_ERROR_UNSUPPORTED, "hd_create: method CD keeps one light volume per direction or point and cannot hold an area light");
+    if ((r = hd__check_cd_lights(d.params.method, d.lights, d.light_count, "hd_create", log)) != HD_SUCCESS) return r;
     if (d.threads < 0) return HD__ERR(log, HD_ERROR_INVALID_PARAMETER, "threads = %d is negative", d.threads);
     if (d.volume.spacing[0] == 0.0f && d.volume.spacing[1] == 0.0f && d.volume.spacing[2] == 0.0f)
         d.volume.spacing[0] = d.volume.spacing[1] = d.volume.spacing[2] = 1.0f;
@@ -194,8 +193,7 @@ static hd_result hd__api_set_lights(hd__ctx *ctx, const hd_light *lights, int co
     int channels_before;
     if ((r = hd__check_lights(lights, count, ctx->env_on ? ctx->env_power : -1.0, &ctx->vw.log)) != HD_SUCCESS) return r;
     if ((r = hd__check_lights_frame(lights, count, &ctx->xf, &ctx->vw.log)) != HD_SUCCESS) return r;
-    if (ctx->vw.params.method == HD_METHOD_CD && hd__area_light_count(lights, count) > 0)
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_lights: method CD keeps one light volume per direction or point and cannot hold an area light");
+    if ((r = hd__check_cd_lights(ctx->vw.params.method, lights, count, "hd_set_lights", &ctx->vw.log)) != HD_SUCCESS) return r;
     channels_before = ctx->vw.channels;
     /* CD keeps one light volume per light: another count makes them anew */
     if (ctx->vw.params.method == HD_METHOD_CD && count != ctx->light_count) ctx->dirty |= HD__INV_LIGHT;
@@ -438,8 +436,7 @@ static hd_result hd__api_set_params(hd__ctx *ctx, const hd_params *params)
     if ((r = hd__check_majorant(ctx, &p)) != HD_SUCCESS) return r;
     if (ctx->env_on && p.method == HD_METHOD_CD)
         return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_params: method CD cannot hold the environment (one light volume per light); clear it first");
-    if (p.method == HD_METHOD_CD && hd__area_light_count(ctx->lights, ctx->light_count) > 0)
-        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "hd_set_params: method CD cannot hold an area light (one light volume per direction or point); remove it first");
+    if ((r = hd__check_cd_lights(p.method, ctx->lights, ctx->light_count, "hd_set_params", &ctx->vw.log)) != HD_SUCCESS) return r;
     ctx->dirty |= hd__params_dirty(&ctx->vw.params, &p);
     ctx->vw.params = p;
     ctx->params_given = *params;

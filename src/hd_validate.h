@@ -135,12 +135,17 @@ static hd_result hd__check_area_light(const hd_light *l, int i, const hd_logger 
     return HD_SUCCESS;
 }
 
-/* How many of the lights are area lights (which method CD cannot hold). */
-static int hd__area_light_count(const hd_light *lights, int count)
+/* Method CD keeps one light volume per direction or point, so it refuses area lights (fn: the
+   calling entry point, for the log line). */
+static hd_result hd__check_cd_lights(hd_method method, const hd_light *lights, int count, const char *fn, const hd_logger *log)
 {
-    int i, n = 0;
-    for (i = 0; lights && i < count; ++i) n += lights[i].type >= HD_LIGHT_QUAD && lights[i].type < HD_LIGHT_TYPE_COUNT;
-    return n;
+    int i;
+    if (method != HD_METHOD_CD) return HD_SUCCESS;
+    for (i = 0; lights && i < count; ++i)
+        if (lights[i].type >= HD_LIGHT_QUAD && lights[i].type < HD_LIGHT_TYPE_COUNT)
+            return HD__ERR(log, HD_ERROR_UNSUPPORTED, "%s: method CD keeps one light volume per direction or point and cannot hold an area light (light %d)",
+                           fn, i);
+    return HD_SUCCESS;
 }
 
 /* Lights as given (env_power: an environment's power, -1 without one), before the defaults (zero colour -> white, zero intensity -> 1), which the
