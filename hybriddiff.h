@@ -1036,8 +1036,9 @@ HDDEF hd_result hd_vulkan_record_illumination(hd_context ctx, void *command_buff
    Like hd_refine it refines converged light too (test hd_stats.light_converged to stop); the
    iterations' convergence is measured by the next call other than hd_vulkan_record_illumination,
    once the caller has run them. The rules of hd_vulkan_record: submit and wait before the next
-   call (hd_vulkan_record_illumination and hd_vulkan_record_depth excepted, which may follow in
-   the same command buffer); MULTIGRID is refused. Errors, one log line each, nothing recorded:
+   call, hd_vulkan_record_illumination excepted (it may follow in the same command buffer, as
+   hd_vulkan_record_depth and hd_vulkan_record_illumination may precede it); MULTIGRID is
+   refused. Errors, one log line each, nothing recorded:
    HD_ERROR_NULL_POINTER (command buffer), HD_ERROR_INVALID_PARAMETER (n < 1, past 2^31
    iterations), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS have no light volume; MULTIGRID). */
 HDDEF hd_result hd_vulkan_record_refine(hd_context ctx, void *command_buffer, int n);
