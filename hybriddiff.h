@@ -1009,12 +1009,15 @@ typedef struct hd_vulkan_volume_target {
    HD_ILLUMINATION_TOTAL (E + phi, as the projection samples it: bit for bit
    hd_read_illumination's) copied on the device into the caller's 3D image or buffer, recorded
    into the caller's command buffer (in the recording state, as hd_vulkan_record's), with no CPU
-   round trip. The light copied is the light at the call, after every earlier call's work (which
-   the caller has run: submit and wait before the next call, as for hd_vulkan_record); where a
-   pass changed E or phi since the last frame, their sum is made first on the library's queue
-   (submitted and waited for). In a frame recorded into one command buffer, call it with
-   hd_vulkan_record_depth before hd_vulkan_record_render: the frame's light iteration then
-   refines the light the next frame copies. Errors, one log line each, nothing recorded:
+   round trip. The light copied is the light the calls before it leave: after
+   hd_vulkan_record_refine or hd_vulkan_record_render in the same command buffer, the light they
+   recorded (the library's barriers order the copy after them; this call measures nothing, so
+   their convergence is still measured by the next other call, once the caller has run them);
+   otherwise the light of the work the caller has run (submit and wait, as for hd_vulkan_record).
+   Where a pass changed E or phi since and nothing recorded their sum, it is made first on the
+   library's queue (submitted and waited for). In one frame's command buffer, before
+   hd_vulkan_record_render it copies the light the frame's iteration then refines, after it the
+   refined light. Errors, one log line each, nothing recorded:
    HD_ERROR_NULL_POINTER (command buffer, target), HD_ERROR_INVALID_PARAMETER (not one of image
    and buffer, the channel, the offset), HD_ERROR_OUTPUT_FORMAT (not R32_SFLOAT),
    HD_ERROR_INVALID_ENUM (a layout), HD_ERROR_OUTPUT_OUTSIDE_TARGET (an image smaller than the
@@ -1022,6 +1025,23 @@ typedef struct hd_vulkan_volume_target {
    PT_MS keep no light volume). */
 HDDEF hd_result hd_vulkan_record_illumination(hd_context ctx, void *command_buffer, int channel,
                                               const hd_vulkan_volume_target *target);
+
+/* Vulkan backend only (the others return HD_ERROR_UNSUPPORTED): hd_refine recorded into the
+   caller's command buffer (in the recording state, as hd_vulkan_record's): n >= 1 light
+   iterations (HD: direct light and diffusion; CD: convection and diffusion) and no projection,
+   the image left as it was, then E + phi summed on the device (the light the projection samples
+   and hd_vulkan_record_illumination copies). The light alone, for a host that lights its own
+   particles and meshes by the volume's light on frames that do not draw the volume: this call,
+   then hd_vulkan_record_illumination in the same command buffer, which copies the refined light.
+   Like hd_refine it refines converged light too (test hd_stats.light_converged to stop); the
+   iterations' convergence is measured by the next call other than hd_vulkan_record_illumination,
+   once the caller has run them. The rules of hd_vulkan_record: submit and wait before the next
+   call, hd_vulkan_record_illumination excepted (it may follow in the same command buffer, as
+   hd_vulkan_record_depth and hd_vulkan_record_illumination may precede it); MULTIGRID is
+   refused. Errors, one log line each, nothing recorded:
+   HD_ERROR_NULL_POINTER (command buffer), HD_ERROR_INVALID_PARAMETER (n < 1, past 2^31
+   iterations), HD_ERROR_UNSUPPORTED (PT_SS, PT_MS have no light volume; MULTIGRID). */
+HDDEF hd_result hd_vulkan_record_refine(hd_context ctx, void *command_buffer, int n);
 
 /* GL backend only (the others return HD_ERROR_UNSUPPORTED): writes the image, sRGB-encoded as
    hd_read_image_rgba8, into the caller's GL_RGBA8 2D texture `texture` (a GLuint; its size must

@@ -13,7 +13,7 @@
     X(project) X(upsample) X(path) X(upload_depth) X(upload_env) X(read_image) X(read_depth) X(record_depth) X(record_illumination) X(read_illumination) X(mg_begin) X(mg_end) \
     X(mg_coarsen) X(mg_zero_lo) X(mg_residual_f64) X(mg_smooth) X(mg_residual) X(mg_restrict) \
     X(mg_prolong) X(mg_dot_rz) X(mg_direction) X(mg_apply) X(mg_row_sums) X(mg_update) \
-    X(mg_extrapolate) X(wait) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output)
+    X(mg_extrapolate) X(wait) X(begin) X(end) X(record_begin) X(record_end) X(output_target_check) X(record_output) X(record_light_sum)
 enum {
 #define HD__NULL_X(name) HD__NULL_##name,
     HD__NULL_PRIMITIVES(HD__NULL_X)
@@ -276,6 +276,12 @@ static hd_result hd__be_record_illumination(const hd__view *vw, void *cb, int ch
 {
     (void)cb; (void)channel; (void)target;
     hd__null_call(vw, HD__NULL_record_illumination);
+    return HD_SUCCESS;
+}
+static hd_result hd__be_record_light_sum(const hd__view *vw)
+{
+    hd__null_call(vw, HD__NULL_record_light_sum);
+    if (!vw->be->recording) vw->be->misuse = 1;
     return HD_SUCCESS;
 }
 static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t offset)

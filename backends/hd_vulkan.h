@@ -1841,6 +1841,29 @@ static hd_result hd__be_diffuse(const hd__view *vw, int jacobi)
     return hd__vk_flush(vw);
 }
 
+/* E + phi into lsum (the light-sum stage), dispatched into cb, where a pass changed them since. */
+static hd_result hd__vk_light_sum(const hd__view *vw, VkCommandBuffer cb)
+{
+    VkPipeline sum;
+    hd_result r;
+    if (vw->be->gg.lsum_ok) return HD_SUCCESS;
+    if ((r = hd__vk_stage_pipeline(vw, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
+        (r = hd__vk_dispatch(vw, cb, sum, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0)) != HD_SUCCESS)
+        return r;
+    vw->be->gg.lsum_ok = 1;
+    return HD_SUCCESS;
+}
+
+/* hd_vulkan_record_refine's sum, into the caller's command buffer. */
+static hd_result hd__be_record_light_sum(const hd__view *vw)
+{
+    VkCommandBuffer cb = VK_NULL_HANDLE;
+    hd_result r;
+    if (!vw->be->rec) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the light's sum recorded outside a recording (internal error)");
+    if ((r = hd__vk_begin(vw, &cb)) != HD_SUCCESS) return r;
+    return hd__vk_light_sum(vw, cb);
+}
+
 /* The projection, after its inputs: lsum rebuilt (the light-sum stage) when a pass changed E or
    phi since, and the TF table (hd__project_table) written when it differs from the one in the
    buffer. A recorded frame reads the table as it is when the command buffer runs, as the TF. */
@@ -1848,7 +1871,7 @@ static hd_result hd__be_project(const hd__view *vw)
 {
     hd__backend *be = vw->be;
     VkCommandBuffer cb = VK_NULL_HANDLE;
-    VkPipeline sum, proj;
+    VkPipeline proj;
     int n = hd__project_table_n(vw), nb, p;
     hd_result r;
     if (!be->ptab.map || be->ptab_cap != n)
@@ -1859,14 +1882,9 @@ static hd_result hd__be_project(const hd__view *vw)
         be->ptab_key = hd__project_table_key(vw);
         be->ptab_n = n;
     }
-    if ((r = hd__vk_stage_pipeline(vw, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS ||
-        (r = hd__vk_stage_pipeline(vw, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(vw, &cb)) != HD_SUCCESS)
+    if ((r = hd__vk_stage_pipeline(vw, HD__VK_PROJECT, &proj)) != HD_SUCCESS || (r = hd__vk_begin(vw, &cb)) != HD_SUCCESS ||
+        (r = hd__vk_light_sum(vw, cb)) != HD_SUCCESS)
         return r;
-    if (!be->gg.lsum_ok) {
-        r = hd__vk_dispatch(vw, cb, sum, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0);
-        if (r != HD_SUCCESS) return r;
-        be->gg.lsum_ok = 1;
-    }
     nb = (vw->kp.image.y + HD__GPU_ROW_BLOCK - 1) / HD__GPU_ROW_BLOCK;
     p = be->spread_rows ? hd__gpu_row_stride(nb) : 1;
     if ((r = hd__vk_dispatch(vw, cb, proj, 0, vw->kp.image.x, p > 1 ? nb * HD__GPU_ROW_BLOCK : vw->kp.image.y, 1, n, p,
@@ -2521,12 +2539,8 @@ static hd_result hd__be_record_illumination(const hd__view *vw, void *cbp, int c
     if (!be->lsum.image) return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: no summed light grid (internal error)");
     if (!be->gg.lsum_ok) {
         VkCommandBuffer own = VK_NULL_HANDLE;
-        VkPipeline sum;
-        if ((r = hd__vk_stage_pipeline(vw, HD__VK_LIGHT_SUM, &sum)) != HD_SUCCESS || (r = hd__vk_begin(vw, &own)) != HD_SUCCESS ||
-            (r = hd__vk_dispatch(vw, own, sum, 0, vw->gdims[0], vw->gdims[1], vw->gdims[2] * vw->channels, 0, 0, 0, 0)) != HD_SUCCESS ||
-            (r = hd__vk_flush(vw)) != HD_SUCCESS)
+        if ((r = hd__vk_begin(vw, &own)) != HD_SUCCESS || (r = hd__vk_light_sum(vw, own)) != HD_SUCCESS || (r = hd__vk_flush(vw)) != HD_SUCCESS)
             return r;
-        be->gg.lsum_ok = 1;
     }
     memset(&mb, 0, sizeof mb);
     mb.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;

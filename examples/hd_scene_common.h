@@ -1,9 +1,13 @@
 /* The host-scene examples' shared pieces (examples/scene.c, examples/scene_vulkan.c): column-major
-   4x4 matrices, the procedural smoke cloud and the unit cube the meshes are made of. */
+   4x4 matrices, the procedural smoke cloud, the animated plume and where it stands, the unit cube
+   the meshes are made of, and the --check test of a volume's image. Include it after
+   hybriddiff.h. */
 #ifndef HD_SCENE_COMMON_H
 #define HD_SCENE_COMMON_H
 
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define PI 3.14159265358979f
@@ -114,6 +118,73 @@ static void make_cloud(unsigned char *v, int n)
                 d = d * 1.6f - (1.0f - fbm) * 0.7f;
                 v[((size_t)z * n + y) * n + x] = (unsigned char)(d <= 0.0f ? 0 : d >= 1.0f ? 255 : (int)(d * 255.0f));
             }
+}
+
+/* ---- the living volume: a plume of smoke rising from the green box -------------------------- */
+#define SMOKE_N 40 /* its voxels per side, F32, replaced every frame by hd_update_volume */
+
+/* The plume at time t (seconds): a column widening upward, its centre swaying, its density
+   carved by two octaves of value noise that rise with the smoke (advected noise). */
+static void make_smoke(float *v, int n, float t)
+{
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                float p[3] = {(x + 0.5f) / n - 0.5f, (y + 0.5f) / n - 0.5f, (z + 0.5f) / n - 0.5f};
+                float h = p[1] + 0.5f, r = 0.08f + 0.3f * h;
+                float cx = 0.12f * h * h * sinf(1.3f * t), cz = 0.1f * h * cosf(0.9f * t);
+                float dx = p[0] - cx, dz = p[2] - cz, d = 1.0f - sqrtf(dx * dx + dz * dz) / r;
+                float rise = 1.2f * t, fbm;
+                if (d <= 0.0f) { v[((size_t)z * n + y) * n + x] = 0.0f; continue; }
+                fbm = 0.65f * value_noise(p[0] * 6.0f, p[1] * 6.0f - rise * 6.0f, p[2] * 6.0f) +
+                      0.35f * value_noise(p[0] * 13.0f + 7.0f, p[1] * 13.0f - rise * 13.0f, p[2] * 13.0f);
+                d = d * (1.0f - 0.8f * h) * (0.3f + 1.4f * fbm);
+                v[((size_t)z * n + y) * n + x] = d > 1.0f ? 1.0f : d;
+            }
+}
+
+/* The plume's box, 1.2 wide and 2.8 tall, standing on the green box: its volume-to-world
+   transform, and its centre in `at` (the blending order). */
+static mat4 smoke_place(float at[3])
+{
+    at[0] = -3.5f, at[1] = 0.8f + 1.4f, at[2] = 2.0f;
+    return mat4_mul(mat4_translate(at[0], at[1], at[2]), mat4_scale(1.2f, 2.8f, 1.2f));
+}
+
+/* Whether the volume centred at p is farther from the eye than the one at q: two volumes that
+   do not overlap are blended the farther first. */
+static int volume_farther(const float eye[3], const float p[3], const float q[3])
+{
+    float dp = 0.0f, dq = 0.0f;
+    for (int k = 0; k < 3; ++k) dp += (p[k] - eye[k]) * (p[k] - eye[k]), dq += (q[k] - eye[k]) * (q[k] - eye[k]);
+    return dp > dq;
+}
+
+/* --check: a volume's last frame, read back as linear floats (w x h), is finite everywhere, opaque
+   enough (alpha above `opaque`) over more than 1/cover_div of the pixels and absent from a
+   quarter (the cloud: the sky above it, where the box in front hides it; the plume: most of the
+   image). `tag` prefixes the line it prints. */
+static int check_volume(const char *tag, hd_context ctx, int w, int h, const char *name, float opaque, size_t cover_div)
+{
+    size_t n = (size_t)w * h, covered = 0, clear = 0, bad = 0;
+    float *img = (float *)malloc(n * 4 * sizeof(float));
+    hd_result r;
+    if (!img) return 0;
+    if ((r = hd_read_image_f32(ctx, img, n * 4)) != HD_SUCCESS) {
+        fprintf(stderr, "%s: %s: hd_read_image_f32: %s\n", tag, name, hd_result_string(r));
+        free(img);
+        return 0;
+    }
+    for (size_t i = 0; i < n; ++i) {
+        float *p = img + 4 * i;
+        bad += !(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && p[3] >= 0.0f && p[3] <= 1.0f);
+        covered += p[3] > opaque;
+        clear += p[3] == 0.0f;
+    }
+    free(img);
+    fprintf(stderr, "%s: %s over %.1f%% of the image (alpha > %.2f), absent from %.1f%%, %zu bad pixels\n", tag, name,
+            100.0 * (double)covered / (double)n, (double)opaque, 100.0 * (double)clear / (double)n, bad);
+    return bad == 0 && covered > n / cover_div && clear > n / 4;
 }
 
 /* 36 vertices of a unit cube centred at 0 (position, normal) */

@@ -37,7 +37,6 @@
 #include "hd_scene_common.h"
 
 #define CLOUD_N 96
-#define SMOKE_N 40
 
 /* gluPerspective: right-handed eye space, NDC z in [-1, 1] */
 static mat4 mat4_perspective(float fov_y_degrees, float aspect, float znear, float zfar)
@@ -51,26 +50,6 @@ static mat4 mat4_perspective(float fov_y_degrees, float aspect, float znear, flo
     r.m[11] = -1.0f;
     r.m[14] = 2.0f * zfar * znear / (znear - zfar);
     return r;
-}
-
-/* The plume at time t (seconds): a column widening upward, its centre swaying, its density
-   carved by two octaves of value noise that rise with the smoke (advected noise). */
-static void make_smoke(float *v, int n, float t)
-{
-    for (int z = 0; z < n; ++z)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                float p[3] = {(x + 0.5f) / n - 0.5f, (y + 0.5f) / n - 0.5f, (z + 0.5f) / n - 0.5f};
-                float h = p[1] + 0.5f, r = 0.08f + 0.3f * h;
-                float cx = 0.12f * h * h * sinf(1.3f * t), cz = 0.1f * h * cosf(0.9f * t);
-                float dx = p[0] - cx, dz = p[2] - cz, d = 1.0f - sqrtf(dx * dx + dz * dz) / r;
-                float rise = 1.2f * t, fbm;
-                if (d <= 0.0f) { v[((size_t)z * n + y) * n + x] = 0.0f; continue; }
-                fbm = 0.65f * value_noise(p[0] * 6.0f, p[1] * 6.0f - rise * 6.0f, p[2] * 6.0f) +
-                      0.35f * value_noise(p[0] * 13.0f + 7.0f, p[1] * 13.0f - rise * 13.0f, p[2] * 13.0f);
-                d = d * (1.0f - 0.8f * h) * (0.3f + 1.4f * fbm);
-                v[((size_t)z * n + y) * n + x] = d > 1.0f ? 1.0f : d;
-            }
 }
 
 /* ---- the meshes: unit cubes under a model matrix, a ground plane ---------------------------- */
@@ -251,14 +230,10 @@ static void draw_frame(app *a, const mesh *meshes, int mesh_count)
     /* 4. composited over the scene: premultiplied alpha, the farther volume first (they do not
        overlap in space, so each is wholly in front of or behind the other along a ray) */
     {
-        float dc = 0.0f, ds = 0.0f;
+        int smoke_first = volume_farther(eye, a->smoke_at, a->cloud_at);
         GLuint order[2];
-        for (int k = 0; k < 3; ++k) {
-            dc += (a->cloud_at[k] - eye[k]) * (a->cloud_at[k] - eye[k]);
-            ds += (a->smoke_at[k] - eye[k]) * (a->smoke_at[k] - eye[k]);
-        }
-        order[0] = ds > dc ? a->smoke_tex : a->cloud_tex;
-        order[1] = ds > dc ? a->cloud_tex : a->smoke_tex;
+        order[0] = smoke_first ? a->smoke_tex : a->cloud_tex;
+        order[1] = smoke_first ? a->cloud_tex : a->smoke_tex;
         glBindFramebuffer(GL_FRAMEBUFFER, a->fbo);
         glEnable(GL_BLEND);
         glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
@@ -295,28 +270,6 @@ static int write_png(app *a, const char *path)
     if (!ok) fprintf(stderr, "scene: cannot write %s: %s\n", path, err);
     free(px);
     return ok;
-}
-
-/* The last frame of a volume, read back as linear floats: finite everywhere, opaque enough (alpha
-   above `opaque`) over more than 1/cover_div of the pixels and absent from a quarter (the cloud:
-   the sky above it, where the box in front hides it; the plume: most of the image). */
-static int check_volume(app *a, hd_context ctx, const char *name, float opaque, size_t cover_div)
-{
-    size_t n = (size_t)a->w * a->h, covered = 0, clear = 0, bad = 0;
-    float *img = (float *)malloc(n * 4 * sizeof(float));
-    hd_result r;
-    if (!img) return 0;
-    if ((r = hd_read_image_f32(ctx, img, n * 4)) != HD_SUCCESS) die("hd_read_image_f32", r);
-    for (size_t i = 0; i < n; ++i) {
-        float *p = img + 4 * i;
-        bad += !(isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]) && p[3] >= 0.0f && p[3] <= 1.0f);
-        covered += p[3] > opaque;
-        clear += p[3] == 0.0f;
-    }
-    free(img);
-    fprintf(stderr, "scene: %s over %.1f%% of the image (alpha > %.2f), absent from %.1f%%, %zu bad pixels\n", name,
-            100.0 * (double)covered / (double)n, (double)opaque, 100.0 * (double)clear / (double)n, bad);
-    return bad == 0 && covered > n / cover_div && clear > n / 4;
 }
 
 static GLuint texture2d(GLenum format, int w, int h)
@@ -449,8 +402,7 @@ int main(int argc, char **argv)
        frame (hd_update_volume in draw_frame), a budget of 10 ms per frame */
     if (!(a.smoke_vox = (float *)malloc(sizeof(float) * SMOKE_N * SMOKE_N * SMOKE_N))) return 1;
     make_smoke(a.smoke_vox, SMOKE_N, 0.0f);
-    a.smoke_at[0] = -3.5f, a.smoke_at[1] = 0.8f + 1.4f, a.smoke_at[2] = 2.0f;
-    place = mat4_mul(mat4_translate(a.smoke_at[0], a.smoke_at[1], a.smoke_at[2]), mat4_scale(1.2f, 2.8f, 1.2f));
+    place = smoke_place(a.smoke_at);
     memcpy(desc.volume.transform, place.m, sizeof desc.volume.transform);
     desc.volume.type = HD_VOXEL_F32;
     desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = SMOKE_N;
@@ -472,7 +424,8 @@ int main(int argc, char **argv)
         glfwSwapBuffers(a.win);
         glfwPollEvents();
     }
-    if (check && !(check_volume(&a, a.hd, "cloud", 0.2f, 100) & check_volume(&a, a.smoke, "plume", 0.05f, 500))) return 1;
+    if (check && !(check_volume("scene", a.hd, a.w, a.h, "cloud", 0.2f, 100) & check_volume("scene", a.smoke, a.w, a.h, "plume", 0.05f, 500)))
+        return 1;
     hd_destroy(a.hd);
     hd_destroy(a.smoke);
     free(a.smoke_vox);

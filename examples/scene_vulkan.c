@@ -1,20 +1,23 @@
 /* scene_vulkan.c - hybriddiff inside a host's Vulkan scene (examples/scene.c's scene on Vulkan,
    headless): the application's own instance and device, a render pass drawing a ground plane and
    boxes with a depth buffer, a smoke cloud placed by a volume-to-world transform, one camera given
-   to both as view and projection matrices (Vulkan's clip space: y down, depth zero to one), and
-   everything recorded into one command buffer per frame:
+   to both as view and projection matrices (Vulkan's clip space: y down, depth zero to one). A
+   second, living volume: smoke rising from the green box (examples/hd_scene_common.h's plume, as
+   examples/scene.c's), its voxels replaced in place every frame by hd_update_volume on its own
+   context; its light continues from the previous frame's (the warm start), one light iteration
+   a frame. Everything is recorded into one command buffer per frame:
      0. hd_vulkan_record_illumination: the cloud's light (E + phi) copied into the application's
         3D image, which the meshes' shader samples: the sun on the post where it stands in the
         cloud's medium comes through the cloud (its shadow darkens the post downward);
      1. the meshes into the application's HDR image (RGBA16F colour, D32_SFLOAT depth);
-     2. hd_vulkan_record_depth: the depth image copied into the library on the device, so the
-        cloud's rays end at the meshes (a post standing in the cloud cuts it, a box in front of it
+     2. hd_vulkan_record_depth: the depth image copied into both contexts on the device, so the
+        volumes' rays end at the meshes (a post standing in the cloud cuts it, a box in front of it
         hides it);
-     3. hd_vulkan_record_render: a frame, written as linear premultiplied RGBA16F into the
-        application's image (the library records its barriers: the image leaves it in
-        SHADER_READ_ONLY_OPTIMAL);
-     4. a second render pass blends it over the meshes with ONE, ONE_MINUS_SRC_ALPHA, in linear
-        light;
+     3. hd_vulkan_record_render for each volume: a frame, written as linear premultiplied
+        RGBA16F into the application's image of it (the library records its barriers: the image
+        leaves it in SHADER_READ_ONLY_OPTIMAL);
+     4. a second render pass blends them over the meshes, the farther first, with ONE,
+        ONE_MINUS_SRC_ALPHA, in linear light;
      5. a third tone-maps and sRGB-encodes into an RGBA8 image, copied to the host for the PNG.
    The library's NDC y points up (row 0 of its image is NDC y = +1), Vulkan's down: the library is
    given the projection with its y row negated, so its rows are the framebuffer's.
@@ -26,7 +29,8 @@
    test-scene-vulkan) lets the view rest until the light has converged, then compares the
    library's image with one of the same light rendered without the depth: where the scene shows
    sky or the ground (behind the whole cloud) the two match; where the box in front covers cloud,
-   the image is empty; where the post stands in the cloud, less of it is in front. Without a
+   the image is empty; where the post stands in the cloud, less of it is in front; and the plume's
+   last frame is finite, covers part of the image and not most of it. Without a
    Vulkan device, or with --validate and no layer, those runs print SKIPPED and exit 0 (1 under
    HD_CONFORMANCE_REQUIRE=1).
    Shaders: examples/scene_vulkan.glsl, compiled by mk/scene.mk. C99, Vulkan 1.1. */
@@ -91,7 +95,6 @@ static void mat4_apply(mat4 a, const float v[4], float out[4])
         out[row] = a.m[row] * v[0] + a.m[4 + row] * v[1] + a.m[8 + row] * v[2] + a.m[12 + row] * v[3];
 }
 
-/* ---- the smoke cloud: a few soft blobs carved by value noise (as examples/scene.c's) ---------- */
 /* ---- the application's Vulkan objects ------------------------------------------------------ */
 typedef struct image { VkImage image; VkImageView view; VkDeviceMemory memory; } image;
 typedef struct buffer { VkBuffer buffer; VkDeviceMemory memory; void *map; } buffer;
@@ -111,6 +114,7 @@ typedef struct app {
     VkCommandPool pool;
     VkCommandBuffer cb;
     image hdr, depth, cloud, ldr;  /* RGBA16F scene, D32 depth, the library's RGBA16F image, RGBA8 */
+    image smoke_img;               /* the plume's RGBA16F image */
     image light;                   /* the cloud's light, R32_SFLOAT 3D (hd_vulkan_record_illumination) */
     int light_dims[3], light_filled;
     buffer vbo, readback;
@@ -119,11 +123,14 @@ typedef struct app {
     VkFramebuffer fb_mesh, fb_blend, fb_tonemap;
     VkDescriptorSetLayout set_layout;
     VkDescriptorPool dpool;
-    VkDescriptorSet set_cloud, set_hdr, set_light;
+    VkDescriptorSet set_cloud, set_hdr, set_light, set_smoke;
     VkPipelineLayout layout_mesh, layout_quad;
     VkPipeline pipe_mesh, pipe_blend, pipe_tonemap;
     mesh meshes[MESHES];
-    hd_context hd;
+    hd_context hd, smoke;
+    float *smoke_vox;                /* the plume's voxels, SMOKE_N^3 */
+    int frame;                       /* frames drawn: the plume's clock (1/30 s each) */
+    float cloud_at[3], smoke_at[3];  /* the volumes' centres in the world (the blending order) */
     mat4 view, proj; /* the last frame's camera (Vulkan's clip space) */
     mat4 place;      /* the cloud's volume-to-world transform */
 } app;
@@ -530,7 +537,7 @@ static void make_scene_objects(app *a)
     VkSamplerCreateInfo sci;
     VkDescriptorSetLayoutBinding b;
     VkDescriptorSetLayoutCreateInfo dslci;
-    VkDescriptorPoolSize ps = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 3};
+    VkDescriptorPoolSize ps = {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4};
     VkDescriptorPoolCreateInfo dpci;
     VkPushConstantRange pcr = {VK_SHADER_STAGE_VERTEX_BIT, 0, 32 * sizeof(float)}; /* 128: every device's minimum */
     VkPipelineLayoutCreateInfo plci;
@@ -543,6 +550,8 @@ static void make_scene_objects(app *a)
     /* the library's output: written by a transfer (hd_vulkan_record_render), sampled by the blend */
     a->cloud = make_image(a, VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
                           VK_IMAGE_ASPECT_COLOR_BIT);
+    a->smoke_img = make_image(a, VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT);
     a->ldr = make_image(a, VK_FORMAT_R8G8B8A8_UNORM, att | VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT);
     a->readback = make_buffer(a, (VkDeviceSize)a->w * a->h * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
     a->vbo = make_buffer(a, 36 * 6 * sizeof(float), VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
@@ -579,11 +588,12 @@ static void make_scene_objects(app *a)
     vk_check(vkCreateDescriptorSetLayout(a->dev, &dslci, NULL, &a->set_layout), "vkCreateDescriptorSetLayout");
     memset(&dpci, 0, sizeof dpci);
     dpci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-    dpci.maxSets = 3;
+    dpci.maxSets = 4;
     dpci.poolSizeCount = 1;
     dpci.pPoolSizes = &ps;
     vk_check(vkCreateDescriptorPool(a->dev, &dpci, NULL, &a->dpool), "vkCreateDescriptorPool");
     a->set_cloud = make_set(a, a->sampler, a->cloud.view);
+    a->set_smoke = make_set(a, a->sampler, a->smoke_img.view);
     a->set_hdr = make_set(a, a->sampler, a->hdr.view);
 
     memset(&plci, 0, sizeof plci);
@@ -669,6 +679,15 @@ static void draw_frame(app *a, float yaw, float pitch, float dist, int read, int
     vp = mat4_mul(a->proj, a->view);
     cam = library_camera(a);
     hd_check(hd_set_camera(a->hd, &cam), "hd_set_camera");
+    hd_check(hd_set_camera(a->smoke, &cam), "hd_set_camera (plume)");
+    { /* the plume's next step: new voxels in place; E and phi carry over as the warm start */
+        hd_volume_update u = HD_VOLUME_UPDATE_INIT;
+        make_smoke(a->smoke_vox, SMOKE_N, (float)a->frame++ / 30.0f);
+        u.type = HD_VOXEL_F32;
+        u.dims[0] = u.dims[1] = u.dims[2] = SMOKE_N;
+        u.data = a->smoke_vox;
+        hd_check(hd_update_volume(a->smoke, &u), "hd_update_volume");
+    }
 
     vk_check(vkResetCommandBuffer(a->cb, 0), "vkResetCommandBuffer");
     memset(&bi, 0, sizeof bi);
@@ -708,12 +727,11 @@ static void draw_frame(app *a, float yaw, float pitch, float dist, int read, int
     vkCmdEndRenderPass(a->cb);
 
     /* 2. the depth to the library, on the device (it records its own barriers) */
-    if (with_depth) {
-        dep.image = (uint64_t)a->depth.image;
-        dep.format = VK_FORMAT_D32_SFLOAT;
-        dep.layout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-        hd_check(hd_vulkan_record_depth(a->hd, a->cb, &dep), "hd_vulkan_record_depth");
-    }
+    dep.image = (uint64_t)a->depth.image;
+    dep.format = VK_FORMAT_D32_SFLOAT;
+    dep.layout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    if (with_depth) hd_check(hd_vulkan_record_depth(a->hd, a->cb, &dep), "hd_vulkan_record_depth");
+    hd_check(hd_vulkan_record_depth(a->smoke, a->cb, &dep), "hd_vulkan_record_depth (plume)");
 
     /* 3. a frame, linear premultiplied RGBA16F into our image, left for sampling */
     target.image = (uint64_t)a->cloud.image;
@@ -723,12 +741,21 @@ static void draw_frame(app *a, float yaw, float pitch, float dist, int read, int
     target.width = a->w, target.height = a->h;
     out.format = HD_OUTPUT_LINEAR_F16;
     hd_check(hd_vulkan_record_render(a->hd, a->cb, &target, &out), "hd_vulkan_record_render");
+    target.image = (uint64_t)a->smoke_img.image; /* the plume's frame: a light iteration while its light moves */
+    hd_check(hd_vulkan_record_render(a->smoke, a->cb, &target, &out), "hd_vulkan_record_render (plume)");
 
-    /* 4. composited over the meshes: premultiplied alpha, in linear light */
+    /* 4. composited over the meshes: premultiplied alpha, in linear light, the farther volume
+       first (they do not overlap in space, so each is wholly in front of or behind the other) */
     begin_pass(a, a->pass_blend, a->fb_blend, 0);
     vkCmdBindPipeline(a->cb, VK_PIPELINE_BIND_POINT_GRAPHICS, a->pipe_blend);
-    vkCmdBindDescriptorSets(a->cb, VK_PIPELINE_BIND_POINT_GRAPHICS, a->layout_quad, 0, 1, &a->set_cloud, 0, NULL);
-    vkCmdDraw(a->cb, 3, 1, 0, 0);
+    {
+        int smoke_first = volume_farther(eye, a->smoke_at, a->cloud_at);
+        for (int k = 0; k < 2; ++k) {
+            const VkDescriptorSet *set = (k == 0) == smoke_first ? &a->set_smoke : &a->set_cloud;
+            vkCmdBindDescriptorSets(a->cb, VK_PIPELINE_BIND_POINT_GRAPHICS, a->layout_quad, 0, 1, set, 0, NULL);
+            vkCmdDraw(a->cb, 3, 1, 0, 0);
+        }
+    }
     vkCmdEndRenderPass(a->cb);
 
     /* 5. tone map into RGBA8 */
@@ -954,6 +981,19 @@ int main(int argc, char **argv)
     desc.vulkan.queue_family = a.family;
     desc.vulkan.get_instance_proc_addr = (hd_proc)vkGetInstanceProcAddr;
     hd_check(hd_create(&desc, &a.hd), "hd_create");
+    a.cloud_at[0] = 0.0f, a.cloud_at[1] = 1.6f, a.cloud_at[2] = 0.0f;
+
+    /* the plume: F32 voxels replaced every frame (hd_update_volume in draw_frame), on the same
+       device, its own context */
+    if (!(a.smoke_vox = (float *)malloc(sizeof(float) * SMOKE_N * SMOKE_N * SMOKE_N))) return 1;
+    make_smoke(a.smoke_vox, SMOKE_N, 0.0f);
+    place = smoke_place(a.smoke_at);
+    memcpy(desc.volume.transform, place.m, sizeof desc.volume.transform);
+    desc.volume.type = HD_VOXEL_F32;
+    desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = SMOKE_N;
+    desc.volume.data = a.smoke_vox;
+    desc.params.extinction = 10.0f;
+    hd_check(hd_create(&desc, &a.smoke), "hd_create (plume)");
     { /* the light's image, of the illumination grid's size; filtered where the format allows */
         hd_stats st;
         VkFormatProperties fp;
@@ -991,9 +1031,12 @@ int main(int argc, char **argv)
         hd_stats st;
         for (int f = 0; f < 400 && hd_get_stats(a.hd, &st) == HD_SUCCESS && !st.light_converged; ++f) draw_frame(&a, yaw, pitch, dist, 0, 1);
         ok &= check_scene(&a, yaw, pitch, dist);
+        ok &= check_volume("scene_vulkan", a.smoke, a.w, a.h, "plume", 0.05f, 500);
     }
 
     hd_destroy(a.hd);
+    hd_destroy(a.smoke);
+    free(a.smoke_vox);
     vkDeviceWaitIdle(a.dev);
     vkDestroyPipeline(a.dev, a.pipe_mesh, NULL);
     vkDestroyPipeline(a.dev, a.pipe_blend, NULL);
@@ -1011,6 +1054,7 @@ int main(int argc, char **argv)
     vkDestroyRenderPass(a.dev, a.pass_blend, NULL);
     vkDestroyRenderPass(a.dev, a.pass_tonemap, NULL);
     free_image(&a, &a.hdr), free_image(&a, &a.depth), free_image(&a, &a.cloud), free_image(&a, &a.ldr), free_image(&a, &a.light);
+    free_image(&a, &a.smoke_img);
     free_buffer(&a, &a.vbo), free_buffer(&a, &a.readback);
     vkDestroyCommandPool(a.dev, a.pool, NULL);
     vkDestroyDevice(a.dev, NULL);

@@ -8,7 +8,8 @@
 #   make test-scene-vulkan  at 256x144 under VK_LAYER_KHRONOS_validation (+ synchronization
 #                           validation) with --check: no validation message; against the image
 #                           without depth, sky and ground match, the box in front hides the
-#                           cloud, the post in it cuts it; the PNG is lit (T)
+#                           cloud, the post in it cuts it; the plume is finite and covers part
+#                           of the image; the PNG is lit (T)
 .PHONY: scene test-scene scene-vulkan test-scene-vulkan
 
 $(B)/scene: examples/scene.c examples/hd_png.h examples/hd_scene_common.h $(LIB_SRC) | $(B)

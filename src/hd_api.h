@@ -378,7 +378,11 @@ static hd_result hd__api_vulkan_record_illumination(hd__ctx *ctx, void *command_
             return HD__ERR(log, HD_ERROR_BUFFER_TOO_SMALL, "%s: %llu bytes from offset %llu past the buffer's %llu", fn,
                            (unsigned long long)bytes, (unsigned long long)t->offset, (unsigned long long)t->buffer_size);
     }
+    /* the caller's command buffer may hold light iterations recorded before this copy, not yet
+       run: their measurement waits for the next other call */
+    ctx->no_measure = 1;
     HD__BE_CALL(r, ctx, hd__be_record_illumination(&ctx->vw, command_buffer, channel, t));
+    ctx->no_measure = 0;
     return r;
 }
 HDDEF hd_result hd_vulkan_record_illumination(hd_context h, void *command_buffer, int channel, const hd_vulkan_volume_target *target)
@@ -643,4 +647,21 @@ static hd_result hd__api_vulkan_record(hd__ctx *ctx, void *command_buffer, int n
 HDDEF hd_result hd_vulkan_record(hd_context h, void *command_buffer, int n)
 {
     HD__GUARDED(h, "hd_vulkan_record", hd__api_vulkan_record(ctx, command_buffer, n));
+}
+
+static hd_result hd__api_vulkan_record_refine(hd__ctx *ctx, void *command_buffer, int n)
+{
+    hd_result r;
+    if ((r = hd__record_check(ctx, command_buffer, n, "hd_vulkan_record_refine")) != HD_SUCCESS) return r;
+    if (hd__method_is_pt(ctx->vw.params.method))
+        return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED,
+                       "hd_vulkan_record_refine: method %s has no light volume to refine; use hd_vulkan_record_render",
+                       hd_method_name(ctx->vw.params.method));
+    hd__record_cost(ctx);
+    HD__BE_CALL(r, ctx, hd__record_refine(ctx, command_buffer, n));
+    return r;
+}
+HDDEF hd_result hd_vulkan_record_refine(hd_context h, void *command_buffer, int n)
+{
+    HD__GUARDED(h, "hd_vulkan_record_refine", hd__api_vulkan_record_refine(ctx, command_buffer, n));
 }

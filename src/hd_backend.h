@@ -261,6 +261,10 @@ static hd_result hd__be_record_depth(const hd__view *vw, void *cb, const hd_vulk
    method (HD, CD), the pointers, one of image and buffer, the channel, the image's extent and the
    buffer's range. Runs in a bracket after the core's preparation. */
 static hd_result hd__be_record_illumination(const hd__view *vw, void *cb, int channel, const hd_vulkan_volume_target *target);
+/* HD__BE_RECORD, inside a recording (hd_vulkan_record_refine): E + phi into the projection's
+   summed light, recorded after the light iterations before it, where a pass changed them since
+   (nothing when the sum is up to date); the sum is then up to date. */
+static hd_result hd__be_record_light_sum(const hd__view *vw);
 /* HD__BE_TEXTURE: checks that `texture` can take the image (its own result code and log line:
    HD_ERROR_INVALID_TEXTURE not a 2D texture, HD_ERROR_OUTPUT_FORMAT its internal format,
    HD_ERROR_OUTPUT_OUTSIDE_TARGET the region past its size; exact: hd_gl_render_to_texture's
@@ -318,6 +322,10 @@ static hd_result hd__be_depth_cl_buffer(const hd__view *vw, void *buffer, size_t
                                                 const hd_vulkan_volume_target *target)                  \
     {                                                                                                   \
         (void)cb; (void)channel; (void)target;                                                          \
+        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
+    }                                                                                                   \
+    static hd_result hd__be_record_light_sum(const hd__view *vw)                                        \
+    {                                                                                                   \
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, NAME ": no recording");                          \
     }
 #define HD__BE_NO_CL_BUFFER(NAME)                                                                       \

@@ -143,7 +143,8 @@ typedef struct hd__ctx {
     hd__cost cost;
     int image_room;          /* the image buffer holds the reduced frames' region (made when a
                                 scale > 1 is first used, hd__image_room) */
-    int no_measure;          /* light iterations are being recorded (hd_vulkan_record), not run */
+    int no_measure;          /* light iterations are being recorded (hd_vulkan_record*), not run, or a
+                                copy is recorded after them (hd_vulkan_record_illumination) */
     int rec_light;           /* light iterations recorded and not yet measured: the next call measures
                                 them once the caller has run them (hd__prepare) */
     unsigned light_gen;      /* bumped whenever E or phi is reset: a solver's run state is stale */

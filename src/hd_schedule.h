@@ -130,7 +130,7 @@ static hd_result hd__prepare(hd__ctx *ctx)
     /* light iterations an earlier call recorded have run by now (the caller waits before the next
        call): their light is measured, unless a setter has reset it or its estimate since */
     if (dirty & (HD__DIRTY_DIRECT | HD__DIRTY_PHI | HD__DIRTY_WARM_E | HD__DIRTY_WARM_PHI)) ctx->rec_light = 0;
-    if (ctx->rec_light) return hd__record_measure(ctx);
+    if (ctx->rec_light && !ctx->no_measure) return hd__record_measure(ctx);
     return HD_SUCCESS;
 }
 
@@ -604,6 +604,23 @@ static hd_result hd__record(hd__ctx *ctx, void *target, int n)
         ctx->cost.rec_pixels = hd__scale_pixels(ctx, ctx->frame_scale);
         ctx->cost.rec_gen = ctx->cost.gen;
     }
+    ctx->no_measure = 0;
+    if (r != HD_SUCCESS) hd__record_failed(ctx);
+    return hd__be_record_end(&ctx->vw, r);
+}
+
+/* hd_vulkan_record_refine's work after hd__prepare: hd_refine's n light iterations recorded (no
+   projection, measured by the next call as hd__record's), then E + phi summed in the recording
+   (hd__be_record_light_sum), so hd_vulkan_record_illumination after it in the same command
+   buffer copies the refined light. */
+static hd_result hd__record_refine(hd__ctx *ctx, void *target, int n)
+{
+    hd_result r;
+    int i;
+    if ((r = hd__be_record_begin(&ctx->vw, target, 3 * n + 2)) != HD_SUCCESS) return r;
+    ctx->no_measure = 1;
+    for (i = 0; i < n && r == HD_SUCCESS; ++i) r = hd__light_iteration(ctx);
+    if (r == HD_SUCCESS) r = hd__be_record_light_sum(&ctx->vw);
     ctx->no_measure = 0;
     if (r != HD_SUCCESS) hd__record_failed(ctx);
     return hd__be_record_end(&ctx->vw, r);

@@ -761,8 +761,9 @@ static void test_depth_out_slab(void)
 /* ---- the light out ------------------------------------------------------------------------------ */
 /* HD_ILLUMINATION_TOTAL is E + phi of the other two read-backs, bit for bit, for one channel and
    three (lights of different colours); the GL-only calls (hd_gl_illumination_texture,
-   hd_gl_set_depth_texture) and the Vulkan-only hd_vulkan_record_illumination are
-   HD_ERROR_UNSUPPORTED here with one logged line, the path tracers' read HD_ERROR_UNSUPPORTED. */
+   hd_gl_set_depth_texture) and the Vulkan-only hd_vulkan_record_illumination and
+   hd_vulkan_record_refine are HD_ERROR_UNSUPPORTED here with one logged line, the path tracers'
+   read HD_ERROR_UNSUPPORTED. */
 static void test_light_out(void)
 {
     hd_desc d = scene_desc(vox_blob, tf_blob, 3);
@@ -797,6 +798,8 @@ static void test_light_out(void)
             vt.buffer_size = (uint64_t)n * sizeof(float);
             log.errors = 0;
             CHECK(hd_vulkan_record_illumination(ctx, &vt, 0, &vt) == HD_ERROR_UNSUPPORTED && log.errors == 1);
+            log.errors = 0;
+            CHECK(hd_vulkan_record_refine(ctx, &vt, 1) == HD_ERROR_UNSUPPORTED && log.errors == 1);
         }
         free(t); free(e); free(p);
         hd_destroy(ctx);

@@ -1411,23 +1411,28 @@ static void fz_op_preset(int ci)
     }
 }
 
-/* The GL and Vulkan backends' calls (bit 0: which; bits 6-7: which call of it): unsupported
-   here, before any other check. */
+/* The GL and Vulkan backends' calls (bit 0: which; GL: bits 6-7, Vulkan: bits 5-7, which call of
+   it): unsupported here, before any other check. */
 static void fz_op_backend(int ci)
 {
-    static const char *const names[2][3] = {{"hd_vulkan_record(c, NULL, 1)", "hd_vulkan_record_depth(c, NULL, NULL)",
-                                             "hd_vulkan_record_render(c, NULL, NULL, NULL)"},
-                                            {"hd_gl_render_to_texture(c, 1)", "hd_gl_illumination_texture(c, 1, 0)",
-                                             "hd_gl_set_depth_texture(c, 1)"}};
+    static const char *const vk_names[5] = {"hd_vulkan_record(c, NULL, 1)", "hd_vulkan_record_depth(c, NULL, NULL)",
+                                            "hd_vulkan_record_render(c, NULL, NULL, NULL)",
+                                            "hd_vulkan_record_illumination(c, NULL, 0, NULL)", "hd_vulkan_record_refine(c, NULL, 1)"};
+    static const char *const gl_names[3] = {"hd_gl_render_to_texture(c, 1)", "hd_gl_illumination_texture(c, 1, 0)",
+                                            "hd_gl_set_depth_texture(c, 1)"};
     fz_pre pre;
     hd_result r;
-    int k = fz_u8(), gl = k & 1, v = (k >> 6) % 3;
-    fz_tr("    r = %s;\n", names[gl][v]);
-    fz_begin(ci, &pre, names[gl][v]);
+    int k = fz_u8(), gl = k & 1, v = gl ? (k >> 6) % 3 : (k >> 5) % 5;
+    const char *name = gl ? gl_names[v] : vk_names[v];
+    fz_tr("    r = %s;\n", name);
+    fz_begin(ci, &pre, name);
     if (gl) r = v == 0 ? hd_gl_render_to_texture(fz_c[ci].h, 1u) : v == 1 ? hd_gl_illumination_texture(fz_c[ci].h, 1u, 0)
                                                                            : hd_gl_set_depth_texture(fz_c[ci].h, 1u);
-    else r = v == 0 ? hd_vulkan_record(fz_c[ci].h, NULL, 1) : v == 1 ? hd_vulkan_record_depth(fz_c[ci].h, NULL, NULL)
-                                                                     : hd_vulkan_record_render(fz_c[ci].h, NULL, NULL, NULL);
+    else r = v == 0   ? hd_vulkan_record(fz_c[ci].h, NULL, 1)
+             : v == 1 ? hd_vulkan_record_depth(fz_c[ci].h, NULL, NULL)
+             : v == 2 ? hd_vulkan_record_render(fz_c[ci].h, NULL, NULL, NULL)
+             : v == 3 ? hd_vulkan_record_illumination(fz_c[ci].h, NULL, 0, NULL)
+                      : hd_vulkan_record_refine(fz_c[ci].h, NULL, 1);
     fz_end(&pre, r, FZ_R(HD_ERROR_UNSUPPORTED));
 }
 

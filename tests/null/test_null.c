@@ -71,6 +71,7 @@ static void test_null_api(void)
     CHECK(hd_read_illumination(h, HD_ILLUMINATION_SCATTERED, ill, sizeof ill / sizeof ill[0]) == HD_SUCCESS);
     CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 3 && s.method == HD_METHOD_HD);
     CHECK(hd_vulkan_record(h, (void *)px, 1) == HD_SUCCESS); /* records nothing, counts the schedule */
+    CHECK(hd_vulkan_record_refine(h, (void *)px, 1) == HD_SUCCESS);
     CHECK(hd_gl_render_to_texture(h, 1) == HD_ERROR_UNSUPPORTED);
     t.rgba = tf;
     t.count = 2;
@@ -303,6 +304,22 @@ static void test_null_record_render(void)
     CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 6);
     c = snap(h);
     CHECK(hd_render(h) == HD_SUCCESS && delta(h, &c, HD__NULL_read_illumination) == 2 && delta(h, &c, HD__NULL_direct) == 0);
+    /* hd_vulkan_record_refine: light iterations and the sum, no frame, converged light refined
+       too; the copies recorded after it measure nothing, the next other call measures them */
+    {
+        hd_vulkan_volume_target vt = HD_VULKAN_VOLUME_TARGET_INIT;
+        vt.buffer = 1;
+        vt.buffer_size = (uint64_t)N * N * N * 4;
+        c = snap(h);
+        CHECK(hd_vulkan_record_refine(h, &cb, 2) == HD_SUCCESS && delta(h, &c, HD__NULL_direct) == 2);
+        CHECK(delta(h, &c, HD__NULL_project) == 0 && delta(h, &c, HD__NULL_record_light_sum) == 1 && delta(h, &c, HD__NULL_record_begin) == 1);
+        CHECK(hd_get_stats(h, &s) == HD_SUCCESS && s.iterations == 8);
+        c = snap(h);
+        CHECK(hd_vulkan_record_illumination(h, &cb, 0, &vt) == HD_SUCCESS && delta(h, &c, HD__NULL_read_illumination) == 0);
+        c = snap(h);
+        CHECK(hd_render(h) == HD_SUCCESS && delta(h, &c, HD__NULL_read_illumination) == 2);
+        CHECK(hd_vulkan_record_refine(h, &cb, 0) == HD_ERROR_INVALID_PARAMETER && hd_vulkan_record_refine(h, NULL, 1) == HD_ERROR_NULL_POINTER);
+    }
     /* refusals before the device: the region, the size, the format enum, the target's kind */
     {
         struct { int x, y, w, fmt; uint64_t image, buffer; hd_result want; } bad[6] = {

@@ -26,13 +26,42 @@
         between red-black's and multigrid's needs fails the first step with
         HD_ERROR_OUT_OF_DEVICE_MEMORY at many points of the levels' allocation, and a device
         lost at any of a step's submissions gives HD_ERROR_DEVICE_LOST; every context is
-        destroyed with no object left (validation on, no message).
-   And, with no device: the order of the projection's blocks of rows on CPU devices
+        destroyed with no object left (validation on, no message);
+     7. contexts that make their own device share one kept instance: 42 created and destroyed
+        (some rendering) through one vkCreateInstance, a validation context through its own;
+     8. the image buffer's reduced-frame region: absent at render scale 1, made by the first
+        reduced frame (submitted or recorded); short device memory fails that frame with
+        HD_ERROR_OUT_OF_DEVICE_MEMORY and full frames go on (validation on, no message);
+     9. HD_RENDER_SCALE_AUTO under recording takes its first scale from the device time of the
+        last recorded frame: full frames with a budget of 100 of them, reduced with an eighth;
+    10. hd_vulkan_record_render into the caller's image (R16G16B16A16_SFLOAT, R32G32B32A32_SFLOAT,
+        R8G8B8A8_UNORM and _SRGB, B8G8R8A8_UNORM) and buffer (offset, padded pitch), after the
+        caller's own clear in the same command buffer: the region byte for byte hd_read_image_ex's,
+        nothing outside it changed; refusals (region, negative y, format, size, image and buffer,
+        layout, short buffer) one error each; core and synchronization validation, no message;
+    11. frames over converged light under recording: light_converged reached, then no light
+        iteration recorded, frame_window frames and then none, the write every call equal to the
+        read-back (no message);
+    12. hd_vulkan_record_depth from the caller's VkBuffer and D32_SFLOAT image in the same
+        command buffer as the frame: bit for bit hd_set_depth's image; refusals one error each
+        (no message);
+    13. hd_vulkan_record_illumination into the caller's buffer and 3D R32_SFLOAT image, 1 and 3
+        channels: bit for bit hd_read_illumination's E + phi, texels past the grid kept, the light
+        after hd_refine, the light at the call before a frame's iteration; refusals one error each
+        (no message);
+    14. hd_vulkan_record_refine, the light alone in the caller's command buffer (HD and CD):
+        followed there by hd_vulkan_record_illumination, the copies are bit for bit
+        hd_read_illumination's E + phi and hd_refine's light on a twin context, the image is kept,
+        the iterations are measured by the next call (not by the copies); a copy after a recorded
+        frame holds the frame's light; refusals one error each (no message).
+   And: every row of a 40x100 projection drawn (the background at every pixel); a volume wider
+   than maxImageDimension3D refused with HD_ERROR_UNSUPPORTED and one error; HD_SOLVER_AUTO's
+   multigrid falls back to red-black under recording while a named multigrid is refused (no
+   message); with no device, the order of the projection's blocks of rows on CPU devices
    (hd__gpu_row_stride) visits every block once at every count up to 4096 and near
    HD_MAX_IMAGE_DIM, and splitting the dispatch's blocks into 2, 3, 4, 8 or 16 contiguous runs
    (llvmpipe's and lavapipe's threads) gives each run blocks from every quarter of the image,
-   within 35 % of a quarter of its blocks each. A 40x100 view of the background (4 blocks, the
-   last partial) is the background at every pixel: every row drawn.
+   within 35 % of a quarter of its blocks each.
    Skips, each reported as SKIPPED with its reason, never as passed: with no Vulkan device
    (found by the runtime's own vkEnumeratePhysicalDevices, not the library) every check that
    needs one; without VK_LAYER_KHRONOS_validation check 1, and the others run without the layer
@@ -622,7 +651,7 @@ static hd_result record_run(hd_context h, int n)
     return r;
 }
 
-/* 7: the image buffer's reduced-frame region: absent at render scale 1, made with the first
+/* 8: the image buffer's reduced-frame region: absent at render scale 1, made with the first
    reduced frame (submitted or recorded); when device memory is short for it, the frame fails
    with HD_ERROR_OUT_OF_DEVICE_MEMORY and the context renders full frames on (validation on, no
    message). */
@@ -662,7 +691,7 @@ static void test_image_room(void)
            ok ? "PASS" : "FAIL", full, full + room, messages);
 }
 
-/* 8: HD_RENDER_SCALE_AUTO while recording picks its first scale from the device time of the last
+/* 9: HD_RENDER_SCALE_AUTO while recording picks its first scale from the device time of the last
    recorded frame, as it does from the measured time of a submitted one: full frames when the
    budget holds many full frames (the prediction from a scale-4 frame, its time times 16, is
    above a full frame's: fixed costs per frame), reduced ones when it holds an eighth of one.
@@ -703,7 +732,7 @@ static void test_record_auto_scale(void)
            first_fit == 1 && first_small >= 2 ? "PASS" : "FAIL", first_fit, 1e3 * t, first_small);
 }
 
-/* 9, 10: hd_vulkan_record_render into the caller's image or buffer. The test's own objects on the
+/* 10, 11: hd_vulkan_record_render into the caller's image or buffer. The test's own objects on the
    backend's device (white box: its function table), so the validation layer (core and
    synchronization, the backend's own instance) sees the caller's commands and the library's. */
 typedef struct vk_obj {
@@ -868,7 +897,7 @@ static void cmd_layout(hd__backend *be, VkCommandBuffer cb, VkImage im, VkImageL
 
 enum { OTW = 50, OTH = 37, ORX = 11, ORY = 6 };
 
-/* 9: each format into a region of the caller's image, and into its buffer: the region equal, byte
+/* 10: each format into a region of the caller's image, and into its buffer: the region equal, byte
    for byte, to hd_read_image_ex of the same format after the caller's submission; everything
    outside as it was; the refusals; no validation message. */
 static void test_output_target(void)
@@ -1036,7 +1065,7 @@ static void test_output_target(void)
            ok && !bad_total && messages == 0 ? "PASS" : "FAIL", bad_total, messages, have_layer ? "" : ": no layer");
 }
 
-/* 10: frames over converged light under recording: hd_vulkan_record_render calls, each submitted
+/* 11: frames over converged light under recording: hd_vulkan_record_render calls, each submitted
    and waited for, reach light_converged 1 (the light measured by the next call); from then on no
    light iteration is recorded (iterations stay), the image restarts and its frames go up to
    frame_window and stop, and the write into the caller's image goes on (equal to the read-back,
@@ -1441,6 +1470,153 @@ static void test_record_illumination(void)
            at_call ? "the light at the call" : "NOT the light at the call", refusals_ok ? "one error each" : "WRONG", messages);
 }
 
+static hd__backend *be_of(hd_context h) { return hd__lookup(h)->vw.be; }
+
+/* 14: hd_vulkan_record_refine, the light alone inside the caller's command buffer: after a frame,
+   three recorded light iterations followed in the same command buffer by
+   hd_vulkan_record_illumination into the caller's 3D R32_SFLOAT image (cleared by the caller in
+   that command buffer first) and into its buffer give, bit for bit, hd_read_illumination's
+   HD_ILLUMINATION_TOTAL after the submission, and the same light as hd_refine(3) on a twin
+   context; the light differs from the one before; the image and its frame count are as they
+   were; the iterations count and are measured by the next call, not by the copies (the light
+   error is that of the same recording without them, and not the one before); a copy recorded
+   after hd_vulkan_record_render in one command buffer holds that frame's refined light.
+   Methods HD and CD. Refusals (NULL command buffer, n 0, PT_SS, solver MULTIGRID) each its own
+   hd_result and one logged error, nothing recorded. No validation message. */
+static void test_record_refine(void)
+{
+    static const hd_method methods[2] = {HD_METHOD_HD, HD_METHOD_CD};
+    int m, ok = 1, same = 1, twin = 1, follows = 1, image_kept = 1, measured = 1, after_frame = 1, refusals_ok = 1;
+    messages = 0;
+    for (m = 0; m < 2; ++m) {
+        hd_desc d = test_desc();
+        hd_context h, ref;
+        hd__backend *be;
+        hd_stats s0, s1, sr;
+        vk_obj buf, im, host;
+        float *before, *tot, *want, *img0, *img1;
+        size_t g, i, npx = (size_t)32 * 24 * 4;
+        int gx, gy, gz, x, y, z;
+        VkDeviceSize bytes, ibytes;
+        vk_cmd c;
+        hd_vulkan_volume_target tb = HD_VULKAN_VOLUME_TARGET_INIT, ti = HD_VULKAN_VOLUME_TARGET_INIT;
+        d.params.method = methods[m];
+        d.vulkan.enable_validation = have_layer;
+        if (hd_create(&d, &h) != HD_SUCCESS || hd_create(&d, &ref) != HD_SUCCESS) { CHECK(0); return; }
+        be = hd__lookup(h)->vw.be;
+        CHECK(hd_iterate(h, 1) == HD_SUCCESS && hd_iterate(ref, 1) == HD_SUCCESS && hd_get_stats(h, &s0) == HD_SUCCESS);
+        gx = s0.illumination_dims[0]; gy = s0.illumination_dims[1]; gz = s0.illumination_dims[2];
+        g = (size_t)gx * gy * gz;
+        bytes = g * sizeof(float);
+        ibytes = (VkDeviceSize)(gx + 1) * (gy + 1) * (gz + 1) * sizeof(float);
+        before = (float *)malloc(g * sizeof(float));
+        tot = (float *)malloc(g * sizeof(float));
+        want = (float *)malloc(g * sizeof(float));
+        img0 = (float *)malloc(npx * sizeof(float));
+        img1 = (float *)malloc(npx * sizeof(float));
+        ok &= before && tot && want && img0 && img1 && vk_buffer(be, 64 + bytes, &buf) && vk_buffer(be, ibytes, &host) &&
+              vk_image_of(be, VK_IMAGE_TYPE_3D, VK_FORMAT_R32_SFLOAT, gx + 1, gy + 1, gz + 1, &im);
+        if (!ok) { CHECK(0); break; }
+        ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, before, g) == HD_SUCCESS;
+        ok &= hd_read_image_f32(h, img0, npx) == HD_SUCCESS;
+        tb.buffer = (uint64_t)buf.buffer; tb.offset = 64; tb.buffer_size = 64 + bytes;
+        ti.image = (uint64_t)im.image; ti.format = VK_FORMAT_R32_SFLOAT;
+        ti.layout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL; ti.final_layout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+        ti.width = gx + 1; ti.height = gy + 1; ti.depth = gz + 1;
+        memset(buf.map, 0xff, (size_t)(64 + bytes));
+        /* the light alone: refined, summed and copied in one command buffer */
+        if (!cmd_begin(be, &c)) { CHECK(0); break; }
+        cmd_clear3d(be, c.cb, im.image, VK_IMAGE_LAYOUT_UNDEFINED);
+        ok &= hd_vulkan_record_refine(h, c.cb, 3) == HD_SUCCESS;
+        ok &= hd_vulkan_record_illumination(h, c.cb, 0, &ti) == HD_SUCCESS;
+        ok &= hd_vulkan_record_illumination(h, c.cb, 0, &tb) == HD_SUCCESS;
+        cmd_read3d(be, c.cb, im.image, host.buffer, gx + 1, gy + 1, gz + 1);
+        ok &= cmd_submit(be, &c, 1);
+        CHECK(ok);
+        /* the read reaches the device: it measures the recorded iterations (hd_get_stats does not) */
+        ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, tot, g) == HD_SUCCESS && hd_get_stats(h, &s1) == HD_SUCCESS;
+        ok &= hd_refine(ref, 3) == HD_SUCCESS && hd_read_illumination(ref, HD_ILLUMINATION_TOTAL, want, g) == HD_SUCCESS &&
+              hd_get_stats(ref, &sr) == HD_SUCCESS;
+        same &= light_equal((const float *)((const char *)buf.map + 64), tot, g);
+        for (z = 0; z <= gz; ++z)
+            for (y = 0; y <= gy; ++y)
+                for (x = 0; x <= gx; ++x) {
+                    float v = ((const float *)host.map)[((size_t)z * (gy + 1) + y) * (gx + 1) + x];
+                    if (x < gx && y < gy && z < gz) same &= memcmp(&v, &tot[((size_t)z * gy + y) * gx + x], sizeof v) == 0;
+                    else same &= v == -7.0f;
+                }
+        twin &= light_equal(tot, want, g);
+        follows &= !light_equal(tot, before, g);
+        for (i = 0, x = 0; i < g; ++i) x += tot[i] > 0.0f;
+        follows &= (size_t)x > g / 20;
+        ok &= hd_read_image_f32(h, img1, npx) == HD_SUCCESS;
+        image_kept &= memcmp(img0, img1, npx * sizeof(float)) == 0 && s1.frames == s0.frames;
+        { /* the copies measured nothing: the error is that of the same recording without them */
+            hd_context solo;
+            hd_stats ss;
+            memset(&ss, 0, sizeof ss);
+            if (hd_create(&d, &solo) == HD_SUCCESS && hd_iterate(solo, 1) == HD_SUCCESS && cmd_begin(be_of(solo), &c)) {
+                ok &= hd_vulkan_record_refine(solo, c.cb, 3) == HD_SUCCESS && cmd_submit(be_of(solo), &c, 1);
+                ok &= hd_read_illumination(solo, HD_ILLUMINATION_TOTAL, want, g) == HD_SUCCESS && hd_get_stats(solo, &ss) == HD_SUCCESS;
+                CHECK(hd_destroy(solo) == HD_SUCCESS);
+            } else ok = 0;
+            measured &= ss.light_error == s1.light_error && light_equal(want, tot, g);
+        }
+        measured &= s1.iterations == s0.iterations + 3 && sr.iterations == s1.iterations && s1.light_error != s0.light_error;
+        if (!measured)
+            fprintf(stderr, "  %s: iterations %llu -> %llu (twin %llu), light error %g -> %g\n", hd_method_name(methods[m]),
+                    (unsigned long long)s0.iterations, (unsigned long long)s1.iterations, (unsigned long long)sr.iterations,
+                    s0.light_error, s1.light_error);
+        /* a copy after a frame in the same command buffer: the frame's refined light */
+        memset(buf.map, 0xff, (size_t)(64 + bytes));
+        if (!cmd_begin(be, &c)) { CHECK(0); break; }
+        ok &= hd_vulkan_record_render(h, c.cb, NULL, NULL) == HD_SUCCESS;
+        ok &= hd_vulkan_record_illumination(h, c.cb, 0, &tb) == HD_SUCCESS;
+        ok &= cmd_submit(be, &c, 1);
+        ok &= hd_read_illumination(h, HD_ILLUMINATION_TOTAL, want, g) == HD_SUCCESS;
+        after_frame &= light_equal((const float *)((const char *)buf.map + 64), want, g) && !light_equal(want, tot, g);
+        if (m == 0) { /* refusals: one error each, nothing recorded */
+            hd_desc dp = test_desc();
+            hd_params p;
+            hd_context pt;
+            unsigned long e0;
+            hd_result r;
+            if (!cmd_begin(be, &c)) { CHECK(0); break; }
+            e0 = err_count; r = hd_vulkan_record_refine(h, NULL, 1);
+            refusals_ok &= r == HD_ERROR_NULL_POINTER && err_count == e0 + 1;
+            e0 = err_count; r = hd_vulkan_record_refine(h, c.cb, 0);
+            refusals_ok &= r == HD_ERROR_INVALID_PARAMETER && err_count == e0 + 1;
+            CHECK(hd_query_desc(h, &dp) == HD_SUCCESS);
+            p = dp.params;
+            p.solver = HD_SOLVER_MULTIGRID;
+            p.diffusion_sweeps = 1;
+            CHECK(hd_set_params(h, &p) == HD_SUCCESS);
+            e0 = err_count; r = hd_vulkan_record_refine(h, c.cb, 1);
+            refusals_ok &= r == HD_ERROR_UNSUPPORTED && err_count == e0 + 1;
+            dp = test_desc();
+            dp.params.method = HD_METHOD_PT_SS;
+            dp.vulkan.enable_validation = have_layer;
+            CHECK(hd_create(&dp, &pt) == HD_SUCCESS);
+            e0 = err_count; r = hd_vulkan_record_refine(pt, c.cb, 1);
+            refusals_ok &= r == HD_ERROR_UNSUPPORTED && err_count == e0 + 1;
+            CHECK(hd_destroy(pt) == HD_SUCCESS);
+            ok &= cmd_submit(be, &c, 1); /* nothing was recorded: an empty command buffer */
+        }
+        vk_free(be, &buf); vk_free(be, &im); vk_free(be, &host);
+        free(before); free(tot); free(want); free(img0); free(img1);
+        CHECK(hd_destroy(h) == HD_SUCCESS && hd_destroy(ref) == HD_SUCCESS);
+    }
+    CHECK(ok && same && twin && follows && image_kept && measured && after_frame && refusals_ok && messages == 0);
+    printf("%s the light alone recorded (hd_vulkan_record_refine, HD and CD): its copy in the same command buffer %s "
+           "hd_read_illumination's E + phi, %s hd_refine's on a twin context, %s the light before; the image %s; iterations %s; "
+           "a copy after a recorded frame %s; refusals %s; %lu validation messages (core and synchronization%s)\n",
+           ok && same && twin && follows && image_kept && measured && after_frame && refusals_ok && messages == 0 ? "PASS" : "FAIL",
+           same ? "bit for bit" : "NOT", twin ? "bit for bit" : "NOT", follows ? "differs from" : "does NOT differ from",
+           image_kept ? "kept" : "CHANGED", measured ? "counted and measured by the next call" : "NOT counted or measured",
+           after_frame ? "holds the frame's refined light" : "does NOT hold the frame's light", refusals_ok ? "one error each" : "WRONG",
+           messages, have_layer ? "" : ": no layer");
+}
+
 /* Every block count's stride makes b -> b p mod n a permutation (p coprime to n), and each
    contiguous run of the dispatch's blocks, as a thread pool of T threads splits them, draws about
    a quarter of its blocks from each quarter of the image (blocks in order would give one run the
@@ -1634,8 +1810,8 @@ int main(void)
         if (!have_layer) {
             ++skips;
             printf("SKIPPED messenger (check 1): VK_LAYER_KHRONOS_validation is not installed (Debian: "
-                   "vulkan-validationlayers); checks 2-7 run without it\n");
-            snprintf(skip_why, sizeof skip_why, "no validation layer: check 1 not run, 2-7 without the layer");
+                   "vulkan-validationlayers); checks 2-14 run without it\n");
+            snprintf(skip_why, sizeof skip_why, "no validation layer: check 1 not run, 2-14 without the layer");
         }
         if (!have_layer || test_messenger()) {
             test_rows_covered();
@@ -1653,6 +1829,7 @@ int main(void)
             test_volume_limit();
             test_record_solver_auto();
             test_record_illumination();
+            test_record_refine();
         }
     }
     if (failures) printf("FAILED\n");
