@@ -1019,10 +1019,9 @@ static void hd__cpu_upsample_row(hd__backend *be, int py)
 {
     const hd__view *vw = be->vw;
     int w = vw->kp.image.x, h = vw->kp.image.y, s = vw->kp.region.y, px, k;
-    int lw = (w + s - 1) / s, lh = (h + s - 1) / s;
-    float fy = hdk_clampf(((float)py + 0.5f) * (float)lh / (float)h - 0.5f, 0.0f, (float)(lh - 1));
-    int y0 = hdk_mini((int)fy, lh - 1), y1 = hdk_mini(y0 + 1, lh - 1);
-    float wy = fy - (float)y0;
+    int lw = (w + s - 1) / s, lh = (h + s - 1) / s, x0, x1, y1;
+    float wx, wy;
+    int y0 = hdk_upsample_axis(py, h, lh, &y1, &wy);
     const float *r0 = be->img + ((size_t)w * h + (size_t)y0 * lw) * 4, *r1 = be->img + ((size_t)w * h + (size_t)y1 * lw) * 4;
     float *o = be->img + (size_t)py * w * 4;
     if (be->up_x && be->up_w == w && be->up_lw == lw) {
@@ -1032,8 +1031,10 @@ static void hd__cpu_upsample_row(hd__backend *be, int py)
         int stream = ((uintptr_t)o & 15u) == 0;
 #endif
         for (px = 0; px < w; ++px) {
-            int x0 = be->up_x[2 * px], x1 = be->up_x[2 * px + 1];
-            float wx = be->up_wx[px], q[4];
+            float q[4];
+            x0 = be->up_x[2 * px];
+            x1 = be->up_x[2 * px + 1];
+            wx = be->up_wx[px];
             for (k = 0; k < 4; ++k) {
                 float top = r0[x0 * 4 + k] + wx * (r0[x1 * 4 + k] - r0[x0 * 4 + k]);
                 float bot = r1[x0 * 4 + k] + wx * (r1[x1 * 4 + k] - r1[x0 * 4 + k]);
@@ -1053,9 +1054,7 @@ static void hd__cpu_upsample_row(hd__backend *be, int py)
         return;
     }
     for (px = 0; px < w; ++px) {
-        float fx = hdk_clampf(((float)px + 0.5f) * (float)lw / (float)w - 0.5f, 0.0f, (float)(lw - 1));
-        int x0 = hdk_mini((int)fx, lw - 1), x1 = hdk_mini(x0 + 1, lw - 1);
-        float wx = fx - (float)x0;
+        x0 = hdk_upsample_axis(px, w, lw, &x1, &wx);
         for (k = 0; k < 4; ++k) {
             float top = r0[x0 * 4 + k] + wx * (r0[x1 * 4 + k] - r0[x0 * 4 + k]);
             float bot = r1[x0 * 4 + k] + wx * (r1[x1 * 4 + k] - r1[x0 * 4 + k]);
@@ -1184,11 +1183,7 @@ static void hd__cpu_upsample_table(const hd__view *vw)
         be->up_w = w;
     }
     for (px = 0; px < w; ++px) {
-        float fx = hdk_clampf(((float)px + 0.5f) * (float)lw / (float)w - 0.5f, 0.0f, (float)(lw - 1));
-        int x0 = hdk_mini((int)fx, lw - 1);
-        be->up_x[2 * px] = x0;
-        be->up_x[2 * px + 1] = hdk_mini(x0 + 1, lw - 1);
-        be->up_wx[px] = fx - (float)x0;
+        be->up_x[2 * px] = hdk_upsample_axis(px, w, lw, &be->up_x[2 * px + 1], &be->up_wx[px]);
     }
     be->up_lw = lw;
 }

@@ -339,8 +339,7 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
 /* One work-item per pixel (x, y); the global size is rounded up to whole work-groups
    (hd__be_project), so items past the image's width or height do nothing. lsum and the table
    (ptab_n entries) as hd_k_project.h reads them, dep the host's depth buffer (a placeholder while
-   depth_dims.z is 0). With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass
-   (hd_k_upsample.h). */
+   depth_dims.z is 0). */
 #define HD__CL_PROJECT(name, is16) \
     __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n, \
                        __global const float *restrict dep) \
@@ -350,11 +349,33 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
         k.f16 = (is16); \
         k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; k.dep = dep; \
         if (px >= p->image.x || py >= p->image.y) return; \
-        if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
-            hdk_upsample_pixel(&k, px, py); \
-        else \
-            hdk_project_pixel(&k, px, py); \
+        hdk_project_pixel(&k, px, py); \
     }
 HD__CL_PROJECT(hd_k_project, 0)
 HD__CL_PROJECT(hd_k_project_half, 1)
+
+/* A reduced frame's upsample pass (hd_k_upsample.h's arithmetic), one work-item per run of
+   HD_CL_UPSAMPLE_RUN pixels of a row (global size (ceil(w / run), h)), the row's source rows
+   found once and each pixel's 4 floats loaded and stored together: on PoCL a work-item per pixel
+   through hdk_upsample_pixel was most of a reduced frame's time (docs/PERFORMANCE.md). */
+#define HD_CL_UPSAMPLE_RUN 16
+__kernel void hd_k_upsample(HD__CL_BUFFERS)
+{
+    int w = p->image.x, h = p->image.y, s = p->region.y, lw = (w + s - 1) / s, lh = (h + s - 1) / s;
+    int px = (int)get_global_id(0) * HD_CL_UPSAMPLE_RUN, py = (int)get_global_id(1), end, x0, x1 = 0, y0, y1 = 0;
+    float wx = 0.0f, wy = 0.0f;
+    __global const float *r0, *r1;
+    if (py >= h) return;
+    y0 = hdk_upsample_axis(py, h, lh, &y1, &wy);
+    r0 = img + ((size_t)w * h + (size_t)y0 * lw) * 4;
+    r1 = img + ((size_t)w * h + (size_t)y1 * lw) * 4;
+    for (end = min(px + HD_CL_UPSAMPLE_RUN, w); px < end; ++px) {
+        float4 a, b, c, d, top, bot;
+        x0 = hdk_upsample_axis(px, w, lw, &x1, &wx);
+        a = vload4(x0, r0); b = vload4(x1, r0); c = vload4(x0, r1); d = vload4(x1, r1);
+        top = a + wx * (b - a);
+        bot = c + wx * (d - c);
+        vstore4(top + wy * (bot - top), (size_t)py * w + px, img);
+    }
+}
 #endif

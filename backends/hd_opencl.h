@@ -41,7 +41,7 @@ enum { HD__CL_CLASSIFY, HD__CL_DIRECT, HD__CL_DIFFUSE, HD__CL_PROJECT = HD__CL_D
        HD__CL_MG_SIG, HD__CL_MG_RESIDUAL, HD__CL_MG_RESTRICT_LINE = HD__CL_MG_RESIDUAL + 4, HD__CL_MG_RESTRICT,
        HD__CL_MG_PROLONG, HD__CL_MG_DIR,
        HD__CL_MG_RES_F64, HD__CL_MG_DOT = HD__CL_MG_RES_F64 + 4, HD__CL_MG_UPDATE, HD__CL_MG_EXTRAP,
-       HD__CL_KERNEL_COUNT };
+       HD__CL_UPSAMPLE, HD__CL_KERNEL_COUNT };
 static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_classify", "hd_k_direct", "hd_k_diffuse", "hd_k_diffuse_rgb", "hd_k_diffuse_surface",
     "hd_k_diffuse_surface_rgb", "hd_k_diffuse_jacobi", "hd_k_diffuse_jacobi_rgb", "hd_k_diffuse_jacobi_surface",
@@ -53,7 +53,7 @@ static const char *const hd__cl_kernel_names[HD__CL_KERNEL_COUNT] = {
     "hd_k_mg_sig", "hd_k_mg_residual", "hd_k_mg_residual_rgb", "hd_k_mg_residual_surface",
     "hd_k_mg_residual_surface_rgb", "hd_k_mg_restrict_line", "hd_k_mg_restrict", "hd_k_mg_prolong", "hd_k_mg_dir", "hd_k_mg_res_f64",
     "hd_k_mg_res_f64_rgb", "hd_k_mg_res_f64_surface", "hd_k_mg_res_f64_surface_rgb", "hd_k_mg_dot", "hd_k_mg_update",
-    "hd_k_mg_extrap"};
+    "hd_k_mg_extrap", "hd_k_upsample"};
 
 /* HD_SOLVER_MULTIGRID's per-level objects besides the grids (hd__gpu_mg_extras) and its grids */
 typedef struct hd__cl_level {
@@ -294,7 +294,7 @@ static hd_result hd__cl_build(const hd__view *vw)
     snprintf(opts, sizeof opts, "-cl-std=CL1.2 -DHD_MAX_LIGHTS=%d -DHD_CL_PROJECTION_PROGRAM", HD_MAX_LIGHTS);
     if ((r = hd__cl_build_program(vw, &be->project_program, opts)) != HD_SUCCESS) return r;
     for (k = 0; k < HD__CL_KERNEL_COUNT; ++k) {
-        int project = k == HD__CL_PROJECT || k == HD__CL_PROJECT_HALF;
+        int project = k == HD__CL_PROJECT || k == HD__CL_PROJECT_HALF || k == HD__CL_UPSAMPLE;
         if (!be->fp64 && k >= HD__CL_MG_RES_F64 && k <= HD__CL_MG_EXTRAP) continue; /* not compiled (HD_MG_F64) */
         be->kernels[k] = clCreateKernel(project ? be->project_program : be->program, hd__cl_kernel_names[k], &e);
         if (e != CL_SUCCESS) { be->kernels[k] = NULL; return hd__cl_fail(vw, e, hd__cl_kernel_names[k], 0, __LINE__); }
@@ -778,14 +778,12 @@ static hd_result hd__cl_project_prepare(const hd__view *vw)
    the same 8-row locality in 2048 pieces. */
 #define HD__CL_PROJECT_GROUP_X 32
 #define HD__CL_PROJECT_GROUP_Y 8
-static hd_result hd__be_project(const hd__view *vw)
+/* Kernel k (bound) over the image in those tiles: fewer items per group where the kernel allows
+   fewer. */
+static hd_result hd__cl_run_tiles(const hd__view *vw, int k)
 {
     hd__backend *be = vw->be;
-    int k = hd__cl_k(vw, HD__CL_PROJECT);
     size_t local[3] = {HD__CL_PROJECT_GROUP_X, HD__CL_PROJECT_GROUP_Y, 1}, wg = 0, gx, gy;
-    cl_int n;
-    hd_result r;
-    if ((r = hd__cl_project_prepare(vw)) != HD_SUCCESS) return r;
     HD__CL_TRY(vw, clGetKernelWorkGroupInfo(be->kernels[k], be->device, CL_KERNEL_WORK_GROUP_SIZE, sizeof wg, &wg, NULL),
                "clGetKernelWorkGroupInfo");
     if (wg < local[0] * local[1]) {
@@ -794,17 +792,32 @@ static hd_result hd__be_project(const hd__view *vw)
     }
     gx = ((size_t)vw->kp.image.x + local[0] - 1) / local[0] * local[0];
     gy = ((size_t)vw->kp.image.y + local[1] - 1) / local[1] * local[1];
+    return hd__cl_run_local(vw, k, 2, gx, gy, 1, local);
+}
+
+static hd_result hd__be_project(const hd__view *vw)
+{
+    hd__backend *be = vw->be;
+    int k = hd__cl_k(vw, HD__CL_PROJECT);
+    cl_int n;
+    hd_result r;
+    if ((r = hd__cl_project_prepare(vw)) != HD_SUCCESS) return r;
     n = be->ptab_n;
     HD__CL_ARG(vw, k, 11, n);
     if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 12, 1, be->dep)) != HD_SUCCESS ||
-        (r = hd__cl_bind(vw, k)) != HD_SUCCESS ||
-        (r = hd__cl_run_local(vw, k, 2, gx, gy, 1, local)) != HD_SUCCESS)
+        (r = hd__cl_bind(vw, k)) != HD_SUCCESS || (r = hd__cl_run_tiles(vw, k)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);
 }
 
-/* The projection's kernel runs the upsample pass too, on HD_FLAG_UPSAMPLE (hd_entry_cl.h). */
-static hd_result hd__be_upsample(const hd__view *vw) { return hd__be_project(vw); }
+#define HD__CL_UPSAMPLE_RUN 16 /* pixels per work-item: HD_CL_UPSAMPLE_RUN in hd_entry_cl.h */
+static hd_result hd__be_upsample(const hd__view *vw)
+{
+    hd_result r;
+    size_t runs = ((size_t)vw->kp.image.x + HD__CL_UPSAMPLE_RUN - 1) / HD__CL_UPSAMPLE_RUN;
+    if ((r = hd__cl_bind_run(vw, HD__CL_UPSAMPLE, 2, runs, (size_t)vw->kp.image.y, 1)) != HD_SUCCESS) return r;
+    return hd__cl_finish(vw);
+}
 
 /* No recording and no GL texture: the core never calls these (hd__be_features). */
 static unsigned hd__be_features(void) { return HD__BE_CL_BUFFER; }

@@ -19,7 +19,6 @@
 #undef HD_FLAG_NO_DIFFUSION
 #undef HD_FLAG_RGB_SCATTERING
 #undef HD_FLAG_SURFACE_BOUNDARY
-#undef HD_FLAG_UPSAMPLE
 #undef HD_FN
 #undef HD_GET
 #undef HD_GET1
@@ -101,6 +100,7 @@
 #undef HD__CL_PROJECT_GROUP_Y
 #undef HD__CL_SOURCE_LINES
 #undef HD__CL_TRY
+#undef HD__CL_UPSAMPLE_RUN
 #undef HD__CONV_SAMPLE
 #undef HD__COST_FRESH
 #undef HD__COST_SLOTS

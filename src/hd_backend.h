@@ -144,7 +144,7 @@ static hd_result hd__be_project(const hd__view *vw);
 /* A reduced frame's upsample pass (hd_k_upsample.h): the frame just projected at render scale
    s > 1 (vw->kp.image at the reduced size, into the image buffer's second region) bilinearly
    filled into the full image's running mean. vw->kp describes the full image, with the scale in
-   region.y and HD_FLAG_UPSAMPLE in counts.z (the GPU entries share the projection's). */
+   region.y. */
 static hd_result hd__be_upsample(const hd__view *vw);
 /* PT_SS / PT_MS: one path per pixel into the image's running mean (hd_k_path.h). */
 static hd_result hd__be_path(const hd__view *vw);

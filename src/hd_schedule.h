@@ -376,7 +376,6 @@ static hd_result hd__project_frame(hd__ctx *ctx)
             ctx->vw.kp.image.y = h;
             ctx->vw.kp.region.x = 0;
             ctx->vw.kp.region.y = s;
-            ctx->vw.kp.counts.z |= HD_FLAG_UPSAMPLE;
             r = hd__be_upsample(&ctx->vw);
         }
         hd__fill_kparams(ctx);

@@ -969,8 +969,8 @@ static void area_cases(const int *odd, const int *other)
 /* The per-frame API: light refined without frames (hd_refine) until it converges, then frames
    from the converged light (hd_render) before and after a camera move; both sides must agree on
    the light, the image, and the iteration and frame counts. With scale != 0 (params.render_scale)
-   the frames are marched at the reduced size and upsampled on the device (the projection's entry
-   point with HD_FLAG_UPSAMPLE, hd_k_upsample.h): a fixed divisor (3: 48x40 -> 16x14, not a
+   the frames are marched at the reduced size and upsampled on the device (the upsample's entry
+   point, hd_k_upsample.h): a fixed divisor (3: 48x40 -> 16x14, not a
    divisor of the height) or HD_RENDER_SCALE_AUTO (1/4, 1/2, then full frames); both sides must
    also agree on the scale and the image size. */
 static void case_render_at(hd_method method, hd_voxel_type type, const int *d, int lights, int scale, int n)
