@@ -82,7 +82,7 @@ int main(int argc, char **argv)
     char err[512];
     hd_context h[9];
     hd_light axis[6];
-    double sec[9][MAX_ROUNDS], med[9], mean_dir;
+    double sec[9][MAX_ROUNDS], sdir[9][MAX_ROUNDS], med[9], mean_dir;
     static const char *names[9] = {"one directional light", "environment (colour)", "environment (grey)",
                                    "directional toward +x", "directional toward -x", "directional toward +y",
                                    "directional toward -y", "directional toward +z", "directional toward -z"};
@@ -154,6 +154,7 @@ int main(int argc, char **argv)
             if (hd_refine(h[k], 2) != HD_SUCCESS) return 1;
             hd_get_stats(h[k], &b);
             sec[k][r] = (b.seconds_direct + b.seconds_diffusion - a.seconds_direct - a.seconds_diffusion) / 2.0;
+            sdir[k][r] = (b.seconds_direct - a.seconds_direct) / 2.0;
         }
     printf("hdbench_env: head CT %dx%dx%d, map %s %dx%d, HD light iterations, %d interleaved rounds of 2\n", vf.desc.dims[0],
            vf.desc.dims[1], vf.desc.dims[2], env_path, env.width, env.height, rounds);
@@ -162,8 +163,9 @@ int main(int argc, char **argv)
         med[k] = hdb_median(sec[k], rounds);
         if (k == 0 || k >= 3) mean_dir += med[k] / (nctx - 2);
         hd_get_stats(h[k], &st);
-        printf("  %-24s %7.3f s per iteration (%.2fx)  %d channel%s  method_bytes %zu\n", names[k], med[k], med[k] / med[0],
-               st.illumination_channels, st.illumination_channels == 1 ? " " : "s", st.method_bytes);
+        printf("  %-24s %7.3f s per iteration (%.2fx), direct light %.3f s  %d channel%s  method_bytes %zu\n", names[k], med[k],
+               med[k] / med[0], hdb_median(sdir[k], rounds), st.illumination_channels, st.illumination_channels == 1 ? " " : "s",
+               st.method_bytes);
     }
     printf("  the map's tables: %zu bytes, %.2f per texel\n", (4 * (size_t)env.width * env.height + 2 * (size_t)env.height + 1) * sizeof(float),
            (4.0 * env.width * env.height + 2.0 * env.height + 1.0) * 4.0 / ((double)env.width * env.height));
