@@ -561,6 +561,14 @@ typedef struct hd_params {
     float depth_threshold;  /* the volume's depth (hd_read_depth) is where a camera ray's
                                accumulated opacity 1 - T first reaches this: 0 -> 0.5; (0, 1]
                                (1: where the march stops, T below 1e-4) */
+    int environment_background; /* 1: camera rays that leave the volume (HD's and CD's projection,
+                               the path tracers' primary rays) see the environment (hd_set_environment)
+                               behind it: T times its radiance in the ray's direction (rotated and
+                               scaled by intensity, as its light), added to params.background.
+                               The output is premultiplied: such a pixel's alpha is 1, not
+                               1 - T, so a host compositing the volume over its own scene
+                               leaves this 0 (default). No effect without an environment (nor
+                               where hd_set_depth's geometry is); 0 or 1 */
 } hd_params;
 
 #define HD_RENDER_SCALE_AUTO (-1) /* hd_params.render_scale: coarse frames first at each new image */
@@ -737,7 +745,8 @@ HDDEF hd_result hd_set_depth(hd_context ctx, const hd_depth_desc *depth);
    texel on the device), the transmittance tracked to the box's edge, the sample weighted by
    radiance over pdf. PT_SS and PT_MS sample it by next-event estimation, and PT_MS's scattered
    paths that leave the box see it, the two combined by multiple importance sampling (balance
-   heuristic). HD_METHOD_CD, one light volume per light, cannot hold it (HD_ERROR_UNSUPPORTED,
+   heuristic). params.environment_background shows it behind the volume to the camera's rays.
+   HD_METHOD_CD, one light volume per light, cannot hold it (HD_ERROR_UNSUPPORTED,
    also from hd_set_params choosing CD while one is set). Errors, each with one logged line and
    nothing changed: HD_ERROR_INVALID_DIMENSIONS (a size outside 1..HD_MAX_ENVIRONMENT_DIM),
    HD_ERROR_NULL_POINTER (rgb NULL), HD_ERROR_INVALID_ENVIRONMENT (a NaN, infinite or negative

@@ -339,15 +339,16 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
 /* One work-item per pixel (x, y); the global size is rounded up to whole work-groups
    (hd__be_project), so items past the image's width or height do nothing. lsum and the table
    (ptab_n entries) as hd_k_project.h reads them, dep the host's depth buffer (a placeholder while
-   depth_dims.z is 0). */
+   depth_dims.z is 0), env the environment's tables (shown behind the volume while background.w
+   is 1; a placeholder while env.x is 0). */
 #define HD__CL_PROJECT(name, is16) \
     __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n, \
-                       __global const float *restrict dep) \
+                       __global const float *restrict dep, __global const float *restrict env) \
     { \
         int px = (int)get_global_id(0), py = (int)get_global_id(1); \
         HD__CL_KCTX; \
         k.f16 = (is16); \
-        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; k.dep = dep; \
+        k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; k.dep = dep; k.env = env; \
         if (px >= p->image.x || py >= p->image.y) return; \
         hdk_project_pixel(&k, px, py); \
     }

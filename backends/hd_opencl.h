@@ -85,7 +85,7 @@ struct hd__backend {
                                 projection's argument 12, the path kernel's 9 */
     size_t dep_floats;       /* what dep holds (0: the placeholder) */
     cl_mem env;              /* the environment's tables (vw->env; a placeholder without one): the
-                                direct kernels' argument 11, the path kernel's 10 */
+                                direct kernels' argument 12, the path kernel's 11, the projection's 13 */
     cl_mem lv[HD_MAX_LIGHTS + 1]; /* CD: gg.nlv light volumes + one spare (the ping-pong buffer) */
     /* the projection's own inputs (hd__cl_project_prepare): E + phi summed x-fastest, valid while
        gg.lsum_ok (backends/hd_gpu.h), and the step's TF table (ptab_n
@@ -804,7 +804,7 @@ static hd_result hd__be_project(const hd__view *vw)
     if ((r = hd__cl_project_prepare(vw)) != HD_SUCCESS) return r;
     n = be->ptab_n;
     HD__CL_ARG(vw, k, 11, n);
-    if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 12, 1, be->dep)) != HD_SUCCESS ||
+    if ((r = hd__cl_mems(vw, k, 9, 2, be->lsum, be->ptab)) != HD_SUCCESS || (r = hd__cl_mems(vw, k, 12, 2, be->dep, be->env)) != HD_SUCCESS ||
         (r = hd__cl_bind(vw, k)) != HD_SUCCESS || (r = hd__cl_run_tiles(vw, k)) != HD_SUCCESS)
         return r;
     return hd__cl_finish(vw);

@@ -46,6 +46,13 @@ HD_FN hd_v3 hdk_normalize(hd_v3 a) { return hdk_scale(a, 1.0f / hdk_len(a)); }
 
 #define hdk_log(x) logf(x)
 #define hdk_exp(x) expf(x)
+/* float trigonometry (hd_k_light.h's default is the double functions): the environment's and the
+   area lights' samples, the phase function's direction */
+#define HD_PRELUDE_HAS_TRIG 1
+#define hdk_cos(x) cosf(x)
+#define hdk_sin(x) sinf(x)
+#define hdk_acos(x) acosf(x)
+#define hdk_atan2(y, x) atan2f((y), (x))
 #define hdk_sqrt(x) sqrtf(x)
 #define hdk_floor(x) floorf(x)
 #define hdk_absf(x) fabsf(x)

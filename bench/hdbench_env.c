@@ -2,14 +2,17 @@
    light, in one process: the evaluation's scene (ct-skin, extinction 100, albedo 0.9, the face
    camera, hdrender's crop box), the key light, or the map given (a Radiance .hdr, top on +z as
    hdrender puts it) at intensity --intensity, in colour and averaged to grey. Prints
-   - the HD iteration's cost: light iterations (hd_refine) of the three contexts interleaved in
+   - the HD iteration's cost: light iterations (hd_refine) of the contexts interleaved in
      rounds, the median seconds per iteration of each and the ratio to the directional light's;
+     with --directions also one directional light from each of the 6 axis directions, and the
+     maps' ratios to the mean over the 7 directional lights (the walk's cost depends on the
+     direction: the head CT is shortest along z);
    - hd_stats.method_bytes of each, and what the map's tables add per texel;
    - PSNR of HD after 32 iterations against PT_MS at --paths paths per pixel (two halves with
      independent seeds: the reference's own PSNR too), tone map sRGB(clamp(8 L)) per channel,
      for the directional light and the coloured map.
    Figures, not a test. Usage: hdbench_env [--size N] [--paths N] [--rounds N] [--intensity X]
-   ENV.hdr [data/head.nrrd] */
+   [--directions] [--cost-only] ENV.hdr [data/head.nrrd] (--cost-only: no PSNR part) */
 #define HYBRIDDIFF_IMPLEMENTATION
 #define HYBRIDDIFF_BACKEND_CPU
 #include "hybriddiff.h"
@@ -36,17 +39,20 @@ static double mean_rgb(const float *a, int n)
 static hd_desc g_desc;
 static hd_light g_key;
 
-/* A context of method m lit by the key light (env NULL) or env alone. */
-static hd_context make(hd_method m, const hd_environment *env, unsigned seed)
+/* A context of method m lit by the directional light l (NULL: the key light; env NULL) or env
+   alone. */
+static hd_context make_lit(hd_method m, const hd_light *l, const hd_environment *env, unsigned seed)
 {
     hd_desc d = g_desc;
     hd_context h;
     d.params.method = m;
     d.params.seed = seed;
+    if (l) d.lights = l;
     if (hd_create(&d, &h) != HD_SUCCESS) exit(1);
     if (env && (hd_set_environment(h, env) != HD_SUCCESS || hd_set_lights(h, NULL, 0) != HD_SUCCESS)) exit(1);
     return h;
 }
+static hd_context make(hd_method m, const hd_environment *env, unsigned seed) { return make_lit(m, NULL, env, seed); }
 
 /* PT_MS at `paths` paths per pixel in two halves; the mean into ref, the halves' PSNR returned. */
 static double reference(const hd_environment *env, int paths, float *ref, float *tmp, int npix)
@@ -67,22 +73,27 @@ static double reference(const hd_environment *env, int paths, float *ref, float 
 int main(int argc, char **argv)
 {
     const char *env_path = NULL, *vol_path = "data/head.nrrd";
-    int size = 128, paths = 1024, rounds = 8, i, r, k, npix;
+    int size = 128, paths = 1024, rounds = 8, i, r, k, npix, dirs = 0, cost_only = 0, nctx;
     float intensity = 0.2f;
     static const float up[3] = {0.0f, 0.0f, 1.0f};
     hd_volume_file vf;
     hdx_tf tf;
     hd_environment env, grey;
     char err[512];
-    hd_context h[3];
-    double sec[3][MAX_ROUNDS], med[3];
-    static const char *names[3] = {"one directional light", "environment (colour)", "environment (grey)"};
+    hd_context h[9];
+    hd_light axis[6];
+    double sec[9][MAX_ROUNDS], sdir[9][MAX_ROUNDS], med[9], mean_dir;
+    static const char *names[9] = {"one directional light", "environment (colour)", "environment (grey)",
+                                   "directional toward +x", "directional toward -x", "directional toward +y",
+                                   "directional toward -y", "directional toward +z", "directional toward -z"};
     float *img, *ref, *tmp, *grey_rgb;
     for (i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--size") && i + 1 < argc) size = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--paths") && i + 1 < argc) paths = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = atoi(argv[++i]);
         else if (!strcmp(argv[i], "--intensity") && i + 1 < argc) intensity = (float)atof(argv[++i]);
+        else if (!strcmp(argv[i], "--directions")) dirs = 1;
+        else if (!strcmp(argv[i], "--cost-only")) cost_only = 1;
         else if (!env_path) env_path = argv[i];
         else vol_path = argv[i];
     }
@@ -124,33 +135,47 @@ int main(int argc, char **argv)
     tmp = (float *)malloc((size_t)npix * 4 * sizeof(float));
 
     /* cost: interleaved rounds of 2 light iterations per context */
+    nctx = dirs ? 9 : 3;
     h[0] = make(HD_METHOD_HD, NULL, 1u);
     h[1] = make(HD_METHOD_HD, &env, 1u);
     h[2] = make(HD_METHOD_HD, &grey, 1u);
-    for (k = 0; k < 3; ++k) hd_refine(h[k], 1); /* uploads and the first iteration outside the timing */
+    for (k = 3; k < nctx; ++k) {
+        hd_light *l = &axis[k - 3];
+        *l = g_key;
+        l->direction[0] = l->direction[1] = l->direction[2] = 0.0f;
+        l->direction[(k - 3) / 2] = (k - 3) % 2 == 0 ? 1.0f : -1.0f;
+        h[k] = make_lit(HD_METHOD_HD, l, NULL, 1u);
+    }
+    for (k = 0; k < nctx; ++k) hd_refine(h[k], 1); /* uploads and the first iteration outside the timing */
     for (r = 0; r < rounds; ++r)
-        for (k = 0; k < 3; ++k) {
+        for (k = 0; k < nctx; ++k) {
             hd_stats a, b;
             hd_get_stats(h[k], &a);
             if (hd_refine(h[k], 2) != HD_SUCCESS) return 1;
             hd_get_stats(h[k], &b);
             sec[k][r] = (b.seconds_direct + b.seconds_diffusion - a.seconds_direct - a.seconds_diffusion) / 2.0;
+            sdir[k][r] = (b.seconds_direct - a.seconds_direct) / 2.0;
         }
     printf("hdbench_env: head CT %dx%dx%d, map %s %dx%d, HD light iterations, %d interleaved rounds of 2\n", vf.desc.dims[0],
            vf.desc.dims[1], vf.desc.dims[2], env_path, env.width, env.height, rounds);
-    for (k = 0; k < 3; ++k) {
+    for (k = 0, mean_dir = 0.0; k < nctx; ++k) {
         hd_stats st;
         med[k] = hdb_median(sec[k], rounds);
+        if (k == 0 || k >= 3) mean_dir += med[k] / (nctx - 2);
         hd_get_stats(h[k], &st);
-        printf("  %-24s %7.3f s per iteration (%.2fx)  %d channel%s  method_bytes %zu\n", names[k], med[k], med[k] / med[0],
-               st.illumination_channels, st.illumination_channels == 1 ? " " : "s", st.method_bytes);
+        printf("  %-24s %7.3f s per iteration (%.2fx), direct light %.3f s  %d channel%s  method_bytes %zu\n", names[k], med[k],
+               med[k] / med[0], hdb_median(sdir[k], rounds), st.illumination_channels, st.illumination_channels == 1 ? " " : "s",
+               st.method_bytes);
     }
     printf("  the map's tables: %zu bytes, %.2f per texel\n", (4 * (size_t)env.width * env.height + 2 * (size_t)env.height + 1) * sizeof(float),
            (4.0 * env.width * env.height + 2.0 * env.height + 1.0) * 4.0 / ((double)env.width * env.height));
-    for (k = 0; k < 3; ++k) hd_destroy(h[k]);
+    if (dirs)
+        printf("  mean over the 7 directional lights %.3f s: colour map %.2fx, grey map %.2fx (the key light %.2fx)\n", mean_dir,
+               med[1] / mean_dir, med[2] / mean_dir, med[0] / mean_dir);
+    for (k = 0; k < nctx; ++k) hd_destroy(h[k]);
 
     /* quality: HD after 32 iterations against PT_MS */
-    for (k = 0; k < 2; ++k) {
+    for (k = 0; k < (cost_only ? 0 : 2); ++k) {
         const hd_environment *e = k == 0 ? NULL : &env;
         double floor_db = reference(e, paths, ref, tmp, npix), p;
         hd_context hd = make(HD_METHOD_HD, e, 7u);

@@ -106,6 +106,7 @@ static const char *usage_text =
     "                          environment light from a Radiance .hdr lat-long map, its\n"
     "                          top toward --up, turned ROTATION degrees about it; alone,\n"
     "                          or beside --light / --lights (scripts/make-env writes one)\n"
+    "  --env-background        show the --env map behind the volume (alpha 1 there)\n"
     "\n"
     "camera (default: in front of the face, for the head CT's axes: face +y, top +z;\n"
     "        data/brainsmall.nrrd: its left side, from the front and above)\n"
@@ -926,6 +927,9 @@ int main(int argc, char **argv)
         } else if (IS("--env")) {
             if (env_arg) fail(2, "--env: given twice");
             env_arg = parse_env(VAL(), &env_rot, &env_intensity, env_path, sizeof env_path);
+        } else if (IS("--env-background")) {
+            FLAG();
+            desc.params.environment_background = 1;
         } else if (IS("--eye")) {
             parse_floats_in(a, VAL(), desc.camera.eye, 3, HD_MAX_CAMERA_DISTANCE);
             camera_given = 1;
@@ -1107,6 +1111,7 @@ int main(int argc, char **argv)
 
     /* ---- lights, the rest ---- */
     memset(&env, 0, sizeof env);
+    if (desc.params.environment_background && !env_arg) fail(2, "--env-background: needs --env");
     if (env_arg) {
         if (!hdx_env_load(env_arg, &env, err, sizeof err)) fail(2, "--env: %s", err);
         env.intensity = env_intensity;

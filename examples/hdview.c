@@ -23,6 +23,7 @@
      I / shift+I  move the selected face 0.02 of the volume in / out (the box shrinks / grows)
      U         crop box: the whole volume / the volume's default (data/head.nrrd: no head rest)
      V / shift+V  turn the environment (--env FILE.hdr[:ROTATION][:INTENSITY]) 15 degrees about +z
+     K         the environment shown behind the volume / not (params.environment_background)
      P         preview on / off: while the camera moves, frames at reduced resolution (render_scale
                HD_RENDER_SCALE_AUTO, the scale whose frame time fits 50 ms), refined to full
                resolution when it stops; on by default in the window, off in scripted runs
@@ -325,6 +326,12 @@ static void key_char(viewer *v, int c)
             hdx_env_rotation(up, v->env_deg, v->env.rotation);
             if ((r = hd_set_environment(v->ctx, &v->env)) != HD_SUCCESS) die("hd_set_environment", r);
             fprintf(stderr, "hdview: environment turned %g degrees\n", (double)v->env_deg);
+        }
+        break;
+    case 'k': case 'K': /* the environment behind the volume, on / off */
+        if (v->env.rgb) {
+            v->params.environment_background = !v->params.environment_background;
+            apply_params(v);
         }
         break;
     case 'l': case 'L':

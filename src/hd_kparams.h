@@ -162,6 +162,7 @@ static void hd__fill_kparams(hd__ctx *ctx)
     k->background.x = ctx->vw.params.background[0];
     k->background.y = ctx->vw.params.background[1];
     k->background.z = ctx->vw.params.background[2];
+    k->background.w = ctx->env_on && ctx->vw.params.environment_background ? 1.0f : 0.0f; /* hdk_env_background */
     k->vstore.x = ctx->vw.vtype;
     k->vnorm.x = ctx->vw.vnorm[0]; k->vnorm.y = ctx->vw.vnorm[1];
     k->chan_color.x = ctx->chan_color[0]; k->chan_color.y = ctx->chan_color[1]; k->chan_color.z = ctx->chan_color[2];

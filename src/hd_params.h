@@ -76,7 +76,8 @@
     INT(light_window, 8, 1, 1000000, "in 1..1000000", HD__INV_NONE) \
     ENUM(rest, hd_rest, HD_REST_HOLD, HD_REST_COUNT, HD__INV_IMAGE) \
     INT(refine_bounces, -1, -1, 100000, "-1 or 1..100000", HD__INV_IMAGE) \
-    FLOAT(depth_threshold, 0.5f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_IMAGE)
+    FLOAT(depth_threshold, 0.5f, 0.0f, 1.0f, 0, "in (0, 1]", HD__INV_IMAGE) \
+    BOOL(environment_background, HD__INV_IMAGE)
 
 /* ---- HD_SOLVER_AUTO -------------------------------------------------------------------------------
    Red-black's iterations to converge grow with the grid (18 at the head CT's 0.9 M grid voxels,

@@ -376,6 +376,74 @@ static void test_env_bad_input(void)
 #undef TE_BAD
 }
 
+/* params.environment_background on an empty volume: every camera ray leaves with T = 1 and shows
+   the map's texel in its direction (turned 30 degrees about +y, times the intensity) over
+   params.background, alpha 1; HD's projection and PT_MS's primary rays alike. The camera's
+   field (2 degrees) stays inside one texel of a 15 x 7 map whose texels all differ. Off, or
+   without a map, the pixels are the background with alpha 0. */
+static void test_env_background(void)
+{
+    static const float clear[8] = {0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f, 1.0f};
+    static float rgb[15 * 7 * 3], img[8 * 8 * 4];
+    const int w = 15, h = 7;
+    const double ang = TE_PI / 6.0, bg[3] = {0.01, 0.02, 0.03};
+    hd_environment env = HD_ENVIRONMENT_INIT;
+    hd_desc d;
+    hd_context ctx;
+    int i, j, k, m, ti = -1, tj = -1;
+    for (j = 0; j < h; ++j)
+        for (i = 0; i < w; ++i) {
+            float *px = rgb + 3 * (j * w + i);
+            px[0] = 0.1f + (float)i; px[1] = 0.2f + (float)j; px[2] = 0.3f + (float)(i * j);
+        }
+    env.width = w; env.height = h; env.rgb = rgb; env.intensity = 0.5f;
+    env.rotation[0] = (float)cos(ang); env.rotation[2] = (float)sin(ang); env.rotation[4] = 1.0f;
+    env.rotation[6] = -(float)sin(ang); env.rotation[8] = (float)cos(ang);
+    /* the texel of the camera's central ray and of its corners' (world -z, -+0.0175 x and y):
+       the map direction is R^T times the world's */
+    for (k = 0; k < 5; ++k) {
+        double wd[3] = {k == 0 ? 0.0 : (k & 1 ? 0.0175 : -0.0175), k == 0 ? 0.0 : (k & 2 ? 0.0175 : -0.0175), -1.0}, md[3], n, th, ph;
+        n = sqrt(wd[0] * wd[0] + wd[1] * wd[1] + wd[2] * wd[2]);
+        for (m = 0; m < 3; ++m) md[m] = (env.rotation[m] * wd[0] + env.rotation[3 + m] * wd[1] + env.rotation[6 + m] * wd[2]) / n;
+        th = acos(md[1]);
+        ph = atan2(md[2], md[0]);
+        if (ph < 0.0) ph += 2.0 * TE_PI;
+        i = (int)(ph / (2.0 * TE_PI) * w);
+        j = (int)(th / TE_PI * h);
+        if (k == 0) { ti = i; tj = j; }
+        CHECK(i == ti && j == tj);
+    }
+    CHECK(ti == 12 && tj == 3);
+    for (i = 0; i < 16 * 16 * 16; ++i) te_vol[i] = 0;
+    for (k = 0; k < 4; ++k) {
+        /* k: 0 HD, 1 PT_MS, 2 HD without the map, 3 HD with the map and the parameter off */
+        te_desc(&d, 8, 8, 8, 4.0f);
+        for (i = 0; i < 8 * 8 * 8; ++i) te_vol[i] = 0;
+        d.transfer_function.rgba = clear;
+        d.params.method = k == 1 ? HD_METHOD_PT_MS : HD_METHOD_HD;
+        d.params.environment_background = k == 3 ? 0 : 1;
+        for (m = 0; m < 3; ++m) d.params.background[m] = (float)bg[m];
+        d.camera.fov_y = 2.0f;
+        CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
+        if (k != 2) CHECK(hd_set_environment(ctx, &env) == HD_SUCCESS);
+        CHECK(hd_iterate(ctx, 3) == HD_SUCCESS);
+        CHECK(hd_read_image_f32(ctx, img, 8 * 8 * 4) == HD_SUCCESS);
+        for (i = 0; i < 64; ++i) {
+            const float *tx = rgb + 3 * (tj * w + ti);
+            int shown = k < 2;
+            for (m = 0; m < 3; ++m) {
+                double want = bg[m] + (shown ? 0.5 * (double)tx[m] : 0.0);
+                CHECK_MSG(fabs((double)img[4 * i + m] - want) <= 1e-5 * want, "case %d pixel %d channel %d: %g, want %g", k, i, m,
+                          (double)img[4 * i + m], want);
+            }
+            CHECK_MSG(img[4 * i + 3] == (shown ? 1.0f : 0.0f), "case %d pixel %d alpha %g", k, i, (double)img[4 * i + 3]);
+        }
+        if (k == 0) printf("  background: pixel 0 (%.4f, %.4f, %.4f, %.1f), texel (%d, %d) * 0.5 + background\n", (double)img[0],
+                           (double)img[1], (double)img[2], (double)img[3], ti, tj);
+        hd_destroy(ctx);
+    }
+}
+
 const hd_test_case hd_tests_environment[] = {
     {"env_uniform_slab_matches_exact", test_env_uniform_slab},
     {"env_importance_matches_quadrature", test_env_importance_matches_quadrature},
@@ -383,5 +451,6 @@ const hd_test_case hd_tests_environment[] = {
     {"env_pt_ms_equilibrium", test_env_pt_ms_equilibrium},
     {"env_method_bytes", test_env_method_bytes},
     {"env_bad_input", test_env_bad_input},
+    {"env_background", test_env_background},
 };
 const int hd_tests_environment_count = (int)(sizeof hd_tests_environment / sizeof hd_tests_environment[0]);

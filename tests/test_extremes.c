@@ -1274,7 +1274,7 @@ static void test_float_coverage(void)
     static const char *not_float[] = {"method", "solver", "diffusion_sweeps", "disable_diffusion", "tracking", "seed",
                                       "frame_window", "max_bounces", "illumination_downsample", "rgb_scattering",
                                       "diffusion_boundary", "illumination_precision", "render_scale", "light_window", "rest",
-                                      "refine_bounces"};
+                                      "refine_bounces", "environment_background"};
     int i, rows = hdt_param_rows();
     CHECK(rows >= 24);
     for (i = 0; i < rows; ++i) {

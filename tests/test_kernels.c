@@ -426,7 +426,7 @@ static void project_pixel_span(const hd__kctx *k, int x, int y, int spans)
     hd_v4 m;
     hdk_project_ray(k, x, y, &pe, &d, &len, &s0, &geo);
     m = hdk_project_march_span(k, pe, d, len, s0, spans, &xs);
-    hdk_project_finish(k, y * k->p->image.x + x, m, geo, xs >= 0.0f ? hdk_depth_q(k, hdk_madd(pe, d, xs)) : 0.0f);
+    hdk_project_finish(k, y * k->p->image.x + x, m, geo, xs >= 0.0f ? hdk_depth_q(k, hdk_madd(pe, d, xs)) : 0.0f, d);
 }
 
 /* The projection's empty-space skip is exact: the fixture's scene projected through the true

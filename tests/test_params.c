@@ -47,6 +47,7 @@ static int param_change(const char *name, hd_params *p)
     F(rest, p->rest = HD_REST_REFINE)
     F(refine_bounces, p->refine_bounces = 2)
     F(depth_threshold, p->depth_threshold = 0.8f)
+    F(environment_background, p->environment_background = 1)
 #undef F
     return 0;
 }

@@ -135,6 +135,19 @@ HD_FN int hdk_env_texel(HD_KARGS hd_v3 d, HD_INOUT(float) st)
     return j * w + i;
 }
 
+/* What a camera ray that leaves the volume in direction d (volume frame, unit) sees behind it:
+   params.background, plus the environment's radiance in d (its texel's, rotated and scaled as
+   the light) where it is shown (background.w = 1, only with a map set). */
+HD_FN hd_v3 hdk_env_background(HD_KARGS hd_v3 d)
+{
+    hd_v3 b = HD_XYZ(HD_PRM(background));
+    if (HD_PRM(background).w > 0.5f) {
+        float st = 0.0f;
+        b = hdk_add(b, hdk_env_rgb(HD_KPASS hdk_env_texel(HD_KPASS d, HD_REF(st))));
+    }
+    return b;
+}
+
 /* A direction toward the environment drawn by importance from xi0 (the row) and xi1 (the texel
    in it), in the volume's frame; its density per steradian in *pdf (> 0), its texel in *t. */
 HD_FN hd_v3 hdk_env_sample(HD_KARGS float xi0, float xi1, HD_INOUT(float) pdf, HD_INOUT(int) t)

@@ -39,7 +39,8 @@ HD_PARAM_F4(depth_m2)
 HD_PARAM_F4(depth_m3)
 HD_PARAM_F4(depth_q)    /* the volume's depth out (hdk_depth_q): the numerator's row over the volume's frame */
 HD_PARAM_F4(depth_w)    /* its denominator's row (clip w); all 0 without a matrix camera */
-HD_PARAM_F4(background) /* rgb radiance behind the volume */
+HD_PARAM_F4(background) /* rgb radiance behind the volume; w = 1: the environment shows behind it too
+                           (params.environment_background with a map set, hdk_env_background) */
 HD_PARAM_F4(chan_color) /* with 1 channel: the lights' common colour, applied at projection */
 HD_PARAM_F4(crop_lo)    /* xyz = the crop box's low corner in texture coordinates; w = 1: on */
 HD_PARAM_F4(crop_hi)    /* xyz = its high corner */

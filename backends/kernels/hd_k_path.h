@@ -21,7 +21,8 @@
    ray, isotropic phase; so PT_MS with max_bounces = 1 and g = 0 is the same estimator.
    Every loop is bounded: at most counts.w (max_bounces <= 100000) vertices per path, each
    free flight and shadow ray at most HD_MAX_TRACK_STEPS (hdk_track).
-   A camera ray that leaves the box unscattered sees the background; a scattered ray that leaves
+   A camera ray that leaves the box unscattered sees the background (and the environment where
+   it is shown, hdk_env_background, with alpha 1); a scattered ray that leaves
    sees the environment (if one is set) with the other weight of the pair, p / (P q + p), so
    each direction is counted once; the background is a backdrop, not a light, as in HD's
    projection. Alpha is 1 if
@@ -101,7 +102,10 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
     hd_v3 p = hdk_madd(o, d, t0);
     float tmax = t1 - t0;
     if (!(t0 < t1)) { /* misses the box */
-        if (geo == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
+        if (geo == 0) {
+            hd_v3 bk = hdk_env_background(HD_KPASS d);
+            lr = bk.x; lg = bk.y; lb = bk.z;
+        }
         tmax = 0.0f;
     } else if (geo != 0) { /* the first free flight ends at the scene's surface */
         tmax = hdk_maxf(hdk_minf(tmax, td - t0), 0.0f);
@@ -115,7 +119,10 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         hd_v3 ld, lw = HD_V3(0.0f, 0.0f, 0.0f);
         dim = nd;
         if (!(t < tmax)) {
-            if (vertices == 0 && geo == 0) { lr = HD_PRM(background).x; lg = HD_PRM(background).y; lb = HD_PRM(background).z; }
+            if (vertices == 0 && geo == 0) {
+                hd_v3 bk = hdk_env_background(HD_KPASS d);
+                lr = bk.x; lg = bk.y; lb = bk.z;
+            }
             if (vertices > 0 && HD_PRM(env).x > 0) { /* a scattered ray that leaves sees the environment */
                 float st = 0.0f;
                 int et = hdk_env_texel(HD_KPASS d, HD_REF(st));
@@ -172,5 +179,6 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         dim += 2u;
         tmax = hdk_box_exit(HD_KPASS p, d);
     }
+    if (geo == 0 && HD_PRM(background).w > 0.5f) alpha = 1.0f; /* the environment fills the pixel */
     hdk_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
 }

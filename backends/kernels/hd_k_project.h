@@ -348,15 +348,17 @@ HD_FN void hdk_project_depth(HD_KARGS int i, float q)
     HD_SET1(img, j, HD_PRM(march).y == 1.0f ? q : hdk_maxf(HD_GET1(img, j), q));
 }
 
-/* Folds the march's (r, g, b, T) into pixel i: the background behind it (none where the host's
-   geometry is, geo = 1), and T = 0 where the march stopped on it; and the crossing's q (0: none)
-   into the depth plane. */
-HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m, int geo, float q)
+/* Folds the march's (r, g, b, T) into pixel i: what is behind it in direction d
+   (hdk_env_background; none where the host's geometry is, geo = 1) times T, and T = 0 where the
+   march stopped on it; and the crossing's q (0: none) into the depth plane. Alpha is 1 - T, or 1
+   where the environment is shown behind the volume (premultiplied: the map fills the pixel). */
+HD_FN void hdk_project_finish(HD_KARGS int i, hd_v4 m, int geo, float q, hd_v3 d)
 {
     float T = m.w < HD_PRM(march).z ? 0.0f : m.w;
     float bg = geo != 0 ? 0.0f : T;
-    hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + bg * HD_PRM(background).x, m.y + bg * HD_PRM(background).y,
-                                          m.z + bg * HD_PRM(background).z, 1.0f - T));
+    float a = geo == 0 && HD_PRM(background).w > 0.5f ? 1.0f : 1.0f - T;
+    hd_v3 b = bg > 0.0f ? hdk_env_background(HD_KPASS d) : HD_V3(0.0f, 0.0f, 0.0f);
+    hdk_accumulate_pixel(HD_KPASS i, HD_V4(m.x + bg * b.x, m.y + bg * b.y, m.z + bg * b.z, a));
     hdk_project_depth(HD_KPASS i, q);
 }
 
@@ -372,5 +374,5 @@ HD_FN void hdk_project_pixel(HD_KARGS int px, int py)
 #else
     m = hdk_project_march_cells(HD_KPASS pe, d, len, s0, HD_REF(xs));
 #endif
-    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, m, geo, xs >= 0.0f ? hdk_depth_q(HD_KPASS hdk_madd(pe, d, xs)) : 0.0f);
+    hdk_project_finish(HD_KPASS py * HD_PRM(image).x + px, m, geo, xs >= 0.0f ? hdk_depth_q(HD_KPASS hdk_madd(pe, d, xs)) : 0.0f, d);
 }

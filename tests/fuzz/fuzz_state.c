@@ -177,6 +177,7 @@ static void fz_tr_params(const char *p, const hd_params *q)
     FZ_TRI(illumination_downsample); FZ_TRI(rgb_scattering); FZ_TRI(diffusion_boundary);
     FZ_TRI(illumination_precision); FZ_TRF(light_tolerance, 1); FZ_TRF(render_budget, 1); FZ_TRF(crop_min, 3);
     FZ_TRF(crop_max, 3); FZ_TRI(render_scale); FZ_TRF(depth_threshold, 1);
+    FZ_TRI(environment_background);
 #undef FZ_TRF
 #undef FZ_TRI
 }
@@ -360,6 +361,7 @@ static fz_set fz_params_want(const hd_params *p)
     if (p->max_bounces < 0 || p->max_bounces > 100000) bad |= FZ_R(IP);
     if (p->illumination_downsample < 1 || p->illumination_downsample > 8) bad |= FZ_R(IP);
     if (p->rgb_scattering != 0 && p->rgb_scattering != 1) bad |= FZ_R(IP);
+    if (p->environment_background != 0 && p->environment_background != 1) bad |= FZ_R(IP);
     if (!fz_finite(p->light_tolerance) || p->light_tolerance < 0.0f) bad |= FZ_R(IP);
     if (!fz_finite(p->render_budget) || !(p->render_budget >= 0.0f && p->render_budget <= FZ_BUDGET_MAX)) bad |= FZ_R(IP);
     if (p->render_scale != HD_RENDER_SCALE_AUTO && (p->render_scale < 1 || p->render_scale > 8)) bad |= FZ_R(IP);
@@ -985,7 +987,7 @@ static void fz_check_params_restart(const fz_snap *a, const fz_snap *b)
     phi = FZ_NE(disable_diffusion) || FZ_NE(diffusion_boundary);
     phi_bits = FZ_BITS(albedo) || FZ_BITS(anisotropy) || phi || warm;
     image = FZ_NE(step) || FZ_NE(frame_window) || FZ_NE(render_scale) || FZ_NE(depth_threshold) || FZ_NE(rest) ||
-            FZ_NE(refine_bounces) || bg;
+            FZ_NE(refine_bounces) || FZ_NE(environment_background) || bg;
     /* "solver, sweeps, tracking, exposure, light_tolerance, render_budget, light_window -> nothing" */
     t.solver = p->solver;
     t.diffusion_sweeps = p->diffusion_sweeps;
