@@ -217,6 +217,9 @@ static hd_result hd__be_mg_update(const hd__view *vw, double alpha);
 static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour);
 /* Bytes the solver's buffers hold (counted in method_bytes); 0 without them or with another solver. */
 static size_t hd__be_solver_bytes(const hd__view *vw);
+/* NULL where multigrid can run on this device, else why not (no double precision): what
+   HD_SOLVER_AUTO's fall-back logs, asked before a step, so no refusal is logged as an error. */
+static const char *hd__be_mg_unavailable(const hd__view *vw);
 
 /* ---- optional features (hd__be_features says which a backend has) ------------------------------
    A backend without a feature still defines its primitives; the core never calls them then. */
