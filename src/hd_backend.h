@@ -226,7 +226,7 @@ static const char *hd__be_mg_unavailable(const hd__view *vw);
    A backend without a feature still defines its primitives; the core never calls them then. */
 #define HD__BE_RECORD 1  /* hd_vulkan_record, _record_render: work recorded into the caller's command buffer */
 #define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture(_ex): the image encoded into the caller's texture */
-#define HD__BE_LIST_FROM_BITS 4 /* the direct light's entries read from vw->dl_bits and vw->dl_brick:
+#define HD__BE_LIST_FROM_BITS 8 /* the direct light's entries read from vw->dl_bits and vw->dl_brick:
                                    the core builds no vw->dl_idx (but for the test hook's every voxel) */
 #define HD__BE_CL_BUFFER 4 /* hd_opencl_set_depth_buffer: the host's depth from its cl_mem */
 static unsigned hd__be_features(void);
