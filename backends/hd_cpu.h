@@ -395,8 +395,8 @@ static void hd__cpu_direct_bits(hd__backend *be, size_t j, size_t end)
 {
     const hd__view *vw = be->vw;
     const int *g = vw->gdims, B = HD__DL_BRICK;
-    int nbx = (g[0] + B - 1) / B, nby = (g[1] + B - 1) / B, nbz = (g[2] + B - 1) / B, x, y, z;
-    size_t nb = (size_t)nbx * nby * nbz, lo = 0, hi = nb, b;
+    int nbr[3], x, y, z;
+    size_t nb = hd__direct_bricks(g, nbr), nbx = (size_t)nbr[0], nby = (size_t)nbr[1], lo = 0, hi = nb, b;
     while (hi - lo > 1) {
         size_t mid = lo + (hi - lo) / 2;
         if (vw->dl_brick[mid] <= j) lo = mid;
@@ -404,7 +404,7 @@ static void hd__cpu_direct_bits(hd__backend *be, size_t j, size_t end)
     }
     for (b = lo; b < nb && j < end; ++b) {
         size_t n = vw->dl_brick[b]; /* the entry of the brick's next tracked voxel */
-        int bx = (int)(b % (size_t)nbx) * B, by = (int)(b / (size_t)nbx % (size_t)nby) * B, bz = (int)(b / ((size_t)nbx * nby)) * B;
+        int bx = (int)(b % nbx) * B, by = (int)(b / nbx % nby) * B, bz = (int)(b / (nbx * nby)) * B;
         for (z = bz; z < bz + B && z < g[2] && j < end; ++z)
             for (y = by; y < by + B && y < g[1] && j < end; ++y) {
                 size_t k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx;

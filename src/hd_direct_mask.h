@@ -98,13 +98,6 @@ static void hd__direct_mask_free(hd__ctx *ctx)
     ctx->vw.dl_count = 0;
 }
 
-/* Bricks of the direct light's list along each axis (HD__DL_BRICK voxels an edge). */
-static size_t hd__direct_bricks(const int *g, int *nb)
-{
-    int d;
-    for (d = 0; d < 3; ++d) nb[d] = (g[d] + HD__DL_BRICK - 1) / HD__DL_BRICK;
-    return (size_t)nb[0] * nb[1] * nb[2];
-}
 
 /* dl_idx from dl_bits (every grid voxel with the test hook dl.all), brick by brick
    (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries, one work item's, start

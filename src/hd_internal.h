@@ -136,6 +136,14 @@ static void *hd__calloc(const hd__view *vw, size_t count, size_t size)
     if (p) memset(p, 0, count * size);
     return p;
 }
+
+/* Bricks of the direct light's list along each axis (HD__DL_BRICK voxels an edge) of grid g. */
+static size_t hd__direct_bricks(const int *g, int *nb)
+{
+    int d;
+    for (d = 0; d < 3; ++d) nb[d] = (g[d] + HD__DL_BRICK - 1) / HD__DL_BRICK;
+    return (size_t)nb[0] * nb[1] * nb[2];
+}
 static void hd__free(const hd__view *vw, void *ptr)
 {
     if (ptr) vw->alloc.free(ptr, vw->alloc.user_data);
