@@ -204,7 +204,8 @@ typedef enum hd_solver {
                                 hd_create and hd_set_params put the choice into params.solver
                                 (hd_get_params reads it) and fill diffusion_sweeps for it.
                                 RED_BLACK with float16 illumination, and for good where multigrid
-                                cannot run (a device without double precision, hd_vulkan_record) */
+                                cannot run (a device without double precision, hd_vulkan_record):
+                                one info line saying why, no error */
     HD_SOLVER_RED_BLACK,     /* red-black Gauss-Seidel, in place: two half-sweeps per sweep */
     HD_SOLVER_JACOBI,        /* Jacobi with a ping-pong buffer (+4 bytes per voxel) */
     HD_SOLVER_MULTIGRID,     /* conjugate gradients preconditioned by a geometric multigrid
@@ -213,7 +214,8 @@ typedef enum hd_solver {
                                 +about 22 bytes per voxel and channel. Every backend; OpenCL
                                 and Vulkan need double precision (cl_khr_fp64, shaderFloat64:
                                 a caller's Vulkan device must have enabled it), else
-                                HD_ERROR_UNSUPPORTED */
+                                HD_ERROR_UNSUPPORTED at hd_create (after hd_set_params: at the
+                                next step) */
     HD_SOLVER_COUNT
 } hd_solver;
 
@@ -631,8 +633,8 @@ typedef struct hd_stats {
                                  (complete ones: see light_progress) */
     uint64_t frames;          /* frames accumulated into the current image */
     size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
-                                 (illumination grids, the projection's summed light E + phi and
-                                 helpers; volume and image excluded) */
+                                 (illumination grids, the projection's summed light E + phi, the
+                                 direct light's voxel list, helpers; volume and image excluded) */
     size_t image_bytes;       /* bytes of the image accumulation */
     size_t volume_bytes;      /* bytes of the volume, the TF and the majorant grid on the device */
     int illumination_dims[3]; /* grid of the illumination volumes */

@@ -388,13 +388,50 @@ static void hd__cpu_classify_row(hd__backend *be, int r)
     int gx = be->vw->gdims[0], gy = be->vw->gdims[1], x;
     for (x = 0; x < gx; ++x) hdk_classify_voxel(&be->k, x, r % gy, r / gy);
 }
-/* Direct light: items of HD__CPU_DIRECT_CHUNK consecutive entries of the tracked voxels' list. */
+/* The direct light's entries [j, end) from the mask's bits, in the list's order (bricks of
+   HD__DL_BRICK^3 x fastest, voxels inside them x fastest): from the brick holding entry j (the
+   last whose count of entries before it, vw->dl_brick, is at most j) on. */
+static void hd__cpu_direct_bits(hd__backend *be, size_t j, size_t end)
+{
+    const hd__view *vw = be->vw;
+    const int *g = vw->gdims, B = HD__DL_BRICK;
+    int nbr[3], x, y, z;
+    size_t nb = hd__direct_bricks(g, nbr), nbx = (size_t)nbr[0], nby = (size_t)nbr[1], lo = 0, hi = nb, b;
+    while (hi - lo > 1) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (vw->dl_brick[mid] <= j) lo = mid;
+        else hi = mid;
+    }
+    for (b = lo; b < nb && j < end; ++b) {
+        size_t n = vw->dl_brick[b]; /* the entry of the brick's next tracked voxel */
+        int bx = (int)(b % nbx) * B, by = (int)(b / nbx % nby) * B, bz = (int)(b / (nbx * nby)) * B;
+        for (z = bz; z < bz + B && z < g[2] && j < end; ++z)
+            for (y = by; y < by + B && y < g[1] && j < end; ++y) {
+                size_t k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx;
+                for (x = bx; x < bx + B && x < g[0] && j < end; ++x, ++k)
+                    if (vw->dl_bits[k >> 3] >> (k & 7) & 1u) {
+                        if (n == j) {
+                            hdk_direct_index(&be->k, (int)k);
+                            ++j;
+                        }
+                        ++n;
+                    }
+            }
+    }
+}
+
+/* Direct light: items of HD__CPU_DIRECT_CHUNK consecutive entries of the tracked voxels: the
+   core's list where it made one (the test hook's every voxel), else the mask's bits. */
 #define HD__CPU_DIRECT_CHUNK 64
 static void hd__cpu_direct_chunk(hd__backend *be, int item)
 {
     const hd__view *vw = be->vw;
     size_t j = be->dl_first + (size_t)item * HD__CPU_DIRECT_CHUNK, end = j + HD__CPU_DIRECT_CHUNK;
     if (end > be->dl_end) end = be->dl_end;
+    if (!vw->dl_idx) {
+        hd__cpu_direct_bits(be, j, end);
+        return;
+    }
     for (; j < end; ++j) hdk_direct_index(&be->k, (int)vw->dl_idx[j]);
 }
 /* ---- diffusion -------------------------------------------------------------------------------
@@ -1082,7 +1119,7 @@ static hd_result hd__be_wait(const hd__view *vw)
     (void)vw;
     return HD_SUCCESS;
 }
-/* The list of voxels to track lives in the context (vw->dl_idx): nothing to upload. */
+/* The voxels to track are the context's (vw->dl_bits, vw->dl_brick): nothing to upload. */
 static hd_result hd__be_direct_list(const hd__view *vw)
 {
     (void)vw;
@@ -1195,8 +1232,9 @@ static hd_result hd__be_upsample(const hd__view *vw)
     return HD_SUCCESS;
 }
 
-/* No recording and no GL texture: the core never calls these (hd__be_features). */
-static unsigned hd__be_features(void) { return 0; }
+/* No recording and no GL texture: the core never calls these (hd__be_features). The direct
+   light reads the core's mask, which it has in memory, instead of a list beside it. */
+static unsigned hd__be_features(void) { return HD__BE_LIST_FROM_BITS; }
 HD__BE_NO_RECORDING("cpu")
 HD__BE_NO_TEXTURE("cpu")
 HD__BE_NO_CL_BUFFER("cpu")

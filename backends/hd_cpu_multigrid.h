@@ -11,6 +11,8 @@
 static size_t hd__mg_slots(const int *d, int channels) { return hd__split_slots(d[0], d[1], (size_t)d[2] * (size_t)channels); }
 
 /* Bytes the solver holds (r, z, p, the fine residual and every coarse grid); 0 without it. */
+static const char *hd__be_mg_unavailable(const hd__view *vw) { (void)vw; return NULL; }
+
 static size_t hd__be_solver_bytes(const hd__view *vw)
 {
     const struct hd__cpu_mg *mg = vw->be->mg;

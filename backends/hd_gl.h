@@ -1176,6 +1176,8 @@ static hd_result hd__be_sum_lights(const hd__view *vw)
    storage buffer 3) and the rows in row order by the core, as on the CPU. */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__view *vw) { return hd__gpu_solver_bytes(vw, &vw->be->gg); }
+/* GL 4.3 core has GLSL doubles (ARB_gpu_shader_fp64): multigrid runs wherever the backend does. */
+static const char *hd__be_mg_unavailable(const hd__view *vw) { (void)vw; return NULL; }
 static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw) { return &vw->be->gg; }
 
 /* The levels' parameter buffers and the row sums (device and host). */

@@ -227,6 +227,7 @@ static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour)
     return HD_SUCCESS;
 }
 static size_t hd__be_solver_bytes(const hd__view *vw) { (void)vw; return 0; }
+static const char *hd__be_mg_unavailable(const hd__view *vw) { (void)vw; return NULL; }
 
 /* ---- optional features: recording (nothing recorded, the schedule counted); no GL texture ---- */
 static unsigned hd__be_features(void) { return HD__BE_RECORD; }

@@ -1114,6 +1114,11 @@ static hd_result hd__gpu_mg_pass(const hd__view *vw, const hd__gpu_mg_run *p)
 }
 
 /* ---- the step's primitives (src/hd_backend.h) ------------------------------------------------ */
+static const char *hd__be_mg_unavailable(const hd__view *vw)
+{
+    return vw->be->fp64 ? NULL : "the device lacks double precision (cl_khr_fp64)";
+}
+
 static hd_result hd__be_mg_begin(const hd__view *vw, int *fresh)
 {
     hd_result r;

@@ -824,9 +824,14 @@ static size_t hd__vk_vol_texels(const hd__view *vw, int n)
     return ((size_t)n + per - 1) / per;
 }
 
-/* The texels holding box vox's voxels, from the core's copy through the staging buffer (one
-   region, submitted and waited for): the box widened to whole texels along x, a row's last
-   texel zero-padded past the volume's end. */
+/* The most bytes of the volume one staged copy takes (at least one slice of the box): the staging
+   buffer stays this small instead of holding a second copy of the volume (2 bytes a voxel of I16
+   in host-visible memory, kept for the context's life). */
+#define HD__VK_VOL_SLAB_BYTES ((size_t)8 << 20)
+
+/* The texels holding box vox's voxels, from the core's copy through the staging buffer, in slabs
+   of z slices of at most HD__VK_VOL_SLAB_BYTES (each a region, submitted and waited for): the box
+   widened to whole texels along x, a row's last texel zero-padded past the volume's end. */
 static hd_result hd__vk_vol_write(const hd__view *vw, const hd__box *vox)
 {
     hd__backend *be = vw->be;
@@ -834,32 +839,39 @@ static hd_result hd__vk_vol_write(const hd__view *vw, const hd__box *vox)
     size_t e = hd__vol_elem(vw->vtype), per = 4 / e;
     size_t t0 = (size_t)vox->lo[0] / per, t1 = hd__vk_vol_texels(vw, vox->hi[0]), row = (t1 - t0) * 4;
     size_t v0 = t0 * per, v1 = t1 * per < (size_t)vw->dims[0] ? t1 * per : (size_t)vw->dims[0];
-    int h = vox->hi[1] - vox->lo[1], dz = vox->hi[2] - vox->lo[2], y, z;
+    int h = vox->hi[1] - vox->lo[1], dz = vox->hi[2] - vox->lo[2], y, z, z0, slab;
+    size_t slice = row * (size_t)h;
     unsigned char *dst;
     VkBufferImageCopy reg = hd__vk_region(im);
-    VkCommandBuffer cb = VK_NULL_HANDLE;
     hd_result r;
+    slab = slice >= HD__VK_VOL_SLAB_BYTES ? 1 : (int)(HD__VK_VOL_SLAB_BYTES / slice);
+    if (slab > dz) slab = dz;
     if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r; /* the staging buffer is free */
-    if ((r = hd__vk_staging(vw, row * (size_t)h * (size_t)dz)) != HD_SUCCESS) return r;
-    dst = (unsigned char *)be->staging.map;
-    for (z = vox->lo[2]; z < vox->hi[2]; ++z)
-        for (y = vox->lo[1]; y < vox->hi[1]; ++y) {
-            const unsigned char *src = (const unsigned char *)vw->vol + (((size_t)z * vw->dims[1] + y) * vw->dims[0] + v0) * e;
-            memcpy(dst, src, (v1 - v0) * e);
-            memset(dst + (v1 - v0) * e, 0, row - (v1 - v0) * e);
-            dst += row;
-        }
-    reg.imageOffset.x = (int32_t)t0;
-    reg.imageOffset.y = vox->lo[1];
-    reg.imageOffset.z = vox->lo[2];
-    reg.imageExtent.width = (uint32_t)(t1 - t0);
-    reg.imageExtent.height = (uint32_t)h;
-    reg.imageExtent.depth = (uint32_t)dz;
-    if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
-    hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
-    hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
-    return hd__vk_flush(vw);
+    if ((r = hd__vk_staging(vw, slice * (size_t)slab)) != HD_SUCCESS) return r;
+    for (z0 = vox->lo[2]; z0 < vox->hi[2]; z0 += slab) {
+        int z1 = z0 + slab < vox->hi[2] ? z0 + slab : vox->hi[2];
+        VkCommandBuffer cb = VK_NULL_HANDLE;
+        dst = (unsigned char *)be->staging.map;
+        for (z = z0; z < z1; ++z)
+            for (y = vox->lo[1]; y < vox->hi[1]; ++y) {
+                const unsigned char *src = (const unsigned char *)vw->vol + (((size_t)z * vw->dims[1] + y) * vw->dims[0] + v0) * e;
+                memcpy(dst, src, (v1 - v0) * e);
+                memset(dst + (v1 - v0) * e, 0, row - (v1 - v0) * e);
+                dst += row;
+            }
+        reg.imageOffset.x = (int32_t)t0;
+        reg.imageOffset.y = vox->lo[1];
+        reg.imageOffset.z = z0;
+        reg.imageExtent.width = (uint32_t)(t1 - t0);
+        reg.imageExtent.height = (uint32_t)h;
+        reg.imageExtent.depth = (uint32_t)(z1 - z0);
+        if ((r = hd__vk_cmd(vw, &cb)) != HD_SUCCESS) return r;
+        hd__vk_layout(be, cb, im->image, HD__VK_G, HD__VK_DST, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+        be->fn.vkCmdCopyBufferToImage(cb, be->staging.buffer, im->image, HD__VK_DST, 1, &reg);
+        hd__vk_layout(be, cb, im->image, HD__VK_DST, HD__VK_G, VK_NULL_HANDLE, HD__VK_G, HD__VK_G);
+        if ((r = hd__vk_flush(vw)) != HD_SUCCESS) return r; /* waited for: the next slab may reuse it */
+    }
+    return HD_SUCCESS;
 }
 
 #ifdef HYBRIDDIFF_TESTING
@@ -1506,9 +1518,7 @@ static hd_result hd__be_create(hd__view *vw)
     if ((r = hd__vk_ring(vw, 16)) != HD_SUCCESS) return r;
     hd__vk_check_half(vw);
     if ((r = hd__vk_half_ok(vw)) != HD_SUCCESS) return r;
-    hd__vk_check_f64(vw);
-    if (vw->params.solver == HD_SOLVER_MULTIGRID && be->no_f64)
-        return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: solver MULTIGRID is not available on %s: %s", be->device_name, be->no_f64);
+    hd__vk_check_f64(vw); /* a multigrid it rules out: hd_create's hd__mg_available */
     if (!be->no_half && (r = hd__vk_image_new_as(vw, &be->dummy16, 1, 1, 1, VK_FORMAT_R16_SFLOAT, "a float16 placeholder image")) != HD_SUCCESS)
         return r;
     if ((r = hd__vk_buffer_create(vw, &be->dummy_buffer, 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, 0, "a placeholder buffer")) != HD_SUCCESS) return r;
@@ -2010,6 +2020,7 @@ static hd_result hd__be_path(const hd__view *vw)
    hd_vulkan_record cannot record it (HD_ERROR_UNSUPPORTED there). */
 /* Bytes the solver holds on the device (counted in method_bytes); 0 without it. */
 static size_t hd__be_solver_bytes(const hd__view *vw) { return hd__gpu_solver_bytes(vw, &vw->be->gg); }
+static const char *hd__be_mg_unavailable(const hd__view *vw) { return vw->be->no_f64; }
 static hd__gpu_grids *hd__gpu_grids_of(const hd__view *vw) { return &vw->be->gg; }
 
 /* The row-sum buffers, the parameter slots and the set pool; nothing of theirs may be in flight

@@ -122,6 +122,7 @@ HDDEF hd_result hd_create(const hd_desc *desc, hd_context *out_ctx)
     hd__set_grid(ctx);
     ctx->dirty = HD__DIRTY_ALL | HD__DIRTY_ENV; /* the environment's placeholder */
     if ((r = hd__be_create(&ctx->vw)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
+    if ((r = hd__mg_available(ctx)) != HD_SUCCESS) { hd__ctx_free(ctx); return r; }
 
     *out_ctx = hd__slot_take(ctx);
     if (out_ctx->id == 0) {

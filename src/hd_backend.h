@@ -122,7 +122,8 @@ static hd_result hd__be_clear(const hd__view *vw, unsigned what);
    (vw->sig_gen) for the solvers' coarse grids. */
 static hd_result hd__be_classify(const hd__view *vw);
 /* HD: one Monte Carlo sample of the direct light into E's running mean (hd_k_direct.h) at each of
-   the grid voxels listed in vw->dl_idx[first, first + count) (first + count <= vw->dl_count; the
+   the grid voxels listed in vw->dl_idx[first, first + count) (with HD__BE_LIST_FROM_BITS and no
+   dl_idx: the same entries of vw->dl_bits, vw->dl_brick) (first + count <= vw->dl_count; the
    core splits a light iteration's list over hd_render calls under render_budget); E elsewhere
    is left as it is. A voxel's sample depends on vw->kp and the voxel alone, so the ranges of one
    iteration give the bits of one call over the whole list. */
@@ -217,11 +218,16 @@ static hd_result hd__be_mg_update(const hd__view *vw, double alpha);
 static hd_result hd__be_mg_extrapolate(const hd__view *vw, int colour);
 /* Bytes the solver's buffers hold (counted in method_bytes); 0 without them or with another solver. */
 static size_t hd__be_solver_bytes(const hd__view *vw);
+/* NULL where multigrid can run on this device, else why not (no double precision): what
+   HD_SOLVER_AUTO's fall-back logs, asked before a step, so no refusal is logged as an error. */
+static const char *hd__be_mg_unavailable(const hd__view *vw);
 
 /* ---- optional features (hd__be_features says which a backend has) ------------------------------
    A backend without a feature still defines its primitives; the core never calls them then. */
 #define HD__BE_RECORD 1  /* hd_vulkan_record, _record_render: work recorded into the caller's command buffer */
 #define HD__BE_TEXTURE 2 /* hd_gl_render_to_texture(_ex): the image encoded into the caller's texture */
+#define HD__BE_LIST_FROM_BITS 8 /* the direct light's entries read from vw->dl_bits and vw->dl_brick:
+                                   the core builds no vw->dl_idx (but for the test hook's every voxel) */
 #define HD__BE_CL_BUFFER 4 /* hd_opencl_set_depth_buffer: the host's depth from its cl_mem */
 static unsigned hd__be_features(void);
 /* Recording (HD__BE_RECORD). The core's hd_vulkan_record and hd_vulkan_record_render run their

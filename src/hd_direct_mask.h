@@ -12,7 +12,6 @@
    an interpolation that reads it (weight 0 included) can sample a non-empty cell. */
 #define HD__DL_VALUE_EPS 1e-5f
 #define HD__DL_COORD_EPS 0.01f /* voxels: kernels' rounding of a sample's coordinates */
-#define HD__DL_BRICK 8 /* voxels per edge of the list's bricks (a multiple of the light's runs of 8) */
 
 /* The run of zero-alpha TF entries (numbered from 1) that every value within HD__DL_VALUE_EPS of
    [t0, t1] lies in, 0 when some of them may have sigma_t > 0. A value's entries lie within those
@@ -91,11 +90,14 @@ static void hd__dl_axis(int x, int g, int n, int *lo, int *hi)
 static void hd__direct_mask_free(hd__ctx *ctx)
 {
     hd__free(&ctx->vw, ctx->vw.dl_idx);
+    hd__free(&ctx->vw, ctx->vw.dl_brick);
     hd__free(&ctx->vw, ctx->dl.bits);
-    ctx->vw.dl_idx = NULL;
+    ctx->vw.dl_idx = ctx->vw.dl_brick = NULL;
     ctx->dl.bits = NULL;
+    ctx->vw.dl_bits = NULL;
     ctx->vw.dl_count = 0;
 }
+
 
 /* dl_idx from dl_bits (every grid voxel with the test hook dl.all), brick by brick
    (HD__DL_BRICK voxels an edge, x fastest inside): consecutive entries, one work item's, start
@@ -104,9 +106,31 @@ static hd_result hd__direct_list_build(hd__ctx *ctx)
 {
     const int *g = ctx->vw.gdims;
     size_t gvox = (size_t)g[0] * g[1] * g[2], i, k;
-    int bx, by, bz, x, y, z, b = HD__DL_BRICK;
+    int bx, by, bz, x, y, z, b = HD__DL_BRICK, nb[3];
     hd__free(&ctx->vw, ctx->vw.dl_idx);
+    hd__free(&ctx->vw, ctx->vw.dl_brick);
+    ctx->vw.dl_idx = ctx->vw.dl_brick = NULL;
+    ctx->vw.dl_bits = ctx->dl.bits;
     ctx->vw.dl_gen++;
+    if ((hd__be_features() & HD__BE_LIST_FROM_BITS) && !ctx->dl.all) {
+        /* the entries before each brick; the backend reads the bits (the list's 4 bytes an entry
+           would hold the same, a second time) */
+        size_t n = hd__direct_bricks(g, nb);
+        ctx->vw.dl_brick = (uint32_t *)hd__alloc(&ctx->vw, (n + 1) * sizeof(uint32_t));
+        if (!ctx->vw.dl_brick)
+            return HD__ERR(&ctx->vw.log, HD_ERROR_OUT_OF_MEMORY, "no memory for the direct light's bricks (%zu)", n);
+        for (bz = 0, i = 0, n = 0; bz < g[2]; bz += b)
+            for (by = 0; by < g[1]; by += b)
+                for (bx = 0; bx < g[0]; bx += b) {
+                    ctx->vw.dl_brick[n++] = (uint32_t)i;
+                    for (z = bz; z < bz + b && z < g[2]; ++z)
+                        for (y = by; y < by + b && y < g[1]; ++y)
+                            for (x = bx, k = ((size_t)z * g[1] + y) * g[0] + (size_t)bx; x < bx + b && x < g[0]; ++x, ++k)
+                                i += ctx->dl.bits[k >> 3] >> (k & 7) & 1u;
+                }
+        ctx->vw.dl_brick[n] = (uint32_t)i;
+        return HD_SUCCESS;
+    }
     if (ctx->dl.all) ctx->vw.dl_count = gvox;
     ctx->vw.dl_idx = (uint32_t *)hd__alloc(&ctx->vw, (ctx->vw.dl_count ? ctx->vw.dl_count : 1) * sizeof(uint32_t));
     if (!ctx->vw.dl_idx)

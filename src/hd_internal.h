@@ -23,6 +23,8 @@
 #define HD__MAX_GRID_CHANNELS 4
 #define HD__MAX_GRID_VOXELS ((1u << 29) - 1u)
 #define HD__MAX_RENDER_SCALE 16 /* params.render_scale's largest divisor */
+#define HD__DL_BRICK 8 /* voxels per edge of the direct light's list's bricks (src/hd_direct_mask.h;
+                          a multiple of the light's runs of 8) */
 #define HD__MAJORANT_CELL 4 /* voxels per majorant-grid cell edge: the balance between tight
                                 majorants and few DDA steps (docs/DESIGN-CPU.md) */
 
@@ -78,7 +80,11 @@ typedef struct hd__view {
     int sig_channels;        /* sigma_t grid channels: 1, or 4 with the TF colour (RGB scattering) */
     hd__kparams kp;          /* the kernels' parameter block for the next primitive */
     /* HD's direct light: the grid voxels it tracks (src/hd_direct_mask.h) */
-    uint32_t *dl_idx;        /* their grid indices in bricks */
+    uint32_t *dl_idx;        /* their grid indices in bricks of HD__DL_BRICK^3, bricks and the
+                                voxels inside them x fastest; NULL with dl_brick */
+    uint32_t *dl_brick;      /* a backend with HD__BE_LIST_FROM_BITS: per brick, the entries
+                                before it (one more: dl_count), the entries read from dl_bits */
+    const uint8_t *dl_bits;  /* the mask, a bit per grid voxel (x fastest): the core's */
     size_t dl_count;
     unsigned dl_gen;         /* bumped whenever dl_idx changes: a backend re-uploads it */
     /* the host's depth buffer (hd_set_depth): depth_w x depth_h window depths, rows top first,
@@ -129,6 +135,14 @@ static void *hd__calloc(const hd__view *vw, size_t count, size_t size)
     p = hd__alloc(vw, count * size);
     if (p) memset(p, 0, count * size);
     return p;
+}
+
+/* Bricks of the direct light's list along each axis (HD__DL_BRICK voxels an edge) of grid g. */
+static size_t hd__direct_bricks(const int *g, int *nb)
+{
+    int d;
+    for (d = 0; d < 3; ++d) nb[d] = (g[d] + HD__DL_BRICK - 1) / HD__DL_BRICK;
+    return (size_t)nb[0] * nb[1] * nb[2];
 }
 static void hd__free(const hd__view *vw, void *ptr)
 {

@@ -257,8 +257,9 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     out->frames = (ctx->dirty & HD__DIRTY_IMAGE) ? 0 : ctx->frames;
     out->render_scale = out->frames > 0 && ctx->frame_scale > 0 ? ctx->frame_scale : 1;
     out->refine_paths = ctx->refined;
-    /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights; CD: the same
-       plus one light volume per light and the spare of its ping-pong; PT: nothing per voxel */
+    /* HD: sigma_t grid + E + phi (+ Jacobi's buffer), independent of the lights, and the direct
+       light's list; CD: the same plus one light volume per light and the spare of its ping-pong,
+       no list; PT: nothing per voxel */
 #ifdef HD__BE_SPLIT_LAYOUT /* the colour layout: one padding slot per row when gx is odd */
     out->method_bytes = hd__split_slots(ctx->vw.gdims[0], ctx->vw.gdims[1], (size_t)ctx->vw.gdims[2] * (size_t)ctx->vw.sig_channels) * sizeof(float) +
                         hd__split_slots(ctx->vw.gdims[0], ctx->vw.gdims[1], (size_t)ctx->vw.gdims[2] * (size_t)ctx->vw.channels) *
@@ -270,6 +271,14 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     if (ctx->vw.params.method == HD_METHOD_CD) out->method_bytes += gvox * sizeof(float) * ((size_t)ctx->light_count + 1);
     out->method_bytes += hd__be_solver_bytes(&ctx->vw); /* the solver's own state (multigrid levels) */
     out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
+    /* HD: the direct light's list of grid voxels (src/hd_direct_mask.h), a uint32 each, which the
+       GPU backends hold on the device; the CPU backend reads the core's mask instead (a bit per
+       grid voxel) and the count of entries before each brick */
+    if (ctx->vw.params.method == HD_METHOD_HD && ctx->vw.dl_idx) out->method_bytes += ctx->vw.dl_count * sizeof(uint32_t);
+    if (ctx->vw.params.method == HD_METHOD_HD && ctx->vw.dl_brick) {
+        int nb[3];
+        out->method_bytes += (gvox + 7) / 8 + (hd__direct_bricks(ctx->vw.gdims, nb) + 1) * sizeof(uint32_t);
+    }
     if (hd__method_is_pt(ctx->vw.params.method)) out->method_bytes = 0;
     out->method_bytes += ctx->vw.env_floats * sizeof(float); /* the environment's tables, any method */
     /* the buffer held, or the one the next call makes for a new camera size */

@@ -150,14 +150,32 @@ static int hd__solver_fallback(hd__ctx *ctx, const char *why)
     return 1;
 }
 
-/* One step of multigrid; where AUTO's multigrid is refused (a device without double precision),
-   red-black's sweeps instead. */
+/* AUTO's multigrid on a device that cannot run it (why: the backend's reason): red-black from
+   now on, with one info line naming the backend and the reason; 0 where the caller named it. */
+static int hd__mg_fall_back(hd__ctx *ctx, const char *why)
+{
+    char line[256];
+    snprintf(line, sizeof line, "%s: multigrid is not available: %s", hd__be_name(), why);
+    return hd__solver_fallback(ctx, line);
+}
+
+/* hd_create's check of the solver against the device: AUTO's multigrid falls back (no error is
+   logged: nothing was refused), a multigrid the caller named is refused. */
+static hd_result hd__mg_available(hd__ctx *ctx)
+{
+    const char *why = ctx->vw.params.solver == HD_SOLVER_MULTIGRID ? hd__be_mg_unavailable(&ctx->vw) : NULL;
+    if (!why || hd__mg_fall_back(ctx, why)) return HD_SUCCESS;
+    return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "%s: solver MULTIGRID is not available: %s", hd__be_name(), why);
+}
+
+/* One step of multigrid; where AUTO's multigrid cannot run (hd_set_params may pick it later, on
+   a larger grid), red-black's sweeps instead, asked before the step so no refusal is logged. A
+   multigrid the caller named is refused by the step, with its error. */
 static hd_result hd__mg_step_or_fallback(hd__ctx *ctx)
 {
-    hd_result r = hd__mg_step(ctx);
-    if (r == HD_ERROR_UNSUPPORTED && hd__solver_fallback(ctx, "multigrid is not available on this device"))
-        r = hd__be_diffuse(&ctx->vw, 0);
-    return r;
+    const char *why = hd__be_mg_unavailable(&ctx->vw);
+    if (why && hd__mg_fall_back(ctx, why)) return hd__be_diffuse(&ctx->vw, 0);
+    return hd__mg_step(ctx);
 }
 
 /* One sweep of the selected solver (multigrid: one conjugate-gradient step, preconditioned by a

@@ -69,6 +69,11 @@ int hdt_volume_state_get(hd_context h, hdt_volume_state *s)
     s->max_sigma = ctx->max_sigma;
     s->bits = ctx->dl.bits;
     s->dl_idx = ctx->vw.dl_idx;
+    s->dl_brick = ctx->vw.dl_brick;
+    {
+        int nb[3];
+        s->dl_bricks = hd__direct_bricks(ctx->vw.gdims, nb);
+    }
     s->dl_n = ctx->dl_n;
     return 1;
 }

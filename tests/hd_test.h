@@ -113,6 +113,15 @@ static inline void hd_test_allocator(hd_desc *d, hd_test_alloc *s)
     d->allocator.free = hd_test_free_fn;
     d->allocator.user_data = s;
 }
+
+/* The CPU backend's bytes of HD's direct light in method_bytes on an illumination grid of st's
+   dims: the mask (a bit per grid voxel) and the entries before each 8^3 brick (one more). */
+static inline size_t hd_test_mask_bytes(const hd_stats *st)
+{
+    const int *g = st->illumination_dims;
+    size_t bricks = (size_t)((g[0] + 7) / 8) * (size_t)((g[1] + 7) / 8) * (size_t)((g[2] + 7) / 8);
+    return ((size_t)g[0] * g[1] * g[2] + 7) / 8 + (bricks + 1) * 4;
+}
 #endif
 
 /* Runs every case whose name contains filter (NULL: all); returns the number of failed cases. */

@@ -15,7 +15,9 @@ typedef struct hdt_volume_state {
     size_t vol_bytes; /* their bytes */
     float *cell_range, *majorant, max_sigma;
     unsigned char *bits;
-    uint32_t *dl_idx;
+    uint32_t *dl_idx;   /* the list, or NULL where the backend reads the bits (dl_brick) */
+    uint32_t *dl_brick; /* the entries before each brick, dl_bricks + 1 of them, or NULL */
+    size_t dl_bricks;
     uint64_t dl_n;
 } hdt_volume_state;
 /* 1 with *s filled, 0 for a stale handle. */

@@ -279,8 +279,8 @@ static void test_memory_independent_of_lights(void)
     CHECK(hd_iterate(a, 2) == HD_SUCCESS && hd_iterate(b, 2) == HD_SUCCESS);
     CHECK(hd_get_stats(a, &sa) == HD_SUCCESS && hd_get_stats(b, &sb) == HD_SUCCESS);
     CHECK(sa.method_bytes == sb.method_bytes);
-    /* sigma_t + E + phi + the projection's E + phi, 4 bytes each */
-    CHECK(sa.method_bytes == (size_t)N * N * N * 16);
+    /* sigma_t + E + phi + the projection's E + phi, 4 bytes each, and the direct light's mask */
+    CHECK(sa.method_bytes == (size_t)N * N * N * 16 + hd_test_mask_bytes(&sa));
     hd_destroy(a);
     hd_destroy(b);
 }
@@ -306,7 +306,7 @@ static void test_illumination_downsample(void)
     CHECK(hd_iterate(full, 24) == HD_SUCCESS && hd_iterate(coarse, 24) == HD_SUCCESS);
     CHECK(hd_get_stats(full, &sf) == HD_SUCCESS && hd_get_stats(coarse, &sc) == HD_SUCCESS);
     CHECK(sc.illumination_dims[0] == 12 && sc.illumination_dims[1] == 12 && sc.illumination_dims[2] == 12);
-    CHECK(sf.method_bytes == 8 * sc.method_bytes);
+    CHECK(sf.method_bytes - hd_test_mask_bytes(&sf) == 8 * (sc.method_bytes - hd_test_mask_bytes(&sc)));
     CHECK(hd_read_image_f32(full, a, n) == HD_SUCCESS && hd_read_image_f32(coarse, b, n) == HD_SUCCESS);
     for (i = 0; i < n; ++i) {
         if (i % 4 == 3) continue; /* opacity does not depend on the grid */
@@ -352,8 +352,9 @@ static void test_rgb_scattering(void)
     CHECK(hd_iterate(grey, 6) == HD_SUCCESS && hd_iterate(rgb, 6) == HD_SUCCESS);
     CHECK(hd_get_stats(grey, &sg) == HD_SUCCESS && hd_get_stats(rgb, &sr) == HD_SUCCESS);
     CHECK(sg.illumination_channels == 1 && sr.illumination_channels == 3);
-    /* RGB: sigma_t with its colour (4 channels), E, phi and the projection's E + phi (3 each) */
-    CHECK(sr.method_bytes == n * 52 && sg.method_bytes == n * 16);
+    /* RGB: sigma_t with its colour (4 channels), E, phi and the projection's E + phi (3 each);
+       the direct light's mask, one for all channels */
+    CHECK(sr.method_bytes == n * 52 + hd_test_mask_bytes(&sr) && sg.method_bytes == n * 16 + hd_test_mask_bytes(&sg));
     CHECK(hd_read_illumination(grey, HD_ILLUMINATION_DIRECT, Eg, n) == HD_SUCCESS);
     CHECK(hd_read_illumination(grey, HD_ILLUMINATION_SCATTERED, Pg, n) == HD_SUCCESS);
     CHECK(hd_read_illumination(rgb, HD_ILLUMINATION_DIRECT, Er, 3 * n) == HD_SUCCESS);

@@ -157,7 +157,9 @@ static int same_volume_state(hd_context a, hd_context b)
     ok = s.nvox == t.nvox && s.ncell == t.ncell && s.gvox == t.gvox && s.max_sigma == t.max_sigma && s.dl_count == t.dl_count &&
          s.vol_bytes == t.vol_bytes && memcmp(s.vol, t.vol, s.vol_bytes) == 0 && memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0 &&
          memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0 && s.bits && t.bits &&
-         memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0 && memcmp(s.dl_idx, t.dl_idx, s.dl_count * sizeof(uint32_t)) == 0;
+         memcmp(s.bits, t.bits, (s.gvox + 7) / 8) == 0 && !s.dl_idx == !t.dl_idx && !s.dl_brick == !t.dl_brick &&
+         (!s.dl_idx || memcmp(s.dl_idx, t.dl_idx, s.dl_count * sizeof(uint32_t)) == 0) &&
+         (!s.dl_brick || (s.dl_bricks == t.dl_bricks && memcmp(s.dl_brick, t.dl_brick, (s.dl_bricks + 1) * sizeof(uint32_t)) == 0));
     CHECK_MSG(ok, "vol %d, cell ranges %d, majorants %d, max_sigma %g/%g, mask %d, list %zu/%zu",
               s.vol_bytes == t.vol_bytes && memcmp(s.vol, t.vol, s.vol_bytes) == 0, memcmp(s.cell_range, t.cell_range, s.ncell * 2 * sizeof(float)) == 0,
               memcmp(s.majorant, t.majorant, s.ncell * sizeof(float)) == 0, (double)s.max_sigma, (double)t.max_sigma,

@@ -13,8 +13,9 @@
         hits hd_create or hd_iterate, the call returns HD_ERROR_DEVICE_LOST with the failing call
         logged, later calls fail fast with the same code, hd_destroy frees everything (validation
         on, no message);
-     5. float16 illumination (r16f E / phi): method_bytes is 3/4 of float32's (grey red-black:
-        sigma_t 4, E and phi 4 against 8, the projection's float32 E + phi 4 bytes per voxel); with $HD_VK_NO_HALF=1 (a device without r16f storage
+     5. float16 illumination (r16f E / phi): method_bytes 4 bytes per grid voxel below float32's
+        (E and phi 2 bytes each against 4; sigma_t, the projection's float32 E + phi and the
+        direct light's list as they were); with $HD_VK_NO_HALF=1 (a device without r16f storage
         images) hd_create refuses FLOAT16 with HD_ERROR_UNSUPPORTED and a log line, and a context
         switched to it by hd_set_params refuses at hd_iterate, then renders again at FLOAT32
         (validation on, no message);
@@ -85,6 +86,7 @@ static unsigned long gipa_calls;
 static char lost_log[512];    /* the last error logged that mentions VK_ERROR_DEVICE_LOST */
 static char half_log[512];    /* the last message that mentions FLOAT16 */
 static char mg_log[512];      /* the last message that mentions MULTIGRID */
+static char auto_log[512];    /* the last message of HD_SOLVER_AUTO's fall-back */
 
 #define CHECK(cond) \
     do { if (!(cond)) { ++failures; fprintf(stderr, "  %s:%d: CHECK(%s) failed\n", __FILE__, __LINE__, #cond); } } while (0)
@@ -98,6 +100,7 @@ static void count_log(void *user, hd_log_level level, hd_result code, const char
     if (strstr(msg, "VK_ERROR_DEVICE_LOST")) snprintf(lost_log, sizeof lost_log, "%s", msg);
     if (strstr(msg, "FLOAT16")) snprintf(half_log, sizeof half_log, "%s", msg);
     if (strstr(msg, "MULTIGRID")) snprintf(mg_log, sizeof mg_log, "%s", msg);
+    if (strstr(msg, "solver AUTO")) snprintf(auto_log, sizeof auto_log, "%s", msg);
     if (level == HD_LOG_ERROR) fprintf(stderr, "  log: %s\n", msg);
 }
 
@@ -422,7 +425,8 @@ static void test_device_lost(void)
 }
 
 /* 5: float16 storage's bytes, and its refusal on a device without r16f storage images. */
-static size_t method_bytes(hd_precision prec)
+/* method_bytes after one iteration; *elems: E's elements (grid voxels times channels). */
+static size_t method_bytes(hd_precision prec, size_t *elems)
 {
     hd_desc d = test_desc();
     hd_context h;
@@ -432,6 +436,7 @@ static size_t method_bytes(hd_precision prec)
     if (hd_create(&d, &h) != HD_SUCCESS) return 0;
     if (hd_iterate(h, 1) != HD_SUCCESS || hd_get_stats(h, &st) != HD_SUCCESS) st.method_bytes = 0;
     hd_destroy(h);
+    *elems = (size_t)st.illumination_dims[0] * st.illumination_dims[1] * st.illumination_dims[2] * (size_t)st.illumination_channels;
     return st.method_bytes;
 }
 
@@ -440,8 +445,8 @@ static void test_half(void)
     hd_desc d = test_desc();
     hd_context h;
     hd_result r;
-    size_t b32 = method_bytes(HD_PRECISION_FLOAT32), b16 = method_bytes(HD_PRECISION_FLOAT16);
-    int ok = b16 > 0 && 4 * b16 == 3 * b32;
+    size_t n = 0, b32 = method_bytes(HD_PRECISION_FLOAT32, &n), b16 = method_bytes(HD_PRECISION_FLOAT16, &n);
+    int ok = b16 > 0 && b32 - b16 == n * 2 * 2; /* E and phi 2 bytes an element, not 4 */
     d.vulkan.enable_validation = have_layer;
     messages = 0;
     setenv("HD_VK_NO_HALF", "1", 1);
@@ -1694,7 +1699,9 @@ static int validation_layer_present(void)
 
 /* HD_SOLVER_AUTO's multigrid (a 160^3 volume at illumination_downsample 1: 4.1 M grid voxels)
    under hd_vulkan_record: red-black from then on (4 sweeps), the recording succeeds; a
-   multigrid the caller named is still refused, with one error. */
+   multigrid the caller named is still refused, with one error. On a device without
+   shaderFloat64 ($HD_VK_NO_F64) AUTO's multigrid becomes red-black at hd_create with one info
+   line naming the reason and no error logged. */
 static void test_record_solver_auto(void)
 {
     enum { N = 160 };
@@ -1738,6 +1745,20 @@ static void test_record_solver_auto(void)
     CHECK(ok && messages == 0);
     printf("%s solver AUTO under recording: multigrid picked %d, record %s, then red-black; multigrid named: %s; %lu validation messages\n",
            ok && messages == 0 ? "PASS" : "FAIL", mg, hd_result_string(r1), hd_result_string(r2), messages);
+    setenv("HD_VK_NO_F64", "1", 1);
+    auto_log[0] = '\0';
+    err_count = 0;
+    ok = hd_create(&d, &h) == HD_SUCCESS;
+    if (ok) {
+        ok = hd_query_desc(h, &q) == HD_SUCCESS && q.params.solver == HD_SOLVER_RED_BLACK && q.params.diffusion_sweeps == 4;
+        ok &= hd_iterate(h, 1) == HD_SUCCESS;
+        CHECK(hd_destroy(h) == HD_SUCCESS);
+    }
+    unsetenv("HD_VK_NO_F64");
+    ok &= err_count == 0 && strstr(auto_log, "HD_VK_NO_F64") != NULL && strstr(auto_log, "red-black") != NULL;
+    CHECK(ok);
+    printf("%s solver AUTO without shaderFloat64: red-black from hd_create, no error logged, info: %s\n", ok ? "PASS" : "FAIL",
+           auto_log);
 }
 
 /* A volume wider than the device's maxImageDimension3D (the library's own limits pass it):
