@@ -339,8 +339,8 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
 /* One work-item per pixel (x, y); the global size is rounded up to whole work-groups
    (hd__be_project), so items past the image's width or height do nothing. lsum and the table
    (ptab_n entries) as hd_k_project.h reads them, dep the host's depth buffer (a placeholder while
-   depth_dims.z is 0). With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass
-   (hd_k_upsample.h). */
+   depth_dims.z is 0). With HD_FLAG_UPSAMPLE the same kernel runs a reduced frame's upsample pass,
+   with HD_FLAG_BLEND HD_REST_BLEND's blend passes (hd_k_upsample.h). */
 #define HD__CL_PROJECT(name, is16) \
     __kernel void name(HD__CL_BUFFERS, __global float *restrict lsum, __global const float *restrict ptab, int ptab_n, \
                        __global const float *restrict dep) \
@@ -350,7 +350,9 @@ __kernel void hd_k_mg_extrap(__constant hd__kparams *p, __global float *sig, __g
         k.f16 = (is16); \
         k.lsum = lsum; k.ptab = ptab; k.ptab_n = ptab_n; k.dep = dep; \
         if (px >= p->image.x || py >= p->image.y) return; \
-        if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
+        if ((k.p->counts.z & HD_FLAG_BLEND) != 0) \
+            hdk_blend_pixel(&k, px, py); \
+        else if ((k.p->counts.z & HD_FLAG_UPSAMPLE) != 0) \
             hdk_upsample_pixel(&k, px, py); \
         else \
             hdk_project_pixel(&k, px, py); \
