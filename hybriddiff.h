@@ -234,6 +234,10 @@ typedef enum hd_rest {
     HD_REST_REFINE,      /* every call adds paths per pixel that start at the camera and end into
                             HD's converged light at vertex params.refine_bounces: the image moves
                             from HD's frame toward the path-traced solution (docs/DESIGN-REFINE.md) */
+    HD_REST_BLEND,       /* every call adds PT_MS paths per pixel into a mean of their own, kept
+                            apart from HD's frame; the image is a per-pixel blend of the two weighted
+                            by the paths' variance and HD's bias estimated over a tile that shrinks
+                            as the paths grow: it tends to PT_MS's (docs/DESIGN-REFINE.md) */
     HD_REST_COUNT
 } hd_rest;
 
@@ -551,15 +555,17 @@ typedef struct hd_params {
     hd_rest rest;           /* HD and CD, once the view rests: HD_REST_HOLD (default) keeps HD's
                                image; HD_REST_REFINE refines it toward PT_MS with paths that read
                                HD's light, as many per call as render_budget allows (at least
-                               one). The first call after any change (camera, setter) still shows
-                               HD's frame, as with HOLD. hd_stats.refine_paths counts them */
+                               one); HD_REST_BLEND blends PT_MS paths' mean with HD's frame (the
+                               image buffer then holds 3 more RGBA planes). The first call after
+                               any change (camera, setter) still shows HD's frame, as with HOLD.
+                               hd_stats.refine_paths counts the paths */
     int refine_bounces;     /* HD_REST_REFINE: the vertex at which a refinement path ends into HD's
                                light ((E + phi) / 4 pi there); the vertices before it track toward
                                the lights and scatter as PT_MS's do. 0 -> -1: never, the paths are
                                PT_MS's and the image tends to PT_MS's (unbiased); K in 1..100000
                                (2: a final gather) converges faster to an image that keeps part of
                                HD's bias (on the head CT 2 and 3 lose to -1 from 1 s on:
-                               docs/DESIGN-REFINE.md) */
+                               docs/DESIGN-REFINE.md). HD_REST_BLEND's paths are always PT_MS's */
     float depth_threshold;  /* the volume's depth (hd_read_depth) is where a camera ray's
                                accumulated opacity 1 - T first reaches this: 0 -> 0.5; (0, 1]
                                (1: where the march stops, T below 1e-4) */
@@ -651,7 +657,7 @@ typedef struct hd_stats {
     int light_converged;      /* light_error < params.light_tolerance twice in a row */
     int render_scale;         /* the divisor of the current image's frames (params.render_scale);
                                  1 for full-resolution frames and for the path tracers */
-    uint64_t refine_paths;    /* paths per pixel a resting view's refinement (HD_REST_REFINE) has
+    uint64_t refine_paths;    /* paths per pixel a resting view's refinement (HD_REST_REFINE, BLEND) has
                                  added to the current image; 0 while it shows HD's frames */
     double light_progress;    /* HD, CD: the part done of a light iteration that render_budget has
                                  split over hd_render calls, in [0, 1): the direct stage is the
@@ -795,8 +801,8 @@ HDDEF hd_result hd_refine(hd_context ctx, int n);
              and phi into the image's running mean. Once the light has converged, no light work:
              the projection alone, and when the frame_window frames since the convergence are in
              the image (it is done), nothing at all until a setter invalidates something; with
-             params.rest HD_REST_REFINE, refinement passes toward PT_MS instead (one, or as many
-             as render_budget allows), until the next change.
+             params.rest HD_REST_REFINE or HD_REST_BLEND, refinement passes toward PT_MS instead
+             (one, or as many as render_budget allows), until the next change.
      PT_SS, PT_MS: one path iteration (or as many as render_budget allows).
    A camera move (hd_set_camera) keeps converged light: the next call projects at once. For a
    frame budget below one projection's time, params.render_scale projects at reduced resolution

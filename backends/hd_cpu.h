@@ -355,13 +355,13 @@ static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable)
     return HD_SUCCESS;
 }
 
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts)
 {
     hd__backend *be = vw->be;
-    float *img = (float *)hd__calloc(vw, hd__image_floats(width, height, reduced), sizeof(float));
+    float *img = (float *)hd__calloc(vw, hd__image_floats(width, height, parts), sizeof(float));
     if (!img)
         return HD__ERR(&vw->log, HD_ERROR_OUT_OF_MEMORY, "cpu: cannot allocate a %dx%d image%s", width, height,
-                       reduced ? " with room for reduced frames" : "");
+                       hd__image_parts_name(parts));
     hd__free(vw, be->img);
     be->img = be->k.img = img;
     return HD_SUCCESS;
@@ -1225,8 +1225,19 @@ static void hd__cpu_upsample_table(const hd__view *vw)
     be->up_lw = lw;
 }
 
+/* A row of HD_REST_BLEND's blend pass (hdk_blend_pixel). */
+static void hd__cpu_blend_row(hd__backend *be, int py)
+{
+    int px, w = be->vw->kp.image.x;
+    for (px = 0; px < w; ++px) hdk_blend_pixel(&be->k, px, py);
+}
+
 static hd_result hd__be_upsample(const hd__view *vw)
 {
+    if (vw->kp.counts.z & HD_FLAG_BLEND) {
+        hd__cpu_parallel(vw->be, hd__cpu_blend_row, vw->kp.image.y);
+        return HD_SUCCESS;
+    }
     hd__cpu_upsample_table(vw);
     hd__cpu_parallel(vw->be, hd__cpu_upsample_row, vw->kp.image.y);
     return HD_SUCCESS;

@@ -358,7 +358,8 @@ HD__CL_PROJECT(hd_k_project_half, 1)
 /* A reduced frame's upsample pass (hd_k_upsample.h's arithmetic), one work-item per run of
    HD_CL_UPSAMPLE_RUN pixels of a row (global size (ceil(w / run), h)), the row's source rows
    found once and each pixel's 4 floats loaded and stored together: on PoCL a work-item per pixel
-   through hdk_upsample_pixel was most of a reduced frame's time (docs/PERFORMANCE.md). */
+   through hdk_upsample_pixel was most of a reduced frame's time (docs/PERFORMANCE.md). With
+   HD_FLAG_BLEND the same runs take HD_REST_BLEND's blend passes (hdk_blend_pixel). */
 #define HD_CL_UPSAMPLE_RUN 16
 __kernel void hd_k_upsample(HD__CL_BUFFERS)
 {
@@ -367,6 +368,11 @@ __kernel void hd_k_upsample(HD__CL_BUFFERS)
     float wx = 0.0f, wy = 0.0f;
     __global const float *r0, *r1;
     if (py >= h) return;
+    if ((p->counts.z & HD_FLAG_BLEND) != 0) { /* HD_REST_BLEND's blend passes instead */
+        HD__CL_KCTX;
+        for (end = min(px + HD_CL_UPSAMPLE_RUN, w); px < end; ++px) hdk_blend_pixel(&k, px, py);
+        return;
+    }
     y0 = hdk_upsample_axis(py, h, lh, &y1, &wy);
     r0 = img + ((size_t)w * h + (size_t)y0 * lw) * 4;
     r1 = img + ((size_t)w * h + (size_t)y1 * lw) * 4;

@@ -153,7 +153,11 @@ void main()
     }
     if (x < HD_PRM(image).x && y < HD_PRM(image).y) hdk_project_pixel(x, y);
 #elif HD_STAGE == HD_STAGE_UPSAMPLE
-    if (x < HD_PRM(image).x && y < HD_PRM(image).y) hdk_upsample_pixel(x, y);
+    /* with HD_FLAG_BLEND, HD_REST_BLEND's blend passes (hd_k_upsample.h) */
+    if (x < HD_PRM(image).x && y < HD_PRM(image).y) {
+        if ((HD_PRM(counts).z & HD_FLAG_BLEND) != 0) hdk_blend_pixel(x, y);
+        else hdk_upsample_pixel(x, y);
+    }
 #elif HD_STAGE == HD_STAGE_CONVECT
     if (x < g.x && y < g.y && z < g.z) hdk_convect_voxel(x, y, z, hd_pc.z);
 #elif HD_STAGE == HD_STAGE_SUM_LIGHT

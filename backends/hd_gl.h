@@ -912,16 +912,16 @@ static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floa
 }
 static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable) { return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable); }
 
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts)
 {
     hd__backend *be = vw->be;
-    size_t floats = hd__image_floats(width, height, reduced), bytes = floats * sizeof(float);
+    size_t floats = hd__image_floats(width, height, parts), bytes = floats * sizeof(float);
     GLuint img = 0;
     hd_result r;
     if (bytes > (size_t)be->max_ssbo_block)
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "gl: a %dx%d image%s needs %zu bytes, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE = %d",
-                       width, height, reduced ? " with room for reduced frames" : "", bytes, (int)be->max_ssbo_block);
-    if ((r = hd__gl_buffer_data(vw, &img, bytes, NULL, GL_DYNAMIC_COPY, reduced ? "the image with room for reduced frames" : "the image")) !=
+                       width, height, hd__image_parts_name(parts), bytes, (int)be->max_ssbo_block);
+    if ((r = hd__gl_buffer_data(vw, &img, bytes, NULL, GL_DYNAMIC_COPY, (parts & HD__IMAGE_REDUCED) ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__gl_free_buffer(be, &img);
         return r;

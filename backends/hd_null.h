@@ -97,12 +97,12 @@ static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable)
     vw->be->jacobi = enable;
     return HD_SUCCESS;
 }
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts)
 {
     hd__null_call(vw, HD__NULL_alloc_image);
     vw->be->width = width;
     vw->be->height = height;
-    vw->be->reduced = reduced;
+    vw->be->reduced = parts & HD__IMAGE_REDUCED;
     return HD_SUCCESS;
 }
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count)

@@ -509,13 +509,13 @@ static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floa
 
 static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable) { return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable); }
 
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts)
 {
     hd__backend *be = vw->be;
-    size_t floats = hd__image_floats(width, height, reduced);
+    size_t floats = hd__image_floats(width, height, parts);
     cl_mem img;
     hd_result r;
-    if ((r = hd__cl_buffer(vw, &img, floats * sizeof(float), NULL, reduced ? "the image with room for reduced frames" : "the image")) !=
+    if ((r = hd__cl_buffer(vw, &img, floats * sizeof(float), NULL, (parts & HD__IMAGE_REDUCED) ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__cl_release(&img);
         return r;

@@ -1607,10 +1607,10 @@ static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable)
     return hd__gpu_alloc_jacobi(vw, &vw->be->gg, enable);
 }
 
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced)
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts)
 {
     hd__backend *be = vw->be;
-    size_t floats = hd__image_floats(width, height, reduced);
+    size_t floats = hd__image_floats(width, height, parts);
     VkDeviceSize bytes = (VkDeviceSize)floats * sizeof(float);
     hd__vk_buffer img;
     hd_result r;
@@ -1619,10 +1619,10 @@ static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, i
         return HD__ERR(&vw->log, HD_ERROR_BACKEND, "vulkan: the image buffer changed while recording (internal error)");
     if (bytes > be->limits.maxStorageBufferRange)
         return HD__ERR(&vw->log, HD_ERROR_UNSUPPORTED, "vulkan: a %dx%d image%s needs %llu bytes, above maxStorageBufferRange = %u",
-                       width, height, reduced ? " with room for reduced frames" : "", (unsigned long long)bytes,
+                       width, height, hd__image_parts_name(parts), (unsigned long long)bytes,
                        be->limits.maxStorageBufferRange);
     if ((r = hd__vk_buffer_create(vw, &img, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, reduced ? "the image with room for reduced frames" : "the image")) !=
+                                  VK_BUFFER_USAGE_TRANSFER_DST_BIT, 0, (parts & HD__IMAGE_REDUCED) ? "the image with room for reduced frames" : "the image")) !=
         HD_SUCCESS) {
         hd__vk_free_buffer(vw, &img);
         return r;

@@ -1,6 +1,6 @@
 /* hdbench_refine - a resting view's refinement (make eval-refine, docs/DESIGN-REFINE.md): PSNR
    against a PT_MS reference per time budget for HD alone, PT_MS alone and HD with
-   params.rest = HD_REST_REFINE at several refine_bounces, on one view of hdrender's default scene
+   params.rest = HD_REST_REFINE at several refine_bounces and HD_REST_BLEND, on one view of hdrender's default scene
    (bench/hd_orbit_scene.h: the head CT, the three-quarter camera, one key light, exposure 8).
 
    Each mode runs in a fresh context (seed 0) and calls hd_render (render_budget 0: one light
@@ -33,7 +33,7 @@ static struct {
     const char *data, *tf, *cache, *csv;
     int size, ref_iters, warm, nb, nm;
     double budgets[MAX_BUDGETS];
-    int modes[MAX_MODES]; /* -1000 HD, -2000 PT_MS, else refine_bounces of HD_REST_REFINE */
+    int modes[MAX_MODES]; /* -1000 HD, -2000 PT_MS, -3000 HD_REST_BLEND, else refine_bounces of HD_REST_REFINE */
 } O;
 
 
@@ -54,7 +54,7 @@ static void usage(int code)
             "  --ref-iters N      PT_MS reference paths per pixel, two halves (default 1024)\n"
             "  --budgets A,B,..   seconds (default 0.25,1,5,30)\n"
             "  --modes M,..       hd, pt, rK (HD_REST_REFINE, refine_bounces K; r-1: never reads\n"
-            "                     HD's light) (default hd,pt,r1,r2,r3,r-1)\n"
+            "                     HD's light), bl (HD_REST_BLEND) (default hd,pt,r1,r2,r3,r-1)\n"
             "  --warm             HD modes start with converged light (as after an orbit)\n"
             "  --csv FILE         results (default: none)\n"
             "  --cache DIR        reference images (default build/refine-cache)\n");
@@ -98,6 +98,7 @@ static void parse_args(int argc, char **argv)
         size_t n = e ? (size_t)(e - modes) : strlen(modes);
         if (n == 2 && !strncmp(modes, "hd", 2)) O.modes[O.nm++] = -1000;
         else if (n == 2 && !strncmp(modes, "pt", 2)) O.modes[O.nm++] = -2000;
+        else if (n == 2 && !strncmp(modes, "bl", 2)) O.modes[O.nm++] = -3000;
         else if (n >= 2 && modes[0] == 'r') O.modes[O.nm++] = atoi(modes + 1);
         else usage(2);
         modes += n + (e ? 1 : 0);
@@ -172,6 +173,7 @@ static void mode_name(int m, char *buf, size_t n)
 {
     if (m == -1000) snprintf(buf, n, "HD");
     else if (m == -2000) snprintf(buf, n, "PT_MS");
+    else if (m == -3000) snprintf(buf, n, "blend");
     else snprintf(buf, n, "refine k=%d", m);
 }
 
@@ -189,7 +191,8 @@ static void run_mode(const hd_desc *desc, int m, const float *ref_tm, double ref
     int j = 0;
     if (!img) { fprintf(stderr, "hdbench_refine: out of memory\n"); exit(1); }
     d.params.method = m == -2000 ? HD_METHOD_PT_MS : HD_METHOD_HD;
-    if (m != -1000 && m != -2000) {
+    if (m == -3000) d.params.rest = HD_REST_BLEND;
+    else if (m != -1000 && m != -2000) {
         d.params.rest = HD_REST_REFINE;
         d.params.refine_bounces = m;
     }

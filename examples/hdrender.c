@@ -134,10 +134,10 @@ static const char *usage_text_method =
     "                          pt_ss, pt_ms: paths per pixel (default 256)\n"
     "  --budget SECONDS        render for this wall time (0.01..86400) instead: hd_render\n"
     "                          calls with hd, cd the light, HD's frames, then the resting\n"
-    "                          view's refinement toward PT_MS (params.rest HD_REST_REFINE);\n"
+    "                          view's blend with PT_MS paths (params.rest HD_REST_BLEND);\n"
     "                          pt_ss, pt_ms: paths until the time is spent\n"
-    "  --refine-bounces K      --budget: the vertex at which refinement paths read HD's light\n"
-    "                          (default -1: never, unbiased PT_MS paths; 2: a final gather)\n"
+    "  --refine-bounces K      --budget: refine with HD's frame as prior instead (HD_REST_REFINE),\n"
+    "                          paths reading HD's light at vertex K (-1: never; 2: a final gather)\n"
     "  --tolerance F           hd, cd: the light's estimated relative error at which it counts\n"
     "                          as converged (default 0.1)\n"
     "  --extinction F          sigma_t per world unit at TF alpha 1 (default 100)\n"
@@ -811,6 +811,7 @@ int main(int argc, char **argv)
     int dims[3] = {0, 0, 0}, have_dims = 0, raw_type = -1, lights_n = 0, iterations = 0;
     int print_tf = 0, i, k, have_spacing = 0, camera_given = 0, min_light = 0, crop_given = 0, window_given = 0;
     double budget = 0.0; /* --budget: seconds of wall time, 0: the iteration schedule */
+    int refine_given = 0; /* --refine-bounces: the resting view refined (HD_REST_REFINE), not blended */
     double mean, lit;
     hd_endian endian = HD_ENDIAN_LITTLE;
     size_t offset = 0;
@@ -972,6 +973,7 @@ int main(int argc, char **argv)
         } else if (IS("--refine-bounces")) {
             desc.params.refine_bounces = (int)parse_int(a, VAL(), -1, 100000);
             if (desc.params.refine_bounces == 0) fail(2, "--refine-bounces: 0 is not -1 or 1..100000");
+            refine_given = 1;
         } else if (IS("--extinction")) {
             desc.params.extinction = parse_float(a, VAL(), 0.0f, 1e6f, 1, 0);
         } else if (IS("--albedo")) {
@@ -1053,7 +1055,7 @@ int main(int argc, char **argv)
 
     pt = desc.params.method == HD_METHOD_PT_SS || desc.params.method == HD_METHOD_PT_MS;
     if (budget > 0.0 && iterations) fail(2, "give either --budget or --iterations, not both");
-    if (budget > 0.0) desc.params.rest = HD_REST_REFINE;
+    if (budget > 0.0) desc.params.rest = refine_given ? HD_REST_REFINE : HD_REST_BLEND;
     if (!iterations && pt && budget <= 0.0) iterations = 256;
     /* CD's multiple scattering spreads one cell per sweep: its convergence estimate settles
        (about 100 iterations on the head CT) long before the light has reached the far side,

@@ -116,6 +116,11 @@ eval-refine: $(B)/hdbench_refine
 	@test -f data/head.nrrd || scripts/fetch-data
 	@for tf in ct-skin ct-bone; do for w in "" --warm; do \
 	    $(B)/hdbench_refine --tf $$tf $$w --csv $(B)/refine-$$tf$$w.csv $(REFINE_ARGS) || exit 1; done; done
+# make eval-refine-256: HD, PT_MS, REFINE and BLEND at 256^2 (scripts/eval-refine-256, about 15
+# min of CPU; docs/DESIGN-REFINE.md).
+.PHONY: eval-refine-256
+eval-refine-256: $(B)/hdbench_refine
+	scripts/eval-refine-256
 
 # make bench-budget: bench/hdbench_budget.c on every backend: the head CT orbit (200 frames,
 # HD_RENDER_SCALE_AUTO, the light cold at the start) at 1280x720 and 1920x1080 under rising

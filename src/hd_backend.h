@@ -86,21 +86,37 @@ static hd_result hd__be_update_volume(const hd__view *vw, const hd__box *vox, co
 static hd_result hd__be_alloc_illumination(const hd__view *vw, size_t illum_floats);
 /* The Jacobi solver's second phi buffer: allocated when enable, freed otherwise. */
 static hd_result hd__be_alloc_jacobi(const hd__view *vw, int enable);
-/* The RGBA float image of width x height and, with reduced, after it the reduced frames' region
-   (hd__image_floats), contents undefined until hd__be_clear. The new buffer is made before the
-   old one is released, so on failure the image held before is kept as it was. */
-static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int reduced);
-/* The image buffer's floats: width x height RGBA, then with reduced the room for a frame at render
-   scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames use, then the
-   depth plane (width x height floats from hd__image_depth_first: hd_k_project.h's
-   hdk_project_depth, read by hd__be_read_depth). */
-HD__MAYBE_UNUSED static size_t hd__image_depth_first(int width, int height, int reduced)
+/* The RGBA float image of width x height and the parts hd__image_floats adds for the flags in
+   `parts` (HD__IMAGE_REDUCED, HD__IMAGE_BLEND), contents undefined until hd__be_clear. The new
+   buffer is made before the old one is released, so on failure the image held before is kept as
+   it was. */
+static hd_result hd__be_alloc_image(const hd__view *vw, int width, int height, int parts);
+#define HD__IMAGE_REDUCED 1 /* the reduced frames' region */
+#define HD__IMAGE_BLEND 2   /* HD_REST_BLEND's four planes */
+/* The image buffer's floats: width x height RGBA, then with HD__IMAGE_REDUCED the room for a
+   frame at render scale 2 (the largest reduced frame; hd_k_upsample.h), which only reduced frames
+   use, then the depth plane (width x height floats from hd__image_depth_first: hd_k_project.h's
+   hdk_project_depth, read by hd__be_read_depth), then with HD__IMAGE_BLEND four RGBA planes of
+   width x height from hd__image_blend_first (the paths' mean and statistics, HD's frame and the
+   blend's own: hd_k_upsample.h's hdk_blend_pixel). */
+HD__MAYBE_UNUSED static size_t hd__image_depth_first(int width, int height, int parts)
 {
-    return ((size_t)width * height + (reduced ? (size_t)((width + 1) / 2) * ((height + 1) / 2) : 0)) * 4;
+    return ((size_t)width * height + ((parts & HD__IMAGE_REDUCED) ? (size_t)((width + 1) / 2) * ((height + 1) / 2) : 0)) * 4;
 }
-HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int reduced)
+HD__MAYBE_UNUSED static size_t hd__image_blend_first(int width, int height, int parts)
 {
-    return hd__image_depth_first(width, height, reduced) + (size_t)width * height;
+    return hd__image_depth_first(width, height, parts) + (size_t)width * height;
+}
+HD__MAYBE_UNUSED static size_t hd__image_floats(int width, int height, int parts)
+{
+    return hd__image_blend_first(width, height, parts) + ((parts & HD__IMAGE_BLEND) ? (size_t)width * height * 16 : 0);
+}
+/* What the buffer holds besides the image, for the backends' messages: "" or " with ...". */
+HD__MAYBE_UNUSED static const char *hd__image_parts_name(int parts)
+{
+    static const char *const names[4] = {"", " with room for reduced frames", " with the blend's planes",
+                                         " with room for reduced frames and the blend's planes"};
+    return names[parts & 3];
 }
 /* CD's light volumes: count of them (0 frees them), dark. */
 static hd_result hd__be_alloc_lights(const hd__view *vw, int count);
@@ -145,7 +161,8 @@ static hd_result hd__be_project(const hd__view *vw);
 /* A reduced frame's upsample pass (hd_k_upsample.h): the frame just projected at render scale
    s > 1 (vw->kp.image at the reduced size, into the image buffer's second region) bilinearly
    filled into the full image's running mean. vw->kp describes the full image, with the scale in
-   region.y. */
+   region.y. With HD_FLAG_BLEND in counts.z instead, HD_REST_BLEND's blend pass (hdk_blend_pixel)
+   into the image. */
 static hd_result hd__be_upsample(const hd__view *vw);
 /* PT_SS / PT_MS: one path per pixel into the image's running mean (hd_k_path.h). */
 static hd_result hd__be_path(const hd__view *vw);

@@ -137,12 +137,14 @@ typedef struct hd__ctx {
     double light_error;
     uint64_t converged_frames; /* projection frames since the light converged */
     uint64_t refined;        /* refinement paths per pixel in the resting view's image (HD_REST_REFINE,
-                                src/hd_schedule.h); 0: the image is HD's frames */
+                                BLEND; src/hd_schedule.h); 0: the image is HD's frames */
     int frame_scale;         /* render scale of the image's frames; 0: none chosen since the image
                                 was reset (HD_RENDER_SCALE_AUTO starts coarse again) */
     hd__cost cost;
     int image_room;          /* the image buffer holds the reduced frames' region (made when a
                                 scale > 1 is first used, hd__image_room) */
+    int image_blend;         /* it holds HD_REST_BLEND's planes (made when the rest asks for them) */
+    double blend_cost;       /* the last blend pass's seconds (hd__blend_image) */
     int no_measure;          /* light iterations are being recorded (hd_vulkan_record*), not run, or a
                                 copy is recorded after them (hd_vulkan_record_illumination) */
     int rec_light;           /* light iterations recorded and not yet measured: the next call measures

@@ -102,6 +102,12 @@ static int hd__next_scale(const hd__ctx *ctx)
     return ctx->frames > 0 && s > 1 ? s / 2 : s;
 }
 
+/* The parts the image buffer holds besides the image (hd__image_floats). */
+static int hd__image_parts(const hd__ctx *ctx)
+{
+    return (ctx->image_room ? HD__IMAGE_REDUCED : 0) | (ctx->image_blend ? HD__IMAGE_BLEND : 0);
+}
+
 /* Gives the image buffer the reduced frames' region if it lacks it (the first frame at a scale
    > 1), then clears it (the new buffer's contents are undefined; the frame about to be made
    restarts the running mean anyway). On failure the full-size image is kept as it was and
@@ -110,7 +116,9 @@ static hd_result hd__image_room(hd__ctx *ctx)
 {
     hd_result r;
     if (ctx->image_room) return HD_SUCCESS;
-    if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height, 1)) != HD_SUCCESS) return r;
+    if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height, hd__image_parts(ctx) | HD__IMAGE_REDUCED)) !=
+        HD_SUCCESS)
+        return r;
     ctx->image_room = 1;
     ctx->frames = ctx->converged_frames = ctx->refined = 0;
     return hd__be_clear(&ctx->vw, HD__DIRTY_IMAGE);

@@ -283,7 +283,8 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     out->method_bytes += ctx->vw.env_floats * sizeof(float); /* the environment's tables, any method */
     /* the buffer held, or the one the next call makes for a new camera size */
     out->image_bytes = hd__image_floats(ctx->vw.camera.width, ctx->vw.camera.height,
-                                        (ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) *
+                                        ((ctx->dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room) |
+                                            (hd__image_blend_wanted(ctx) ? HD__IMAGE_BLEND : 0)) *
                        sizeof(float);
     /* the volume as stored (U8, U16, I16 or normalised floats; Vulkan pads each row to 4 bytes),
        the majorant grid as floats and the TF as RGBA floats */

@@ -20,7 +20,20 @@ static int hd__image_room_kept(const hd__ctx *ctx)
     return ctx->image_room && ctx->vw.params.render_scale != 1 && !hd__method_is_pt(ctx->vw.params.method);
 }
 
+/* Whether the image buffer should hold HD_REST_BLEND's planes. */
+static int hd__image_blend_wanted(const hd__ctx *ctx)
+{
+    return ctx->vw.params.rest == HD_REST_BLEND && !hd__method_is_pt(ctx->vw.params.method);
+}
+
+/* Whether a resting view adds paths (HD_REST_REFINE, HD_REST_BLEND). */
+static int hd__rest_paths(const hd__ctx *ctx)
+{
+    return ctx->vw.params.rest == HD_REST_REFINE || ctx->vw.params.rest == HD_REST_BLEND;
+}
+
 static hd_result hd__record_measure(hd__ctx *ctx);
+static hd_result hd__blend_image(hd__ctx *ctx, uint64_t n);
 
 /* The dirty bits that end a split light iteration (hd__prepare). */
 #define HD__PART_ENDS \
@@ -56,10 +69,20 @@ static hd_result hd__prepare(hd__ctx *ctx)
     }
     /* the path tracers' state is their image: whatever resets it restarts them */
     if (pt && (dirty & HD__DIRTY_IMAGE)) dirty |= HD__DIRTY_DIRECT;
-    if (dirty & HD__DIRTY_IMAGE_ALLOC) {
-        int room = hd__image_room_kept(ctx);
-        if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height, room)) != HD_SUCCESS) return r;
+    /* a new camera size, or HD_REST_BLEND's planes wanted or no longer (a change of rest or
+       method restarts the image) */
+    if ((dirty & HD__DIRTY_IMAGE_ALLOC) || ((dirty & HD__DIRTY_IMAGE) && hd__image_blend_wanted(ctx) != ctx->image_blend)) {
+        int room = (dirty & HD__DIRTY_IMAGE_ALLOC) ? hd__image_room_kept(ctx) : ctx->image_room, blend = hd__image_blend_wanted(ctx);
+        size_t floats = hd__image_floats(ctx->vw.camera.width, ctx->vw.camera.height, (room ? HD__IMAGE_REDUCED : 0) | HD__IMAGE_BLEND);
+        /* the kernels address the blend planes with 32-bit offsets */
+        if (blend && floats > 0x7fffffffu)
+            return HD__ERR(&ctx->vw.log, HD_ERROR_UNSUPPORTED, "params.rest HD_REST_BLEND: a %dx%d image's planes need %zu floats, above 2^31 - 1",
+                           ctx->vw.camera.width, ctx->vw.camera.height, floats);
+        if ((r = hd__be_alloc_image(&ctx->vw, ctx->vw.camera.width, ctx->vw.camera.height,
+                                    (room ? HD__IMAGE_REDUCED : 0) | (blend ? HD__IMAGE_BLEND : 0))) != HD_SUCCESS)
+            return r;
         ctx->image_room = room;
+        ctx->image_blend = blend;
         dirty |= HD__DIRTY_IMAGE;
     }
     ctx->dirty = dirty & ~(unsigned)(HD__DIRTY_ALLOC | HD__DIRTY_IMAGE_ALLOC | HD__DIRTY_JACOBI);
@@ -380,8 +403,10 @@ static hd_result hd__project_frame(hd__ctx *ctx)
     if ((r = hd__use_scale(ctx, hd__next_scale(ctx))) != HD_SUCCESS) return r;
     t1 = hd__now(); /* the frame cost starts after a first reduced frame's allocation */
     s = ctx->frame_scale;
+    /* the image is HD's frames again (a blended one gets HD's frame back first) */
+    if (ctx->refined > 0 && ctx->image_blend && ctx->vw.params.rest == HD_REST_BLEND && (r = hd__blend_image(ctx, 0)) != HD_SUCCESS) return r;
     ctx->frames++;
-    ctx->refined = 0; /* the image is HD's frames again */
+    ctx->refined = 0;
     hd__fill_kparams(ctx);
     if (s > 1) {
         int w = ctx->vw.kp.image.x, h = ctx->vw.kp.image.y;
@@ -440,21 +465,57 @@ static hd_result hd__iterate_pt(hd__ctx *ctx)
 
 /* One refinement pass of a resting HD or CD view (HD_REST_REFINE): one path per pixel that ends
    into the converged E + phi at vertex refine_bounces (hd_k_path.h, image.w), into the image's
-   mean. The view rests only after a projection of the current light, so the backends' summed
+   mean; HD_REST_BLEND: one PT_MS path per pixel into the blend planes (region.w). The view rests only after a projection of the current light, so the backends' summed
    light (lsum) the paths read is up to date. Its time counts as the projection's. */
 static hd_result hd__refine_paths(hd__ctx *ctx)
 {
     hd_result r;
     double t0 = hd__now();
-    int k = ctx->vw.params.refine_bounces;
+    int k = ctx->vw.params.refine_bounces, blend = ctx->vw.params.rest == HD_REST_BLEND;
     ctx->refined++;
     hd__fill_kparams(ctx);
-    ctx->vw.kp.image.w = k < 0 ? 0 : k;
+    ctx->vw.kp.image.w = k < 0 || blend ? 0 : k;
+    ctx->vw.kp.region.w = blend ? (int32_t)hd__image_blend_first(ctx->vw.camera.width, ctx->vw.camera.height, hd__image_parts(ctx)) : 0;
     ctx->vw.kp.frame.x = (int32_t)ctx->refined;
-    ctx->vw.kp.march.y = (float)(1.0 / (HD__REFINE_PRIOR + (double)ctx->refined));
+    /* BLEND: the paths' plain mean; REFINE: HD's frame as HD__REFINE_PRIOR paths */
+    ctx->vw.kp.march.y = (float)(1.0 / ((blend ? 0.0 : HD__REFINE_PRIOR) + (double)ctx->refined));
     r = hd__be_path(&ctx->vw);
     hd__fill_kparams(ctx);
     ctx->seconds[2] += hd__now() - t0;
+    return r;
+}
+
+/* HD_REST_BLEND's tile radii after n paths per pixel (hd_k_upsample.h): pass 1's, over which
+   HD's bias is smoothed, from 3 (n < 8) to 1 (n > 16); pass 2's, over which the weights'
+   variance and bias are estimated, from 3 (n < 29) to 1 (n > 64). As the paths' noise falls the
+   estimates follow the image's detail more closely; the radii were measured on the head CT
+   (docs/DESIGN-REFINE.md). */
+static int hd__blend_radius(uint64_t n, double c)
+{
+    double r = c / sqrt((double)(n < 1 ? 1 : n));
+    return r >= 3.0 ? 3 : r >= 2.0 ? 2 : 1;
+}
+
+/* HD_REST_BLEND's blend passes (hdk_blend_pixel, through hd__be_upsample) after n paths per
+   pixel: the image from HD's frame and the paths' mean; n < 2 puts HD's frame back. Their time
+   counts as the projection's. */
+static hd_result hd__blend_image(hd__ctx *ctx, uint64_t n)
+{
+    hd_result r = HD_SUCCESS;
+    double t0 = hd__now();
+    int pass;
+    for (pass = n < 2 ? 2 : 1; pass <= 2 && r == HD_SUCCESS; ++pass) {
+        hd__fill_kparams(ctx);
+        ctx->vw.kp.counts.z |= HD_FLAG_BLEND;
+        ctx->vw.kp.frame.x = (int32_t)n;
+        ctx->vw.kp.frame.w = pass;
+        ctx->vw.kp.region.y = hd__blend_radius(n, pass == 1 ? 8.0 : 16.0);
+        ctx->vw.kp.region.w = (int32_t)hd__image_blend_first(ctx->vw.camera.width, ctx->vw.camera.height, hd__image_parts(ctx));
+        r = hd__be_upsample(&ctx->vw);
+    }
+    hd__fill_kparams(ctx);
+    ctx->blend_cost = hd__now() - t0;
+    ctx->seconds[2] += ctx->blend_cost;
     return r;
 }
 
@@ -566,17 +627,21 @@ static hd_result hd__render(hd__ctx *ctx)
     }
     if (hd__light_converged(ctx)) {
         /* the image is done once frame_window frames at its final scale are in; then the view
-           rests: HD_REST_REFINE adds refinement paths, at least one pass, while the budget has
-           room for another */
+           rests: HD_REST_REFINE and BLEND add refinement paths, at least one pass, while the
+           budget has room for another (and BLEND's blend pass) */
         int s = hd__next_scale(ctx);
         if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) {
-            if (ctx->vw.params.rest != HD_REST_REFINE) return HD_SUCCESS;
+            int blend = ctx->vw.params.rest == HD_REST_BLEND;
+            uint64_t n0 = ctx->refined;
+            if (!hd__rest_paths(ctx)) return HD_SUCCESS;
             do {
                 double ti = hd__now();
                 if (ctx->refined >= 0x7fffffffu) break;
                 if ((r = hd__refine_paths(ctx)) != HD_SUCCESS) return r;
                 last = hd__now() - ti;
-            } while (hd__now() - t0 + last <= budget);
+            } while (hd__now() - t0 + last + (blend ? ctx->blend_cost : 0.0) <= budget);
+            /* the blend pass once per call, after its paths */
+            if (blend && ctx->refined > n0) return hd__blend_image(ctx, ctx->refined);
             return HD_SUCCESS;
         }
         if ((r = hd__use_scale(ctx, s)) != HD_SUCCESS) return r;
@@ -668,7 +733,9 @@ static hd_result hd__record_render(hd__ctx *ctx, void *cb, const hd_vulkan_targe
         int s = hd__next_scale(ctx);
         if (s == ctx->frame_scale && ctx->converged_frames >= (uint64_t)ctx->vw.params.frame_window) {
             frame = 0;
-            if (ctx->vw.params.rest == HD_REST_REFINE && ctx->refined < 0x7fffffffu) r = hd__refine_paths(ctx);
+            if (hd__rest_paths(ctx) && ctx->refined < 0x7fffffffu && (r = hd__refine_paths(ctx)) == HD_SUCCESS &&
+                ctx->vw.params.rest == HD_REST_BLEND)
+                r = hd__blend_image(ctx, ctx->refined);
         } else if ((r = hd__use_scale(ctx, s)) == HD_SUCCESS) ctx->converged_frames++;
     }
     if (r == HD_SUCCESS && frame) {

@@ -12,12 +12,14 @@ HD_PARAM_I4(dims)       /* volume dims x, y, z; w = TF entry count */
 HD_PARAM_I4(gdims)      /* illumination grid dims x, y, z; w = channels (1 or 3) */
 HD_PARAM_I4(mdims)      /* majorant grid dims x, y, z; w = voxels per cell edge */
 HD_PARAM_I4(counts)     /* x = lights, y = tracking (1 ratio, 2 delta), z = flags, w = bounces */
-HD_PARAM_I4(frame)      /* x = iteration (1-based), y = frame (1-based), z = seed, w = half-sweep parity */
+HD_PARAM_I4(frame)      /* x = iteration (1-based), y = frame (1-based), z = seed, w = half-sweep parity (the blend: its pass) */
 HD_PARAM_I4(image)      /* x = width, y = height, z = method, w = the path vertex that reads HD's light (0: none, hd_k_path.h) */
 HD_PARAM_I4(region)     /* x = the first pixel of the frame's region of the image buffer (0; a
                            reduced frame's: the full image's width * height, hd_k_upsample.h),
                            y = the upsample pass's render scale (0 in every other pass), z = the
-                           depth plane's first float in the image buffer (hdk_project_depth), w = 0 */
+                           depth plane's first float in the image buffer (hdk_project_depth), w = the
+                           blend planes' first float (HD_REST_BLEND's paths and blend pass; 0 in every
+                           other pass); the blend pass has its tile radius in y */
 HD_PARAM_F4(box)        /* world size of the volume box (centred at 0); w = 1 / (4 pi) */
 HD_PARAM_F4(medium)     /* x = extinction, y = albedo, z = anisotropy g, w = global majorant */
 HD_PARAM_F4(grid)       /* xyz = 1 / h^2 of the illumination grid (world), w = sigma' floor */

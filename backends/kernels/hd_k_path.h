@@ -35,7 +35,8 @@
    cache instead of tracking toward a light, adding w * (E + phi)(x) / (4 pi) (the in-scattered
    radiance HD's projection uses there, isotropic), so vertices 1..k-1 carry what the diffusion
    lacks (light across air, exact shadows) and the cache the rest. k = 1 is HD's own estimator
-   traced; image.w = 0 never reads it: PT_MS.
+   traced; image.w = 0 never reads it: PT_MS. With region.w > 0 (HD_REST_BLEND) the path goes
+   into the blend planes instead (hdk_blend_accumulate, hd_k_upsample.h).
    Random numbers: key (pixel, iteration, seed, HD_STREAM_PATH); dims 0, 1 jitter the pixel,
    then every decision takes the next dims in order. Frames go into the image's running mean with
    weight march.y, which the host sets to 1/n for these methods (a plain progressive mean). */
@@ -180,5 +181,6 @@ HD_FN void hdk_path_pixel(HD_KARGS int px, int py)
         tmax = hdk_box_exit(HD_KPASS p, d);
     }
     if (geo == 0 && HD_PRM(background).w > 0.5f) alpha = 1.0f; /* the environment fills the pixel */
-    hdk_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
+    if (HD_PRM(region).w > 0) hdk_blend_accumulate(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
+    else hdk_accumulate_pixel(HD_KPASS i, HD_V4(lr, lg, lb, alpha));
 }

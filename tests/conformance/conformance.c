@@ -393,8 +393,9 @@ static int errors_within(const errors *e, int deterministic, int pt)
 
 static void report(const char *name, const pair *p, const guard *g, const errors *e, int deterministic)
 {
-    /* a resting view's refinement (HD_REST_REFINE) makes a path-traced image too */
-    int inputs_ok = guard_intact(g), pt = p->s && (method_is_pt(p->s->params.method) || p->s->params.rest == HD_REST_REFINE);
+    /* a resting view's refinement (HD_REST_REFINE, BLEND) makes a path-traced image too */
+    int inputs_ok = guard_intact(g),
+        pt = p->s && (method_is_pt(p->s->params.method) || p->s->params.rest == HD_REST_REFINE || p->s->params.rest == HD_REST_BLEND);
     int within = errors_within(e, deterministic, pt);
     int pass = p->ok && inputs_ok && within;
     char rest[96] = "";
@@ -1340,8 +1341,10 @@ static void scene_cases(void)
    frame_window frames, then `passes` refinement passes, paths ending into HD's light at vertex
    k (the path kernel reading the backends' summed light), before and after a camera move (which
    shows HD's frame again: compared too); the light, the image and the counts must agree. half:
-   binary16 illumination storage (the path stage must load no r16f image). */
-static void case_refine(hd_method method, hd_voxel_type type, const int *d, int lights, int mixed, int k, int half, int passes)
+   binary16 illumination storage (the path stage must load no r16f image). rest HD_REST_BLEND
+   instead: PT_MS paths into the blend planes and the blend passes (k is not used). */
+static void case_refine(hd_method method, hd_rest rest, hd_voxel_type type, const int *d, int lights, int mixed, int k, int half,
+                        int passes)
 {
     scene s;
     guard g;
@@ -1352,12 +1355,14 @@ static void case_refine(hd_method method, hd_voxel_type type, const int *d, int 
     scene_init(&s, type, d[0], d[1], d[2], lights, mixed, 0);
     s.params.method = method;
     s.params.light_tolerance = 1000.0f; /* converged after the first two estimates */
-    s.params.rest = HD_REST_REFINE;
+    s.params.rest = rest;
     s.params.refine_bounces = k;
     if (half) s.params.illumination_precision = HD_PRECISION_FLOAT16;
     guard_take(&g, &s);
-    snprintf(name, sizeof name, "%s rest refine k=%d x%d%s %s %dx%dx%d %dL%s", hd_api_cpu.method_name(method), k, passes,
-             half ? " f16" : "", type_name(type), d[0], d[1], d[2], lights, mixed ? " rgb" : "");
+    if (rest == HD_REST_BLEND) snprintf(name, sizeof name, "%s rest blend x%d%s %s %dx%dx%d %dL%s", hd_api_cpu.method_name(method), passes,
+                                        half ? " f16" : "", type_name(type), d[0], d[1], d[2], lights, mixed ? " rgb" : "");
+    else snprintf(name, sizeof name, "%s rest refine k=%d x%d%s %s %dx%dx%d %dL%s", hd_api_cpu.method_name(method), k, passes,
+                  half ? " f16" : "", type_name(type), d[0], d[1], d[2], lights, mixed ? " rgb" : "");
     if (pair_create(&p, &s)) {
         hd_stats a, b;
         hd_camera cam = s.camera;
@@ -1500,9 +1505,12 @@ static void render_cases(const int *odd, const int *other)
 {
     case_budget_split(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 3);
     case_budget_split(HD_METHOD_CD, HD_VOXEL_F32, other, 2, 3);
-    case_refine(HD_METHOD_HD, HD_VOXEL_U8, odd, 3, 0, 2, 0, 8);
-    case_refine(HD_METHOD_HD, HD_VOXEL_U16, other, 1, 1, 3, 1, 6);
-    case_refine(HD_METHOD_CD, HD_VOXEL_F32, odd, 1, 0, -1, 0, 6);
+    case_refine(HD_METHOD_HD, HD_REST_REFINE, HD_VOXEL_U8, odd, 3, 0, 2, 0, 8);
+    case_refine(HD_METHOD_HD, HD_REST_REFINE, HD_VOXEL_U16, other, 1, 1, 3, 1, 6);
+    case_refine(HD_METHOD_CD, HD_REST_REFINE, HD_VOXEL_F32, odd, 1, 0, -1, 0, 6);
+    case_refine(HD_METHOD_HD, HD_REST_BLEND, HD_VOXEL_U8, odd, 3, 0, -1, 0, 8);
+    case_refine(HD_METHOD_HD, HD_REST_BLEND, HD_VOXEL_U16, other, 1, 1, -1, 1, 40);
+    case_refine(HD_METHOD_CD, HD_REST_BLEND, HD_VOXEL_F32, odd, 1, 0, -1, 0, 1);
     case_render_at(HD_METHOD_HD, HD_VOXEL_U8, odd, 1, 0, 6);
     case_render_at(HD_METHOD_CD, HD_VOXEL_U16, other, 3, 0, 6);
     case_render_at(HD_METHOD_CD, HD_VOXEL_U8, odd, 1, 3, 4);

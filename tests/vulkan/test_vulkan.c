@@ -1074,8 +1074,9 @@ static void test_output_target(void)
    and waited for, reach light_converged 1 (the light measured by the next call); from then on no
    light iteration is recorded (iterations stay), the image restarts and its frames go up to
    frame_window and stop, and the write into the caller's image goes on (equal to the read-back,
-   every call). */
-static void test_record_converged(void)
+   every call). With rest HD_REST_BLEND the calls after the frames record a pass of paths and the
+   blend passes instead: the paths are counted and the written image is still the read-back. */
+static void test_record_converged(hd_rest rest)
 {
     hd_desc d = test_desc();
     hd_context h;
@@ -1088,6 +1089,7 @@ static void test_record_converged(void)
     d.vulkan.enable_validation = have_layer;
     d.params.light_tolerance = 0.2f;
     d.params.frame_window = 3;
+    d.params.rest = rest;
     messages = 0;
     if (hd_create(&d, &h) != HD_SUCCESS) { CHECK(0); return; }
     be = hd__lookup(h)->vw.be;
@@ -1122,16 +1124,19 @@ static void test_record_converged(void)
     /* the read-back after a call's submission measured its light iteration (the next call to reach
        the device does) and found it converged: the image restarted there (no frame yet), and no
        later call recorded a light iteration; the image then holds frame_window frames */
-    k = conv_at >= 0 && s.light_converged && s.iterations == it_conv && s.frames == 3 && fr == 0;
+    k = conv_at >= 0 && s.light_converged && s.iterations == it_conv && s.frames == 3 && fr == 0 &&
+        (rest == HD_REST_BLEND ? s.refine_paths >= 2 : s.refine_paths == 0);
     CHECK(k);
     vk_free(be, &im);
     vk_free(be, &host);
     CHECK(hd_destroy(h) == HD_SUCCESS);
     CHECK(ok && region == 0 && messages == 0);
-    printf("%s frames over converged light under recording: light_converged after %d calls (%llu iterations, %llu after 6 more "
-           "calls), %llu frame then, %llu after (frame_window 3); %d written images differ from the read-back; %lu validation messages\n",
-           ok && k && region == 0 && messages == 0 ? "PASS" : "FAIL", conv_at + 1, (unsigned long long)it_conv,
-           (unsigned long long)s.iterations, (unsigned long long)fr, (unsigned long long)s.frames, region, messages);
+    printf("%s frames over converged light under recording%s: light_converged after %d calls (%llu iterations, %llu after 6 more "
+           "calls), %llu frame then, %llu after (frame_window 3), %llu paths; %d written images differ from the read-back; %lu "
+           "validation messages\n",
+           ok && k && region == 0 && messages == 0 ? "PASS" : "FAIL", rest == HD_REST_BLEND ? " (rest BLEND)" : "", conv_at + 1,
+           (unsigned long long)it_conv, (unsigned long long)s.iterations, (unsigned long long)fr, (unsigned long long)s.frames,
+           (unsigned long long)s.refine_paths, region, messages);
 }
 
 /* 12: hd_vulkan_record_depth: the host's depth as a VkBuffer of floats, and as a D32_SFLOAT
@@ -1845,7 +1850,8 @@ int main(void)
             test_image_room();
             test_record_auto_scale();
             test_output_target();
-            test_record_converged();
+            test_record_converged(HD_REST_HOLD);
+            test_record_converged(HD_REST_BLEND);
             test_record_depth();
             test_volume_limit();
             test_record_solver_auto();
