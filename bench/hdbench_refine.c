@@ -132,7 +132,8 @@ static void reference(const hd_desc *desc, float *lin, double *halves_psnr)
     FILE *f;
     float *h[2];
     int k;
-    snprintf(path, sizeof path, "%s/ref-%s-%s-%d-%dspp.f32", O.cache, hd_backend_name(), O.tf, O.size, O.ref_iters);
+    const char *vol = strrchr(O.data, '/') ? strrchr(O.data, '/') + 1 : O.data; /* one reference per volume */
+    snprintf(path, sizeof path, "%s/ref-%s-%s-%s-%d-%dspp.f32", O.cache, hd_backend_name(), vol, O.tf, O.size, O.ref_iters);
     h[0] = (float *)malloc(n * sizeof(float));
     h[1] = (float *)malloc(n * sizeof(float));
     if (!h[0] || !h[1]) { fprintf(stderr, "hdbench_refine: out of memory\n"); exit(1); }
