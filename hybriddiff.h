@@ -640,7 +640,8 @@ typedef struct hd_stats {
     uint64_t frames;          /* frames accumulated into the current image */
     size_t method_bytes;      /* bytes of per-voxel state the method holds on the device
                                  (illumination grids, the projection's summed light E + phi, the
-                                 direct light's voxel list, helpers; volume and image excluded) */
+                                 direct light's voxel list once the first light work after a
+                                 change has made it, helpers; volume and image excluded) */
     size_t image_bytes;       /* bytes of the image accumulation */
     size_t volume_bytes;      /* bytes of the volume, the TF and the majorant grid on the device */
     int illumination_dims[3]; /* grid of the illumination volumes */

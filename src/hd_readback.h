@@ -273,9 +273,11 @@ static hd_result hd__api_get_stats(hd__ctx *ctx, hd_stats *out)
     out->method_bytes += hd__illum_floats(ctx) * sizeof(float); /* the projection's E + phi, float32 */
     /* HD: the direct light's list of grid voxels (src/hd_direct_mask.h), a uint32 each, which the
        GPU backends hold on the device; the CPU backend reads the core's mask instead (a bit per
-       grid voxel) and the count of entries before each brick */
-    if (ctx->vw.params.method == HD_METHOD_HD && ctx->vw.dl_idx) out->method_bytes += ctx->vw.dl_count * sizeof(uint32_t);
-    if (ctx->vw.params.method == HD_METHOD_HD && ctx->vw.dl_brick) {
+       grid voxel) and the count of entries before each brick, whose size the grid fixes, so it is
+       counted before they are made (a list's size is known once it is) */
+    if (ctx->vw.params.method == HD_METHOD_HD && ctx->vw.dl_idx) {
+        out->method_bytes += ctx->vw.dl_count * sizeof(uint32_t);
+    } else if (ctx->vw.params.method == HD_METHOD_HD && (hd__be_features() & HD__BE_LIST_FROM_BITS)) {
         int nb[3];
         out->method_bytes += (gvox + 7) / 8 + (hd__direct_bricks(ctx->vw.gdims, nb) + 1) * sizeof(uint32_t);
     }
