@@ -143,12 +143,23 @@ static void make_smoke(float *v, int n, float t)
             }
 }
 
-/* The plume's box, 1.2 wide and 2.8 tall, standing on the green box: its volume-to-world
-   transform, and its centre in `at` (the blending order). */
-static mat4 smoke_place(float at[3])
+/* The plume's volume in desc: its first voxels (returned, malloc'd; NULL without memory) as F32
+   in a box 1.2 wide and 2.8 tall standing on the green box (the volume-to-world transform), the
+   box's centre in `at` (the blending order), extinction 10. */
+static float *smoke_volume(hd_desc *desc, float at[3])
 {
+    float *vox = (float *)malloc(sizeof(float) * SMOKE_N * SMOKE_N * SMOKE_N);
+    mat4 place;
+    if (!vox) return NULL;
+    make_smoke(vox, SMOKE_N, 0.0f);
     at[0] = -3.5f, at[1] = 0.8f + 1.4f, at[2] = 2.0f;
-    return mat4_mul(mat4_translate(at[0], at[1], at[2]), mat4_scale(1.2f, 2.8f, 1.2f));
+    place = mat4_mul(mat4_translate(at[0], at[1], at[2]), mat4_scale(1.2f, 2.8f, 1.2f));
+    memcpy(desc->volume.transform, place.m, sizeof desc->volume.transform);
+    desc->volume.type = HD_VOXEL_F32;
+    desc->volume.dims[0] = desc->volume.dims[1] = desc->volume.dims[2] = SMOKE_N;
+    desc->volume.data = vox;
+    desc->params.extinction = 10.0f;
+    return vox;
 }
 
 /* Whether the volume centred at p is farther from the eye than the one at q: two volumes that

@@ -400,14 +400,7 @@ int main(int argc, char **argv)
 
     /* the plume: a box 1.2 wide and 2.8 tall standing on the green box, F32 voxels replaced every
        frame (hd_update_volume in draw_frame), a budget of 10 ms per frame */
-    if (!(a.smoke_vox = (float *)malloc(sizeof(float) * SMOKE_N * SMOKE_N * SMOKE_N))) return 1;
-    make_smoke(a.smoke_vox, SMOKE_N, 0.0f);
-    place = smoke_place(a.smoke_at);
-    memcpy(desc.volume.transform, place.m, sizeof desc.volume.transform);
-    desc.volume.type = HD_VOXEL_F32;
-    desc.volume.dims[0] = desc.volume.dims[1] = desc.volume.dims[2] = SMOKE_N;
-    desc.volume.data = a.smoke_vox;
-    desc.params.extinction = 10.0f;
+    if (!(a.smoke_vox = smoke_volume(&desc, a.smoke_at))) return 1;
     desc.params.render_budget = frames > 0 ? 0.0f : 0.01f;
     if ((r = hd_create(&desc, &a.smoke)) != HD_SUCCESS) die("hd_create (plume)", r);
 
