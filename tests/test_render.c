@@ -691,6 +691,23 @@ static double rms_rgb(const float *x, const float *y)
     return sqrt(s / (3.0 * W * W));
 }
 
+/* Two PT_MS images of d's scene, n paths each, seeds 11 and 12, into pa and pb: their RMS
+   difference (returned) is the noise a refined image is held to. d keeps its other fields. */
+static double pt_ms_pair(hd_desc *d, int n, float *pa, float *pb)
+{
+    hd_context ctx;
+    int k;
+    d->params.method = HD_METHOD_PT_MS;
+    for (k = 0; k < 2; ++k) {
+        d->params.seed = 11u + (uint32_t)k;
+        CHECK(hd_create(d, &ctx) == HD_SUCCESS);
+        CHECK(hd_iterate(ctx, n) == HD_SUCCESS);
+        CHECK(hd_read_image_f32(ctx, k ? pb : pa, W * W * 4) == HD_SUCCESS);
+        hd_destroy(ctx);
+    }
+    return rms_rgb(pa, pb);
+}
+
 /* refine_bounces -1: the refinement's paths are PT_MS's, so their mean (the image less HD's
    prior share, HD__REFINE_PRIOR = 8 paths' worth) agrees with PT_MS's within the noise: its RMS
    difference from one PT_MS image is about that of a second PT_MS image of another seed. Read
@@ -708,15 +725,7 @@ static void test_render_refine_unbiased(void)
     make_desc(&d, NULL);
     d.params.light_tolerance = 0.05f;
     d.params.max_bounces = 8;
-    d.params.method = HD_METHOD_PT_MS;
-    for (k = 0; k < 2; ++k) {
-        d.params.seed = 11u + (uint32_t)k;
-        CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
-        CHECK(hd_iterate(ctx, n) == HD_SUCCESS);
-        CHECK(hd_read_image_f32(ctx, k ? pb : pa, W * W * 4) == HD_SUCCESS);
-        hd_destroy(ctx);
-    }
-    noise = rms_rgb(pa, pb);
+    noise = pt_ms_pair(&d, n, pa, pb);
     d.params.method = HD_METHOD_HD;
     d.params.seed = 0;
     d.params.rest = HD_REST_REFINE;
@@ -807,19 +816,11 @@ static void test_render_blend_unbiased(void)
     double noise, err, errh, ma = 0.0, mr = 0.0;
     hd_desc d;
     hd_context ctx;
-    int i, k;
+    int i;
     make_desc(&d, NULL);
     d.params.light_tolerance = 0.05f;
     d.params.max_bounces = 8;
-    d.params.method = HD_METHOD_PT_MS;
-    for (k = 0; k < 2; ++k) {
-        d.params.seed = 11u + (uint32_t)k;
-        CHECK(hd_create(&d, &ctx) == HD_SUCCESS);
-        CHECK(hd_iterate(ctx, n) == HD_SUCCESS);
-        CHECK(hd_read_image_f32(ctx, k ? pb : pa, W * W * 4) == HD_SUCCESS);
-        hd_destroy(ctx);
-    }
-    noise = rms_rgb(pa, pb);
+    noise = pt_ms_pair(&d, n, pa, pb);
     d.params.method = HD_METHOD_HD;
     d.params.seed = 0;
     d.params.rest = HD_REST_BLEND;
