@@ -200,21 +200,12 @@ static double mean_of(const float *img, size_t npix)
     return s / (3.0 * (double)npix);
 }
 
-/* The MSE over RGB of image a scaled by k against b, both linear and tone-mapped on the fly in
-   double (hdx_psnr_rgb's metric without tone-mapped float copies of every image). k = 1: the plain
-   MSE (k * a is then exact). PSNR after scaling HD by the ratio of the means separates a global
-   energy error (the scaled PSNR is high) from one of the image's structure (it stays low). */
+/* The MSE over RGB of image a scaled by k against b, both linear and tone-mapped on the fly
+   (hdx_mse_linear). PSNR after scaling HD by the ratio of the means separates a global energy
+   error (the scaled PSNR is high) from one of the image's structure (it stays low). */
 static double mse_of(const float *a, const float *b, size_t npix, double k)
 {
-    double s = 0.0;
-    size_t i;
-    int c;
-    for (i = 0; i < npix; ++i)
-        for (c = 0; c < 3; ++c) {
-            double d = tonemap(k * a[4 * i + c]) - tonemap(b[4 * i + c]);
-            s += d * d;
-        }
-    return s / (3.0 * (double)npix);
+    return hdx_mse_linear(a, EXPOSURE * k, b, EXPOSURE, npix);
 }
 
 /* ---- where the light differs: regions and images ---------------------------------------------

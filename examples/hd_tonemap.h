@@ -50,19 +50,26 @@ HDX_TM_FN double hdx_psnr_rgb(const float *a, const float *b, size_t npix)
     return hdx_psnr(s / (3.0 * (double)npix));
 }
 
-/* PSNR over the RGB channels of two linear RGBA float images, each tone-mapped at exposure on the
-   fly (hdx_psnr_rgb's metric without tone-mapped copies). */
-HDX_TM_FN double hdx_psnr_linear(const float *a, const float *b, size_t npix, double exposure)
+/* The MSE over the RGB channels of two linear RGBA float images, a tone-mapped at exposure ea and
+   b at eb on the fly (hdx_psnr_rgb's metric without tone-mapped copies; ea != eb compares a
+   scaled by ea / eb). */
+HDX_TM_FN double hdx_mse_linear(const float *a, double ea, const float *b, double eb, size_t npix)
 {
     double s = 0.0;
     size_t i;
     int c;
     for (i = 0; i < npix; ++i)
         for (c = 0; c < 3; ++c) {
-            double d = hdx_srgb(exposure * a[4 * i + c]) - hdx_srgb(exposure * b[4 * i + c]);
+            double d = hdx_srgb(ea * a[4 * i + c]) - hdx_srgb(eb * b[4 * i + c]);
             s += d * d;
         }
-    return hdx_psnr(s / (3.0 * (double)npix));
+    return s / (3.0 * (double)npix);
+}
+
+/* PSNR over the RGB channels of two linear RGBA float images, both tone-mapped at exposure. */
+HDX_TM_FN double hdx_psnr_linear(const float *a, const float *b, size_t npix, double exposure)
+{
+    return hdx_psnr(hdx_mse_linear(a, exposure, b, exposure, npix));
 }
 
 #endif
